@@ -1,0 +1,1 @@
+//! Orthtree (placeholder, being written).

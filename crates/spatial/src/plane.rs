@@ -1,0 +1,1 @@
+//! Plane grid boxes (placeholder, being written).
