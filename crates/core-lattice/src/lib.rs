@@ -1,1 +1,28 @@
-//! placeholder
+//! # core-lattice
+//!
+//! The foundation every model of the workspace stands on:
+//!
+//! - [`lattice`]: d-dimensional hypercubic lattices (d = 1..=8) addressed by the k-index of
+//!   Hawick, James & Scogings (seed 000, section III, Fig. 3), with periodic or wall boundaries
+//!   per axis, face neighbours, unit translations and minimum-image displacements.
+//! - [`rng`]: deterministic `Pcg64Mcg` streams derived from `(seed, stream id)`, and the sampling
+//!   helpers the models share (isotropic unit vectors, weighted lattice directions, shuffles).
+//! - [`stats`]: Welford mean/variance, integer and logarithmic histograms, least-squares and
+//!   log-log fits with standard errors, and radius-of-gyration accumulators that stay accurate
+//!   far from the origin.
+//! - [`io`]: atomic file writes, the run manifest `run.json`, the checkpoint envelope, PNG and
+//!   CSV writers, and the stable state hash.
+//!
+//! Conventions (see `DESIGN.md`): a run is a pure function of its parameters and seed; bad input
+//! is a typed error, never a panic; every output file is written atomically.
+
+pub mod io;
+pub mod lattice;
+pub mod rng;
+pub mod stats;
+
+pub use lattice::{Blocked, Boundary, Coords, Direction, Lattice, LatticeError, MAX_DIM, Offset};
+pub use rng::{SimRng, stream, stream_id};
+pub use stats::{
+    Gyration, IntHistogram, LatticeGyration, LinearFit, LogHistogram, LogLogFit, Welford,
+};

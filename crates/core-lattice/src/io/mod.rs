@@ -1,0 +1,24 @@
+//! Output and checkpoint I/O shared by every model (DESIGN.md, "Outputs" and "Long runs").
+//!
+//! - [`atomic`]: every file is written to a temporary file in its target directory, flushed to
+//!   disk and renamed into place, so a crashed or failed run never leaves a partial file.
+//! - [`manifest`]: `run.json`, the record of one run (model, version, seed, threads, parameters,
+//!   wall and CPU seconds, peak memory from the operating system, results).
+//! - [`checkpoint`]: a versioned, checksummed envelope around a model's serde state.
+//! - [`image`]: grayscale and RGB PNG.
+//! - [`table`]: CSV with a header line.
+//! - [`hash`]: the stable 64-bit state hash models report as `state_hash`.
+
+pub mod atomic;
+pub mod checkpoint;
+pub mod hash;
+pub mod image;
+pub mod manifest;
+pub mod table;
+
+pub use atomic::{AtomicFile, write_atomic};
+pub use checkpoint::{CheckpointError, read_checkpoint, write_checkpoint};
+pub use hash::StateHasher;
+pub use image::{write_png_gray, write_png_rgb};
+pub use manifest::{ProcessUsage, RunClock, RunManifest};
+pub use table::{CsvField, CsvWriter};
