@@ -15,9 +15,8 @@
 //! [`shuffle`] (the fresh random visiting order of every sweep or step, seed 000).
 
 use crate::lattice::{Direction, MAX_DIM};
-use rand::RngExt;
 use rand::seq::SliceRandom;
-pub use rand::{Rng, SeedableRng};
+pub use rand::{Rng, RngExt, SeedableRng};
 
 /// The generator every model uses: PCG-XSL-RR 128/64 (MCG), `pcg64_fast`. Fast, 2^126 period,
 /// passes BigCrush, and its state serialises with serde for checkpoints.

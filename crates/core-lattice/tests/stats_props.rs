@@ -181,26 +181,23 @@ proptest! {
     }
 }
 
-/// Seed 002 measures R_g of clusters of up to 1e10 particles; the accumulator must not lose
-/// precision to a cluster's distance from the origin. 1e7 points spread over a radius of 1e4,
-/// shifted 1e6 from the origin: relative error <= 1e-9 against a two-pass reference (computed
-/// about the known shift, in compensated arithmetic, so the reference itself is accurate).
-#[test]
-fn gyration_far_from_origin() {
-    const N: usize = 10_000_000;
-    let shift = [1e6, -1e6];
-    let mut rng = stream(2024, 0);
-    let mut pts = Vec::with_capacity(N);
-    for _ in 0..N {
+/// Relative error of the accumulator against an accurate two-pass reference, for `n` points
+/// uniform in a disc of radius `radius` centred at `(shift, -shift)`.
+fn far_from_origin_error(n: usize, shift: f64, radius: f64, seed: u64) -> f64 {
+    let centre = [shift, -shift];
+    let mut rng = stream(seed, 0);
+    let mut pts = Vec::with_capacity(n);
+    for _ in 0..n {
         let u: [f64; 2] = unit_vector::<2, _>(&mut rng);
-        let r = 1e4 * uniform01(&mut rng).sqrt();
-        pts.push([shift[0] + r * u[0], shift[1] + r * u[1]]);
+        let r = radius * uniform01(&mut rng).sqrt();
+        pts.push([centre[0] + r * u[0], centre[1] + r * u[1]]);
     }
     let mut g = Gyration::<2>::new();
     pts.iter().for_each(|p| g.push(p));
+    assert_eq!(g.count(), n as u64);
 
-    // Reference: two passes over the coordinates relative to the shift (exactly representable
-    // differences, no cancellation), with Neumaier-compensated sums.
+    // Reference: two passes over the coordinates relative to the known centre (the differences
+    // are exact, so nothing cancels), with Neumaier-compensated sums.
     let neumaier = |it: &mut dyn Iterator<Item = f64>| {
         let (mut s, mut c) = (0.0f64, 0.0f64);
         for x in it {
@@ -214,20 +211,30 @@ fn gyration_far_from_origin() {
         }
         s + c
     };
-    let n = N as f64;
+    let nf = n as f64;
     let mean: Vec<f64> = (0..2)
-        .map(|a| neumaier(&mut pts.iter().map(|p| p[a] - shift[a])) / n)
+        .map(|a| neumaier(&mut pts.iter().map(|p| p[a] - centre[a])) / nf)
         .collect();
     let reference = neumaier(&mut pts.iter().map(|p| {
         (0..2)
-            .map(|a| (p[a] - shift[a] - mean[a]).powi(2))
+            .map(|a| (p[a] - centre[a] - mean[a]).powi(2))
             .sum::<f64>()
-    })) / n;
-    let rel = (g.radius_squared() - reference).abs() / reference;
-    assert!(
-        rel <= 1e-9,
-        "relative error {rel:e} (accumulator {}, reference {reference})",
-        g.radius_squared()
-    );
-    assert_eq!(g.count(), N as u64);
+    })) / nf;
+    (g.radius_squared() - reference).abs() / reference
+}
+
+/// Seed 002 measures R_g of clusters of up to 1e10 particles; the accumulator must not lose
+/// precision to a cluster's distance from the origin.
+///
+/// The required case: 1e7 points spread over a radius of 1e4, shifted 1e6 from the origin,
+/// relative error <= 1e-9. The naive `sum x^2 / N - mean^2` is borderline there (about 4e-9 on
+/// some seeds, below 1e-9 on others), so a second case with a larger shift relative to the
+/// spread (1e8 and 1e2, where the naive formula is off by tens of percent) makes sure the test
+/// fails for any accumulator with that cancellation.
+#[test]
+fn gyration_far_from_origin() {
+    let rel = far_from_origin_error(10_000_000, 1e6, 1e4, 2024);
+    assert!(rel <= 1e-9, "shift 1e6, radius 1e4: relative error {rel:e}");
+    let rel = far_from_origin_error(2_000_000, 1e8, 1e2, 7);
+    assert!(rel <= 1e-9, "shift 1e8, radius 1e2: relative error {rel:e}");
 }
