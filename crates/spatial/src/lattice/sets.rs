@@ -1,0 +1,156 @@
+//! The clusters themselves: arrays of k-indices, one per live item, with an indirect list of
+//! live items (seed 000, section III, Fig. 2).
+
+use super::ItemId;
+use core_lattice::{Blocked, Boundary, Direction, Lattice};
+
+/// Items (clusters) as sets of lattice sites, stored as k-index arrays (seed 000, Fig. 2).
+///
+/// Ids are handed out in increasing order from 0 and never reused. The live list plays the role
+/// of the paper's left-hand array: it makes iterating over the live items cheap although merged
+/// items leave holes among the ids. Its order changes when items are removed (the last live
+/// item takes the removed one's place), deterministically for a given sequence of operations.
+#[derive(Debug, Clone)]
+pub struct SiteSets {
+    lattice: Lattice,
+    sets: Vec<Vec<u64>>,
+    live: Vec<ItemId>,
+    /// Position of each id in `live`, or `DEAD`.
+    position: Vec<u32>,
+    total_sites: u64,
+}
+
+const DEAD: u32 = u32::MAX;
+
+impl SiteSets {
+    /// No items on `lattice`.
+    pub fn new(lattice: Lattice) -> Self {
+        SiteSets {
+            lattice,
+            sets: Vec::new(),
+            live: Vec::new(),
+            position: Vec::new(),
+            total_sites: 0,
+        }
+    }
+
+    /// The lattice the sites live on.
+    pub fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+
+    /// Add an item occupying `sites` (k-indices on the lattice) and return its id.
+    ///
+    /// # Panics
+    /// If a site is outside the lattice or the number of ids reaches `u32::MAX` (programming
+    /// errors: models validate their sizes first).
+    pub fn push(&mut self, sites: Vec<u64>) -> ItemId {
+        assert!(
+            sites.iter().all(|&k| k < self.lattice.volume()),
+            "site outside the lattice"
+        );
+        let id = ItemId::try_from(self.sets.len())
+            .ok()
+            .filter(|&i| i != DEAD)
+            .expect("too many items");
+        self.total_sites += sites.len() as u64;
+        self.sets.push(sites);
+        self.position.push(self.live.len() as u32);
+        self.live.push(id);
+        id
+    }
+
+    /// Whether `id` is a live item.
+    pub fn contains(&self, id: ItemId) -> bool {
+        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+    }
+
+    /// The sites of item `id` (empty for a removed item).
+    #[inline]
+    pub fn sites(&self, id: ItemId) -> &[u64] {
+        &self.sets[id as usize]
+    }
+
+    /// Live item ids (see the type docs for their order).
+    pub fn live(&self) -> &[ItemId] {
+        &self.live
+    }
+
+    /// Number of live items.
+    pub fn len(&self) -> usize {
+        self.live.len()
+    }
+
+    /// Whether there are no live items.
+    pub fn is_empty(&self) -> bool {
+        self.live.is_empty()
+    }
+
+    /// One more than the largest id ever handed out: the size of arrays indexed by id.
+    pub fn id_bound(&self) -> usize {
+        self.sets.len()
+    }
+
+    /// Total number of sites over the live items.
+    pub fn total_sites(&self) -> u64 {
+        self.total_sites
+    }
+
+    /// Translate every site of `id` by the unit vector `dir`, all or nothing: if any site would
+    /// cross a wall, nothing moves and [`Blocked`] is returned. On success `old` receives the
+    /// previous sites (in the same order as the new ones).
+    pub fn translate(
+        &mut self,
+        id: ItemId,
+        dir: Direction,
+        old: &mut Vec<u64>,
+    ) -> Result<(), Blocked> {
+        let lattice = &self.lattice;
+        let set = &mut self.sets[id as usize];
+        if lattice.boundary(dir.axis()) == Boundary::Wall
+            && set.iter().any(|&k| lattice.translate(k, dir).is_err())
+        {
+            return Err(Blocked);
+        }
+        old.clear();
+        old.extend_from_slice(set);
+        for k in set.iter_mut() {
+            *k = lattice.translate(*k, dir).expect("checked above");
+        }
+        Ok(())
+    }
+
+    /// Merge item `from` into item `into` (the union keeps `into`'s id, as DLCA keeps the lower
+    /// id) and return the sites `from` had. `from` stops being live.
+    ///
+    /// # Panics
+    /// If either is not live or they are the same item.
+    pub fn merge(&mut self, into: ItemId, from: ItemId) -> Vec<u64> {
+        assert!(into != from && self.contains(into) && self.contains(from));
+        let moved = std::mem::take(&mut self.sets[from as usize]);
+        self.sets[into as usize].extend_from_slice(&moved);
+        self.unlink(from);
+        moved
+    }
+
+    /// Remove item `id` and return its sites.
+    ///
+    /// # Panics
+    /// If `id` is not live.
+    pub fn remove(&mut self, id: ItemId) -> Vec<u64> {
+        assert!(self.contains(id));
+        let sites = std::mem::take(&mut self.sets[id as usize]);
+        self.total_sites -= sites.len() as u64;
+        self.unlink(id);
+        sites
+    }
+
+    fn unlink(&mut self, id: ItemId) {
+        let p = self.position[id as usize] as usize;
+        self.live.swap_remove(p);
+        if let Some(&moved) = self.live.get(p) {
+            self.position[moved as usize] = p as u32;
+        }
+        self.position[id as usize] = DEAD;
+    }
+}
