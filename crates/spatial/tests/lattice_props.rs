@@ -149,6 +149,9 @@ impl World {
             want.sort_unstable();
             want.dedup();
             prop_assert_eq!(boxes, want);
+            for &k in self.sets.sites(id) {
+                prop_assert_eq!(self.occupancy.item_at(k), Some(id));
+            }
             let sets = &self.sets;
             let mut out = Vec::new();
             let n_live = live.len();
@@ -226,8 +229,14 @@ fn run(case: Case) -> Result<(), TestCaseError> {
                     continue;
                 }
                 let (into, from) = (a.min(b), a.max(b));
-                let from_sites = w.sets.merge(into, from);
-                w.each(|s, sets| s.merge(sets, into, from, &from_sites));
+                let before_into = w.sets.sites(into).to_vec();
+                let before_from = w.sets.sites(from).to_vec();
+                let from_len = w.sets.merge(into, from);
+                prop_assert_eq!(from_len, before_from.len());
+                let (pi, pf) = w.sets.merged_parts(into, from_len);
+                prop_assert_eq!(pi, &before_into[..]);
+                prop_assert_eq!(pf, &before_from[..]);
+                w.each(|s, sets| s.merge(sets, into, from, from_len));
                 prop_assert!(!w.sets.contains(from));
             }
             Op::Remove { item } => {

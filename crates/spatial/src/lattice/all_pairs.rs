@@ -30,7 +30,7 @@ impl ContactSearch for AllPairs {
 
     fn moved(&mut self, _: &SiteSets, _: ItemId, _: &[u64], _: &[u64], _: Direction) {}
 
-    fn merge(&mut self, _: &SiteSets, _: ItemId, _: ItemId, _: &[u64]) {}
+    fn merge(&mut self, _: &SiteSets, _: ItemId, _: ItemId, _: usize) {}
 
     fn contacts(&mut self, sets: &SiteSets, id: ItemId, out: &mut Vec<ItemId>) -> usize {
         out.clear();

@@ -286,7 +286,7 @@ impl ContactSearch for LatticeGridBoxes {
         }
     }
 
-    fn merge(&mut self, _: &SiteSets, into: ItemId, from: ItemId, _: &[u64]) {
+    fn merge(&mut self, _: &SiteSets, into: ItemId, from: ItemId, _: usize) {
         while let Some(&b) = self.item_boxes.get(from as usize).and_then(|v| v.last()) {
             let n = self.take(b, from, u32::MAX);
             self.add(b, into, n);

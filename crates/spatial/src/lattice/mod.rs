@@ -56,9 +56,10 @@ pub trait ContactSearch {
     /// sets already hold `new`).
     fn moved(&mut self, sets: &SiteSets, id: ItemId, old: &[u64], new: &[u64], dir: Direction);
 
-    /// Item `from` was merged into item `into`: the sets already hold the union under `into`
-    /// and `from` is gone; `from_sites` are the sites `from` had.
-    fn merge(&mut self, sets: &SiteSets, into: ItemId, from: ItemId, from_sites: &[u64]);
+    /// Item `from` was merged into item `into` by [`SiteSets::merge`], which returned
+    /// `from_len`: the sets already hold the union under `into` and `from` is gone
+    /// ([`SiteSets::merged_parts`] recovers which sites were whose).
+    fn merge(&mut self, sets: &SiteSets, into: ItemId, from: ItemId, from_len: usize);
 
     /// The items other than `id` with a site face-adjacent to a site of `id`, in increasing
     /// id, without repeats, written to `out` (which is cleared first). Returns the number of

@@ -1,4 +1,4 @@
-//! The occupancy lattice: the cluster id of every site.
+//! The occupancy lattice: which item holds every site.
 
 use super::{ContactSearch, ItemId, SiteSets, StampSet};
 use core_lattice::{Direction, Lattice};
@@ -21,21 +21,30 @@ pub enum OccupancyError {
 }
 
 /// Marks an empty site.
-const EMPTY: ItemId = ItemId::MAX;
+const EMPTY: u32 = u32::MAX;
 
-/// An array holding the item id of every lattice site (4 bytes a site). A contact query is `2d`
-/// lookups per particle of the mover, independent of how many items there are; the cost is the
-/// memory of the whole lattice, so it suits 2D and 3D lattices, and dense fills, best.
+/// An array holding, for every lattice site, the label of the item on it (4 bytes a site). A
+/// contact query is `2d` lookups per particle of the mover, independent of how many items there
+/// are; the cost is the memory of the whole lattice, so it suits 2D and 3D lattices, and dense
+/// fills, best.
+///
+/// Sites hold *labels*, and a small table maps labels to item ids. A merge relabels only the
+/// smaller of the two items' sites and points the larger one's label at the surviving id, so
+/// merging costs O(smaller item), whichever id survives.
 #[derive(Debug, Clone)]
 pub struct Occupancy {
-    cells: Vec<ItemId>,
+    cells: Vec<u32>,
+    /// Label carried by each item's sites, indexed by item id.
+    label_of: Vec<u32>,
+    /// Item currently owning each label, indexed by label.
+    id_of: Vec<ItemId>,
     seen: StampSet,
 }
 
 impl Occupancy {
     /// Bytes the occupancy array of `lattice` takes.
     pub fn bytes_needed(lattice: &Lattice) -> u64 {
-        lattice.volume().saturating_mul(size_of::<ItemId>() as u64)
+        lattice.volume().saturating_mul(size_of::<u32>() as u64)
     }
 
     /// An empty occupancy lattice, refusing one that needs more than `budget_bytes`.
@@ -52,18 +61,22 @@ impl Occupancy {
         let sites = usize::try_from(lattice.volume()).map_err(|_| too_large)?;
         Ok(Occupancy {
             cells: vec![EMPTY; sites],
+            label_of: Vec::new(),
+            id_of: Vec::new(),
             seen: StampSet::default(),
         })
     }
 
     /// The item occupying site `k`, if any.
+    #[inline]
     pub fn item_at(&self, k: u64) -> Option<ItemId> {
-        Some(self.cells[k as usize]).filter(|&c| c != EMPTY)
+        let label = self.cells[k as usize];
+        (label != EMPTY).then(|| self.id_of[label as usize])
     }
 
-    fn fill(&mut self, sites: &[u64], id: ItemId) {
+    fn fill(&mut self, sites: &[u64], label: u32) {
         for &k in sites {
-            self.cells[k as usize] = id;
+            self.cells[k as usize] = label;
         }
     }
 }
@@ -74,6 +87,14 @@ impl ContactSearch for Occupancy {
     }
 
     fn insert(&mut self, sets: &SiteSets, id: ItemId) {
+        let i = id as usize;
+        if i >= self.label_of.len() {
+            self.label_of.resize(i + 1, EMPTY);
+            self.id_of.resize(i + 1, ItemId::MAX);
+        }
+        // An item's first label is its own id; ids are never reused, so neither are labels.
+        self.label_of[i] = id;
+        self.id_of[i] = id;
         debug_assert!(
             sets.sites(id)
                 .iter()
@@ -88,28 +109,38 @@ impl ContactSearch for Occupancy {
     }
 
     fn moved(&mut self, _: &SiteSets, id: ItemId, old: &[u64], new: &[u64], _: Direction) {
+        let label = self.label_of[id as usize];
         self.fill(old, EMPTY);
         debug_assert!(
             new.iter().all(|&k| self.cells[k as usize] == EMPTY),
             "items overlap"
         );
-        self.fill(new, id);
+        self.fill(new, label);
     }
 
-    fn merge(&mut self, _: &SiteSets, into: ItemId, _: ItemId, from_sites: &[u64]) {
-        self.fill(from_sites, into);
+    fn merge(&mut self, sets: &SiteSets, into: ItemId, from: ItemId, from_len: usize) {
+        let (into_sites, from_sites) = sets.merged_parts(into, from_len);
+        let (into_label, from_label) = (self.label_of[into as usize], self.label_of[from as usize]);
+        if from_sites.len() <= into_sites.len() {
+            self.fill(from_sites, into_label);
+        } else {
+            self.fill(into_sites, from_label);
+            self.label_of[into as usize] = from_label;
+            self.id_of[from_label as usize] = into;
+        }
     }
 
     fn contacts(&mut self, sets: &SiteSets, id: ItemId, out: &mut Vec<ItemId>) -> usize {
         out.clear();
         self.seen.clear();
         let lattice = sets.lattice();
+        let mine = self.label_of[id as usize];
         for &k in sets.sites(id) {
             for dir in Direction::all(lattice.dim()) {
                 if let Some(n) = lattice.neighbour(k, dir) {
-                    let c = self.cells[n as usize];
-                    if c != EMPTY && c != id && self.seen.insert(c as usize) {
-                        out.push(c);
+                    let label = self.cells[n as usize];
+                    if label != EMPTY && label != mine && self.seen.insert(label as usize) {
+                        out.push(self.id_of[label as usize]);
                     }
                 }
             }

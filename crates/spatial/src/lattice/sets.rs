@@ -121,16 +121,38 @@ impl SiteSets {
     }
 
     /// Merge item `from` into item `into` (the union keeps `into`'s id, as DLCA keeps the lower
-    /// id) and return the sites `from` had. `from` stops being live.
+    /// id) and return the number of sites `from` had. `from` stops being live.
+    ///
+    /// Cost O(smaller of the two): the larger site array keeps its place and the smaller is
+    /// appended to it. So the union's array is laid out as `[larger..., smaller...]` (with `into`
+    /// first on a tie), and [`SiteSets::merged_parts`] tells the strategies which part was whose.
     ///
     /// # Panics
     /// If either is not live or they are the same item.
-    pub fn merge(&mut self, into: ItemId, from: ItemId) -> Vec<u64> {
+    pub fn merge(&mut self, into: ItemId, from: ItemId) -> usize {
         assert!(into != from && self.contains(into) && self.contains(from));
-        let moved = std::mem::take(&mut self.sets[from as usize]);
-        self.sets[into as usize].extend_from_slice(&moved);
+        let mut moved = std::mem::take(&mut self.sets[from as usize]);
+        let from_len = moved.len();
+        let target = &mut self.sets[into as usize];
+        if moved.len() > target.len() {
+            std::mem::swap(target, &mut moved);
+        }
+        target.extend_from_slice(&moved);
         self.unlink(from);
-        moved
+        from_len
+    }
+
+    /// After `merge(into, from)` returned `from_len`: the sites that were `into`'s and the
+    /// sites that were `from`'s, as slices of the union's array.
+    pub fn merged_parts(&self, into: ItemId, from_len: usize) -> (&[u64], &[u64]) {
+        let all = &self.sets[into as usize];
+        let into_len = all.len() - from_len;
+        if from_len > into_len {
+            let (f, i) = all.split_at(from_len);
+            (i, f)
+        } else {
+            all.split_at(into_len)
+        }
     }
 
     /// Remove item `id` and return its sites.
