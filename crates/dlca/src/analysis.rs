@@ -1,0 +1,109 @@
+//! Final-state measurements: the cluster size distribution and, with `--gyration`, each
+//! cluster's radius of gyration (unwrapped across periodic boundaries) and the fractal dimension
+//! `D` from the fit `log s = D log R_g + c` over the clusters (MODELS.md section 1).
+
+use crate::sim::Simulation;
+use core_lattice::stats::StatsError;
+use core_lattice::{Direction, IntHistogram, LatticeGyration, LogLogFit, MAX_DIM};
+use spatial::lattice::ItemId;
+use std::collections::{HashMap, VecDeque};
+
+/// One final cluster.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClusterMeasure {
+    /// Cluster id.
+    pub id: ItemId,
+    /// Number of particles.
+    pub size: u64,
+    /// Radius of gyration, unwrapped across periodic boundaries.
+    pub radius_of_gyration: f64,
+    /// Whether the cluster wraps around a periodic axis (spans the system), where unwrapping is
+    /// ill-defined; such clusters are left out of the fit.
+    pub wraps: bool,
+}
+
+/// Size distribution of the final clusters.
+pub fn size_distribution(sim: &Simulation) -> IntHistogram {
+    let mut h = IntHistogram::new();
+    for &id in sim.sets().live() {
+        h.add(sim.sets().sites(id).len() as u64);
+    }
+    h
+}
+
+/// Radius of gyration of every final cluster, in increasing id. Each cluster is unwrapped by a
+/// breadth-first walk over its face-adjacent particles from its first particle, accumulating
+/// unit steps, so periodic images are joined; a cluster reached at two different unwrapped
+/// positions wraps around the system and is flagged.
+pub fn gyration(sim: &Simulation) -> Vec<ClusterMeasure> {
+    let lattice = sim.lattice();
+    let sets = sim.sets();
+    let dim = lattice.dim();
+    let mut owner: HashMap<u64, ItemId> = HashMap::with_capacity(sim.particles() as usize);
+    for &id in sets.live() {
+        for &k in sets.sites(id) {
+            owner.insert(k, id);
+        }
+    }
+    let mut ids: Vec<ItemId> = sets.live().to_vec();
+    ids.sort_unstable();
+    let mut out = Vec::with_capacity(ids.len());
+    let mut pos: HashMap<u64, [i64; MAX_DIM]> = HashMap::new();
+    let mut queue = VecDeque::new();
+    for id in ids {
+        let sites = sets.sites(id);
+        pos.clear();
+        let start = lattice.decode(sites[0]).expect("site on the lattice");
+        let mut u = [0i64; MAX_DIM];
+        for a in 0..dim {
+            u[a] = start[a] as i64;
+        }
+        pos.insert(sites[0], u);
+        queue.push_back(sites[0]);
+        let mut wraps = false;
+        let mut g = LatticeGyration::new(dim);
+        while let Some(k) = queue.pop_front() {
+            let here = pos[&k];
+            g.push(&here[..dim]);
+            for dir in Direction::all(dim) {
+                let Some(n) = lattice.neighbour(k, dir) else {
+                    continue;
+                };
+                if owner.get(&n) != Some(&id) {
+                    continue;
+                }
+                let mut next = here;
+                next[dir.axis()] += if dir.is_positive() { 1 } else { -1 };
+                match pos.get(&n) {
+                    None => {
+                        pos.insert(n, next);
+                        queue.push_back(n);
+                    }
+                    Some(p) if *p != next => wraps = true,
+                    Some(_) => {}
+                }
+            }
+        }
+        out.push(ClusterMeasure {
+            id,
+            size: sites.len() as u64,
+            radius_of_gyration: g.radius(),
+            wraps,
+        });
+    }
+    out
+}
+
+/// Fit `log s = D log R_g + c` over the clusters of at least `min_size` particles that do not
+/// wrap; the slope is the fractal dimension `D`.
+pub fn fractal_dimension(
+    clusters: &[ClusterMeasure],
+    min_size: u64,
+) -> Result<LogLogFit, StatsError> {
+    let (rg, s): (Vec<f64>, Vec<f64>) = clusters
+        .iter()
+        .filter(|c| c.size >= min_size.max(2) && !c.wraps)
+        .map(|c| (c.radius_of_gyration, c.size as f64))
+        .unzip();
+    LogLogFit::fit(&rg, &s)
+}

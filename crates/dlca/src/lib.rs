@@ -1,0 +1,30 @@
+//! # dlca: diffusion-limited cluster-cluster aggregation
+//!
+//! The DLCA model of Hawick, James & Scogings (seed 000, sections II.A, III, IV.A), defined
+//! precisely in MODELS.md section 1: particles on a periodic or walled hypercubic lattice in
+//! 1 to 5 dimensions form clusters that random-walk one lattice step at a time and stick on
+//! contact. Three contact searches (all-pairs, grid boxes, occupancy lattice) give bit-identical
+//! trajectories.
+//!
+//! ```
+//! use dlca::{Params, Init, Simulation};
+//! let params = Params {
+//!     size: vec![64, 64],
+//!     boundary: vec![core_lattice::Boundary::Periodic; 2],
+//!     init: Init::Fill(0.05),
+//!     target_clusters: 10,
+//!     ..Params::default()
+//! };
+//! let mut sim = Simulation::new(params, 42).unwrap();
+//! sim.run();
+//! assert!(sim.clusters() <= 10);
+//! ```
+
+pub mod analysis;
+pub mod output;
+pub mod params;
+pub mod record;
+pub mod sim;
+
+pub use params::{Init, ParamError, Params, Search};
+pub use sim::Simulation;

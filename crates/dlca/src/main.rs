@@ -1,0 +1,335 @@
+//! `dlca`: diffusion-limited cluster-cluster aggregation on lattices of 1 to 5 dimensions
+//! (MODELS.md section 1; Hawick, James & Scogings 2006). A thin layer over the `dlca` library:
+//! parse flags, validate, run, write outputs.
+
+use anyhow::Context;
+use clap::{ArgGroup, Parser};
+use core_lattice::Boundary;
+use core_lattice::io::RunClock;
+use dlca::{Init, Params, Search, Simulation};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Diffusion-limited cluster-cluster aggregation (DLCA) on a periodic or walled lattice.
+///
+/// Particles are placed on distinct random sites; face-adjacent particles form clusters. Each
+/// sweep visits every cluster in a fresh random order; a cluster moves one site in a random
+/// direction and merges with every cluster it then touches. Stops at --target-clusters or
+/// --max-sweeps. Outputs go into --out DIR (see docs/dlca.md).
+#[derive(Parser, Debug)]
+#[command(name = "dlca", version, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
+struct Cli {
+    /// Lattice dimension, 1 to 5. With a single --size value, every axis gets that length.
+    #[arg(long, default_value_t = 2)]
+    dim: usize,
+
+    /// Side lengths: one number for every axis (`1024`) or one per axis (`1024x512`).
+    #[arg(long, value_parser = parse_size)]
+    size: Option<Sizes>,
+
+    /// Fraction of sites holding a particle at the start, in (0, 1).
+    #[arg(long)]
+    fill: Option<f64>,
+
+    /// Number of particles at the start, 1 to the number of sites.
+    #[arg(long)]
+    particles: Option<u64>,
+
+    /// Seed of every random stream of the run: same seed and flags, same run.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+
+    /// Output directory (created if missing; nothing is written on bad input).
+    #[arg(long)]
+    out: PathBuf,
+
+    /// Boundaries: `periodic` or `wall` for every axis, or one per axis separated by commas
+    /// (`periodic,wall`).
+    #[arg(long, default_value = "periodic")]
+    boundary: String,
+
+    /// Overall move probability of a cluster per sweep, in (0, 1].
+    #[arg(long, default_value_t = 1.0)]
+    temperature: f64,
+
+    /// Gravity g in [0, 1): the move down the last axis has weight 1+g, up 1-g, others 1.
+    #[arg(long, default_value_t = 0.0)]
+    gravity: f64,
+
+    /// Mobility exponent gamma >= 0: a cluster of s particles moves with probability
+    /// temperature * s^-gamma (0: all clusters equally mobile, as in the paper).
+    #[arg(long, default_value_t = 0.0)]
+    mobility_exponent: f64,
+
+    /// Stop when at most this many clusters remain (>= 1; the paper stops at 100 to 1000).
+    #[arg(long, default_value_t = 100)]
+    target_clusters: u64,
+
+    /// Stop after this many sweeps at the latest (default: no limit).
+    #[arg(long)]
+    max_sweeps: Option<u64>,
+
+    /// Contact search. All give the same trajectory; `auto` picks by regime and logs why.
+    #[arg(long, value_enum, default_value_t = Search::Auto)]
+    search: Search,
+
+    /// Initial grid-box side for `--search grid`, a power of two (default: from the cluster
+    /// spacing and the largest initial cluster). It doubles as clusters grow.
+    #[arg(long)]
+    grid_box: Option<u64>,
+
+    /// Memory the occupancy lattice (`--search lattice`) may take, in bytes; suffixes K, M, G
+    /// (powers of 1024) are accepted.
+    #[arg(long, default_value = "4G", value_parser = parse_bytes)]
+    max_memory: u64,
+
+    /// Record the wall time of every sweep (a `seconds` column in sweeps.csv).
+    #[arg(long)]
+    timing: bool,
+
+    /// Record histograms of candidate clusters examined per move (histogram.csv) at the sweeps
+    /// of --histogram-sweeps (seed 000 Figs. 4, 7, 8).
+    #[arg(long)]
+    histogram: bool,
+
+    /// Sweeps at which --histogram records, comma separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000"
+    )]
+    histogram_sweeps: Vec<u64>,
+
+    /// Measure every final cluster's radius of gyration (clusters.csv) and fit the fractal
+    /// dimension from log s = D log R_g + c.
+    #[arg(long)]
+    gyration: bool,
+
+    /// Smallest cluster size used in the fractal-dimension fit.
+    #[arg(long, default_value_t = 10)]
+    fit_min_size: u64,
+
+    /// Write dlca.png: the final state, one colour per cluster (first two axes).
+    #[arg(long)]
+    png: bool,
+
+    /// No progress bar, warnings only.
+    #[arg(long, short)]
+    quiet: bool,
+
+    /// More log output (-v info, -vv debug); RUST_LOG overrides.
+    #[arg(short, action = clap::ArgAction::Count)]
+    verbose: u8,
+}
+
+/// Side lengths as given to `--size`.
+#[derive(Debug, Clone)]
+struct Sizes(Vec<u64>);
+
+fn parse_size(s: &str) -> Result<Sizes, String> {
+    s.split('x')
+        .map(|p| {
+            p.trim()
+                .parse::<u64>()
+                .map_err(|_| format!("'{s}' is not a size like 1024 or 1024x512"))
+        })
+        .collect::<Result<_, _>>()
+        .map(Sizes)
+}
+
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let (digits, mult) = match s.trim().chars().last() {
+        Some('K' | 'k') => (&s[..s.len() - 1], 1u64 << 10),
+        Some('M' | 'm') => (&s[..s.len() - 1], 1 << 20),
+        Some('G' | 'g') => (&s[..s.len() - 1], 1 << 30),
+        Some('T' | 't') => (&s[..s.len() - 1], 1 << 40),
+        _ => (s, 1),
+    };
+    digits
+        .trim()
+        .parse::<u64>()
+        .ok()
+        .and_then(|v| v.checked_mul(mult))
+        .ok_or_else(|| format!("'{s}' is not a byte count like 4G or 500M"))
+}
+
+/// Turn the flags into validated parameters.
+fn params(cli: &Cli) -> Result<Params, String> {
+    if cli.dim == 0 || cli.dim > dlca::params::MAX_MODEL_DIM {
+        return Err(format!(
+            "--dim {} is outside the accepted range 1..={}",
+            cli.dim,
+            dlca::params::MAX_MODEL_DIM
+        ));
+    }
+    let given = cli
+        .size
+        .as_ref()
+        .map(|s| s.0.as_slice())
+        .unwrap_or_default();
+    let size = match given {
+        [] => return Err("--size is required (for example --size 1024 or --size 1024x512)".into()),
+        [l] => vec![*l; cli.dim],
+        many if many.len() == cli.dim => many.to_vec(),
+        many => {
+            return Err(format!(
+                "--size has {} axes but --dim is {}; give one length or {} lengths",
+                many.len(),
+                cli.dim,
+                cli.dim
+            ));
+        }
+    };
+    let names: Vec<&str> = cli.boundary.split(',').map(str::trim).collect();
+    let boundary: Vec<Boundary> = match names.as_slice() {
+        [one] => vec![parse_boundary(one)?; cli.dim],
+        many if many.len() == cli.dim => many
+            .iter()
+            .map(|b| parse_boundary(b))
+            .collect::<Result<_, _>>()?,
+        many => {
+            return Err(format!(
+                "--boundary has {} entries but --dim is {}; give one or {}",
+                many.len(),
+                cli.dim,
+                cli.dim
+            ));
+        }
+    };
+    let init = match (cli.fill, cli.particles) {
+        (Some(f), None) => Init::Fill(f),
+        (None, Some(n)) => Init::Particles(n),
+        _ => return Err("give exactly one of --fill and --particles".into()),
+    };
+    let p = Params {
+        size,
+        boundary,
+        init,
+        temperature: cli.temperature,
+        gravity: cli.gravity,
+        mobility_exponent: cli.mobility_exponent,
+        target_clusters: cli.target_clusters,
+        max_sweeps: cli.max_sweeps,
+        search: cli.search,
+        grid_box: cli.grid_box,
+        max_memory: cli.max_memory,
+        timing: cli.timing,
+        histogram_sweeps: if cli.histogram {
+            cli.histogram_sweeps.clone()
+        } else {
+            Vec::new()
+        },
+        gyration: cli.gyration,
+        fit_min_size: cli.fit_min_size,
+    };
+    p.validate().map_err(|e| e.to_string())?;
+    Ok(p)
+}
+
+fn parse_boundary(s: &str) -> Result<Boundary, String> {
+    s.parse::<Boundary>()
+        .map_err(|e| format!("--boundary: {e}"))
+}
+
+fn init_logging(cli: &Cli) {
+    let default = if cli.quiet {
+        "warn"
+    } else {
+        match cli.verbose {
+            0 => "warn",
+            1 => "info",
+            _ => "debug",
+        }
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
+}
+
+/// Print a one-line error and return exit code 2 (bad input; nothing written).
+fn usage_error(msg: &str) -> ExitCode {
+    eprintln!("dlca: error: {msg}");
+    ExitCode::from(2)
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            // clap's message up to its blank line, folded onto one line.
+            let text = e.to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            return usage_error(message.join(" ").trim_start_matches("error: "));
+        }
+    };
+    init_logging(&cli);
+    let params = match params(&cli) {
+        Ok(p) => p,
+        Err(msg) => return usage_error(&msg),
+    };
+    match run(&cli, params) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("dlca: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
+    let clock = RunClock::start();
+    // Created before the run so a long run cannot end with nowhere to write.
+    std::fs::create_dir_all(&cli.out)
+        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    let target = params.target_clusters;
+    let mut sim = Simulation::new(params, cli.seed).context("setting up the run")?;
+    tracing::info!("{}", sim.strategy_reason());
+    let initial = sim.clusters();
+    let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(initial.saturating_sub(target));
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
+            )
+            .expect("valid template"),
+        );
+        bar
+    });
+    sim.run_with(|s| {
+        if let Some(bar) = &bar {
+            if s.sweeps() % 16 == 0 || s.is_done() {
+                bar.set_position(initial - s.clusters().max(target).min(initial));
+                bar.set_message(format!("sweep {}, {} clusters", s.sweeps(), s.clusters()));
+            }
+        }
+    });
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let m = dlca::output::write_outputs(&sim, cli.seed, &clock, &cli.out, cli.png)?;
+    if !cli.quiet {
+        eprintln!(
+            "dlca: {} clusters (largest {}) after {} sweeps in {:.2} s with {}; outputs in {}",
+            sim.clusters(),
+            sim.largest(),
+            sim.sweeps(),
+            m.wall_seconds,
+            sim.strategy().name(),
+            cli.out.display()
+        );
+    }
+    Ok(())
+}

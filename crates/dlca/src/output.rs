@@ -1,0 +1,185 @@
+//! Writing a finished run into its output directory (DESIGN.md, "Outputs"). Every file is
+//! written atomically.
+//!
+//! | file | content |
+//! |---|---|
+//! | `run.json` | manifest: parameters, seed, timings, peak memory, results |
+//! | `sweeps.csv` | `sweep,clusters,largest` (and `seconds` with `--timing`), from sweep 0 |
+//! | `sizes.csv` | `size,count`: the final cluster size distribution |
+//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id |
+//! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
+//! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
+//! | `dlca.png` | with `--png`: the final state, one colour per cluster |
+
+use crate::analysis::{ClusterMeasure, fractal_dimension, gyration, size_distribution};
+use crate::sim::Simulation;
+use core_lattice::io::{CsvField, CsvWriter, RunClock, write_png_rgb};
+use serde_json::json;
+use std::path::Path;
+
+/// Write every output of `sim` into `dir` (which must exist) and return the manifest written.
+pub fn write_outputs(
+    sim: &Simulation,
+    seed: u64,
+    clock: &RunClock,
+    dir: &Path,
+    png: bool,
+) -> anyhow::Result<core_lattice::io::RunManifest> {
+    let params = sim.params();
+    let dim = sim.lattice().dim();
+
+    // sweeps.csv
+    let mut header = vec!["sweep", "clusters", "largest"];
+    if params.timing {
+        header.push("seconds");
+    }
+    let mut w = CsvWriter::create(dir.join("sweeps.csv"), &header)?;
+    for r in sim.records().sweeps() {
+        if params.timing {
+            w.row(&[&r.sweep, &r.clusters, &r.largest, &r.seconds.unwrap_or(0.0)])?;
+        } else {
+            w.row(&[&r.sweep, &r.clusters, &r.largest])?;
+        }
+    }
+    w.finish()?;
+
+    // sizes.csv
+    let sizes = size_distribution(sim);
+    let mut w = CsvWriter::create(dir.join("sizes.csv"), &["size", "count"])?;
+    for (size, count) in sizes.iter() {
+        w.row(&[&size, &count])?;
+    }
+    w.finish()?;
+
+    // particles.csv
+    let names: Vec<String> = (1..=dim)
+        .map(|a| format!("x{a}"))
+        .chain(["cluster".to_string()])
+        .collect();
+    let header: Vec<&str> = names.iter().map(String::as_str).collect();
+    let mut w = CsvWriter::create(dir.join("particles.csv"), &header)?;
+    let mut ids = sim.sets().live().to_vec();
+    ids.sort_unstable();
+    let mut row: Vec<u64> = vec![0; dim + 1];
+    for &id in &ids {
+        let mut sites = sim.sets().sites(id).to_vec();
+        sites.sort_unstable();
+        for k in sites {
+            let x = sim.lattice().decode(k)?;
+            row[..dim].copy_from_slice(&x);
+            row[dim] = u64::from(id);
+            let fields: Vec<&dyn CsvField> = row.iter().map(|v| v as &dyn CsvField).collect();
+            w.row(&fields)?;
+        }
+    }
+    w.finish()?;
+
+    // histogram.csv
+    if !params.histogram_sweeps.is_empty() {
+        let mut w =
+            CsvWriter::create(dir.join("histogram.csv"), &["sweep", "candidates", "moves"])?;
+        for (sweep, h) in sim.records().histograms() {
+            for (candidates, moves) in h.iter() {
+                w.row(&[sweep, &candidates, &moves])?;
+            }
+        }
+        w.finish()?;
+    }
+
+    // clusters.csv and the fit
+    let mut fit_results = serde_json::Map::new();
+    if params.gyration {
+        let measures = gyration(sim);
+        write_clusters(dir, &measures)?;
+        let wrapping = measures.iter().filter(|c| c.wraps).count();
+        match fractal_dimension(&measures, params.fit_min_size) {
+            Ok(fit) => {
+                fit_results.insert("fractal_dimension".into(), json!(fit.slope));
+                fit_results.insert("fractal_dimension_stderr".into(), json!(fit.slope_stderr));
+                fit_results.insert("fit_clusters".into(), json!(fit.n));
+                fit_results.insert("fit_r2".into(), json!(fit.r2));
+            }
+            Err(e) => {
+                tracing::warn!("no fractal dimension: {e}");
+                fit_results.insert("fractal_dimension".into(), serde_json::Value::Null);
+                fit_results.insert("fractal_dimension_stderr".into(), serde_json::Value::Null);
+                fit_results.insert("fit_error".into(), json!(e.to_string()));
+            }
+        }
+        fit_results.insert("wrapping_clusters".into(), json!(wrapping));
+    }
+
+    if png {
+        write_picture(sim, &dir.join("dlca.png"))?;
+    }
+
+    let mut m = clock.finish("dlca", env!("CARGO_PKG_VERSION"), seed, 1, params)?;
+    m.set_result("particles", sim.particles())
+        .set_result("clusters", sim.clusters())
+        .set_result("largest_cluster", sim.largest())
+        .set_result("sweeps", sim.sweeps())
+        .set_result("strategy", sim.strategy().name())
+        .set_result("strategy_requested", params.search.name())
+        .set_result("strategy_reason", sim.strategy_reason())
+        .set_result("state_hash", sim.state_hash())
+        .set_result("moves", sim.records().moves())
+        .set_result("mean_candidates_examined", sim.records().mean_examined())
+        .set_result(
+            "search_events",
+            sim.events()
+                .iter()
+                .map(|e| json!({"sweep": e.sweep, "what": e.what}))
+                .collect::<Vec<_>>(),
+        );
+    for (k, v) in fit_results {
+        m.results.insert(k, v);
+    }
+    m.write(dir)?;
+    Ok(m)
+}
+
+fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> anyhow::Result<()> {
+    let mut w = CsvWriter::create(
+        dir.join("clusters.csv"),
+        &["cluster", "size", "radius_of_gyration", "wraps"],
+    )?;
+    for c in measures {
+        w.row(&[&c.id, &c.size, &c.radius_of_gyration, &c.wraps])?;
+    }
+    w.finish()?;
+    Ok(())
+}
+
+/// A colour for cluster `id`: a hash spread over bright hues, never black.
+fn colour(id: u32) -> [u8; 3] {
+    let h = core_lattice::io::hash::xxh3_64(&id.to_le_bytes());
+    let c = |shift: u32| 64 + ((h >> shift) & 0xBF) as u8;
+    [c(0), c(16), c(32)]
+}
+
+/// The final state as a picture: the lattice's first two axes (a projection for d >= 3; a strip
+/// for d = 1), one colour per cluster, scaled down by an integer factor so neither side exceeds
+/// 8192 pixels.
+fn write_picture(sim: &Simulation, path: &Path) -> anyhow::Result<()> {
+    let l = sim.lattice();
+    let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
+    let factor = w0.max(h0).div_ceil(8192).max(1);
+    let (w, h) = (w0.div_ceil(factor), h0.div_ceil(factor));
+    let mut pixels = vec![0u8; (w * h * 3) as usize];
+    for &id in sim.sets().live() {
+        let c = colour(id);
+        for &k in sim.sets().sites(id) {
+            let x = l.coord(k, 0) / factor;
+            let y = if l.dim() >= 2 {
+                l.coord(k, 1) / factor
+            } else {
+                0
+            };
+            // Row 0 at the top: flip y so the last axis points up, as gravity pulls down.
+            let at = (((h - 1 - y) * w + x) * 3) as usize;
+            pixels[at..at + 3].copy_from_slice(&c);
+        }
+    }
+    write_png_rgb(path, w as u32, h as u32, &pixels)?;
+    Ok(())
+}

@@ -1,0 +1,337 @@
+//! Parameters of a DLCA run (MODELS.md section 1), validated before anything runs.
+
+use core_lattice::{Boundary, Lattice, LatticeError};
+use serde::{Deserialize, Serialize};
+
+/// Largest dimension the model accepts (seed 000 runs 2 to 5; 1 is included for tests and
+/// teaching).
+pub const MAX_MODEL_DIM: usize = 5;
+
+/// Default memory budget for the occupancy lattice: 4 GiB.
+pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
+
+/// How many particles to place.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Init {
+    /// A fraction of all sites, in (0, 1): `N = round(fill * sites)`.
+    Fill(f64),
+    /// An exact number of particles.
+    Particles(u64),
+}
+
+/// The contact search (MODELS.md section 1, "Search strategies"). All give bit-identical
+/// trajectories; they differ only in speed and memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Search {
+    /// Pick by regime (memory, dimension, density) and log why.
+    Auto,
+    /// Seed 000's all-pairs baseline.
+    AllPairs,
+    /// Seed 000's grid boxes, doubling with the largest cluster, falling back to all-pairs once
+    /// `3A >= L` on some axis.
+    Grid,
+    /// Occupancy lattice: a cluster id per site.
+    Lattice,
+}
+
+impl Search {
+    /// The name used on the command line and in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Search::Auto => "auto",
+            Search::AllPairs => "all-pairs",
+            Search::Grid => "grid",
+            Search::Lattice => "lattice",
+        }
+    }
+}
+
+/// Every parameter of a run. Build one, call [`Params::validate`] (the simulation does), run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Params {
+    /// Side length of each axis (`--size 1024x512`); its length is the dimension.
+    pub size: Vec<u64>,
+    /// Boundary of each axis (`--boundary`).
+    pub boundary: Vec<Boundary>,
+    /// Number of particles, directly or as a fill fraction.
+    pub init: Init,
+    /// Overall move probability, in (0, 1] (`--temperature`).
+    pub temperature: f64,
+    /// Bias of moves down the last axis, in [0, 1) (`--gravity`).
+    pub gravity: f64,
+    /// Mobility exponent `gamma >= 0`: a cluster of size `s` moves with probability
+    /// `temperature * s^-gamma` (`--mobility-exponent`).
+    pub mobility_exponent: f64,
+    /// Stop when at most this many clusters remain (`--target-clusters`, >= 1).
+    pub target_clusters: u64,
+    /// Stop after this many sweeps at the latest (`--max-sweeps`).
+    pub max_sweeps: Option<u64>,
+    /// Contact search strategy (`--search`).
+    pub search: Search,
+    /// Initial grid-box side for the `grid` strategy, a power of two (`--grid-box`); by default
+    /// chosen from the cluster spacing and the largest initial cluster.
+    pub grid_box: Option<u64>,
+    /// Memory the occupancy lattice may take, in bytes (`--max-memory`).
+    pub max_memory: u64,
+    /// Record the wall time of each sweep (`--timing`).
+    pub timing: bool,
+    /// Record histograms of candidate clusters examined per move at these sweeps
+    /// (`--histogram`, `--histogram-sweeps`); empty: none.
+    pub histogram_sweeps: Vec<u64>,
+    /// Measure each final cluster's radius of gyration and fit the fractal dimension
+    /// (`--gyration`).
+    pub gyration: bool,
+    /// Smallest cluster size used in the fractal-dimension fit (`--fit-min-size`).
+    pub fit_min_size: u64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            size: vec![1024, 1024],
+            boundary: vec![Boundary::Periodic; 2],
+            init: Init::Fill(0.01),
+            temperature: 1.0,
+            gravity: 0.0,
+            mobility_exponent: 0.0,
+            target_clusters: 100,
+            max_sweeps: None,
+            search: Search::Auto,
+            grid_box: None,
+            max_memory: DEFAULT_MAX_MEMORY,
+            timing: false,
+            histogram_sweeps: Vec::new(),
+            gyration: false,
+            fit_min_size: 10,
+        }
+    }
+}
+
+/// A parameter outside its accepted range. The message names the value and the range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamError {
+    /// Dimension outside 1..=5.
+    #[error("dimension {0} is outside the accepted range 1..={MAX_MODEL_DIM}")]
+    Dimension(usize),
+    /// The lattice itself is invalid.
+    #[error("{0}")]
+    Lattice(#[from] LatticeError),
+    /// Fill fraction outside (0, 1).
+    #[error("fill {0} is outside the accepted range (0, 1)")]
+    Fill(f64),
+    /// Fill too small to place a single particle.
+    #[error("fill {fill} of {sites} sites places no particle; use a larger fill or --particles")]
+    EmptyFill {
+        /// Fill asked for.
+        fill: f64,
+        /// Sites in the lattice.
+        sites: u64,
+    },
+    /// Particle count outside 1..=sites.
+    #[error(
+        "{particles} particles is outside the accepted range 1..={sites} (the number of sites)"
+    )]
+    Particles {
+        /// Particles asked for.
+        particles: u64,
+        /// Sites in the lattice.
+        sites: u64,
+    },
+    /// Temperature outside (0, 1].
+    #[error("temperature {0} is outside the accepted range (0, 1]")]
+    Temperature(f64),
+    /// Gravity outside [0, 1).
+    #[error("gravity {0} is outside the accepted range [0, 1)")]
+    Gravity(f64),
+    /// Negative or non-finite mobility exponent.
+    #[error("mobility exponent {0} is outside the accepted range [0, inf)")]
+    MobilityExponent(f64),
+    /// Target of zero clusters.
+    #[error("target clusters {0} is outside the accepted range 1..")]
+    TargetClusters(u64),
+    /// Grid-box side not a power of two.
+    #[error("grid box {0} is not a power of two >= 1")]
+    GridBox(u64),
+    /// The occupancy lattice does not fit the memory budget.
+    #[error(
+        "the lattice strategy needs {bytes} bytes for {sites} sites, over --max-memory {budget}; use --search grid or raise --max-memory"
+    )]
+    TooLarge {
+        /// Bytes needed.
+        bytes: u64,
+        /// Sites in the lattice.
+        sites: u64,
+        /// The budget.
+        budget: u64,
+    },
+    /// Particle count too large to number.
+    #[error("{0} particles is more than this implementation supports (2^32 - 2)")]
+    TooManyParticles(u64),
+}
+
+impl Params {
+    /// The lattice these parameters describe.
+    pub fn lattice(&self) -> Result<Lattice, ParamError> {
+        if self.size.is_empty() || self.size.len() > MAX_MODEL_DIM {
+            return Err(ParamError::Dimension(self.size.len()));
+        }
+        Ok(Lattice::new(&self.size, &self.boundary)?)
+    }
+
+    /// The dimension.
+    pub fn dim(&self) -> usize {
+        self.size.len()
+    }
+
+    /// Number of particles these parameters place (after validation).
+    pub fn particles(&self) -> Result<u64, ParamError> {
+        let sites = self.lattice()?.volume();
+        match self.init {
+            Init::Fill(f) => {
+                if !(f > 0.0 && f < 1.0) {
+                    return Err(ParamError::Fill(f));
+                }
+                let n = (f * sites as f64).round() as u64;
+                if n == 0 {
+                    return Err(ParamError::EmptyFill { fill: f, sites });
+                }
+                Ok(n.min(sites))
+            }
+            Init::Particles(n) => {
+                if n == 0 || n > sites {
+                    return Err(ParamError::Particles {
+                        particles: n,
+                        sites,
+                    });
+                }
+                Ok(n)
+            }
+        }
+    }
+
+    /// Check every parameter; the first problem found is returned.
+    pub fn validate(&self) -> Result<(), ParamError> {
+        let lattice = self.lattice()?;
+        let n = self.particles()?;
+        if n >= u64::from(u32::MAX) - 1 {
+            return Err(ParamError::TooManyParticles(n));
+        }
+        if !(self.temperature > 0.0 && self.temperature <= 1.0) {
+            return Err(ParamError::Temperature(self.temperature));
+        }
+        if !(0.0..1.0).contains(&self.gravity) {
+            return Err(ParamError::Gravity(self.gravity));
+        }
+        if !(self.mobility_exponent >= 0.0 && self.mobility_exponent.is_finite()) {
+            return Err(ParamError::MobilityExponent(self.mobility_exponent));
+        }
+        if self.target_clusters == 0 {
+            return Err(ParamError::TargetClusters(0));
+        }
+        if let Some(a) = self.grid_box {
+            if !a.is_power_of_two() {
+                return Err(ParamError::GridBox(a));
+            }
+        }
+        if self.search == Search::Lattice {
+            let bytes = spatial::lattice::Occupancy::bytes_needed(&lattice);
+            if bytes > self.max_memory {
+                return Err(ParamError::TooLarge {
+                    bytes,
+                    sites: lattice.volume(),
+                    budget: self.max_memory,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with(f: impl FnOnce(&mut Params)) -> Result<(), ParamError> {
+        let mut p = Params::default();
+        f(&mut p);
+        p.validate()
+    }
+
+    #[test]
+    fn defaults_are_valid() {
+        assert_eq!(with(|_| {}), Ok(()));
+    }
+
+    #[test]
+    fn rejects_each_bad_value() {
+        assert_eq!(with(|p| p.size = vec![]), Err(ParamError::Dimension(0)));
+        assert_eq!(with(|p| p.size = vec![8; 6]), Err(ParamError::Dimension(6)));
+        assert!(matches!(
+            with(|p| p.size = vec![8, 0]),
+            Err(ParamError::Lattice(_))
+        ));
+        assert_eq!(
+            with(|p| p.init = Init::Fill(0.0)),
+            Err(ParamError::Fill(0.0))
+        );
+        assert_eq!(
+            with(|p| p.init = Init::Fill(1.0)),
+            Err(ParamError::Fill(1.0))
+        );
+        assert!(matches!(
+            with(|p| p.init = Init::Fill(f64::NAN)),
+            Err(ParamError::Fill(_))
+        ));
+        assert!(matches!(
+            with(|p| p.init = Init::Fill(1e-9)),
+            Err(ParamError::EmptyFill { .. })
+        ));
+        assert!(matches!(
+            with(|p| p.init = Init::Particles(1024 * 1024 + 1)),
+            Err(ParamError::Particles { .. })
+        ));
+        assert!(matches!(
+            with(|p| p.init = Init::Particles(0)),
+            Err(ParamError::Particles { .. })
+        ));
+        assert_eq!(with(|p| p.gravity = 1.0), Err(ParamError::Gravity(1.0)));
+        assert_eq!(with(|p| p.gravity = -0.5), Err(ParamError::Gravity(-0.5)));
+        assert_eq!(
+            with(|p| p.temperature = 0.0),
+            Err(ParamError::Temperature(0.0))
+        );
+        assert_eq!(
+            with(|p| p.mobility_exponent = -1.0),
+            Err(ParamError::MobilityExponent(-1.0))
+        );
+        assert_eq!(
+            with(|p| p.target_clusters = 0),
+            Err(ParamError::TargetClusters(0))
+        );
+        assert_eq!(
+            with(|p| p.grid_box = Some(12)),
+            Err(ParamError::GridBox(12))
+        );
+        assert!(matches!(
+            with(|p| {
+                p.size = vec![1 << 20, 1 << 20];
+                p.init = Init::Particles(1000);
+                p.search = Search::Lattice;
+            }),
+            Err(ParamError::TooLarge { .. })
+        ));
+    }
+
+    #[test]
+    fn serde_round_trip() {
+        let p = Params {
+            histogram_sweeps: vec![1, 100],
+            ..Params::default()
+        };
+        let json = serde_json::to_string(&p).unwrap();
+        assert_eq!(serde_json::from_str::<Params>(&json).unwrap(), p);
+    }
+}

@@ -1,0 +1,183 @@
+//! Every contact search gives the same trajectory (MODELS.md section 1; DESIGN.md "Same seed, same
+//! result"), and the model's invariants hold after every move.
+
+use core_lattice::Boundary;
+use core_lattice::rng::{RngExt, stream};
+use dlca::{Init, Params, Search, Simulation};
+
+/// 24 random configurations: d = 1..5, periodic and walled axes, with and without gravity,
+/// mobility exponent and temperature below 1. Small enough for all-pairs.
+fn configs() -> Vec<Params> {
+    let mut rng = stream(2006, 0);
+    (0..24)
+        .map(|i| {
+            let dim = 1 + i % 5;
+            let max_side = [0, 300, 40, 14, 8, 6][dim];
+            let size: Vec<u64> = (0..dim).map(|_| rng.random_range(3..=max_side)).collect();
+            let boundary: Vec<Boundary> = (0..dim)
+                .map(|_| {
+                    if rng.random_bool(0.35) {
+                        Boundary::Wall
+                    } else {
+                        Boundary::Periodic
+                    }
+                })
+                .collect();
+            Params {
+                size,
+                boundary,
+                init: Init::Fill(rng.random_range(0.02..0.15)),
+                temperature: if i % 4 == 3 { 0.6 } else { 1.0 },
+                gravity: if i % 3 == 1 {
+                    rng.random_range(0.1..0.9)
+                } else {
+                    0.0
+                },
+                mobility_exponent: if i % 4 == 2 {
+                    rng.random_range(0.2..1.5)
+                } else {
+                    0.0
+                },
+                target_clusters: 1 + (i as u64 % 3),
+                max_sweeps: Some(400),
+                ..Params::default()
+            }
+        })
+        .collect()
+}
+
+struct Outcome {
+    hash: String,
+    series: Vec<(u64, u64, u64)>,
+    events: Vec<String>,
+}
+
+fn run(params: &Params, seed: u64, search: Search, grid_box: Option<u64>, checks: bool) -> Outcome {
+    let p = Params {
+        search,
+        grid_box,
+        ..params.clone()
+    };
+    let mut sim = Simulation::new(p, seed)
+        .unwrap()
+        .with_invariant_checks(checks);
+    sim.run();
+    Outcome {
+        hash: sim.state_hash(),
+        series: sim
+            .records()
+            .sweeps()
+            .iter()
+            .map(|r| (r.sweep, r.clusters, r.largest))
+            .collect(),
+        events: sim.events().iter().map(|e| e.what.clone()).collect(),
+    }
+}
+
+#[test]
+fn every_strategy_gives_the_same_trajectory() {
+    let mut doublings = 0;
+    let mut fallbacks = 0;
+    let mut merged_to_target = 0;
+    for (i, params) in configs().iter().enumerate() {
+        for seed in [1, 2] {
+            // The reference run also checks every invariant after every move.
+            let reference = run(params, seed, Search::AllPairs, None, true);
+            let others = [
+                ("grid", run(params, seed, Search::Grid, None, false)),
+                ("grid A=1", run(params, seed, Search::Grid, Some(1), false)),
+                ("grid A=2", run(params, seed, Search::Grid, Some(2), false)),
+                ("lattice", run(params, seed, Search::Lattice, None, false)),
+                ("auto", run(params, seed, Search::Auto, None, false)),
+            ];
+            for (name, o) in &others {
+                assert_eq!(
+                    o.hash, reference.hash,
+                    "config {i} seed {seed}: {name} differs from all-pairs ({params:?})"
+                );
+                assert_eq!(
+                    o.series, reference.series,
+                    "config {i} seed {seed}: {name} cluster series differs"
+                );
+                doublings += o.events.iter().filter(|e| e.contains("doubled")).count();
+                fallbacks += o.events.iter().filter(|e| e.contains("all-pairs")).count();
+            }
+            let last = reference.series.last().unwrap();
+            if last.1 <= params.target_clusters {
+                merged_to_target += 1;
+            }
+            // Clusters only merge: the count never rises, the largest never shrinks.
+            for w in reference.series.windows(2) {
+                assert!(w[1].1 <= w[0].1 && w[1].2 >= w[0].2);
+            }
+        }
+    }
+    // The grid's doubling and its fall-back to all-pairs were exercised, and most runs
+    // actually aggregated to their target.
+    assert!(doublings > 5, "only {doublings} grid doublings");
+    assert!(fallbacks > 5, "only {fallbacks} fall-backs to all-pairs");
+    assert!(
+        merged_to_target > 30,
+        "only {merged_to_target} of 48 runs reached their target"
+    );
+}
+
+#[test]
+fn invariants_hold_with_gravity_walls_and_dense_fill() {
+    let params = Params {
+        size: vec![24, 16],
+        boundary: vec![Boundary::Periodic, Boundary::Wall],
+        init: Init::Fill(0.3),
+        gravity: 0.5,
+        target_clusters: 1,
+        max_sweeps: Some(300),
+        ..Params::default()
+    };
+    for search in [Search::Lattice, Search::Grid] {
+        let mut sim = Simulation::new(
+            Params {
+                search,
+                ..params.clone()
+            },
+            9,
+        )
+        .unwrap()
+        .with_invariant_checks(true);
+        sim.run();
+        assert!(sim.clusters() >= 1);
+        assert_eq!(sim.sets().total_sites(), sim.particles());
+    }
+}
+
+#[test]
+fn same_seed_same_run_different_seed_different_run() {
+    let params = Params {
+        size: vec![64, 64],
+        init: Init::Fill(0.05),
+        target_clusters: 5,
+        ..Params::default()
+    };
+    let a = run(&params, 7, Search::Auto, None, false);
+    let b = run(&params, 7, Search::Auto, None, false);
+    let c = run(&params, 8, Search::Auto, None, false);
+    assert_eq!(a.hash, b.hash);
+    assert_eq!(a.series, b.series);
+    assert_ne!(a.hash, c.hash);
+}
+
+#[test]
+fn initial_adjacent_particles_form_one_cluster() {
+    // A dense fill: many particles start face-adjacent and must start merged.
+    let params = Params {
+        size: vec![20, 20],
+        init: Init::Fill(0.4),
+        max_sweeps: Some(0),
+        ..Params::default()
+    };
+    let sim = Simulation::new(params, 3)
+        .unwrap()
+        .with_invariant_checks(true);
+    assert_eq!(sim.particles(), 160);
+    assert!(sim.clusters() < 160, "no particles merged at the start");
+    assert!(sim.largest() > 1);
+}
