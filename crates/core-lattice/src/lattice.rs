@@ -226,6 +226,9 @@ pub struct Lattice {
     /// `strides[a] = L_1 * ... * L_a` (so `strides[0] = 1`).
     strides: [u64; MAX_DIM],
     volume: u64,
+    /// When every side is a power of two, `log2(strides[a])`: coordinates are then extracted
+    /// with a shift and a mask instead of two divisions.
+    shifts: Option<[u32; MAX_DIM]>,
 }
 
 /// The serialised form of a [`Lattice`]: its side lengths and boundaries.
@@ -284,6 +287,7 @@ impl Lattice {
             boundaries: [Boundary::Periodic; MAX_DIM],
             strides: [0; MAX_DIM],
             volume: 1,
+            shifts: None,
         };
         for (axis, &size) in sizes.iter().enumerate() {
             if size == 0 {
@@ -299,6 +303,13 @@ impl Lattice {
                     })?;
             lattice.sizes[axis] = size;
             lattice.boundaries[axis] = boundaries[axis];
+        }
+        if sizes.iter().all(|s| s.is_power_of_two()) {
+            let mut shifts = [0; MAX_DIM];
+            for axis in 0..dim {
+                shifts[axis] = lattice.strides[axis].trailing_zeros();
+            }
+            lattice.shifts = Some(shifts);
         }
         Ok(lattice)
     }
@@ -396,7 +407,57 @@ impl Lattice {
     #[inline]
     pub fn coord(&self, k: u64, axis: usize) -> u64 {
         debug_assert!(k < self.volume);
-        (k / self.strides[axis]) % self.sizes[axis]
+        match &self.shifts {
+            Some(shifts) => (k >> shifts[axis]) & (self.sizes[axis] - 1),
+            None => (k / self.strides[axis]) % self.sizes[axis],
+        }
+    }
+
+    /// Decode `k` into a fixed array of coordinates (entries beyond the dimension are 0):
+    /// the allocation-free, division-light form of [`Lattice::decode`] for hot loops.
+    #[inline]
+    pub fn coords_array(&self, k: u64) -> [u64; MAX_DIM] {
+        debug_assert!(k < self.volume);
+        let mut out = [0; MAX_DIM];
+        match &self.shifts {
+            Some(shifts) => {
+                for axis in 0..self.dim {
+                    out[axis] = (k >> shifts[axis]) & (self.sizes[axis] - 1);
+                }
+            }
+            None => {
+                let mut rest = k;
+                for axis in 0..self.dim {
+                    out[axis] = rest % self.sizes[axis];
+                    rest /= self.sizes[axis];
+                }
+            }
+        }
+        out
+    }
+
+    /// The neighbour of the site with coordinates `x` (and k-index `k`) in direction `dir`,
+    /// computed without any division; `None` across a wall or onto itself (an axis of length 1).
+    #[inline]
+    pub fn neighbour_of(&self, k: u64, x: &[u64; MAX_DIM], dir: Direction) -> Option<u64> {
+        let axis = dir.axis();
+        let (size, stride) = (self.sizes[axis], self.strides[axis]);
+        let n = if dir.is_positive() {
+            if x[axis] + 1 < size {
+                k + stride
+            } else if self.boundaries[axis] == Boundary::Periodic {
+                k - x[axis] * stride
+            } else {
+                return None;
+            }
+        } else if x[axis] > 0 {
+            k - stride
+        } else if self.boundaries[axis] == Boundary::Periodic {
+            k + (size - 1) * stride
+        } else {
+            return None;
+        };
+        (n != k).then_some(n)
     }
 
     /// Translate site `k` by the unit vector `dir` (seed 000 DLCA moves, MODELS.md section 1).
@@ -410,7 +471,7 @@ impl Lattice {
         debug_assert!(axis < self.dim);
         let size = self.sizes[axis];
         let stride = self.strides[axis];
-        let x = (k / stride) % size;
+        let x = self.coord(k, axis);
         if dir.is_positive() {
             if x + 1 < size {
                 Ok(k + stride)

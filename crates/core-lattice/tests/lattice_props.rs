@@ -30,6 +30,26 @@ fn lattice_and_site() -> impl Strategy<Value = (Lattice, u64)> {
     })
 }
 
+/// Lattices whose sides are all powers of two (the shift-and-mask fast path), up to 2^20.
+fn pow2_lattice_and_site() -> impl Strategy<Value = (Lattice, u64)> {
+    (1usize..=5)
+        .prop_flat_map(|d| {
+            (
+                prop::collection::vec(0u32..=(60 / d as u32).min(20), d),
+                prop::collection::vec(
+                    prop_oneof![Just(Boundary::Periodic), Just(Boundary::Wall)],
+                    d,
+                ),
+            )
+        })
+        .prop_flat_map(|(logs, b)| {
+            let sizes: Vec<u64> = logs.iter().map(|&e| 1u64 << e).collect();
+            let l = Lattice::new(&sizes, &b).unwrap();
+            let v = l.volume();
+            (Just(l), 0..v)
+        })
+}
+
 /// Lattices with huge sides, to exercise k-index arithmetic near `u64::MAX`.
 fn big_lattice() -> impl Strategy<Value = Lattice> {
     (1usize..=8)
@@ -82,6 +102,23 @@ proptest! {
     }
 
     #[test]
+    fn power_of_two_fast_path_matches_decode((l, k) in pow2_lattice_and_site()) {
+        let x = l.coords_array(k);
+        let reference = l.decode(k).unwrap();
+        prop_assert_eq!(&x[..l.dim()], &reference[..]);
+        for axis in 0..l.dim() {
+            prop_assert_eq!(l.coord(k, axis), reference[axis]);
+        }
+        for dir in Direction::all(l.dim()) {
+            let n = l.neighbour_of(k, &x, dir);
+            prop_assert_eq!(n, l.neighbour(k, dir));
+            if let Some(n) = n {
+                prop_assert!(l.adjacent(k, n));
+            }
+        }
+    }
+
+    #[test]
     fn k_index_round_trips_on_huge_lattices(l in big_lattice(), frac in 0.0f64..1.0) {
         let k = ((l.volume() as f64 * frac) as u64).min(l.volume() - 1);
         let x = l.decode(k).unwrap();
@@ -112,6 +149,17 @@ proptest! {
         if l.volume() <= 4096 {
             let expected = (0..l.volume()).filter(|&j| l.adjacent(k, j)).count();
             prop_assert_eq!(expected, n.len());
+        }
+    }
+
+    #[test]
+    fn fast_paths_match_decode_and_neighbour((l, k) in lattice_and_site()) {
+        let x = l.coords_array(k);
+        let reference = l.decode(k).unwrap();
+        prop_assert_eq!(&x[..l.dim()], &reference[..]);
+        prop_assert!(x[l.dim()..].iter().all(|&v| v == 0));
+        for dir in Direction::all(l.dim()) {
+            prop_assert_eq!(l.neighbour_of(k, &x, dir), l.neighbour(k, dir));
         }
     }
 

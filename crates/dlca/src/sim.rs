@@ -75,6 +75,8 @@ pub struct Simulation {
     events: Vec<SearchEvent>,
     records: Records,
     check_invariants: bool,
+    /// Size of each cluster when its sites were last sorted.
+    sorted_size: Vec<usize>,
     // Scratch buffers reused by every move.
     old: Vec<u64>,
     contacts: Vec<ItemId>,
@@ -121,10 +123,12 @@ impl Simulation {
             largest,
             events: Vec::new(),
             check_invariants: false,
+            sorted_size: Vec::new(),
             old: Vec::new(),
             contacts: Vec::new(),
             order: Vec::new(),
         };
+        sim.sorted_size = vec![0; sim.sets.id_bound()];
         sim.install(kind)?;
         sim.records
             .record_sweep(0, sim.sets.len() as u64, largest, None);
@@ -135,13 +139,14 @@ impl Simulation {
     fn install(&mut self, kind: Search) -> Result<(), ParamError> {
         self.engine = match kind {
             Search::Lattice => Engine::Lattice(
-                Occupancy::new(&self.lattice, self.params.max_memory).map_err(|_| {
-                    ParamError::TooLarge {
+                // Clusters merge as soon as they touch, so they are separated before every move.
+                Occupancy::new(&self.lattice, self.params.max_memory)
+                    .map_err(|_| ParamError::TooLarge {
                         bytes: Occupancy::bytes_needed(&self.lattice),
                         sites: self.lattice.volume(),
                         budget: self.params.max_memory,
-                    }
-                })?,
+                    })?
+                    .with_separated_items(true),
             ),
             Search::AllPairs | Search::Auto => Engine::AllPairs(AllPairs::new()),
             Search::Grid => {
@@ -295,7 +300,14 @@ impl Simulation {
                 self.merge_bbox(survivor, other, anchors);
             }
         }
-        self.largest = self.largest.max(self.sets.sites(survivor).len() as u64);
+        let size = self.sets.sites(survivor).len();
+        self.largest = self.largest.max(size as u64);
+        // Keep large clusters' sites in k-index order (re-sorted each time they double), so
+        // moves walk the occupancy lattice in memory order. Amortised O(log s) per particle.
+        if size >= 64 && size >= 2 * self.sorted_size[survivor as usize] {
+            self.sets.sort_sites(survivor);
+            self.sorted_size[survivor as usize] = size;
+        }
         group.clear();
         self.contacts = group;
         if matches!(self.engine, Engine::Grid(_)) {

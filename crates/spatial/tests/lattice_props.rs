@@ -83,6 +83,9 @@ struct World {
     all_pairs: AllPairs,
     grid: LatticeGridBoxes,
     occupancy: Occupancy,
+    /// An occupancy lattice with the leading-face shortcut, queried only for a mover that
+    /// touched nothing before its move (the promise it relies on).
+    separated: Occupancy,
 }
 
 impl World {
@@ -93,9 +96,15 @@ impl World {
             all_pairs,
             grid,
             occupancy,
+            separated,
             ..
         } = self;
-        for s in [all_pairs as &mut dyn ContactSearch, grid, occupancy] {
+        for s in [
+            all_pairs as &mut dyn ContactSearch,
+            grid,
+            occupancy,
+            separated,
+        ] {
             f(s, sets);
         }
     }
@@ -180,6 +189,9 @@ fn run(case: Case) -> Result<(), TestCaseError> {
         all_pairs: AllPairs::new(),
         grid: LatticeGridBoxes::new(&lattice, 1 << case.log_side).unwrap(),
         occupancy: Occupancy::new(&lattice, 1 << 30).unwrap(),
+        separated: Occupancy::new(&lattice, 1 << 30)
+            .unwrap()
+            .with_separated_items(true),
     };
     for picks in &case.items {
         w.insert(picks);
@@ -215,6 +227,7 @@ fn run(case: Case) -> Result<(), TestCaseError> {
                 {
                     continue;
                 }
+                let was_separate = brute_contacts(&w.sets, id).is_empty();
                 w.sets.translate(id, dir, &mut old).unwrap();
                 prop_assert_eq!(w.sets.sites(id), &target[..]);
                 for k in &old {
@@ -222,6 +235,11 @@ fn run(case: Case) -> Result<(), TestCaseError> {
                 }
                 w.occupied.extend(&target);
                 w.each(|s, sets| s.moved(sets, id, &old, &target, dir));
+                if was_separate {
+                    let mut out = Vec::new();
+                    w.separated.contacts(&w.sets, id, &mut out);
+                    prop_assert_eq!(out, brute_contacts(&w.sets, id), "leading-face shortcut");
+                }
             }
             Op::Merge { a, b } => {
                 let (a, b) = (live[a % live.len()], live[b % live.len()]);

@@ -70,14 +70,7 @@ pub trait ContactSearch {
 /// Coordinates of a site as a fixed array (axes beyond the dimension are 0).
 #[inline]
 fn coords_of(lattice: &Lattice, k: u64) -> [u64; MAX_DIM] {
-    let mut out = [0; MAX_DIM];
-    let mut rest = k;
-    for (axis, slot) in out.iter_mut().enumerate().take(lattice.dim()) {
-        let size = lattice.size(axis);
-        *slot = rest % size;
-        rest /= size;
-    }
-    out
+    lattice.coords_array(k)
 }
 
 /// Whether site coordinates `p` and `q` are face-adjacent, comparing one axis at a time and
