@@ -18,7 +18,7 @@ use std::process::ExitCode;
 /// direction and merges with every cluster it then touches. Stops at --target-clusters or
 /// --max-sweeps. Outputs go into --out DIR (see docs/dlca.md).
 #[derive(Parser, Debug)]
-#[command(name = "dlca", version, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
+#[command(name = "dlca", version, allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
 struct Cli {
     /// Lattice dimension, 1 to 5. With a single --size value, every axis gets that length.
     #[arg(long, default_value_t = 2)]

@@ -15,7 +15,7 @@ const STREAM_DYNAMICS: u32 = 2;
 /// The contact search in use.
 enum Engine {
     AllPairs(AllPairs),
-    Grid(LatticeGridBoxes),
+    Grid(Box<LatticeGridBoxes>),
     Lattice(Occupancy),
 }
 
@@ -23,7 +23,7 @@ impl Engine {
     fn search(&mut self) -> &mut dyn ContactSearch {
         match self {
             Engine::AllPairs(s) => s,
-            Engine::Grid(s) => s,
+            Engine::Grid(s) => s.as_mut(),
             Engine::Lattice(s) => s,
         }
     }
@@ -178,7 +178,7 @@ impl Simulation {
                 } else {
                     grid.set_side(side, &self.sets).expect("power of two");
                     self.note(format!("grid box side {side}"));
-                    Engine::Grid(grid)
+                    Engine::Grid(Box::new(grid))
                 }
             }
         };
@@ -413,11 +413,8 @@ impl Simulation {
             while let Some(k) = queue.pop_front() {
                 for n in self.lattice.neighbours(k) {
                     match owner.get(&n) {
-                        Some(&o) if o == id => {
-                            if seen.insert(n) {
-                                queue.push_back(n);
-                            }
-                        }
+                        Some(&o) if o == id && seen.insert(n) => queue.push_back(n),
+                        Some(&o) if o == id => {}
                         Some(&o) => panic!("clusters {id} and {o} are face-adjacent at {k}-{n}"),
                         None => {}
                     }

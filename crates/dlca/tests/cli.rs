@@ -1,0 +1,187 @@
+//! The `dlca` binary: outputs, and one-line errors with exit code 2 and nothing written.
+
+use std::path::Path;
+use std::process::Command;
+
+fn dlca(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_dlca"))
+        .args(args)
+        .output()
+        .expect("dlca runs")
+}
+
+fn run_json(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn writes_every_output() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let o = dlca(&[
+        "--size",
+        "64x48",
+        "--fill",
+        "0.05",
+        "--seed",
+        "4",
+        "--target-clusters",
+        "5",
+        "--timing",
+        "--histogram",
+        "--gyration",
+        "--png",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j = run_json(&out);
+    let r = &j["results"];
+    assert_eq!(j["model"], "dlca");
+    assert_eq!(j["seed"], 4);
+    assert_eq!(r["particles"], 154); // round(0.05 * 64 * 48)
+    assert!(r["clusters"].as_u64().unwrap() <= 5);
+    assert!(r["sweeps"].as_u64().unwrap() > 0);
+    assert_eq!(r["strategy"], "lattice");
+    assert_eq!(r["state_hash"].as_str().unwrap().len(), 16);
+    assert!(r.get("fractal_dimension").is_some() && r.get("fractal_dimension_stderr").is_some());
+    let sweeps = std::fs::read_to_string(out.join("sweeps.csv")).unwrap();
+    assert!(sweeps.starts_with("sweep,clusters,largest,seconds\n0,"));
+    assert_eq!(
+        sweeps.lines().count() as u64,
+        r["sweeps"].as_u64().unwrap() + 2
+    );
+    let particles = std::fs::read_to_string(out.join("particles.csv")).unwrap();
+    assert!(particles.starts_with("x1,x2,cluster\n"));
+    assert_eq!(particles.lines().count(), 155);
+    let sizes = std::fs::read_to_string(out.join("sizes.csv")).unwrap();
+    let total: u64 = sizes
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let (s, c) = l.split_once(',').unwrap();
+            s.parse::<u64>().unwrap() * c.parse::<u64>().unwrap()
+        })
+        .sum();
+    assert_eq!(total, 154);
+    assert!(
+        std::fs::read_to_string(out.join("histogram.csv"))
+            .unwrap()
+            .starts_with("sweep,candidates,moves\n1,")
+    );
+    assert!(
+        std::fs::read_to_string(out.join("clusters.csv"))
+            .unwrap()
+            .starts_with("cluster,size,radius_of_gyration,wraps\n")
+    );
+    assert!(
+        std::fs::read(out.join("dlca.png"))
+            .unwrap()
+            .starts_with(b"\x89PNG")
+    );
+}
+
+#[test]
+fn strategies_agree_through_the_cli() {
+    let tmp = tempfile::tempdir().unwrap();
+    let hashes: Vec<String> = ["all-pairs", "grid", "lattice"]
+        .iter()
+        .map(|s| {
+            let out = tmp.path().join(s);
+            let o = dlca(&[
+                "--dim",
+                "3",
+                "--size",
+                "12",
+                "--boundary",
+                "periodic,wall,periodic",
+                "--fill",
+                "0.05",
+                "--gravity",
+                "0.3",
+                "--search",
+                s,
+                "--target-clusters",
+                "3",
+                "-q",
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            run_json(&out)["results"]["state_hash"]
+                .as_str()
+                .unwrap()
+                .to_string()
+        })
+        .collect();
+    assert_eq!(hashes[0], hashes[1]);
+    assert_eq!(hashes[0], hashes[2]);
+}
+
+#[test]
+fn bad_input_is_one_line_exit_2_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("never");
+    let cases: &[(&[&str], &str)] = &[
+        (&["--dim", "0", "--size", "8", "--fill", "0.1"], "--dim 0"),
+        (&["--dim", "6", "--size", "8", "--fill", "0.1"], "--dim 6"),
+        (&["--size", "0", "--fill", "0.1"], "length on axis 0 is 0"),
+        (&["--size", "16", "--fill", "0"], "fill 0 is outside"),
+        (&["--size", "16", "--fill", "1"], "fill 1 is outside"),
+        (&["--size", "16", "--particles", "257"], "257 particles"),
+        (
+            &["--size", "16", "--fill", "0.1", "--gravity", "1"],
+            "gravity 1 is outside",
+        ),
+        (
+            &["--size", "16", "--fill", "0.1", "--gravity", "-0.2"],
+            "gravity -0.2",
+        ),
+        (
+            &[
+                "--size",
+                "100000",
+                "--particles",
+                "10",
+                "--search",
+                "lattice",
+            ],
+            "--max-memory",
+        ),
+        (
+            &["--size", "16", "--fill", "0.1", "--boundary", "sticky"],
+            "unknown boundary",
+        ),
+        (
+            &["--size", "16x16x16", "--fill", "0.1"],
+            "--size has 3 axes",
+        ),
+        (
+            &["--size", "16", "--fill", "0.1", "--grid-box", "3"],
+            "power of two",
+        ),
+        (&["--size", "16"], "required"),
+        (
+            &["--size", "16", "--fill", "0.1", "--frobnicate"],
+            "frobnicate",
+        ),
+    ];
+    for (args, expect) in cases {
+        let mut a: Vec<&str> = args.to_vec();
+        a.extend(["--out", out.to_str().unwrap()]);
+        let o = dlca(&a);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(
+            err.trim_end().lines().count(),
+            1,
+            "{args:?}: not one line: {err}"
+        );
+        assert!(
+            err.contains(expect),
+            "{args:?}: '{err}' does not mention '{expect}'"
+        );
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
+}
