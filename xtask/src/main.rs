@@ -10,7 +10,10 @@ use std::process::Command;
 use std::time::Instant;
 
 #[derive(Parser)]
-#[command(name = "cargo xtask", about = "Project automation for the aggsim workspace")]
+#[command(
+    name = "cargo xtask",
+    about = "Project automation for the aggsim workspace"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Cmd,
@@ -36,10 +39,21 @@ struct Step {
 
 /// The steps of `cargo xtask ci`, in order. The test step is the README's test command.
 const CI_STEPS: &[Step] = &[
-    Step { name: "format", args: &["fmt", "--all", "--", "--check"], env: &[] },
+    Step {
+        name: "format",
+        args: &["fmt", "--all", "--", "--check"],
+        env: &[],
+    },
     Step {
         name: "clippy",
-        args: &["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"],
+        args: &[
+            "clippy",
+            "--workspace",
+            "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
         env: &[],
     },
     Step {
@@ -47,12 +61,19 @@ const CI_STEPS: &[Step] = &[
         args: &["doc", "--workspace", "--no-deps"],
         env: &[("RUSTDOCFLAGS", "-D warnings")],
     },
-    Step { name: "tests", args: &["test", "--workspace"], env: &[] },
+    Step {
+        name: "tests",
+        args: &["test", "--workspace"],
+        env: &[],
+    },
 ];
 
 fn workspace_root() -> PathBuf {
     // xtask/ is one level below the workspace root.
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask has a parent").to_path_buf()
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask has a parent")
+        .to_path_buf()
 }
 
 fn cargo() -> String {
@@ -71,7 +92,11 @@ fn run_step(step: &Step) -> Result<()> {
     if !status.success() {
         bail!("{} step failed ({status})", step.name);
     }
-    eprintln!("    {} passed in {:.1} s", step.name, start.elapsed().as_secs_f64());
+    eprintln!(
+        "    {} passed in {:.1} s",
+        step.name,
+        start.elapsed().as_secs_f64()
+    );
     Ok(())
 }
 
@@ -101,7 +126,9 @@ mod tests {
         use clap::CommandFactory;
         Cli::command().debug_assert();
         assert!(matches!(
-            Cli::try_parse_from(["xtask", "ci", "--no-tests"]).unwrap().command,
+            Cli::try_parse_from(["xtask", "ci", "--no-tests"])
+                .unwrap()
+                .command,
             Cmd::Ci { no_tests: true }
         ));
         assert!(Cli::try_parse_from(["xtask", "frobnicate"]).is_err());
@@ -115,7 +142,13 @@ mod tests {
         let ci_script = std::fs::read_to_string(root.join(".ci/run")).unwrap();
         let test_step = CI_STEPS.iter().find(|s| s.name == "tests").unwrap();
         let command = format!("cargo {}", test_step.args.join(" "));
-        assert!(readme.contains(&command), "README does not mention `{command}`");
-        assert!(ci_script.lines().any(|l| l.trim() == command), ".ci/run does not run `{command}`");
+        assert!(
+            readme.contains(&command),
+            "README does not mention `{command}`"
+        );
+        assert!(
+            ci_script.lines().any(|l| l.trim() == command),
+            ".ci/run does not run `{command}`"
+        );
     }
 }

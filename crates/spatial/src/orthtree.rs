@@ -1,1 +1,700 @@
-//! Orthtree (placeholder, being written).
+//! Orthtree: quadtree (D = 2), octree (D = 3), 2^D children in general, with an exact nearest
+//! distance query and the variable-precision distance search `vpdist` of Sosa-Herrera &
+//! Rodriguez-Romo, *Variable precision distance search for random fractal cluster simulations*
+//! (seed 002, section 3.1 and Listing 1; storage after section 3.3).
+//!
+//! Built for off-lattice DLA/PDLA (MODELS.md section 2): particle centres in units of particle
+//! diameters, inserted one at a time, queried millions of times by random walkers.
+//!
+//! # Structure
+//!
+//! Space is cut into **leaf cells**: the cubes `[k s, (k + 1) s)^D` of side `s` (the *leaf side*,
+//! a power of two, default [`DEFAULT_LEAF_SIDE`] = 4 diameters), integer `k`. A node at level `l`
+//! covers `2^l x 2^l (x ...)` leaf cells; leaves are level 0, the root has level >= 1. All leaves
+//! sit at level 0 (the paper's `ISLEAF`: "the node is at the last level"), so the depth is
+//! `log2(root side / s)` and no leaf ever splits.
+//!
+//! - **Root growth.** The first point gets a root of level 1 (2 x 2 leaf cells) whose centre is
+//!   the leaf-cell corner nearest to it. A point outside the root makes the root grow by
+//!   doubling: a new root of twice the side is created with the old root as one of its children,
+//!   on the side of the new point along each axis where the point is outside, and on the side
+//!   that keeps the root centred on the first point along the other axes. Leaf cells never move,
+//!   so the stored (decoded) position of a point does not depend on insertion order or growth.
+//! - **Nodes.** One flat `Vec<u32>` with `2^D` child slots per internal node (16 bytes per node
+//!   in 2D, 32 in 3D): a child is a node index, or a leaf index for level-1 nodes, or `u32::MAX`
+//!   when empty. Nodes exist only on the paths to stored points, so every node holds at least one
+//!   point (the error bound below relies on this).
+//! - **Leaves.** `Vec<Leaf>`, 8 bytes each: the start and length of the leaf's block in the pool.
+//! - **Points.** One pool of `[u32; D]` records: each coordinate is a fixed-point offset inside
+//!   the leaf cell, in units of `s / 2^32` (seed 002, section 3.3 stores relative coordinates in
+//!   one byte; that is far too coarse for contact within 1e-6, 32 bits give `s / 2^33`, about
+//!   5e-10 for `s = 4`). A leaf's points are contiguous; blocks come in size classes with free
+//!   lists (exact sizes up to 16 points, see `pool.rs`), so small leaves waste nothing. When
+//!   more than 1/8 of the pool sits on free lists (leaves that all grow at once, e.g. uniform
+//!   points inserted in random order), an insert compacts the pool in place: O(N) at that
+//!   insert, amortised O(leaf size) per insert. DLA growth, which keeps creating leaves at the
+//!   front, reuses the free blocks and practically never compacts.
+//! - **Growth of the vectors** is capped at 1/8 of their capacity, not doubled, so the heap slack
+//!   counted by [`Orthtree::memory_bytes`] stays near 12 %; this also bounds the latency of an
+//!   insert under a writer lock.
+//!
+//! Memory (2D, 8 bytes per point record): with the default leaf side, measured 12.0 to 12.4
+//! bytes per point on a DLA-like cluster and 10.6 to 11.1 on uniform points at unit density, at
+//! 1e6 and 1e7 points (`examples/orthtree_memory.rs`, `docs/spatial.md`). Positions are restored
+//! to within `s / 2^33` per coordinate (4.7e-10 for the default), far inside the 1e-6 that DLA
+//! contact needs, plus the rounding of `f64` at the coordinate's magnitude.
+//!
+//! # Choosing the leaf side
+//!
+//! The leaf side `s` trades memory against query work: a larger `s` means fewer nodes and leaf
+//! records (less memory, a shallower tree) but more points scanned per visited leaf (and a
+//! larger exact region of `vpdist`, `(kappa - 1/2)` leaf diagonals); a smaller `s` means more
+//! nodes per point. For unit-diameter
+//! particles `s = 4` holds 4 to 5 DLA particles per leaf and keeps the structure near 12 bytes
+//! per point in 2D; `s = 8` (12 particles per leaf) takes about 10 bytes per point and, being
+//! shallower, touched less memory per query in our measurements at 1e6 points, so it is worth
+//! benchmarking for large clusters. `s = 2` costs more memory (18 bytes per point) than it saves
+//! work. Accepted: powers of two from [`MIN_LEAF_SIDE`] to [`MAX_LEAF_SIDE`] (powers of two make
+//! every cell corner, centre and decoded position an exact binary fraction, so the geometry used
+//! by the queries is exact).
+//!
+//! # Queries and complexity
+//!
+//! `h = log2(root side / s)` is the depth (about `log2(2 R / s)` for a cluster of radius `R`).
+//!
+//! | operation | cost |
+//! |---|---|
+//! | [`insert`](Orthtree::insert) | O(h + points in the leaf) (a leaf's block is copied when it grows) |
+//! | [`nearest`](Orthtree::nearest), [`nearest_distance`](Orthtree::nearest_distance) | branch and bound: O(h) plus the nodes whose box is closer than the answer |
+//! | [`vpdist`](Orthtree::vpdist) | O(h) nodes times a constant depending on `kappa` and `D` only (seed 002, Listing 1) |
+//! | [`for_each_within`](Orthtree::for_each_within) | O(h + nodes meeting the ball + points reported) |
+//! | [`iter`](Orthtree::iter) | O(N + nodes) |
+//!
+//! Queries take `&self` and never allocate (except [`iter`](Orthtree::iter), which keeps an
+//! O(h) stack); inserts take `&mut self`. The type is `Send + Sync` with no interior mutability,
+//! so PDLA can share it behind a `RwLock` (many walkers querying, one inserting).
+//!
+//! # Variable-precision distance and its error bound
+//!
+//! [`vpdist`](Orthtree::vpdist) is Listing 1 of seed 002 in `D` dimensions with the precision
+//! `kappa` as a parameter (the paper uses `kappa = 2`). Starting from the root, for each node `n`
+//! with centre `c` and half diagonal `r` (`DIAGONAL = 2 r`):
+//!
+//! 1. if `|p - c| > kappa * 2 r` (the node is *far*), the node contributes the lower bound
+//!    `|p - c| - r` and is not descended (lines 07-11);
+//! 2. else if `n` is a leaf, its points contribute their exact distances (lines 13-19);
+//! 3. else the children are visited, the one containing `p` first, skipping every child whose
+//!    box does not meet the ball of radius "best so far" around `p` (lines 21-33).
+//!
+//! The answer `v` is the smallest contribution. Let `d` be the exact nearest distance.
+//!
+//! - **Never too large: `v <= d`.** Every point lies within `r` of the centre of each node
+//!   containing it, so `|p - c| - r` is at most its distance; a skipped child's points are all
+//!   farther than the best value already found. This holds for every `kappa`.
+//! - **Absolute gap (the paper's `d in [d_app, d_app + 2r]`).** If `v < d`, then `v` was produced
+//!   by a far node `eta` of half diagonal `r_eta`: `v = |p - c_eta| - r_eta`. The node holds at
+//!   least one point, at distance at most `|p - c_eta| + r_eta`, so `d <= v + 2 r_eta`: the gap
+//!   is at most the diagonal of the node that produced `v`. [`Orthtree::vpdist_detailed`]
+//!   reports `r_eta`.
+//! - **Relative gap.** `eta` was far: `|p - c_eta| > 2 kappa r_eta`, so `v > (2 kappa - 1) r_eta`
+//!   and `d <= v + 2 r_eta < v (2 kappa + 1) / (2 kappa - 1)`. Hence, for `kappa > 1/2`,
+//!
+//!   `v > d (2 kappa - 1) / (2 kappa + 1)`, i.e. `(d - v) / d < 2 / (2 kappa + 1)`:
+//!
+//!   at most 2/3 of `d` for `kappa = 1`, **0.4 for `kappa = 2`** (the paper's "+0.4 d(p,q)"),
+//!   2/9 for `kappa = 4`, and 0 for `kappa = inf` (the exact search). The bound is attained in
+//!   the limit (a lone point in the far corner of a leaf seen along its diagonal from just beyond
+//!   `2 kappa r`), so it cannot be improved.
+//! - **Exact near the cluster.** If `d <= (2 kappa - 1) r_leaf = (kappa - 1/2) DIAGONAL(leaf)`,
+//!   then `v = d`: every far node gives more than `(2 kappa - 1) r >= (2 kappa - 1) r_leaf`.
+//!   For `kappa = 2` and `s = 4` this is 1.5 leaf diagonals, 8.49 diameters. The paper states
+//!   exactness for `d(p, q) < 2 d_g` (2 leaf diagonals) or when `p` is closer than `2 d_g` to the
+//!   centre of `q`'s leaf; neither is sufficient (another far leaf next to `p` can undercut `d`,
+//!   see the unit test `paper_exactness_radius_is_not_sufficient`), while
+//!   `(kappa - 1/2) d_g` is sufficient and tight.
+//!
+//! Floating point: distances to stored points are computed exactly as a brute-force loop over
+//! [`iter`](Orthtree::iter) would (same operations, same order), child boxes are skipped using
+//! face coordinates that are exact, and far-node bounds are shrunk by a relative `2^-44`, so
+//! `v <= d` holds in floating point against that brute force, and the exact queries return its
+//! value bit for bit.
+//!
+//! # Example
+//!
+//! ```
+//! use spatial::orthtree::Orthtree;
+//!
+//! let mut tree = Orthtree::<2>::new();
+//! tree.insert([0.0, 0.0])?;
+//! tree.insert([1.0, 0.0])?;
+//! assert_eq!(tree.nearest_distance(&[4.0, 0.0]), Some(3.0));
+//! let v = tree.vpdist(&[100.0, 0.0], 2.0).unwrap();
+//! assert!(v <= 99.0 && v > 99.0 * 3.0 / 5.0);
+//! # Ok::<(), spatial::orthtree::OrthtreeError>(())
+//! ```
+
+mod pool;
+mod query;
+#[cfg(test)]
+mod tests;
+
+use std::fmt;
+
+use pool::LeafPool;
+pub use query::{Neighbour, VpEstimate};
+
+/// Default leaf side (seed 002, section 3.3: the leaf cell holding a chunk of particles), in
+/// particle diameters: a few to a dozen DLA particles per leaf. See the module docs for the
+/// trade-off.
+pub const DEFAULT_LEAF_SIDE: f64 = 4.0;
+
+/// Smallest accepted leaf side, `2^-20`.
+pub const MIN_LEAF_SIDE: f64 = 1.0 / 1_048_576.0;
+
+/// Largest accepted leaf side, `2^11`: fixed-point offsets of `s / 2^32` then still restore
+/// positions to within `2^-22`, about 2.4e-7 per coordinate.
+pub const MAX_LEAF_SIDE: f64 = 2048.0;
+
+/// Coordinates must satisfy `|x| < COORD_LIMIT_LEAVES * leaf_side` (`2^50` leaf sides, 4.5e15
+/// diameters for the default), so that all cell geometry is exact in `f64`.
+pub const COORD_LIMIT_LEAVES: f64 = 1_125_899_906_842_624.0;
+
+/// The precision used in the paper (seed 002, Listing 1, line 07: `DIAGONAL(node) * 2`).
+pub const PAPER_KAPPA: f64 = 2.0;
+
+/// Empty child slot.
+const EMPTY: u32 = u32::MAX;
+
+/// Largest number of internal nodes or leaves (indices are `u32`, `u32::MAX` is reserved).
+const MAX_INDEX: u64 = u32::MAX as u64 - 1;
+
+/// `2^32`: fixed-point offsets per leaf side.
+const CODE_SCALE: f64 = 4_294_967_296.0;
+
+/// Errors of the orthtree (construction parameters and inserted points).
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OrthtreeError {
+    /// A coordinate of an inserted point is NaN or infinite.
+    #[error("coordinate {axis} of the point is {value}; expected a finite number")]
+    NonFinite {
+        /// Axis of the offending coordinate.
+        axis: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// A coordinate is too large for exact cell geometry.
+    #[error("coordinate {axis} of the point is {value}; expected |x| < {limit} (2^50 leaf sides)")]
+    OutOfRange {
+        /// Axis of the offending coordinate.
+        axis: usize,
+        /// The offending value.
+        value: f64,
+        /// The exclusive bound on `|x|`.
+        limit: f64,
+    },
+    /// The leaf side is not a power of two in the accepted range.
+    #[error(
+        "leaf side {0} is invalid; expected a power of two in [2^-20, 2^11] (default 4 diameters)"
+    )]
+    InvalidLeafSide(f64),
+    /// The precision `kappa` is not usable (see [`Orthtree::check_kappa`]).
+    #[error(
+        "kappa {0} is invalid; expected kappa > 0.5 (paper value 2) or +inf for the exact search"
+    )]
+    InvalidKappa(f64),
+    /// The tree is full: more than `u32::MAX - 1` nodes, leaves or point slots.
+    #[error("orthtree capacity exceeded: more than 2^32 - 2 {0}")]
+    CapacityExceeded(&'static str),
+}
+
+/// A leaf's block in the point pool.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Leaf {
+    /// First slot of the block.
+    start: u32,
+    /// Number of points stored.
+    len: u32,
+}
+
+/// Quadtree (`D = 2`), octree (`D = 3`) or `2^D`-ary tree of points with exact nearest-distance
+/// and variable-precision distance queries (seed 002, sections 3.1 and 3.3, Listing 1).
+///
+/// See the [module documentation](self) for the layout, the complexity and the error bound of
+/// [`vpdist`](Self::vpdist). `D` must be in `1..=8`.
+#[derive(Clone)]
+pub struct Orthtree<const D: usize> {
+    /// Leaf side `s` (a power of two).
+    leaf_side: f64,
+    /// `s / 2^32`: the unit of the fixed-point offsets.
+    step: f64,
+    /// `sqrt(D)` rounded up, so half diagonals `half_side * sqrt_d_up` are never too small.
+    sqrt_d_up: f64,
+    /// Root node index, `EMPTY` while the tree is empty.
+    root: u32,
+    /// Level of the root (>= 1); its side is `2^root_level` leaf sides.
+    root_level: u32,
+    /// Lower corner of the root, in leaf sides.
+    root_origin: [i64; D],
+    /// Centre of the first root, in leaf sides: growth keeps the root centred on it.
+    anchor: [i64; D],
+    /// `2^D` child slots per internal node.
+    children: Vec<u32>,
+    /// Leaf records.
+    leaves: Vec<Leaf>,
+    /// Point records of all leaves.
+    pool: LeafPool<D>,
+    /// Number of stored points.
+    len: usize,
+}
+
+/// Counts describing an [`Orthtree`]'s shape and memory, for diagnostics and benchmarks (seed
+/// 002, section 3.3 reports bytes per particle).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OrthtreeStats {
+    /// Stored points.
+    pub points: usize,
+    /// Internal nodes (including the root).
+    pub nodes: usize,
+    /// Leaves (non-empty leaf cells).
+    pub leaves: usize,
+    /// Levels below the root: the root side is `2^depth` leaf sides.
+    pub depth: u32,
+    /// Point slots allocated in the pool, used or on a free list.
+    pub point_slots: usize,
+    /// Point slots on the free lists.
+    pub free_slots: usize,
+    /// Same as [`Orthtree::memory_bytes`].
+    pub memory_bytes: usize,
+}
+
+impl<const D: usize> Default for Orthtree<D> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const D: usize> fmt::Debug for Orthtree<D> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Orthtree")
+            .field("dim", &D)
+            .field("leaf_side", &self.leaf_side)
+            .field("len", &self.len)
+            .field("root_level", &self.root_level)
+            .field("root_origin", &self.root_origin)
+            .field("nodes", &self.node_count())
+            .field("leaves", &self.leaves.len())
+            .finish()
+    }
+}
+
+impl<const D: usize> Orthtree<D> {
+    /// Children per internal node.
+    const FANOUT: usize = 1 << D;
+
+    /// An empty tree with the default leaf side [`DEFAULT_LEAF_SIDE`] (seed 002, section 3.3).
+    pub fn new() -> Self {
+        match Self::with_leaf_side(DEFAULT_LEAF_SIDE) {
+            Ok(t) => t,
+            Err(_) => unreachable!("the default leaf side is valid"),
+        }
+    }
+
+    /// An empty tree whose leaf cells have side `leaf_side` (a power of two in
+    /// [`MIN_LEAF_SIDE`, `MAX_LEAF_SIDE`], in particle diameters). See the module docs for the
+    /// trade-off (seed 002, section 3.3).
+    pub fn with_leaf_side(leaf_side: f64) -> Result<Self, OrthtreeError> {
+        const { assert!(D >= 1 && D <= 8, "Orthtree supports 1 to 8 dimensions") };
+        let power_of_two = leaf_side.is_normal()
+            && leaf_side > 0.0
+            && leaf_side.to_bits() & ((1u64 << 52) - 1) == 0;
+        if !(power_of_two && (MIN_LEAF_SIDE..=MAX_LEAF_SIDE).contains(&leaf_side)) {
+            return Err(OrthtreeError::InvalidLeafSide(leaf_side));
+        }
+        Ok(Self {
+            leaf_side,
+            step: leaf_side / CODE_SCALE,
+            sqrt_d_up: (D as f64).sqrt() * (1.0 + f64::EPSILON * 4.0),
+            root: EMPTY,
+            root_level: 1,
+            root_origin: [0; D],
+            anchor: [0; D],
+            children: Vec::new(),
+            leaves: Vec::new(),
+            pool: LeafPool::new(),
+            len: 0,
+        })
+    }
+
+    /// Checks a precision parameter for [`vpdist`](Self::vpdist) (seed 002, Listing 1, line 07):
+    /// `kappa > 1/2` (finite) or `+inf`. Use it when validating run parameters; `vpdist` itself
+    /// accepts any value.
+    pub fn check_kappa(kappa: f64) -> Result<f64, OrthtreeError> {
+        if kappa > 0.5 {
+            Ok(kappa)
+        } else {
+            Err(OrthtreeError::InvalidKappa(kappa))
+        }
+    }
+
+    /// Number of stored points.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether no point is stored.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Side of the leaf cells (seed 002, section 3.1: the last level of the tree).
+    pub fn leaf_side(&self) -> f64 {
+        self.leaf_side
+    }
+
+    /// The root cell as `(lower corner, side)`, or `None` while the tree is empty.
+    pub fn root_cell(&self) -> Option<([f64; D], f64)> {
+        if self.root == EMPTY {
+            return None;
+        }
+        let corner = self.root_origin.map(|o| o as f64 * self.leaf_side);
+        Some((corner, self.leaf_side * (1u64 << self.root_level) as f64))
+    }
+
+    /// Number of internal nodes.
+    pub fn node_count(&self) -> usize {
+        self.children.len() / Self::FANOUT
+    }
+
+    /// Number of leaves (non-empty leaf cells).
+    pub fn leaf_count(&self) -> usize {
+        self.leaves.len()
+    }
+
+    /// Heap and inline bytes of the structure: the capacities (not lengths) of the node, leaf
+    /// and point vectors, free blocks included, plus `size_of::<Self>()` (seed 002, section 3.3
+    /// reports memory per particle).
+    pub fn memory_bytes(&self) -> usize {
+        size_of::<Self>()
+            + self.children.capacity() * size_of::<u32>()
+            + self.leaves.capacity() * size_of::<Leaf>()
+            + self.pool.slots.capacity() * size_of::<[u32; D]>()
+    }
+
+    /// Shape and memory counts.
+    pub fn stats(&self) -> OrthtreeStats {
+        OrthtreeStats {
+            points: self.len,
+            nodes: self.node_count(),
+            leaves: self.leaves.len(),
+            depth: if self.root == EMPTY {
+                0
+            } else {
+                self.root_level
+            },
+            point_slots: self.pool.slots.len(),
+            free_slots: self.pool.free_slots(),
+            memory_bytes: self.memory_bytes(),
+        }
+    }
+
+    /// Leaf cell of `p` in leaf sides and the fixed-point offsets inside it, after checking the
+    /// point. Offsets are rounded to the nearest multiple of `s / 2^32`; one that rounds up to
+    /// the cell's upper face is stored as offset 0 of the next cell (the same position), so the
+    /// error stays within half a step on every axis.
+    fn locate(&self, p: &[f64; D]) -> Result<([i64; D], [u32; D]), OrthtreeError> {
+        let mut k = [0i64; D];
+        let mut code = [0u32; D];
+        let inv_step = CODE_SCALE / self.leaf_side;
+        for (axis, &x) in p.iter().enumerate() {
+            if !x.is_finite() {
+                return Err(OrthtreeError::NonFinite { axis, value: x });
+            }
+            let u = x / self.leaf_side;
+            if u.abs() >= COORD_LIMIT_LEAVES {
+                return Err(OrthtreeError::OutOfRange {
+                    axis,
+                    value: x,
+                    limit: COORD_LIMIT_LEAVES * self.leaf_side,
+                });
+            }
+            let cell = u.floor();
+            let t = ((x - cell * self.leaf_side) * inv_step).round();
+            if t >= CODE_SCALE {
+                k[axis] = cell as i64 + 1;
+                code[axis] = 0;
+            } else {
+                k[axis] = cell as i64;
+                // t is in [0, 2^32).
+                code[axis] = t as u32;
+            }
+        }
+        Ok((k, code))
+    }
+
+    /// Whether the leaf cell `k` lies inside the root.
+    fn root_contains(&self, k: &[i64; D]) -> bool {
+        let side = 1i64 << self.root_level;
+        (0..D).all(|i| k[i] >= self.root_origin[i] && k[i] < self.root_origin[i] + side)
+    }
+
+    /// Child slot index of leaf cell `k` inside the node at `level` on its path (bits of
+    /// `k - root_origin` at `level - 1`).
+    #[inline]
+    fn child_index(&self, k: &[i64; D], level: u32) -> usize {
+        let mut ci = 0;
+        for i in 0..D {
+            let rel = (k[i] - self.root_origin[i]) as u64;
+            ci |= (((rel >> (level - 1)) & 1) as usize) << i;
+        }
+        ci
+    }
+
+    /// Length of the leaf for cell `k`, 0 if it does not exist yet (read-only).
+    fn existing_leaf_len(&self, k: &[i64; D]) -> u32 {
+        if self.root == EMPTY || !self.root_contains(k) {
+            return 0;
+        }
+        let mut node = self.root;
+        let mut level = self.root_level;
+        loop {
+            let child = self.children[node as usize * Self::FANOUT + self.child_index(k, level)];
+            if child == EMPTY {
+                return 0;
+            }
+            if level == 1 {
+                return self.leaves[child as usize].len;
+            }
+            node = child;
+            level -= 1;
+        }
+    }
+
+    /// Appends an internal node with no children.
+    fn new_node(&mut self) -> u32 {
+        let n = self.node_count() as u32;
+        pool::reserve_slowly(&mut self.children, Self::FANOUT);
+        self.children
+            .resize(self.children.len() + Self::FANOUT, EMPTY);
+        n
+    }
+
+    /// Doubles the root towards leaf cell `k` (seed 002 builds its tree over a fixed domain;
+    /// here the domain grows, the old root becoming a child of the new one).
+    fn grow_root(&mut self, k: &[i64; D]) {
+        let side = 1i64 << self.root_level;
+        let mut origin = self.root_origin;
+        let mut slot = 0;
+        for i in 0..D {
+            let lo = self.root_origin[i];
+            let down = if k[i] < lo {
+                true
+            } else if k[i] >= lo + side {
+                false
+            } else {
+                lo + side / 2 > self.anchor[i]
+            };
+            if down {
+                origin[i] = lo - side;
+                slot |= 1 << i;
+            }
+        }
+        let n = self.new_node();
+        self.children[n as usize * Self::FANOUT + slot] = self.root;
+        self.root = n;
+        self.root_level += 1;
+        self.root_origin = origin;
+    }
+
+    /// Inserts a particle centre (seed 002, section 3.3: the particle is stored in the leaf
+    /// containing it, in relative coordinates) and returns its stored position, which is what
+    /// every query sees: within `leaf_side / 2^33` of `p` per coordinate (plus `f64` rounding
+    /// at the coordinate's magnitude).
+    ///
+    /// Duplicate points are allowed. On error the tree is unchanged.
+    pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], OrthtreeError> {
+        let (k, code) = self.locate(&p)?;
+        // Capacity checks before any change, so that an error leaves the tree as it was.
+        if self.node_count() as u64 + 128 > MAX_INDEX {
+            return Err(OrthtreeError::CapacityExceeded("nodes"));
+        }
+        if self.leaves.len() as u64 + 1 > MAX_INDEX {
+            return Err(OrthtreeError::CapacityExceeded("leaves"));
+        }
+        let leaf_len = self.existing_leaf_len(&k);
+        if leaf_len == u32::MAX
+            || self.pool.slots.len() as u64 + LeafPool::<D>::push_needs(leaf_len)
+                > u64::from(u32::MAX)
+        {
+            return Err(OrthtreeError::CapacityExceeded("point slots"));
+        }
+
+        if self.root == EMPTY {
+            // Root of 2 x 2 leaf cells centred on the leaf-cell corner nearest to p.
+            for i in 0..D {
+                let frac = p[i] / self.leaf_side - k[i] as f64;
+                self.root_origin[i] = if frac < 0.5 { k[i] - 1 } else { k[i] };
+                self.anchor[i] = self.root_origin[i] + 1;
+            }
+            self.root_level = 1;
+            self.root = self.new_node();
+        }
+        while !self.root_contains(&k) {
+            self.grow_root(&k);
+        }
+
+        let mut node = self.root;
+        let mut level = self.root_level;
+        let leaf = loop {
+            let slot = node as usize * Self::FANOUT + self.child_index(&k, level);
+            let child = self.children[slot];
+            if level == 1 {
+                break if child == EMPTY {
+                    let l = self.leaves.len() as u32;
+                    pool::reserve_slowly(&mut self.leaves, 1);
+                    self.leaves.push(Leaf { start: 0, len: 0 });
+                    self.children[slot] = l;
+                    l
+                } else {
+                    child
+                };
+            }
+            node = if child == EMPTY {
+                let n = self.new_node();
+                self.children[slot] = n;
+                n
+            } else {
+                child
+            };
+            level -= 1;
+        };
+
+        let mut stored = [0.0; D];
+        for i in 0..D {
+            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
+        }
+        let mut rec = self.leaves[leaf as usize];
+        self.pool.push(&mut rec, code);
+        self.leaves[leaf as usize] = rec;
+        self.len += 1;
+        if self.pool.wants_compaction() {
+            self.pool.compact(&mut self.leaves);
+        }
+        Ok(stored)
+    }
+
+    /// Iterates over the stored positions of all points, leaf by leaf (seed 002, section 3.3:
+    /// base coordinates are rebuilt while traversing the tree).
+    pub fn iter(&self) -> Points<'_, D> {
+        let mut stack = Vec::new();
+        if self.root != EMPTY {
+            stack.reserve(self.root_level as usize);
+            stack.push(Frame {
+                node: self.root,
+                level: self.root_level,
+                origin: self.root_origin,
+                next: 0,
+            });
+        }
+        Points {
+            tree: self,
+            stack,
+            leaf: &[],
+            leaf_origin: [0.0; D],
+            pos: 0,
+            remaining: self.len,
+        }
+    }
+}
+
+/// Stored position of a fixed-point offset: the single formula used everywhere, so that every
+/// query and [`Orthtree::iter`] see bit-identical coordinates.
+#[inline(always)]
+fn decode(origin: f64, code: u32, step: f64) -> f64 {
+    origin + f64::from(code) * step
+}
+
+/// A node on the iteration stack.
+#[derive(Debug, Clone, Copy)]
+struct Frame<const D: usize> {
+    node: u32,
+    level: u32,
+    origin: [i64; D],
+    next: usize,
+}
+
+/// Iterator over the stored positions of an [`Orthtree`], from [`Orthtree::iter`].
+#[derive(Debug, Clone)]
+pub struct Points<'a, const D: usize> {
+    tree: &'a Orthtree<D>,
+    stack: Vec<Frame<D>>,
+    leaf: &'a [[u32; D]],
+    leaf_origin: [f64; D],
+    pos: usize,
+    remaining: usize,
+}
+
+impl<const D: usize> Iterator for Points<'_, D> {
+    type Item = [f64; D];
+
+    fn next(&mut self) -> Option<[f64; D]> {
+        let tree = self.tree;
+        loop {
+            if let Some(code) = self.leaf.get(self.pos) {
+                self.pos += 1;
+                self.remaining -= 1;
+                let mut x = [0.0; D];
+                for i in 0..D {
+                    x[i] = decode(self.leaf_origin[i], code[i], tree.step);
+                }
+                return Some(x);
+            }
+            let top = self.stack.last_mut()?;
+            if top.next == Orthtree::<D>::FANOUT {
+                self.stack.pop();
+                continue;
+            }
+            let ci = top.next;
+            top.next += 1;
+            let child = tree.children[top.node as usize * Orthtree::<D>::FANOUT + ci];
+            if child == EMPTY {
+                continue;
+            }
+            let half = 1i64 << (top.level - 1);
+            let mut origin = top.origin;
+            for (i, o) in origin.iter_mut().enumerate() {
+                if ci >> i & 1 == 1 {
+                    *o += half;
+                }
+            }
+            if top.level == 1 {
+                self.leaf = tree.pool.points(tree.leaves[child as usize]);
+                self.leaf_origin = origin.map(|o| o as f64 * tree.leaf_side);
+                self.pos = 0;
+            } else {
+                let level = top.level - 1;
+                self.stack.push(Frame {
+                    node: child,
+                    level,
+                    origin,
+                    next: 0,
+                });
+            }
+        }
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.remaining, Some(self.remaining))
+    }
+}
+
+impl<const D: usize> ExactSizeIterator for Points<'_, D> {}
+
+impl<'a, const D: usize> IntoIterator for &'a Orthtree<D> {
+    type Item = [f64; D];
+    type IntoIter = Points<'a, D>;
+
+    fn into_iter(self) -> Points<'a, D> {
+        self.iter()
+    }
+}

@@ -1,0 +1,265 @@
+//! Property tests of the orthtree against brute force (seed 002, section 3.1, Listing 1 and its
+//! error analysis; storage of section 3.3).
+//!
+//! Brute force works on the stored positions returned by `insert` (they differ from the inserted
+//! ones by at most `leaf_side / 2^33` per coordinate, checked here too) with the reference
+//! formula `sqrt(sum over axes of (p_i - x_i)^2)`, summed from 0 in axis order. Exact queries must
+//! return that value bit for bit; `vpdist` must never exceed it and must satisfy the bounds
+//! derived in the module docs of `spatial::orthtree`:
+//!
+//! - exact answer when it says so (`half_diagonal == None`), and always when
+//!   `d <= (2 kappa - 1) r_leaf`;
+//! - otherwise the producing node of half diagonal `r` was far (`|p - c| > 2 kappa r`) and
+//!   `d - v <= 2 r` (the paper's `d in [d_app, d_app + 2r]`);
+//! - `v > d (2 kappa - 1) / (2 kappa + 1)`.
+
+use proptest::prelude::*;
+use spatial::orthtree::Orthtree;
+
+/// Reference squared distance.
+fn d2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+    let mut s = 0.0;
+    for i in 0..D {
+        let e = a[i] - b[i];
+        s += e * e;
+    }
+    s
+}
+
+/// Relative tolerance for the bounds (the far-node shrink is 2^-44 ~ 6e-14).
+const TOL: f64 = 1e-12;
+
+const KAPPAS: [f64; 6] = [0.75, 1.0, 2.0, 3.0, 4.0, f64::INFINITY];
+
+/// Builds the tree, checks storage, and checks every query against brute force.
+fn check<const D: usize>(
+    leaf_side: f64,
+    pts: &[[f64; D]],
+    queries: &[[f64; D]],
+    radii: &[f64],
+) -> Result<(), TestCaseError> {
+    let mut tree = Orthtree::<D>::with_leaf_side(leaf_side).unwrap();
+    let mut stored = Vec::with_capacity(pts.len());
+    for p in pts {
+        let s = tree.insert(*p).unwrap();
+        for i in 0..D {
+            let err = (s[i] - p[i]).abs();
+            // s / 2^33 from the fixed point, plus f64 rounding at the coordinate's magnitude.
+            let allowed = leaf_side / 8_589_934_592.0 + p[i].abs() * f64::EPSILON;
+            prop_assert!(err <= allowed, "{p:?} stored as {s:?}");
+            if p[i].abs() < 1e6 {
+                prop_assert!(err <= 1e-6);
+            }
+        }
+        stored.push(s);
+    }
+    prop_assert_eq!(tree.len(), pts.len());
+
+    // Iteration gives back exactly the stored positions.
+    let key = |a: &[f64; D], b: &[f64; D]| a.partial_cmp(b).unwrap();
+    let mut it: Vec<[f64; D]> = tree.iter().collect();
+    prop_assert_eq!(tree.iter().len(), pts.len());
+    it.sort_by(key);
+    let mut sorted = stored.clone();
+    sorted.sort_by(key);
+    prop_assert_eq!(&it, &sorted);
+
+    // Every stored point lies in the root.
+    let (corner, side) = tree.root_cell().unwrap();
+    for x in &stored {
+        for i in 0..D {
+            prop_assert!(x[i] >= corner[i] && x[i] <= corner[i] + side);
+        }
+    }
+
+    let r_leaf = leaf_side * (D as f64).sqrt() / 2.0;
+    for q in queries.iter().chain(stored.iter()) {
+        let best_sq = stored
+            .iter()
+            .map(|x| d2(q, x))
+            .fold(f64::INFINITY, f64::min);
+        let d = best_sq.sqrt();
+
+        // Exact queries: bit for bit.
+        prop_assert_eq!(tree.nearest_distance(q), Some(d), "query {:?}", q);
+        let n = tree.nearest(q).unwrap();
+        prop_assert_eq!(n.distance, d);
+        prop_assert_eq!(d2(q, &n.point), best_sq);
+        prop_assert!(stored.contains(&n.point));
+
+        for kappa in KAPPAS {
+            let est = tree.vpdist_detailed(q, kappa).unwrap();
+            let v = est.distance;
+            prop_assert_eq!(tree.vpdist(q, kappa), Some(v));
+            // Never more than the exact distance: no tolerance.
+            prop_assert!(
+                v <= d,
+                "kappa {}: vpdist {} > exact {} at {:?}",
+                kappa,
+                v,
+                d,
+                q
+            );
+            match est.half_diagonal {
+                None => prop_assert_eq!(v, d, "kappa {}: claimed exact", kappa),
+                Some(r) => {
+                    prop_assert!(kappa.is_finite(), "kappa = inf must be exact");
+                    // r is a half diagonal of some level: r_leaf * 2^k.
+                    let k = (r / r_leaf).log2();
+                    prop_assert!(k > -1e-9 && (k - k.round()).abs() < 1e-9, "r = {}", r);
+                    // The producing node was far: |p - c| = v + r > 2 kappa r.
+                    prop_assert!(
+                        v + r > 2.0 * kappa * r * (1.0 - TOL),
+                        "not far: {} {}",
+                        v,
+                        r
+                    );
+                    // Absolute gap: d in [v, v + 2r].
+                    prop_assert!(
+                        d - v <= 2.0 * r * (1.0 + TOL) + TOL * d,
+                        "kappa {}: gap {} > 2r = {}",
+                        kappa,
+                        d - v,
+                        2.0 * r
+                    );
+                }
+            }
+            if kappa.is_finite() {
+                // Relative bound.
+                let ratio = (2.0 * kappa - 1.0) / (2.0 * kappa + 1.0);
+                prop_assert!(
+                    v >= d * ratio * (1.0 - TOL),
+                    "kappa {}: vpdist {} < {} * exact {}",
+                    kappa,
+                    v,
+                    ratio,
+                    d
+                );
+                // Exact within (2 kappa - 1) r_leaf.
+                if d <= (2.0 * kappa - 1.0) * r_leaf * (1.0 - 1e-9) {
+                    prop_assert_eq!(v, d, "kappa {}: not exact at d = {}", kappa, d);
+                }
+            } else {
+                prop_assert_eq!(v, d);
+            }
+        }
+
+        // Range queries, including radii equal to a stored point's distance (inclusive).
+        let mut rs: Vec<f64> = radii.to_vec();
+        rs.push(d);
+        if let Some(x) = stored.get(stored.len() / 2) {
+            rs.push(d2(q, x).sqrt());
+        }
+        for r in rs {
+            let mut got = Vec::new();
+            tree.for_each_within(q, r, |x| got.push(x));
+            let mut want: Vec<[f64; D]> = stored
+                .iter()
+                .filter(|x| d2(q, x) <= r * r)
+                .copied()
+                .collect();
+            got.sort_by(key);
+            want.sort_by(key);
+            prop_assert_eq!(got, want, "range {} around {:?}", r, q);
+        }
+    }
+    Ok(())
+}
+
+/// One coordinate: ordinary, on cell boundaries (multiples of 1/2 up to 2^7), or large.
+fn coord() -> impl Strategy<Value = f64> {
+    prop_oneof![
+        4 => -40.0..40.0f64,
+        3 => (-128i32..=128).prop_map(|k| f64::from(k) * 0.5),
+        1 => (-8i32..=8).prop_map(|k| f64::from(k) * 1024.0),
+        1 => -1e7..1e7f64,
+    ]
+}
+
+fn point<const D: usize>() -> impl Strategy<Value = [f64; D]> {
+    prop::collection::vec(coord(), D).prop_map(|v| std::array::from_fn(|i| v[i]))
+}
+
+/// Points plus near-duplicates (offsets from 0 to 1e-6) of some of them.
+fn cloud<const D: usize>(max: usize) -> impl Strategy<Value = Vec<[f64; D]>> {
+    (
+        prop::collection::vec(point::<D>(), 1..max),
+        prop::collection::vec(
+            (
+                any::<prop::sample::Index>(),
+                prop::collection::vec(prop_oneof![Just(0.0), -1e-6..1e-6f64, -1e-11..1e-11f64], D),
+            ),
+            0..max / 3,
+        ),
+    )
+        .prop_map(|(mut pts, dups)| {
+            let n = pts.len();
+            for (ix, off) in dups {
+                let b = pts[ix.index(n)];
+                pts.push(std::array::from_fn(|i| b[i] + off[i]));
+            }
+            pts
+        })
+}
+
+/// Query points: anywhere, on boundaries, or far away (beyond the root).
+fn queries<const D: usize>() -> impl Strategy<Value = Vec<[f64; D]>> {
+    prop::collection::vec(
+        prop_oneof![
+            3 => point::<D>(),
+            1 => prop::collection::vec(-1e9..1e9f64, D)
+                .prop_map(|v| std::array::from_fn(|i| v[i])),
+        ],
+        1..12,
+    )
+}
+
+fn leaf_side() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(0.5), Just(1.0), Just(2.0), Just(4.0), Just(8.0)]
+}
+
+fn radii() -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::vec(prop_oneof![0.0..3.0f64, 0.0..100.0f64, Just(0.0)], 0..3)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2500))]
+
+    #[test]
+    fn quadtree_matches_brute_force(
+        s in leaf_side(), pts in cloud::<2>(90), qs in queries::<2>(), rs in radii()
+    ) {
+        check::<2>(s, &pts, &qs, &rs)?;
+    }
+
+    #[test]
+    fn octree_matches_brute_force(
+        s in leaf_side(), pts in cloud::<3>(90), qs in queries::<3>(), rs in radii()
+    ) {
+        check::<3>(s, &pts, &qs, &rs)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1500))]
+
+    /// Dense clusters of touching-scale points, queried close by: exercises the exact region
+    /// and the transitions between exact and approximate answers.
+    #[test]
+    fn dense_cluster_near_queries_2d(
+        s in leaf_side(),
+        pts in prop::collection::vec(prop::collection::vec(-12.0..12.0f64, 2), 1..200),
+        qs in prop::collection::vec(prop::collection::vec(-40.0..40.0f64, 2), 1..20),
+    ) {
+        let pts: Vec<[f64; 2]> = pts.iter().map(|v| [v[0], v[1]]).collect();
+        let qs: Vec<[f64; 2]> = qs.iter().map(|v| [v[0], v[1]]).collect();
+        check::<2>(s, &pts, &qs, &[1.5])?;
+    }
+
+    #[test]
+    fn hypercube_tree_4d(
+        s in leaf_side(), pts in cloud::<4>(40), qs in queries::<4>(), rs in radii()
+    ) {
+        check::<4>(s, &pts, &qs, &rs)?;
+    }
+}
