@@ -251,6 +251,29 @@ pub enum StatsError {
     BadParameter(String),
 }
 
+/// The checks every fit makes first: equal lengths, at least 3 points, all finite.
+fn check_points(x: &[f64], y: &[f64]) -> Result<(), StatsError> {
+    if x.len() != y.len() {
+        return Err(StatsError::LengthMismatch {
+            x: x.len(),
+            y: y.len(),
+        });
+    }
+    if x.len() < 3 {
+        return Err(StatsError::TooFewPoints(x.len()));
+    }
+    for (index, (&xi, &yi)) in x.iter().zip(y).enumerate() {
+        if !xi.is_finite() || !yi.is_finite() {
+            return Err(StatsError::NonFinite {
+                index,
+                x: xi,
+                y: yi,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Ordinary least-squares line `y = slope * x + intercept`, with standard errors.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LinearFit {
@@ -273,25 +296,8 @@ impl LinearFit {
     /// at least two distinct x. Sums are taken about the means (two passes), so large offsets
     /// in x or y do not cancel.
     pub fn fit(x: &[f64], y: &[f64]) -> Result<Self, StatsError> {
-        if x.len() != y.len() {
-            return Err(StatsError::LengthMismatch {
-                x: x.len(),
-                y: y.len(),
-            });
-        }
+        check_points(x, y)?;
         let n = x.len();
-        if n < 3 {
-            return Err(StatsError::TooFewPoints(n));
-        }
-        for (index, (&xi, &yi)) in x.iter().zip(y).enumerate() {
-            if !xi.is_finite() || !yi.is_finite() {
-                return Err(StatsError::NonFinite {
-                    index,
-                    x: xi,
-                    y: yi,
-                });
-            }
-        }
         let nf = n as f64;
         let mx = x.iter().sum::<f64>() / nf;
         let my = y.iter().sum::<f64>() / nf;
@@ -360,23 +366,8 @@ impl LogLogFit {
     /// Fit `ln y = slope ln x + intercept`. Refuses fewer than 3 points and any `x <= 0` or
     /// `y <= 0` (or NaN/infinite values) with a typed error naming the first bad point.
     pub fn fit(x: &[f64], y: &[f64]) -> Result<Self, StatsError> {
-        if x.len() != y.len() {
-            return Err(StatsError::LengthMismatch {
-                x: x.len(),
-                y: y.len(),
-            });
-        }
-        if x.len() < 3 {
-            return Err(StatsError::TooFewPoints(x.len()));
-        }
+        check_points(x, y)?;
         for (index, (&xi, &yi)) in x.iter().zip(y).enumerate() {
-            if !xi.is_finite() || !yi.is_finite() {
-                return Err(StatsError::NonFinite {
-                    index,
-                    x: xi,
-                    y: yi,
-                });
-            }
             if xi <= 0.0 || yi <= 0.0 {
                 return Err(StatsError::NonPositive {
                     index,

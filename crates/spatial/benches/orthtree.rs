@@ -16,72 +16,9 @@ use std::time::Duration;
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use kiddo::{ImmutableKdTree, MutableKdTree, SquaredEuclidean};
 use spatial::orthtree::Orthtree;
+use spatial::testdata::{SplitMix as Rng, branching_cluster, uniform_disc};
 
-/// splitmix64: deterministic data without extra dependencies.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n as u64) as usize
-    }
-}
-
-/// DLA-like branched cluster of touching unit discs: persistent self-avoiding walks from random
-/// tips, branching with probability 0.08 per step. Locally chains of touching particles, like
-/// DLA; returned in growth order.
-fn branching_cluster(n: usize, seed: u64) -> Vec<[f64; 2]> {
-    use std::f64::consts::TAU;
-    let mut rng = Rng(seed);
-    let mut t = Orthtree::<2>::new();
-    let mut all = vec![t.insert([0.0, 0.0]).unwrap()];
-    let mut tips: Vec<([f64; 2], f64)> =
-        (0..3).map(|k| ([0.0, 0.0], k as f64 * TAU / 3.0)).collect();
-    while all.len() < n {
-        if tips.is_empty() {
-            tips.push((all[rng.below(all.len())], rng.uniform() * TAU));
-        }
-        let k = rng.below(tips.len());
-        let (from, dir) = tips[k];
-        let a = dir + (rng.uniform() - 0.5) * 1.2;
-        let cand = [from[0] + a.cos(), from[1] + a.sin()];
-        if t.nearest_distance(&cand).unwrap() >= 1.0 - 1e-9 {
-            let s = t.insert(cand).unwrap();
-            all.push(s);
-            tips[k] = (s, a);
-            if rng.uniform() < 0.08 {
-                tips.push((s, a + if rng.uniform() < 0.5 { 1.0 } else { -1.0 }));
-            }
-        } else if rng.uniform() < 0.3 {
-            tips.swap_remove(k);
-        }
-    }
-    all
-}
-
-/// Uniform points in the disc of area `n` (unit density).
-fn uniform_disc(n: usize, seed: u64) -> Vec<[f64; 2]> {
-    let mut rng = Rng(seed);
-    let radius = (n as f64 / std::f64::consts::PI).sqrt();
-    (0..n)
-        .map(|_| {
-            let r = radius * rng.uniform().sqrt();
-            let a = rng.uniform() * std::f64::consts::TAU;
-            [r * a.cos(), r * a.sin()]
-        })
-        .collect()
-}
-
-/// Walker-like query points for a cluster.
+/// Walker-like query points around a cluster.
 fn walker_queries(pts: &[[f64; 2]], count: usize, seed: u64) -> Vec<[f64; 2]> {
     let mut rng = Rng(seed);
     let r_ext = pts.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max);

@@ -12,3 +12,4 @@
 pub mod lattice;
 pub mod orthtree;
 pub mod plane;
+pub mod testdata;

@@ -4,21 +4,7 @@
 
 use super::*;
 
-/// Minimal deterministic generator (splitmix64) so the tests need no extra dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
+use crate::testdata::SplitMix as Rng;
 
 /// Brute-force squared distance, axis by axis from 0 (the reference formula).
 fn d2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
@@ -380,50 +366,13 @@ fn concurrent_readers_share_the_tree() {
     });
 }
 
-/// Points in the disc of area `n` (unit density: unit spacing on average).
-fn uniform_disc(n: usize, seed: u64) -> Vec<[f64; 2]> {
-    let mut rng = Rng(seed);
-    let radius = (n as f64 / std::f64::consts::PI).sqrt();
-    (0..n)
-        .map(|_| {
-            let r = radius * rng.uniform().sqrt();
-            let a = rng.uniform() * std::f64::consts::TAU;
-            [r * a.cos(), r * a.sin()]
-        })
-        .collect()
-}
+use crate::testdata::uniform_disc;
 
-/// A DLA-like branched cluster of touching unit discs: persistent self-avoiding walks that
-/// branch (see `benches/orthtree.rs`); locally chains of touching particles like DLA, which is
-/// the sparsest (so most memory-hungry per point) case for the leaves.
+/// The DLA-like branched cluster of `crate::testdata`, in an orthtree.
 fn branching_cluster(n: usize, seed: u64) -> Orthtree<2> {
-    let mut rng = Rng(seed);
     let mut t = Orthtree::<2>::new();
-    t.insert([0.0, 0.0]).unwrap();
-    // Tips: (position, direction).
-    let mut tips: Vec<([f64; 2], f64)> = (0..3)
-        .map(|k| ([0.0, 0.0], k as f64 * std::f64::consts::TAU / 3.0))
-        .collect();
-    let mut all = vec![[0.0, 0.0]];
-    while t.len() < n {
-        if tips.is_empty() {
-            let from = all[(rng.next_u64() % all.len() as u64) as usize];
-            tips.push((from, rng.uniform() * std::f64::consts::TAU));
-        }
-        let k = (rng.next_u64() % tips.len() as u64) as usize;
-        let (from, dir) = tips[k];
-        let a = dir + (rng.uniform() - 0.5) * 1.2;
-        let cand = [from[0] + a.cos(), from[1] + a.sin()];
-        if t.nearest_distance(&cand).unwrap() >= 1.0 - 1e-9 {
-            let stored = t.insert(cand).unwrap();
-            all.push(stored);
-            tips[k] = (stored, a);
-            if rng.uniform() < 0.08 {
-                tips.push((stored, a + if rng.uniform() < 0.5 { 1.0 } else { -1.0 }));
-            }
-        } else if rng.uniform() < 0.3 {
-            tips.swap_remove(k);
-        }
+    for p in crate::testdata::branching_cluster(n, seed) {
+        t.insert(p).unwrap();
     }
     t
 }
