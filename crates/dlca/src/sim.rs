@@ -533,17 +533,31 @@ fn choose_strategy(params: &Params, lattice: &Lattice, particles: u64) -> (Searc
     }
 }
 
-/// `n` distinct sites drawn uniformly (rejection sampling), in draw order.
+/// `n` distinct sites drawn uniformly (rejection sampling), in draw order. Taken sites are
+/// tracked in a bitset (one bit per site) when the lattice has at most 64 sites per particle,
+/// else in a hash set; both give the same draws.
 fn place_particles(lattice: &Lattice, n: u64, rng: &mut SimRng) -> Vec<u64> {
     let volume = lattice.volume();
-    let mut taken = std::collections::HashSet::with_capacity(n as usize);
     let mut sites = Vec::with_capacity(n as usize);
-    while (sites.len() as u64) < n {
-        let k = (uniform01(rng) * volume as f64) as u64;
-        let k = k.min(volume - 1);
-        if taken.insert(k) {
-            sites.push(k);
+    let mut draw = |taken: &mut dyn FnMut(u64) -> bool| {
+        while (sites.len() as u64) < n {
+            let k = ((uniform01(rng) * volume as f64) as u64).min(volume - 1);
+            if taken(k) {
+                sites.push(k);
+            }
         }
+    };
+    if volume <= n.saturating_mul(64) {
+        let mut bits = vec![0u64; volume.div_ceil(64) as usize];
+        draw(&mut |k| {
+            let (w, b) = ((k / 64) as usize, 1u64 << (k % 64));
+            let fresh = bits[w] & b == 0;
+            bits[w] |= b;
+            fresh
+        });
+    } else {
+        let mut taken = std::collections::HashSet::with_capacity(n as usize);
+        draw(&mut |k| taken.insert(k));
     }
     sites
 }
@@ -621,6 +635,11 @@ mod tests {
         let a = place_particles(&l, 90, &mut stream(1, 1));
         let b = place_particles(&l, 90, &mut stream(1, 1));
         assert_eq!(a, b);
+        // Sparse (hash set) and dense (bitset) tracking draw the same sites.
+        let big = Lattice::periodic(&[1000, 1000]).unwrap();
+        let sparse = place_particles(&big, 1000, &mut stream(2, 1));
+        let dense = place_particles(&big, 20_000, &mut stream(2, 1));
+        assert_eq!(&dense[..1000], &sparse[..]);
         let mut s = a.clone();
         s.sort_unstable();
         s.dedup();
