@@ -1,0 +1,216 @@
+//! `dla`: off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D and 3D
+//! (MODELS.md section 2; Sosa-Herrera & Rodriguez-Romo, seed 002). A thin layer over the
+//! `dla_pdla` library: parse flags, validate, run, write outputs.
+
+use anyhow::Context;
+use clap::Parser;
+use core_lattice::io::RunClock;
+use dla_pdla::output::{PositionsFormat, write_outputs};
+use dla_pdla::{FarField, Params, Simulation};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA), 2D and 3D.
+///
+/// A seed particle sits at the origin. Walkers (balls of diameter 1) are born on the sphere of
+/// radius R_b = R_ext + birth-gap, jump by the variable-precision distance to the cluster when
+/// far from it, take steps of step-min near it, and stick at exact contact. Outputs go into
+/// --out DIR (see docs/dla.md).
+#[derive(Parser, Debug)]
+#[command(name = "dla", version, allow_negative_numbers = true)]
+struct Cli {
+    /// Space dimension: 2 or 3.
+    #[arg(long, default_value_t = 2)]
+    dim: usize,
+
+    /// Particles in the final cluster, seed particle included (>= 1).
+    #[arg(long)]
+    particles: u64,
+
+    /// Seed of every random stream of the run: same seed and flags, same run (one thread).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+
+    /// Output directory (created if missing; nothing is written on bad input).
+    #[arg(long)]
+    out: PathBuf,
+
+    /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters (>= 1).
+    #[arg(long, default_value_t = 5.0)]
+    birth_gap: f64,
+
+    /// Far field (|p| > R_b): `return` puts the walker exactly where Brownian motion would first
+    /// hit the birth sphere; `jump` is the paper's jump of |p| - R_ext - 1 with relaunch beyond
+    /// the death radius.
+    #[arg(long, value_enum, default_value_t = FarField::Return)]
+    far_field: FarField,
+
+    /// Death radius R_d = death-ratio * R_b for `--far-field jump` (> 1).
+    #[arg(long, default_value_t = 100.0)]
+    death_ratio: f64,
+
+    /// Near-field step length in diameters (> 0): used when the distance to the cluster minus
+    /// one is at most this. Smaller is closer to Brownian motion and slower.
+    #[arg(long, default_value_t = 0.5)]
+    step_min: f64,
+
+    /// Precision kappa of the variable-precision distance (> 0.5; the paper uses 2; `inf` is
+    /// the exact search). Larger is more exact and slower.
+    #[arg(long, default_value_t = 2.0)]
+    precision: f64,
+
+    /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
+    #[arg(long, default_value_t = 1)]
+    threads: usize,
+
+    /// With --threads > 1: grow with one walker until the cluster has this many particles.
+    #[arg(long, default_value_t = 0)]
+    serial_until: u64,
+
+    /// Smallest N used in the fractal-dimension fit log N = D log R_g + c.
+    #[arg(long, default_value_t = 1000)]
+    fit_from: u64,
+
+    /// Write the positions in arrival order: positions.csv, positions.bin or positions.xyz
+    /// (keeps 8 bytes per coordinate per particle in memory).
+    #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
+    positions: PositionsFormat,
+
+    /// Write dla.png: the cluster shaded by arrival order (3D: projected on x, y).
+    #[arg(long)]
+    png: bool,
+
+    /// No progress bar, warnings only.
+    #[arg(long, short)]
+    quiet: bool,
+
+    /// More log output (-v info, -vv debug); RUST_LOG overrides.
+    #[arg(short, action = clap::ArgAction::Count)]
+    verbose: u8,
+}
+
+fn params(cli: &Cli) -> Result<Params, String> {
+    let p = Params {
+        dim: cli.dim,
+        particles: cli.particles,
+        birth_gap: cli.birth_gap,
+        far_field: cli.far_field,
+        death_ratio: cli.death_ratio,
+        step_min: cli.step_min,
+        precision: cli.precision,
+        threads: cli.threads,
+        serial_until: cli.serial_until,
+        fit_from: cli.fit_from,
+        keep_positions: cli.png || cli.positions != PositionsFormat::None,
+    };
+    p.validate().map_err(|e| e.to_string())?;
+    Ok(p)
+}
+
+fn init_logging(cli: &Cli) {
+    let default = if cli.quiet {
+        "warn"
+    } else {
+        match cli.verbose {
+            0 => "warn",
+            1 => "info",
+            _ => "debug",
+        }
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
+}
+
+/// Print a one-line error and return exit code 2 (bad input; nothing written).
+fn usage_error(msg: &str) -> ExitCode {
+    eprintln!("dla: error: {msg}");
+    ExitCode::from(2)
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            let text = e.to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            return usage_error(message.join(" ").trim_start_matches("error: "));
+        }
+    };
+    init_logging(&cli);
+    let params = match params(&cli) {
+        Ok(p) => p,
+        Err(msg) => return usage_error(&msg),
+    };
+    let result = match params.dim {
+        2 => run::<2>(&cli, params),
+        _ => run::<3>(&cli, params),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("dla: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()> {
+    let clock = RunClock::start();
+    std::fs::create_dir_all(&cli.out)
+        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    let total = params.particles;
+    tracing::info!(?params, seed = cli.seed, "starting growth");
+    let mut sim = Simulation::<D>::new(params, cli.seed).context("setting up the run")?;
+    let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})",
+            )
+            .expect("valid template"),
+        );
+        bar
+    });
+    sim.run_with(&|n| {
+        if let Some(bar) = &bar {
+            bar.set_position(n);
+        }
+    })?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let m = write_outputs(&sim, &clock, &cli.out, cli.positions, cli.png)?;
+    tracing::info!(discarded = sim.discarded_walkers(), "done");
+    if !cli.quiet {
+        let d = m
+            .results
+            .get("fractal_dimension")
+            .and_then(|v| v.as_f64())
+            .map_or_else(|| "n/a".to_string(), |d| format!("{d:.4}"));
+        eprintln!(
+            "dla: {} particles in {}D, R_g {:.2}, R_ext {:.2}, D_f {} in {:.2} s; outputs in {}",
+            sim.particles(),
+            D,
+            sim.radius_of_gyration(),
+            sim.r_ext(),
+            d,
+            m.wall_seconds,
+            cli.out.display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,187 @@
+//! Parameters of a DLA/PDLA run (MODELS.md section 2), validated before anything runs.
+
+use serde::{Deserialize, Serialize};
+
+/// What happens to a walker outside the birth sphere (`|p| > R_b`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum FarField {
+    /// Exact return to the birth circle/sphere at the harmonic-measure hit point
+    /// (REFERENCE.md, "Exact far-field return"); no walker is ever killed.
+    Return,
+    /// Seed 002, section 3.2: jump `|p| - R_ext - 1` in a random direction (the distance to the
+    /// cluster's bounding sphere less the contact distance), relaunch beyond the death radius.
+    Jump,
+}
+
+impl FarField {
+    /// The flag value.
+    pub fn name(self) -> &'static str {
+        match self {
+            FarField::Return => "return",
+            FarField::Jump => "jump",
+        }
+    }
+}
+
+/// Every parameter of MODELS.md section 2, with its default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Params {
+    /// Space dimension, 2 or 3 (`--dim`, default 2).
+    pub dim: usize,
+    /// Number of particles of the final cluster, seed included (`--particles`).
+    pub particles: u64,
+    /// `R_b - R_ext`, distance of the birth sphere outside the cluster (`--birth-gap`, default 5).
+    pub birth_gap: f64,
+    /// Far-field rule (`--far-field`, default `return`).
+    pub far_field: FarField,
+    /// `R_d / R_b` for `--far-field jump` (`--death-ratio`, default 100).
+    pub death_ratio: f64,
+    /// Near-field step length in diameters (`--step-min`, default 0.5).
+    pub step_min: f64,
+    /// `vpdist` precision kappa (`--precision`, default 2, the paper's value; `inf` = exact).
+    pub precision: f64,
+    /// Walkers moving at once (`--threads`, default 1 = DLA).
+    pub threads: usize,
+    /// Grow serially (one walker) until the cluster has this many particles (`--serial-until`).
+    pub serial_until: u64,
+    /// Smallest N used in the fractal-dimension fit (`--fit-from`, default 1000).
+    pub fit_from: u64,
+    /// Keep every position in arrival order (needed for position files and pictures). Costs
+    /// `8 D` bytes per particle; off by default.
+    pub keep_positions: bool,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            dim: 2,
+            particles: 10_000,
+            birth_gap: 5.0,
+            far_field: FarField::Return,
+            death_ratio: 100.0,
+            step_min: 0.5,
+            precision: 2.0,
+            threads: 1,
+            serial_until: 0,
+            fit_from: 1000,
+            keep_positions: false,
+        }
+    }
+}
+
+/// Largest accepted particle count (the orthtree stores at most `u32::MAX` points).
+pub const MAX_PARTICLES: u64 = u32::MAX as u64 - 1;
+
+/// A parameter outside its accepted range; the message names the value and the range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamsError {
+    /// `dim` not 2 or 3.
+    #[error("--dim {0} is outside the accepted range {{2, 3}}")]
+    Dim(usize),
+    /// `particles` is 0 or too large.
+    #[error("--particles {0} is outside the accepted range 1..={MAX_PARTICLES}")]
+    Particles(u64),
+    /// `birth_gap` below 1 or not finite.
+    #[error(
+        "--birth-gap {0} is outside the accepted range [1, 1e9] (a walker born closer than one diameter could overlap the cluster)"
+    )]
+    BirthGap(f64),
+    /// `death_ratio` not > 1 or not finite.
+    #[error("--death-ratio {0} is outside the accepted range (1, 1e300]")]
+    DeathRatio(f64),
+    /// `step_min` not positive or too large.
+    #[error("--step-min {0} is outside the accepted range (0, 1e3]")]
+    StepMin(f64),
+    /// `precision` not > 1/2 (vpdist needs kappa > 1/2 to be useful).
+    #[error("--precision {0} is outside the accepted range (0.5, inf] (inf = exact search)")]
+    Precision(f64),
+    /// `threads` is 0 or absurd.
+    #[error("--threads {0} is outside the accepted range 1..=1024")]
+    Threads(usize),
+}
+
+impl Params {
+    /// Check every field against its accepted range.
+    pub fn validate(&self) -> Result<(), ParamsError> {
+        if !(2..=3).contains(&self.dim) {
+            return Err(ParamsError::Dim(self.dim));
+        }
+        if self.particles == 0 || self.particles > MAX_PARTICLES {
+            return Err(ParamsError::Particles(self.particles));
+        }
+        if !(self.birth_gap >= 1.0 && self.birth_gap <= 1e9) {
+            return Err(ParamsError::BirthGap(self.birth_gap));
+        }
+        if !(self.death_ratio > 1.0 && self.death_ratio <= 1e300) {
+            return Err(ParamsError::DeathRatio(self.death_ratio));
+        }
+        if !(self.step_min > 0.0 && self.step_min <= 1e3) {
+            return Err(ParamsError::StepMin(self.step_min));
+        }
+        if self.precision.is_nan() || self.precision <= 0.5 {
+            return Err(ParamsError::Precision(self.precision));
+        }
+        if self.threads == 0 || self.threads > 1024 {
+            return Err(ParamsError::Threads(self.threads));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_bad_values_are_named() {
+        assert!(Params::default().validate().is_ok());
+        let bad = [
+            Params {
+                dim: 4,
+                ..Params::default()
+            },
+            Params {
+                particles: 0,
+                ..Params::default()
+            },
+            Params {
+                precision: 0.0,
+                ..Params::default()
+            },
+            Params {
+                precision: f64::NAN,
+                ..Params::default()
+            },
+            Params {
+                step_min: 0.0,
+                ..Params::default()
+            },
+            Params {
+                step_min: -1.0,
+                ..Params::default()
+            },
+            Params {
+                threads: 0,
+                ..Params::default()
+            },
+            Params {
+                birth_gap: 0.5,
+                ..Params::default()
+            },
+            Params {
+                death_ratio: 1.0,
+                ..Params::default()
+            },
+        ];
+        for p in bad {
+            let e = p.validate().unwrap_err().to_string();
+            assert!(e.contains("accepted range"), "{e}");
+        }
+        let inf = Params {
+            precision: f64::INFINITY,
+            ..Params::default()
+        };
+        assert!(inf.validate().is_ok());
+    }
+}

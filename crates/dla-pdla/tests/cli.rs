@@ -1,0 +1,107 @@
+//! The `dla` binary: outputs and bad-flag errors.
+
+use std::process::Command;
+
+fn dla() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_dla"))
+}
+
+#[test]
+fn run_writes_every_output() {
+    for (dim, fmt, file, header) in [
+        ("2", "csv", "positions.csv", "x,y"),
+        ("3", "csv", "positions.csv", "x,y,z"),
+        ("2", "bin", "positions.bin", "DLAPOS01"),
+        ("3", "xyz", "positions.xyz", "500"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let st = dla()
+            .args([
+                "--dim",
+                dim,
+                "--particles",
+                "500",
+                "--seed",
+                "3",
+                "--fit-from",
+                "50",
+                "--quiet",
+                "--png",
+            ])
+            .args(["--positions", fmt, "--out"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(st.success());
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        let r = &m["results"];
+        for key in [
+            "particles",
+            "fractal_dimension",
+            "fractal_dimension_stderr",
+            "radius_of_gyration",
+            "r_ext",
+            "discarded_walkers",
+            "bytes_per_particle",
+            "state_hash",
+        ] {
+            assert!(!r[key].is_null(), "{key} missing: {r}");
+        }
+        assert_eq!(r["particles"], 500);
+        let growth = std::fs::read_to_string(out.join("growth.csv")).unwrap();
+        assert!(growth.starts_with("n,radius_of_gyration,r_ext,seconds"));
+        let bytes = std::fs::read(out.join(file)).unwrap();
+        assert!(bytes.starts_with(header.as_bytes()), "{file}");
+        if fmt == "bin" {
+            assert_eq!(bytes.len(), 8 + 4 + 8 + 500 * 2 * 8);
+        }
+        assert!(out.join("dla.png").exists());
+    }
+}
+
+#[test]
+fn bad_flags_exit_2_and_write_nothing() {
+    for bad in [
+        &["--dim", "4"][..],
+        &["--particles", "0"],
+        &["--precision", "0"],
+        &["--step-min", "0"],
+        &["--step-min", "-1"],
+        &["--threads", "0"],
+        &["--far-field", "teleport"],
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let mut cmd = dla();
+        if !bad.contains(&"--particles") {
+            cmd.args(["--particles", "10"]);
+        }
+        let o = cmd.args(bad).arg("--out").arg(&out).output().unwrap();
+        assert_eq!(o.status.code(), Some(2), "{bad:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(err.trim().lines().count(), 1, "{bad:?}: {err}");
+        assert!(err.contains(bad[1]), "{bad:?}: {err}");
+        assert!(!out.exists(), "{bad:?} wrote output");
+    }
+}
+
+#[test]
+fn same_seed_same_state_hash_through_the_cli() {
+    let hash = |seed: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let st = dla()
+            .args(["--particles", "800", "--quiet", "--seed", seed, "--out"])
+            .arg(dir.path())
+            .status()
+            .unwrap();
+        assert!(st.success());
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("run.json")).unwrap())
+                .unwrap();
+        m["results"]["state_hash"].as_str().unwrap().to_string()
+    };
+    assert_eq!(hash("9"), hash("9"));
+    assert_ne!(hash("9"), hash("10"));
+}

@@ -1,0 +1,133 @@
+//! Contact, determinism and far-field-jump tests of whole runs (MODELS.md section 2).
+
+use dla_pdla::{FarField, Params, Simulation};
+
+fn grow<const D: usize>(n: u64, seed: u64, threads: usize) -> Simulation<D> {
+    let params = Params {
+        dim: D,
+        particles: n,
+        threads,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let mut sim = Simulation::<D>::new(params, seed).unwrap();
+    sim.run().unwrap();
+    sim
+}
+
+/// Brute force: no two centres closer than 1 - 1e-6; every particle after the first within
+/// 1 + 1e-6 of an earlier one. Returns (min pair distance, max contact distance).
+fn check_contacts<const D: usize>(pos: &[[f64; D]]) -> (f64, f64) {
+    let mut min_pair = f64::INFINITY;
+    let mut max_contact: f64 = 0.0;
+    for i in 1..pos.len() {
+        let mut nearest_earlier = f64::INFINITY;
+        for j in 0..i {
+            let d2: f64 = (0..D).map(|a| (pos[i][a] - pos[j][a]).powi(2)).sum();
+            nearest_earlier = nearest_earlier.min(d2);
+        }
+        let d = nearest_earlier.sqrt();
+        min_pair = min_pair.min(d);
+        max_contact = max_contact.max(d);
+    }
+    (min_pair, max_contact)
+}
+
+fn contacts<const D: usize>(threads: usize) {
+    let n = 20_000;
+    let sim = grow::<D>(n, 11, threads);
+    let pos = sim.positions().unwrap();
+    assert_eq!(pos.len() as u64, n);
+    let (min_pair, max_contact) = check_contacts(pos);
+    assert!(
+        min_pair >= 1.0 - 1e-6,
+        "{D}D, {threads} threads: two particles at {min_pair}"
+    );
+    assert!(
+        max_contact <= 1.0 + 1e-6,
+        "{D}D, {threads} threads: a particle at {max_contact} from every earlier one"
+    );
+    assert!(pos.iter().flatten().all(|x| x.is_finite()));
+    if threads == 1 {
+        assert_eq!(sim.discarded_walkers(), 0);
+    }
+}
+
+#[test]
+fn contacts_2d_one_thread() {
+    contacts::<2>(1);
+}
+
+#[test]
+fn contacts_3d_one_thread() {
+    contacts::<3>(1);
+}
+
+#[test]
+fn contacts_2d_two_threads() {
+    contacts::<2>(2);
+}
+
+#[test]
+fn contacts_3d_two_threads() {
+    contacts::<3>(2);
+}
+
+#[test]
+fn same_seed_same_hash_different_seed_different_hash() {
+    let a = grow::<2>(3000, 5, 1);
+    let b = grow::<2>(3000, 5, 1);
+    let c = grow::<2>(3000, 6, 1);
+    assert_eq!(a.state_hash(), b.state_hash());
+    assert_eq!(a.positions(), b.positions());
+    assert_ne!(a.state_hash(), c.state_hash());
+    let a3 = grow::<3>(2000, 5, 1);
+    let b3 = grow::<3>(2000, 5, 1);
+    let c3 = grow::<3>(2000, 6, 1);
+    assert_eq!(a3.state_hash(), b3.state_hash());
+    assert_ne!(a3.state_hash(), c3.state_hash());
+    // The hash does not depend on keeping positions.
+    let mut p = a.params().clone();
+    p.keep_positions = false;
+    let mut d = Simulation::<2>::new(p, 5).unwrap();
+    d.run().unwrap();
+    assert_eq!(d.state_hash(), a.state_hash());
+}
+
+#[test]
+fn far_field_jump_with_huge_death_radius_finishes_finite() {
+    for (dim, n) in [(2usize, 1500u64), (3, 1500)] {
+        let params = Params {
+            dim,
+            particles: n,
+            far_field: FarField::Jump,
+            death_ratio: 1e20,
+            keep_positions: true,
+            ..Params::default()
+        };
+        if dim == 2 {
+            let mut sim = Simulation::<2>::new(params, 3).unwrap();
+            sim.run().unwrap();
+            let pos = sim.positions().unwrap();
+            assert!(pos.iter().flatten().all(|x| x.is_finite()));
+            let (mn, mx) = check_contacts(pos);
+            assert!(mn >= 1.0 - 1e-6 && mx <= 1.0 + 1e-6, "{mn} {mx}");
+        } else {
+            let mut sim = Simulation::<3>::new(params, 3).unwrap();
+            sim.run().unwrap();
+            let pos = sim.positions().unwrap();
+            assert!(pos.iter().flatten().all(|x| x.is_finite()));
+            let (mn, mx) = check_contacts(pos);
+            assert!(mn >= 1.0 - 1e-6 && mx <= 1.0 + 1e-6, "{mn} {mx}");
+        }
+    }
+}
+
+#[test]
+fn growth_samples_are_log_spaced_and_end_at_n() {
+    let sim = grow::<2>(20_000, 1, 1);
+    let s = sim.samples();
+    assert!(s.len() > 500 && s.len() <= 1001, "{}", s.len());
+    assert_eq!(s.last().unwrap().n, 20_000);
+    assert!(s.windows(2).all(|w| w[1].n > w[0].n));
+}
