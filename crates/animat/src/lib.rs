@@ -1,0 +1,25 @@
+//! # animat: predator-prey artificial life with rule priorities and grid boxes
+//!
+//! The foxes-and-rabbits animat model of Hawick, James & Scogings (seed 000, sections II.B and
+//! IV.B), defined precisely in MODELS.md section 3: animats on the unbounded integer plane, one
+//! per cell, each running its species' rule list in priority order and executing the first
+//! rule whose condition holds. Perception is lazy: a rule asks only the neighbour queries its
+//! condition needs. Neighbour searches go through [`spatial::plane::PlaneGrid`]; every grid-box
+//! size, and the exhaustive "no grid" search, gives a bit-identical trajectory.
+//!
+//! ```
+//! use animat::{Params, World};
+//! let params = Params { foxes: 20, rabbits: 200, start_radius: 30, ..Params::default() };
+//! let mut world = World::new(params, 42).unwrap();
+//! world.run(10);
+//! assert_eq!(world.steps(), 10);
+//! assert_eq!(world.state_hash().len(), 16);
+//! ```
+
+pub mod config;
+pub mod output;
+pub mod params;
+pub mod world;
+
+pub use params::{FoxRule, GridBox, Params, ParamsError, RabbitRule, Species};
+pub use world::{Animat, QueryCounts, StepStats, World, WorldError};

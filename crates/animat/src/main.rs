@@ -1,0 +1,265 @@
+//! `animat`: the predator-prey animat model of seed 000, section II.B (MODELS.md section 3). A
+//! thin layer over the `animat` library: parse flags and the config file, validate, run, write
+//! outputs.
+
+use animat::output::{self, PopulationRow};
+use animat::{GridBox, Params, World};
+use anyhow::Context;
+use clap::Parser;
+use core_lattice::io::RunClock;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Foxes and rabbits on an unbounded plane, each running its rule list in priority order.
+///
+/// Parameters come from the defaults, then --config FILE.toml, then the flags below (flags
+/// win). Outputs go into --out DIR: run.json, populations.csv, and on request PNG snapshots
+/// and positions.csv (see docs/animat.md).
+#[derive(Parser, Debug)]
+#[command(name = "animat", version, allow_negative_numbers = true)]
+struct Cli {
+    /// Steps to run.
+    #[arg(long, default_value_t = 1000)]
+    steps: u64,
+
+    /// Seed of every random stream of the run: same seed and parameters, same run.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+
+    /// Output directory (created if missing; nothing is written on bad input).
+    #[arg(long)]
+    out: PathBuf,
+
+    /// TOML file with any model parameters (see data/animat-default.toml); unknown keys are
+    /// errors.
+    #[arg(long)]
+    config: Option<PathBuf>,
+
+    /// Foxes at the start.
+    #[arg(long)]
+    foxes: Option<u64>,
+
+    /// Rabbits at the start.
+    #[arg(long)]
+    rabbits: Option<u64>,
+
+    /// Radius of the start disc around the origin, in cells.
+    #[arg(long, conflicts_with = "density")]
+    start_radius: Option<i64>,
+
+    /// Start density in animats per cell, in (0, 0.5]: sets the start radius.
+    #[arg(long)]
+    density: Option<f64>,
+
+    /// Vision radius in cells (>= 1).
+    #[arg(long)]
+    vision: Option<i64>,
+
+    /// Grid-box side: a positive integer, `vision` (the default) or `none` (exhaustive).
+    /// Changes only the speed, never the result.
+    #[arg(long)]
+    grid_box: Option<String>,
+
+    /// Record neighbour-search seconds and distance evaluations per step in populations.csv.
+    #[arg(long)]
+    timing: bool,
+
+    /// Write a PNG snapshot every K steps (and of the start and the end).
+    #[arg(long)]
+    snapshot_every: Option<u64>,
+
+    /// Write positions.csv: every live animat at the end.
+    #[arg(long)]
+    positions: bool,
+
+    /// No progress bar or summary, warnings only.
+    #[arg(long, short)]
+    quiet: bool,
+
+    /// More log output (-v info, -vv debug); RUST_LOG overrides.
+    #[arg(short, action = clap::ArgAction::Count)]
+    verbose: u8,
+}
+
+/// Builds validated parameters: defaults, then the config file, then the flags.
+fn params(cli: &Cli) -> Result<Params, String> {
+    let mut p = match &cli.config {
+        Some(path) => animat::config::read_config(path).map_err(|e| e.to_string())?,
+        None => Params::default(),
+    };
+    if let Some(v) = cli.foxes {
+        p.foxes = v;
+    }
+    if let Some(v) = cli.rabbits {
+        p.rabbits = v;
+    }
+    if let Some(v) = cli.start_radius {
+        p.start_radius = v;
+    }
+    if let Some(d) = cli.density {
+        if !(d > 0.0 && d <= 0.5) {
+            return Err(format!(
+                "--density {d} is outside the accepted range (0, 0.5]"
+            ));
+        }
+        p.start_radius = Params::radius_for_density(p.foxes.saturating_add(p.rabbits), d);
+    }
+    if let Some(v) = cli.vision {
+        p.vision = v;
+    }
+    if let Some(g) = &cli.grid_box {
+        p.grid_box = g
+            .parse::<GridBox>()
+            .map_err(|e| format!("--grid-box: {e}"))?;
+    }
+    if cli.snapshot_every == Some(0) {
+        return Err("--snapshot-every 0 is outside the accepted range 1..".into());
+    }
+    p.validate().map_err(|e| e.to_string())?;
+    Ok(p)
+}
+
+fn init_logging(cli: &Cli) {
+    let default = match (cli.quiet, cli.verbose) {
+        (true, _) | (false, 0) => "warn",
+        (false, 1) => "info",
+        _ => "debug",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
+}
+
+/// Prints a one-line error and returns exit code 2 (bad input; nothing written).
+fn usage_error(msg: &str) -> ExitCode {
+    eprintln!("animat: error: {msg}");
+    ExitCode::from(2)
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            let text = e.to_string();
+            let message: Vec<&str> = text
+                .lines()
+                .take_while(|l| !l.trim().is_empty())
+                .map(str::trim)
+                .collect();
+            return usage_error(message.join(" ").trim_start_matches("error: "));
+        }
+    };
+    init_logging(&cli);
+    let params = match params(&cli) {
+        Ok(p) => p,
+        Err(msg) => return usage_error(&msg),
+    };
+    match run(&cli, params) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("animat: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
+    let clock = RunClock::start();
+    let mut world = World::new(params, cli.seed).context("setting up the run")?;
+    world.set_timing(cli.timing);
+    std::fs::create_dir_all(&cli.out)
+        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    tracing::info!(
+        foxes = world.foxes(),
+        rabbits = world.rabbits(),
+        grid = %world.grid().box_size(),
+        "start"
+    );
+    let snapshot = |w: &World| -> anyhow::Result<()> {
+        let path = cli.out.join(format!("snapshot_{:06}.png", w.steps()));
+        output::write_snapshot(&path, w)
+    };
+    let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
+        let bar = indicatif::ProgressBar::new(cli.steps);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {pos}/{len} steps, {msg}",
+            )
+            .expect("valid template"),
+        );
+        bar
+    });
+    let mut rows = vec![PopulationRow {
+        step: 0,
+        foxes: world.foxes(),
+        rabbits: world.rabbits(),
+        search_seconds: 0.0,
+        distance_evals: 0,
+    }];
+    if cli.snapshot_every.is_some() {
+        snapshot(&world)?;
+    }
+    for _ in 0..cli.steps {
+        if world.foxes() + world.rabbits() == 0 {
+            tracing::info!(step = world.steps(), "every animat has died");
+            break;
+        }
+        let s = world.step();
+        rows.push(PopulationRow {
+            step: world.steps(),
+            foxes: world.foxes(),
+            rabbits: world.rabbits(),
+            search_seconds: s.search_seconds,
+            distance_evals: s.distance_evals,
+        });
+        if let Some(k) = cli.snapshot_every {
+            if world.steps() % k == 0 {
+                snapshot(&world)?;
+            }
+        }
+        if let Some(bar) = &bar {
+            bar.inc(1);
+            if world.steps() % 16 == 0 {
+                bar.set_message(format!(
+                    "{} foxes, {} rabbits",
+                    world.foxes(),
+                    world.rabbits()
+                ));
+            }
+        }
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    if let Some(k) = cli.snapshot_every {
+        if world.steps() % k != 0 {
+            snapshot(&world)?;
+        }
+    }
+    output::write_populations(&cli.out, &rows, cli.timing)?;
+    if cli.positions {
+        output::write_positions(&cli.out, &world)?;
+    }
+    let m = output::write_manifest(&cli.out, &world, cli.seed, &clock)?;
+    if !cli.quiet {
+        eprintln!(
+            "animat: {} foxes, {} rabbits after {} steps in {:.2} s (state {}); outputs in {}",
+            world.foxes(),
+            world.rabbits(),
+            world.steps(),
+            m.wall_seconds,
+            world.state_hash(),
+            cli.out.display()
+        );
+    }
+    Ok(())
+}

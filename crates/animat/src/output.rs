@@ -1,0 +1,148 @@
+//! Recording a run and writing it into its output directory (DESIGN.md, "Outputs"). Every
+//! file is written atomically.
+//!
+//! | file | content |
+//! |---|---|
+//! | `run.json` | manifest: parameters, seed, timings, peak memory, results (`steps`, `foxes`, `rabbits`, `state_hash`, `distance_evaluations`, `queries`) |
+//! | `populations.csv` | `step,foxes,rabbits` from step 0 (with `--timing` also `search_seconds,distance_evaluations`) |
+//! | `snapshot_NNNNNN.png` | with `--snapshot-every K`: foxes red, rabbits green, on black, framing the population |
+//! | `positions.csv` | with `--positions`: `id,species,x,y,age,hunger` of every live animat at the end |
+
+use crate::params::Species;
+use crate::world::World;
+use core_lattice::io::{CsvWriter, RunClock, RunManifest, write_png_rgb};
+use std::path::Path;
+
+/// One row of `populations.csv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PopulationRow {
+    /// Step number (0 = the start).
+    pub step: u64,
+    /// Live foxes.
+    pub foxes: u64,
+    /// Live rabbits.
+    pub rabbits: u64,
+    /// Seconds in perception queries during the step (with timing on).
+    pub search_seconds: f64,
+    /// Distance evaluations during the step.
+    pub distance_evals: u64,
+}
+
+/// Writes `populations.csv`; `timing` adds the search columns.
+///
+/// # Errors
+/// I/O errors.
+pub fn write_populations(dir: &Path, rows: &[PopulationRow], timing: bool) -> anyhow::Result<()> {
+    let mut header = vec!["step", "foxes", "rabbits"];
+    if timing {
+        header.extend(["search_seconds", "distance_evaluations"]);
+    }
+    let mut w = CsvWriter::create(dir.join("populations.csv"), &header)?;
+    for r in rows {
+        if timing {
+            w.row(&[
+                &r.step,
+                &r.foxes,
+                &r.rabbits,
+                &r.search_seconds,
+                &r.distance_evals,
+            ])?;
+        } else {
+            w.row(&[&r.step, &r.foxes, &r.rabbits])?;
+        }
+    }
+    w.finish()?;
+    Ok(())
+}
+
+/// Writes `positions.csv`: every live animat at the end, in id order.
+///
+/// # Errors
+/// I/O errors.
+pub fn write_positions(dir: &Path, world: &World) -> anyhow::Result<()> {
+    let mut w = CsvWriter::create(
+        dir.join("positions.csv"),
+        &["id", "species", "x", "y", "age", "hunger"],
+    )?;
+    for a in world.animats() {
+        w.row(&[
+            &a.id,
+            &a.species.name(),
+            &a.pos[0],
+            &a.pos[1],
+            &a.age,
+            &a.hunger,
+        ])?;
+    }
+    w.finish()?;
+    Ok(())
+}
+
+/// Largest side of a snapshot in pixels.
+pub const SNAPSHOT_MAX_SIDE: i64 = 1024;
+
+/// Writes a PNG of the world: foxes red, rabbits green, on black. The frame is the bounding
+/// box of the live animats plus a margin, one pixel per cell, scaled down by an integer factor
+/// when it would exceed [`SNAPSHOT_MAX_SIDE`]; y points up.
+///
+/// # Errors
+/// I/O errors.
+pub fn write_snapshot(path: &Path, world: &World) -> anyhow::Result<()> {
+    let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
+    for a in world.animats() {
+        x0 = x0.min(a.pos[0]);
+        y0 = y0.min(a.pos[1]);
+        x1 = x1.max(a.pos[0]);
+        y1 = y1.max(a.pos[1]);
+    }
+    if x0 > x1 {
+        (x0, y0, x1, y1) = (0, 0, 0, 0);
+    }
+    let margin = 5;
+    let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
+    let span = (x1.saturating_add(margin) - x0 + 1).max(y1.saturating_add(margin) - y0 + 1);
+    let factor = (span + SNAPSHOT_MAX_SIDE - 1) / SNAPSHOT_MAX_SIDE;
+    let side = (span + factor - 1) / factor;
+    let mut pixels = vec![0u8; (side * side * 3) as usize];
+    for a in world.animats() {
+        let px = (a.pos[0] - x0) / factor;
+        let py = side - 1 - (a.pos[1] - y0) / factor;
+        let at = ((py * side + px) * 3) as usize;
+        let c: [u8; 3] = match a.species {
+            Species::Fox => [255, 60, 40],
+            Species::Rabbit => [80, 220, 80],
+        };
+        // A fox drawn over a rabbit in a shared scaled pixel stays visible.
+        if a.species == Species::Fox || pixels[at] != 255 {
+            pixels[at..at + 3].copy_from_slice(&c);
+        }
+    }
+    write_png_rgb(path, side as u32, side as u32, &pixels)?;
+    Ok(())
+}
+
+/// Writes `run.json` with the headline results and returns it.
+///
+/// # Errors
+/// I/O or serialisation errors.
+pub fn write_manifest(
+    dir: &Path,
+    world: &World,
+    seed: u64,
+    clock: &RunClock,
+) -> anyhow::Result<RunManifest> {
+    let mut m = clock.finish("animat", env!("CARGO_PKG_VERSION"), seed, 1, world.params())?;
+    let q = world.queries();
+    m.set_result("steps", world.steps())
+        .set_result("foxes", world.foxes())
+        .set_result("rabbits", world.rabbits())
+        .set_result("state_hash", world.state_hash())
+        .set_result("distance_evaluations", world.distance_evals())
+        .set_result("grid_box", world.grid().box_size().to_string())
+        .set_result(
+            "queries",
+            serde_json::json!({"adjacent": q.adjacent, "nearest": q.nearest, "count": q.count}),
+        );
+    m.write(dir)?;
+    Ok(m)
+}

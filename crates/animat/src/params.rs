@@ -1,0 +1,531 @@
+//! Parameters of an animat run (MODELS.md section 3), validated before anything runs.
+//!
+//! Every field has a default ([`Params::default`]) chosen by the experiment documented in
+//! `docs/animat.md`; `data/animat-default.toml` spells the same values out. A config file may
+//! set any subset of the fields; unknown keys are rejected.
+
+use serde::{Deserialize, Serialize};
+use spatial::plane::BoxSize;
+use std::fmt;
+
+/// The two species of seed 000, section II.B.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Species {
+    /// Predator.
+    Fox,
+    /// Prey.
+    Rabbit,
+}
+
+impl Species {
+    /// `fox` or `rabbit`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Species::Fox => "fox",
+            Species::Rabbit => "rabbit",
+        }
+    }
+
+    /// A stable code for state hashes: fox 0, rabbit 1.
+    pub fn code(self) -> u64 {
+        match self {
+            Species::Fox => 0,
+            Species::Rabbit => 1,
+        }
+    }
+}
+
+/// A fox rule (MODELS.md section 3, "Fox"). Priority is the position in [`Params::fox_rules`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FoxRule {
+    /// Hungry and a rabbit adjacent: eat it, hunger = 0.
+    Eat,
+    /// Not hungry, a fox adjacent, not overcrowded, enough prey within vision: breed with
+    /// probability `fox_breed_p`.
+    Breed,
+    /// Hungry and a rabbit within vision: step towards the nearest rabbit.
+    Hunt,
+    /// Not hungry and another fox within vision: step towards the nearest fox.
+    SeekMate,
+    /// Random step.
+    Wander,
+}
+
+impl FoxRule {
+    /// Every fox rule, in the default priority order.
+    pub const ALL: [FoxRule; 5] = [
+        FoxRule::Eat,
+        FoxRule::Breed,
+        FoxRule::Hunt,
+        FoxRule::SeekMate,
+        FoxRule::Wander,
+    ];
+
+    /// The rule's name in config files.
+    pub fn name(self) -> &'static str {
+        match self {
+            FoxRule::Eat => "eat",
+            FoxRule::Breed => "breed",
+            FoxRule::Hunt => "hunt",
+            FoxRule::SeekMate => "seek_mate",
+            FoxRule::Wander => "wander",
+        }
+    }
+}
+
+/// A rabbit rule (MODELS.md section 3, "Rabbit"). Priority is the position in
+/// [`Params::rabbit_rules`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RabbitRule {
+    /// A fox adjacent: step directly away from the nearest adjacent fox.
+    Flee,
+    /// Another rabbit adjacent, not overcrowded: breed with probability `rabbit_breed_p`.
+    Breed,
+    /// Another rabbit within vision: step towards the nearest rabbit.
+    Herd,
+    /// Random step.
+    Wander,
+}
+
+impl RabbitRule {
+    /// Every rabbit rule, in the default priority order.
+    pub const ALL: [RabbitRule; 4] = [
+        RabbitRule::Flee,
+        RabbitRule::Breed,
+        RabbitRule::Herd,
+        RabbitRule::Wander,
+    ];
+
+    /// The rule's name in config files.
+    pub fn name(self) -> &'static str {
+        match self {
+            RabbitRule::Flee => "flee",
+            RabbitRule::Breed => "breed",
+            RabbitRule::Herd => "herd",
+            RabbitRule::Wander => "wander",
+        }
+    }
+}
+
+/// The grid-box setting (`--grid-box`, MODELS.md section 3, "Search"): in config files an
+/// integer side, `"none"` or `"vision"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum GridBox {
+    /// Boxes of side equal to the vision radius (the paper's choice; the default).
+    #[default]
+    Vision,
+    /// No boxes: the exhaustive "no grid" search of seed 000, Fig. 9.
+    None,
+    /// Boxes of this side (must be positive).
+    Side(i64),
+}
+
+impl GridBox {
+    /// The box size this setting gives for vision radius `vision`.
+    pub fn box_size(self, vision: i64) -> BoxSize {
+        match self {
+            GridBox::Vision => BoxSize::Side(vision),
+            GridBox::None => BoxSize::None,
+            GridBox::Side(a) => BoxSize::Side(a),
+        }
+    }
+}
+
+impl fmt::Display for GridBox {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            GridBox::Vision => f.write_str("vision"),
+            GridBox::None => f.write_str("none"),
+            GridBox::Side(a) => write!(f, "{a}"),
+        }
+    }
+}
+
+impl std::str::FromStr for GridBox {
+    type Err = String;
+
+    /// Parses `none`, `vision` or an integer side (checked by [`Params::validate`]).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let t = s.trim();
+        if t.eq_ignore_ascii_case("none") {
+            Ok(GridBox::None)
+        } else if t.eq_ignore_ascii_case("vision") {
+            Ok(GridBox::Vision)
+        } else {
+            t.parse::<i64>().map(GridBox::Side).map_err(|_| {
+                format!("invalid grid box {s:?}: expected `none`, `vision` or a positive integer")
+            })
+        }
+    }
+}
+
+/// How [`GridBox`] appears in config files and `run.json`.
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum GridBoxRepr {
+    Side(i64),
+    Name(String),
+}
+
+impl Serialize for GridBox {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            GridBox::Side(a) => GridBoxRepr::Side(*a),
+            other => GridBoxRepr::Name(other.to_string()),
+        }
+        .serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for GridBox {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        match GridBoxRepr::deserialize(d)? {
+            GridBoxRepr::Side(a) => Ok(GridBox::Side(a)),
+            GridBoxRepr::Name(n) => n.parse().map_err(serde::de::Error::custom),
+        }
+    }
+}
+
+/// Bad parameters: each names the offending value and the accepted range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParamsError {
+    /// A probability outside `[0, 1]` (or NaN).
+    #[error("{name} = {value} is outside the accepted range [0, 1]")]
+    Probability {
+        /// Field name.
+        name: &'static str,
+        /// Value given.
+        value: f64,
+    },
+    /// An integer outside its accepted range.
+    #[error("{name} = {value} is outside the accepted range {min}..={max}")]
+    Range {
+        /// Field name.
+        name: &'static str,
+        /// Value given.
+        value: i128,
+        /// Smallest accepted value.
+        min: i128,
+        /// Largest accepted value.
+        max: i128,
+    },
+    /// A rule name that is not a rule of that species.
+    #[error("unknown {species} rule {name:?}; accepted: {accepted}")]
+    UnknownRule {
+        /// `fox` or `rabbit`.
+        species: &'static str,
+        /// The name given.
+        name: String,
+        /// The accepted names, comma separated.
+        accepted: String,
+    },
+    /// A rule listed twice.
+    #[error("{species} rule {name:?} is listed twice; each rule may appear at most once")]
+    DuplicateRule {
+        /// `fox` or `rabbit`.
+        species: &'static str,
+        /// The repeated name.
+        name: String,
+    },
+    /// More animats than the start disc can hold at half occupancy.
+    #[error(
+        "{animats} animats do not fit in a start disc of radius {radius} \
+         (at most {max} = half its cells); raise start_radius or lower the populations"
+    )]
+    StartTooDense {
+        /// Foxes plus rabbits.
+        animats: u64,
+        /// `start_radius`.
+        radius: i64,
+        /// Largest accepted number of animats.
+        max: u64,
+    },
+}
+
+/// Largest vision, crowding radius, start radius and grid-box side accepted: squared radii stay
+/// far inside `u64` and coordinates far inside `i64`.
+pub const MAX_RADIUS: i64 = 1 << 30;
+
+/// Every parameter of the model (MODELS.md section 3). Build one (or start from
+/// [`Params::default`]), call [`Params::validate`] (the [`World`](crate::World) does), run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Foxes at the start (`--foxes`).
+    pub foxes: u64,
+    /// Rabbits at the start (`--rabbits`).
+    pub rabbits: u64,
+    /// Radius of the disc around the origin in which the start population is placed, on
+    /// distinct cells drawn uniformly (`--start-radius`, or `--density`).
+    pub start_radius: i64,
+    /// Vision radius V, Euclidean, in cells (`--vision`; the paper's 60).
+    pub vision: i64,
+    /// Grid-box side (`--grid-box`): a positive integer, `"vision"` (the default: V) or
+    /// `"none"` (exhaustive search). Every setting gives the same trajectory.
+    pub grid_box: GridBox,
+    /// A fox is hungry when its hunger (steps since it last ate) is at least this.
+    pub hungry_at: u32,
+    /// A fox whose hunger exceeds this dies of starvation.
+    pub starve: u32,
+    /// A fox older than this dies.
+    pub fox_max_age: u32,
+    /// A rabbit older than this dies.
+    pub rabbit_max_age: u32,
+    /// Probability that the fox `breed` rule, once its condition holds, produces a fox.
+    pub fox_breed_p: f64,
+    /// Probability that the rabbit `breed` rule, once its condition holds, produces a rabbit.
+    pub rabbit_breed_p: f64,
+    /// Rabbits needed within vision for a fox to breed.
+    pub prey_needed: u32,
+    /// Overcrowding: more than this many animats (either species, the breeder excluded)
+    /// within `crowd_radius` forbid breeding.
+    pub crowd_max: u32,
+    /// Radius of the overcrowding count, Euclidean, in cells.
+    pub crowd_radius: i64,
+    /// Fox rules in priority order (names: eat, breed, hunt, seek_mate, wander).
+    pub fox_rules: Vec<String>,
+    /// Rabbit rules in priority order (names: flee, breed, herd, wander).
+    pub rabbit_rules: Vec<String>,
+}
+
+impl Default for Params {
+    /// The documented defaults (docs/animat.md, "Defaults and the experiment behind them").
+    fn default() -> Self {
+        Params {
+            foxes: 300,
+            rabbits: 2000,
+            start_radius: 60,
+            vision: 60,
+            grid_box: GridBox::Vision,
+            hungry_at: 10,
+            starve: 30,
+            fox_max_age: 400,
+            rabbit_max_age: 200,
+            fox_breed_p: 0.02,
+            rabbit_breed_p: 0.1,
+            prey_needed: 10,
+            crowd_max: 4,
+            crowd_radius: 2,
+            fox_rules: FoxRule::ALL.iter().map(|r| r.name().to_string()).collect(),
+            rabbit_rules: RabbitRule::ALL
+                .iter()
+                .map(|r| r.name().to_string())
+                .collect(),
+        }
+    }
+}
+
+fn check_prob(name: &'static str, value: f64) -> Result<(), ParamsError> {
+    if (0.0..=1.0).contains(&value) {
+        Ok(())
+    } else {
+        Err(ParamsError::Probability { name, value })
+    }
+}
+
+fn check_range(name: &'static str, value: i128, min: i128, max: i128) -> Result<(), ParamsError> {
+    if (min..=max).contains(&value) {
+        Ok(())
+    } else {
+        Err(ParamsError::Range {
+            name,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
+fn parse_rules<R: Copy + PartialEq>(
+    species: &'static str,
+    names: &[String],
+    all: &[R],
+    name_of: fn(R) -> &'static str,
+) -> Result<Vec<R>, ParamsError> {
+    let mut out: Vec<R> = Vec::with_capacity(names.len());
+    for n in names {
+        let rule = all
+            .iter()
+            .copied()
+            .find(|&r| name_of(r) == n.as_str())
+            .ok_or_else(|| ParamsError::UnknownRule {
+                species,
+                name: n.clone(),
+                accepted: all
+                    .iter()
+                    .map(|&r| name_of(r))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })?;
+        if out.contains(&rule) {
+            return Err(ParamsError::DuplicateRule {
+                species,
+                name: n.clone(),
+            });
+        }
+        out.push(rule);
+    }
+    Ok(out)
+}
+
+impl Params {
+    /// The fox rules as typed values, in priority order.
+    ///
+    /// # Errors
+    /// [`ParamsError::UnknownRule`] or [`ParamsError::DuplicateRule`].
+    pub fn fox_rule_list(&self) -> Result<Vec<FoxRule>, ParamsError> {
+        parse_rules("fox", &self.fox_rules, &FoxRule::ALL, FoxRule::name)
+    }
+
+    /// The rabbit rules as typed values, in priority order.
+    ///
+    /// # Errors
+    /// [`ParamsError::UnknownRule`] or [`ParamsError::DuplicateRule`].
+    pub fn rabbit_rule_list(&self) -> Result<Vec<RabbitRule>, ParamsError> {
+        parse_rules(
+            "rabbit",
+            &self.rabbit_rules,
+            &RabbitRule::ALL,
+            RabbitRule::name,
+        )
+    }
+
+    /// Largest start population the start disc accepts: half the cells of the disc.
+    pub fn start_capacity(&self) -> u64 {
+        let r = self.start_radius as f64;
+        (std::f64::consts::PI * r * r / 2.0).floor() as u64
+    }
+
+    /// Checks every value against its accepted range.
+    ///
+    /// # Errors
+    /// The first offending value, as a [`ParamsError`] naming it and its accepted range.
+    pub fn validate(&self) -> Result<(), ParamsError> {
+        let m = i128::from(MAX_RADIUS);
+        check_range("vision", self.vision.into(), 1, m)?;
+        if let GridBox::Side(a) = self.grid_box {
+            check_range("grid_box", a.into(), 1, m)?;
+        }
+        check_range("start_radius", self.start_radius.into(), 0, m)?;
+        check_range("crowd_radius", self.crowd_radius.into(), 1, m)?;
+        check_range("starve", self.starve.into(), 1, u32::MAX.into())?;
+        check_range("fox_max_age", self.fox_max_age.into(), 1, u32::MAX.into())?;
+        check_range(
+            "rabbit_max_age",
+            self.rabbit_max_age.into(),
+            1,
+            u32::MAX.into(),
+        )?;
+        check_range(
+            "crowd_max",
+            self.crowd_max.into(),
+            0,
+            i128::from(u32::MAX) - 1,
+        )?;
+        check_prob("fox_breed_p", self.fox_breed_p)?;
+        check_prob("rabbit_breed_p", self.rabbit_breed_p)?;
+        self.fox_rule_list()?;
+        self.rabbit_rule_list()?;
+        let animats = self.foxes.saturating_add(self.rabbits);
+        let max = self.start_capacity();
+        if animats > max {
+            return Err(ParamsError::StartTooDense {
+                animats,
+                radius: self.start_radius,
+                max,
+            });
+        }
+        Ok(())
+    }
+
+    /// Start radius giving `animats` animats at `density` animats per cell:
+    /// `ceil(sqrt(animats / (pi density)))` (`--density`).
+    pub fn radius_for_density(animats: u64, density: f64) -> i64 {
+        (animats as f64 / (std::f64::consts::PI * density))
+            .sqrt()
+            .ceil() as i64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid() {
+        Params::default().validate().unwrap();
+    }
+
+    #[test]
+    fn bad_values_name_the_value_and_range() {
+        let p = Params {
+            fox_breed_p: 1.5,
+            ..Params::default()
+        };
+        let e = p.validate().unwrap_err().to_string();
+        assert_eq!(e, "fox_breed_p = 1.5 is outside the accepted range [0, 1]");
+        let p = Params {
+            rabbit_breed_p: f64::NAN,
+            ..Params::default()
+        };
+        assert!(matches!(p.validate(), Err(ParamsError::Probability { .. })));
+        let p = Params {
+            vision: 0,
+            ..Params::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .starts_with("vision = 0 is outside")
+        );
+        let p = Params {
+            grid_box: GridBox::Side(-5),
+            ..Params::default()
+        };
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .starts_with("grid_box = -5")
+        );
+        let p = Params {
+            fox_rules: vec!["eat".into(), "fly".into()],
+            ..Params::default()
+        };
+        assert_eq!(
+            p.validate().unwrap_err().to_string(),
+            "unknown fox rule \"fly\"; accepted: eat, breed, hunt, seek_mate, wander"
+        );
+        let p = Params {
+            rabbit_rules: vec!["herd".into(), "herd".into()],
+            ..Params::default()
+        };
+        assert!(matches!(
+            p.validate(),
+            Err(ParamsError::DuplicateRule { .. })
+        ));
+        let p = Params {
+            start_radius: 10,
+            ..Params::default()
+        };
+        assert!(matches!(
+            p.validate(),
+            Err(ParamsError::StartTooDense { .. })
+        ));
+    }
+
+    #[test]
+    fn grid_box_serde() {
+        for (g, s) in [
+            (GridBox::Side(30), "30"),
+            (GridBox::None, "\"none\""),
+            (GridBox::Vision, "\"vision\""),
+        ] {
+            assert_eq!(serde_json::to_string(&g).unwrap(), s);
+            assert_eq!(serde_json::from_str::<GridBox>(s).unwrap(), g);
+        }
+        assert!(serde_json::from_str::<GridBox>("\"huge\"").is_err());
+    }
+}

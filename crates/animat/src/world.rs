@@ -1,0 +1,921 @@
+//! The animat world: animats on the unbounded plane, their rules, and one step of the model
+//! (MODELS.md section 3; seed 000, section II.B).
+
+use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
+use core_lattice::io::StateHasher;
+use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
+use spatial::plane::{PlaneError, PlaneGrid, Pos};
+use std::time::Instant;
+
+/// Random stream purposes of a run (each its own stream of the run seed).
+const STREAM_PLACEMENT: u32 = 1;
+/// The visiting order of each step.
+const STREAM_ORDER: u32 = 2;
+/// Breeding draws, birth cells and wander directions.
+const STREAM_ACTION: u32 = 3;
+
+/// Squared radius of "adjacent": Chebyshev distance 1 is squared Euclidean distance <= 2.
+pub const ADJACENT_R2: u64 = 2;
+
+/// The 8 unit steps, in a fixed order (wander directions, birth cells).
+pub const DIRECTIONS: [[i64; 2]; 8] = [
+    [1, 0],
+    [1, 1],
+    [0, 1],
+    [-1, 1],
+    [-1, 0],
+    [-1, -1],
+    [0, -1],
+    [1, -1],
+];
+
+/// One animat.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Animat {
+    /// Unique id; ids increase with creation and are never reused.
+    pub id: u64,
+    /// Fox or rabbit.
+    pub species: Species,
+    /// Cell.
+    pub pos: Pos,
+    /// Steps lived.
+    pub age: u32,
+    /// Foxes: steps since the fox last ate. Always 0 for rabbits.
+    pub hunger: u32,
+    /// False once dead (eaten, starved, too old) until removed at the end of the step.
+    alive: bool,
+}
+
+/// Perception queries asked, by kind (for the lazy-perception tests and diagnostics).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QueryCounts {
+    /// "Is an animat of a kind adjacent" (including "which adjacent one is nearest").
+    pub adjacent: u64,
+    /// "Nearest animat of a kind within vision".
+    pub nearest: u64,
+    /// Counting queries (overcrowding, enough prey).
+    pub count: u64,
+}
+
+impl QueryCounts {
+    /// All queries.
+    pub fn total(&self) -> u64 {
+        self.adjacent + self.nearest + self.count
+    }
+}
+
+/// What an animat decided to do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Action {
+    /// Eat this rabbit.
+    Eat(u64),
+    /// Breed (the probability is drawn when applied).
+    Breed,
+    /// Step by this unit vector (blocked steps stay put).
+    Step([i64; 2]),
+    /// Random step.
+    Wander,
+    /// No rule fired.
+    Stay,
+}
+
+/// Errors building a hand-made scene.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WorldError {
+    /// Bad parameters.
+    #[error(transparent)]
+    Params(#[from] ParamsError),
+    /// The cell is already occupied (at most one animat per cell).
+    #[error("cell [{}, {}] is already occupied", .0[0], .0[1])]
+    Occupied(Pos),
+    /// An error of the search structure.
+    #[error(transparent)]
+    Plane(#[from] PlaneError),
+}
+
+/// Counters of one step.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepStats {
+    /// Seconds spent in perception queries (only with [`World::set_timing`]; else 0).
+    pub search_seconds: f64,
+    /// Distance evaluations of the search structure during the step.
+    pub distance_evals: u64,
+}
+
+/// The simulation: a pure function of `(Params, seed)`; every grid-box setting gives the same
+/// trajectory.
+#[derive(Debug, Clone)]
+pub struct World {
+    params: Params,
+    fox_rules: Vec<FoxRule>,
+    rabbit_rules: Vec<RabbitRule>,
+    vision2: u64,
+    crowd2: u64,
+    grid: PlaneGrid<Species>,
+    /// Live animats (and, during a step, the ones that died in it), sorted by id.
+    animats: Vec<Animat>,
+    next_id: u64,
+    steps: u64,
+    order_rng: SimRng,
+    action_rng: SimRng,
+    queries: QueryCounts,
+    timing: bool,
+    search_seconds: f64,
+    total_distance_evals: u64,
+    foxes: u64,
+    rabbits: u64,
+}
+
+/// Sign of `b - a` without overflow.
+fn sign_towards(a: i64, b: i64) -> i64 {
+    match b.cmp(&a) {
+        std::cmp::Ordering::Greater => 1,
+        std::cmp::Ordering::Less => -1,
+        std::cmp::Ordering::Equal => 0,
+    }
+}
+
+/// `p + d`, or `None` on overflow.
+fn offset(p: Pos, d: [i64; 2]) -> Option<Pos> {
+    Some([p[0].checked_add(d[0])?, p[1].checked_add(d[1])?])
+}
+
+impl World {
+    /// An empty world (no animats) with validated parameters: for hand-built scenes.
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] if the parameters are invalid.
+    pub fn empty(params: Params, seed: u64) -> Result<Self, WorldError> {
+        params.validate()?;
+        let fox_rules = params.fox_rule_list()?;
+        let rabbit_rules = params.rabbit_rule_list()?;
+        let grid = PlaneGrid::new(params.grid_box.box_size(params.vision))?;
+        let v = params.vision as u64;
+        let c = params.crowd_radius as u64;
+        Ok(World {
+            fox_rules,
+            rabbit_rules,
+            vision2: v * v,
+            crowd2: c * c,
+            grid,
+            animats: Vec::new(),
+            next_id: 0,
+            steps: 0,
+            order_rng: stream(seed, stream_id(STREAM_ORDER, 0)),
+            action_rng: stream(seed, stream_id(STREAM_ACTION, 0)),
+            queries: QueryCounts::default(),
+            timing: false,
+            search_seconds: 0.0,
+            total_distance_evals: 0,
+            foxes: 0,
+            rabbits: 0,
+            params,
+        })
+    }
+
+    /// The default start: `foxes + rabbits` animats on distinct cells drawn uniformly in the
+    /// disc of radius `start_radius` around the origin (foxes first, so foxes have the lower
+    /// ids), with ages uniform in `[0, max_age / 2]` and fox hunger uniform in
+    /// `[0, hungry_at]`, all from the placement stream of `seed`.
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] if the parameters are invalid.
+    pub fn new(params: Params, seed: u64) -> Result<Self, WorldError> {
+        let mut w = World::empty(params, seed)?;
+        let mut rng = stream(seed, stream_id(STREAM_PLACEMENT, 0));
+        let r = w.params.start_radius;
+        let r2 = (r as i128) * (r as i128);
+        let counts = [
+            (Species::Fox, w.params.foxes),
+            (Species::Rabbit, w.params.rabbits),
+        ];
+        for (species, n) in counts {
+            let max_age = match species {
+                Species::Fox => w.params.fox_max_age,
+                Species::Rabbit => w.params.rabbit_max_age,
+            };
+            let mut placed = 0;
+            while placed < n {
+                let x = rng.random_range(-r..=r);
+                let y = rng.random_range(-r..=r);
+                if (x as i128) * (x as i128) + (y as i128) * (y as i128) > r2
+                    || w.grid.is_occupied([x, y])
+                {
+                    continue;
+                }
+                let age = rng.random_range(0..=max_age / 2);
+                let hunger = match species {
+                    Species::Fox => rng.random_range(0..=w.params.hungry_at),
+                    Species::Rabbit => 0,
+                };
+                w.add(species, [x, y], age, hunger)?;
+                placed += 1;
+            }
+        }
+        Ok(w)
+    }
+
+    /// Adds an animat (a newborn, or part of a hand-built scene) and returns its id.
+    ///
+    /// # Errors
+    /// [`WorldError::Occupied`] if the cell holds an animat.
+    pub fn add(
+        &mut self,
+        species: Species,
+        pos: Pos,
+        age: u32,
+        hunger: u32,
+    ) -> Result<u64, WorldError> {
+        if self.grid.is_occupied(pos) {
+            return Err(WorldError::Occupied(pos));
+        }
+        let id = self.next_id;
+        self.grid.insert(id, pos, species)?;
+        self.next_id += 1;
+        self.animats.push(Animat {
+            id,
+            species,
+            pos,
+            age,
+            hunger: if species == Species::Fox { hunger } else { 0 },
+            alive: true,
+        });
+        match species {
+            Species::Fox => self.foxes += 1,
+            Species::Rabbit => self.rabbits += 1,
+        }
+        Ok(id)
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Steps done.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Live foxes.
+    pub fn foxes(&self) -> u64 {
+        self.foxes
+    }
+
+    /// Live rabbits.
+    pub fn rabbits(&self) -> u64 {
+        self.rabbits
+    }
+
+    /// Live animats, sorted by id (between steps).
+    pub fn animats(&self) -> impl Iterator<Item = &Animat> + '_ {
+        self.animats.iter().filter(|a| a.alive)
+    }
+
+    /// A live animat by id.
+    pub fn get(&self, id: u64) -> Option<&Animat> {
+        self.index_of(id)
+            .map(|i| &self.animats[i])
+            .filter(|a| a.alive)
+    }
+
+    /// Perception queries asked so far.
+    pub fn queries(&self) -> QueryCounts {
+        self.queries
+    }
+
+    /// The search structure (for work counters and diagnostics).
+    pub fn grid(&self) -> &PlaneGrid<Species> {
+        &self.grid
+    }
+
+    /// Distance evaluations of the search structure since the start.
+    pub fn distance_evals(&self) -> u64 {
+        self.total_distance_evals + self.grid.distance_evals()
+    }
+
+    /// Measure the wall time of perception queries (`--timing`); off by default because the
+    /// clock reads cost time themselves. Does not change the trajectory.
+    pub fn set_timing(&mut self, on: bool) {
+        self.timing = on;
+    }
+
+    /// Hash of every live animat's id, species, position, age and hunger, in id order, as 16
+    /// hex digits.
+    pub fn state_hash(&self) -> String {
+        let mut h = StateHasher::new();
+        for a in self.animats() {
+            h.u64(a.id)
+                .u64(a.species.code())
+                .i64(a.pos[0])
+                .i64(a.pos[1])
+                .u64(a.age.into())
+                .u64(a.hunger.into());
+        }
+        h.finish_hex()
+    }
+
+    fn index_of(&self, id: u64) -> Option<usize> {
+        self.animats.binary_search_by_key(&id, |a| a.id).ok()
+    }
+
+    /// Runs `n` steps (stopping early if every animat has died).
+    pub fn run(&mut self, n: u64) {
+        for _ in 0..n {
+            if self.animats.is_empty() {
+                break;
+            }
+            self.step();
+        }
+    }
+
+    /// One step: every animat alive at its start acts once, in a fresh uniformly random order
+    /// (ids sorted, then shuffled with the order stream); an animat eaten earlier in the step
+    /// does not act; newborns first act in the next step. Each runs its species' rules in
+    /// priority order and executes the first whose condition holds; then its age (and a fox's
+    /// hunger) grow by one and it dies if a fox's hunger exceeds `starve` or its age exceeds
+    /// its species' `max_age`.
+    pub fn step(&mut self) -> StepStats {
+        let evals_before = self.grid.take_distance_evals();
+        self.total_distance_evals += evals_before;
+        self.search_seconds = 0.0;
+        let n = self.animats.len();
+        let mut order: Vec<u32> = (0..n as u32).collect();
+        shuffle(&mut self.order_rng, &mut order);
+        for &i in &order {
+            let i = i as usize;
+            if !self.animats[i].alive {
+                continue;
+            }
+            let action = if self.timing {
+                let t = Instant::now();
+                let a = self.decide(i);
+                self.search_seconds += t.elapsed().as_secs_f64();
+                a
+            } else {
+                self.decide(i)
+            };
+            self.apply(i, action);
+            self.age_and_die(i);
+        }
+        self.animats.retain(|a| a.alive);
+        self.steps += 1;
+        let evals = self.grid.take_distance_evals();
+        self.total_distance_evals += evals;
+        StepStats {
+            search_seconds: self.search_seconds,
+            distance_evals: evals,
+        }
+    }
+
+    /// Chooses the action of animat `i`: the first rule whose condition holds. Asks only the
+    /// queries each condition needs, in priority order.
+    fn decide(&mut self, i: usize) -> Action {
+        let a = self.animats[i];
+        match a.species {
+            Species::Fox => {
+                let hungry = a.hunger >= self.params.hungry_at;
+                for k in 0..self.fox_rules.len() {
+                    if let Some(act) = self.fox_rule(self.fox_rules[k], &a, hungry) {
+                        return act;
+                    }
+                }
+                Action::Stay
+            }
+            Species::Rabbit => {
+                for k in 0..self.rabbit_rules.len() {
+                    if let Some(act) = self.rabbit_rule(self.rabbit_rules[k], &a) {
+                        return act;
+                    }
+                }
+                Action::Stay
+            }
+        }
+    }
+
+    fn fox_rule(&mut self, rule: FoxRule, a: &Animat, hungry: bool) -> Option<Action> {
+        match rule {
+            FoxRule::Eat => {
+                if !hungry {
+                    return None;
+                }
+                self.nearest_adjacent(a, Species::Rabbit)
+                    .map(|(id, _)| Action::Eat(id))
+            }
+            FoxRule::Breed => (!hungry
+                && self.adjacent(a, Species::Fox)
+                && !self.overcrowded(a)
+                && self.enough_prey(a))
+            .then_some(Action::Breed),
+            FoxRule::Hunt => {
+                if !hungry {
+                    return None;
+                }
+                self.nearest_seen(a, Species::Rabbit)
+                    .map(|t| Action::Step(self.towards(a.pos, t)))
+            }
+            FoxRule::SeekMate => {
+                if hungry {
+                    return None;
+                }
+                self.nearest_seen(a, Species::Fox)
+                    .map(|t| Action::Step(self.towards(a.pos, t)))
+            }
+            FoxRule::Wander => Some(Action::Wander),
+        }
+    }
+
+    fn rabbit_rule(&mut self, rule: RabbitRule, a: &Animat) -> Option<Action> {
+        match rule {
+            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox).map(|(_, f)| {
+                let t = self.towards(a.pos, f);
+                Action::Step([-t[0], -t[1]])
+            }),
+            RabbitRule::Breed => {
+                (self.adjacent(a, Species::Rabbit) && !self.overcrowded(a)).then_some(Action::Breed)
+            }
+            RabbitRule::Herd => self
+                .nearest_seen(a, Species::Rabbit)
+                .map(|t| Action::Step(self.towards(a.pos, t))),
+            RabbitRule::Wander => Some(Action::Wander),
+        }
+    }
+
+    fn towards(&self, from: Pos, to: Pos) -> [i64; 2] {
+        [sign_towards(from[0], to[0]), sign_towards(from[1], to[1])]
+    }
+
+    /// The nearest adjacent animat of `kind` (ties: lower id) and its position.
+    fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<(u64, Pos)> {
+        self.queries.adjacent += 1;
+        let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
+        self.grid.get(id).map(|(p, _)| (id, p))
+    }
+
+    fn adjacent(&mut self, a: &Animat, kind: Species) -> bool {
+        self.queries.adjacent += 1;
+        self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
+    }
+
+    /// Position of the nearest animat of `kind` within vision (ties: lower id).
+    fn nearest_seen(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
+        self.queries.nearest += 1;
+        let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
+        self.grid.get(id).map(|(p, _)| p)
+    }
+
+    /// More than `crowd_max` animats (either species, `a` excluded) within `crowd_radius`.
+    fn overcrowded(&mut self, a: &Animat) -> bool {
+        self.queries.count += 1;
+        let n = self.params.crowd_max as usize + 1;
+        self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
+    }
+
+    /// At least `prey_needed` rabbits within vision.
+    fn enough_prey(&mut self, a: &Animat) -> bool {
+        self.queries.count += 1;
+        let n = self.params.prey_needed as usize;
+        self.grid
+            .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
+    }
+
+    /// Moves animat `i` one step by `d` unless the target cell is occupied.
+    fn try_step(&mut self, i: usize, d: [i64; 2]) {
+        if d == [0, 0] {
+            return;
+        }
+        let a = self.animats[i];
+        let Some(to) = offset(a.pos, d) else { return };
+        if self.grid.is_occupied(to) {
+            return;
+        }
+        self.grid
+            .move_to(a.id, to)
+            .expect("a live animat is in the grid");
+        self.animats[i].pos = to;
+    }
+
+    fn apply(&mut self, i: usize, action: Action) {
+        match action {
+            Action::Stay => {}
+            Action::Step(d) => self.try_step(i, d),
+            Action::Wander => {
+                let d = DIRECTIONS[self.action_rng.random_range(0..8usize)];
+                self.try_step(i, d);
+            }
+            Action::Eat(rabbit) => {
+                self.kill_id(rabbit);
+                self.animats[i].hunger = 0;
+            }
+            Action::Breed => {
+                let a = self.animats[i];
+                let p = match a.species {
+                    Species::Fox => self.params.fox_breed_p,
+                    Species::Rabbit => self.params.rabbit_breed_p,
+                };
+                if uniform01(&mut self.action_rng) >= p {
+                    return;
+                }
+                let mut free = [[0i64; 2]; 8];
+                let mut n = 0;
+                for d in DIRECTIONS {
+                    if let Some(c) = offset(a.pos, d) {
+                        if !self.grid.is_occupied(c) {
+                            free[n] = c;
+                            n += 1;
+                        }
+                    }
+                }
+                if n > 0 {
+                    let c = free[self.action_rng.random_range(0..n)];
+                    self.add(a.species, c, 0, 0)
+                        .expect("the birth cell was free");
+                }
+            }
+        }
+    }
+
+    fn kill_id(&mut self, id: u64) {
+        if let Some(j) = self.index_of(id) {
+            self.kill(j);
+        }
+    }
+
+    fn kill(&mut self, j: usize) {
+        let a = &mut self.animats[j];
+        if !a.alive {
+            return;
+        }
+        a.alive = false;
+        match a.species {
+            Species::Fox => self.foxes -= 1,
+            Species::Rabbit => self.rabbits -= 1,
+        }
+        let id = a.id;
+        self.grid.remove(id).expect("a live animat is in the grid");
+    }
+
+    fn age_and_die(&mut self, i: usize) {
+        let a = &mut self.animats[i];
+        a.age = a.age.saturating_add(1);
+        let dies = match a.species {
+            Species::Fox => {
+                a.hunger = a.hunger.saturating_add(1);
+                a.hunger > self.params.starve || a.age > self.params.fox_max_age
+            }
+            Species::Rabbit => a.age > self.params.rabbit_max_age,
+        };
+        if dies {
+            self.kill(i);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::GridBox;
+    use Species::{Fox, Rabbit};
+
+    /// Parameters for hand-built scenes: breeding always succeeds, nobody dies of age or
+    /// hunger within a step.
+    fn scene_params() -> Params {
+        Params {
+            foxes: 0,
+            rabbits: 0,
+            fox_breed_p: 1.0,
+            rabbit_breed_p: 1.0,
+            hungry_at: 5,
+            starve: 100,
+            fox_max_age: 1000,
+            rabbit_max_age: 1000,
+            prey_needed: 2,
+            crowd_max: 3,
+            crowd_radius: 2,
+            ..Params::default()
+        }
+    }
+
+    fn world(p: Params) -> World {
+        World::empty(p, 1).unwrap()
+    }
+
+    fn only(rules_f: &[&str], rules_r: &[&str]) -> Params {
+        Params {
+            fox_rules: rules_f.iter().map(|s| s.to_string()).collect(),
+            rabbit_rules: rules_r.iter().map(|s| s.to_string()).collect(),
+            ..scene_params()
+        }
+    }
+
+    #[test]
+    fn flee_steps_directly_away_from_the_nearest_adjacent_fox() {
+        let mut w = world(only(&[], &["flee"]));
+        let r = w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [1, 1], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.get(r).unwrap().pos, [-1, -1]);
+        // Orthogonal fox (d2 = 1) is nearer than a diagonal one (d2 = 2).
+        let mut w = world(only(&[], &["flee"]));
+        let r = w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [1, 1], 0, 0).unwrap();
+        w.add(Fox, [0, -1], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.get(r).unwrap().pos, [0, 1]);
+    }
+
+    #[test]
+    fn eat_removes_the_rabbit_and_resets_hunger() {
+        let mut w = world(only(&["eat"], &[]));
+        let f = w.add(Fox, [0, 0], 0, 7).unwrap();
+        let r = w.add(Rabbit, [1, 0], 0, 0).unwrap();
+        w.step();
+        assert!(w.get(r).is_none());
+        assert_eq!(w.rabbits(), 0);
+        // Hunger reset to 0 by eating, then +1 at the end of the turn.
+        assert_eq!(w.get(f).unwrap().hunger, 1);
+        assert!(!w.grid().is_occupied([1, 0]));
+        // A fox that is not hungry does not eat.
+        let mut w = world(only(&["eat"], &[]));
+        w.add(Fox, [0, 0], 0, 4).unwrap();
+        let r = w.add(Rabbit, [1, 0], 0, 0).unwrap();
+        w.step();
+        assert!(w.get(r).is_some());
+    }
+
+    #[test]
+    fn an_eaten_rabbit_does_not_act() {
+        // Whatever the order, the rabbit acts only if it moves before the fox; with flee it
+        // would step away. Run several seeds: when the fox goes first, the rabbit is gone and
+        // has not moved; the world never holds a dead rabbit.
+        for seed in 0..20 {
+            let mut w = World::empty(only(&["eat"], &["flee"]), seed).unwrap();
+            w.add(Fox, [0, 0], 0, 7).unwrap();
+            let r = w.add(Rabbit, [1, 0], 0, 0).unwrap();
+            w.step();
+            match w.get(r) {
+                Some(a) => assert_eq!(a.pos, [2, 0]),
+                None => assert_eq!(w.rabbits(), 0),
+            }
+        }
+    }
+
+    #[test]
+    fn fox_breeding_needs_prey_and_room() {
+        // Two foxes side by side, not hungry, two rabbits within vision: breeds.
+        let scene = |rabbits: &[Pos], crowd: &[Pos]| {
+            let mut w = world(only(&["breed"], &[]));
+            let f = w.add(Fox, [0, 0], 0, 0).unwrap();
+            w.add(Fox, [10, 10], 0, 0).unwrap(); // far fox: no partner
+            for &p in rabbits {
+                w.add(Rabbit, p, 0, 0).unwrap();
+            }
+            for &p in crowd {
+                w.add(Rabbit, p, 0, 0).unwrap();
+            }
+            (w, f)
+        };
+        // No adjacent fox: no breeding.
+        let (mut w, _) = scene(&[[30, 0], [0, 30]], &[]);
+        w.step();
+        assert_eq!(w.foxes(), 2);
+        // Adjacent partner, enough prey.
+        let (mut w, _) = scene(&[[30, 0], [0, 30]], &[]);
+        w.add(Fox, [1, 0], 0, 0).unwrap();
+        w.step();
+        assert!(w.foxes() > 3, "breeding refused with prey and room");
+        // Prey short: only one rabbit within vision (prey_needed = 2).
+        let (mut w, _) = scene(&[[30, 0], [100, 100]], &[]);
+        w.add(Fox, [1, 0], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.foxes(), 3, "breeding allowed with prey short");
+        // Overcrowded for both foxes: within radius 2 of [0, 0] the partner and 4 rabbits
+        // (5 > crowd_max 3); of [1, 0] the fox and 3 rabbits (4 > 3).
+        let (mut w, _) = scene(&[[30, 0], [0, 30]], &[[-1, 0], [0, -1], [-1, -1], [1, -1]]);
+        w.add(Fox, [1, 0], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.foxes(), 3, "breeding allowed when overcrowded");
+    }
+
+    #[test]
+    fn rabbit_breeding_refused_when_overcrowded() {
+        let mut w = world(only(&[], &["breed"]));
+        w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Rabbit, [1, 0], 0, 0).unwrap();
+        w.step();
+        assert!(w.rabbits() >= 3);
+        let mut w = world(only(&[], &["breed"]));
+        // A dense 3x3 block: every rabbit has more than 3 others within radius 2.
+        for x in 0..3 {
+            for y in 0..3 {
+                w.add(Rabbit, [x, y], 0, 0).unwrap();
+            }
+        }
+        w.step();
+        assert_eq!(w.rabbits(), 9);
+    }
+
+    #[test]
+    fn crowding_and_prey_thresholds_are_exact() {
+        // crowd_max = 3, crowd_radius = 2: exactly 3 others within radius 2 (one exactly at
+        // distance 2) is not overcrowded, 4 is; [2, 1] at d2 = 5 never counts.
+        let mut w = world(scene_params());
+        let me = w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [2, 0], 0, 0).unwrap();
+        w.add(Rabbit, [1, 1], 0, 0).unwrap();
+        w.add(Rabbit, [2, 1], 0, 0).unwrap();
+        w.add(Rabbit, [0, -2], 0, 0).unwrap();
+        let a = *w.get(me).unwrap();
+        assert!(!w.overcrowded(&a));
+        w.add(Fox, [-1, 0], 0, 0).unwrap();
+        assert!(w.overcrowded(&a));
+        // prey_needed = 2: rabbits within vision 60, the one at [60, 0] exactly on the edge.
+        let mut w = world(scene_params());
+        let f = w.add(Fox, [0, 0], 0, 0).unwrap();
+        w.add(Rabbit, [60, 0], 0, 0).unwrap();
+        w.add(Rabbit, [43, 43], 0, 0).unwrap(); // d2 = 3698 > 3600: unseen
+        let a = *w.get(f).unwrap();
+        assert!(!w.enough_prey(&a));
+        w.add(Rabbit, [0, -60], 0, 0).unwrap();
+        assert!(w.enough_prey(&a));
+    }
+
+    #[test]
+    fn newborns_act_next_step_and_ids_increase() {
+        let mut w = world(only(&[], &["breed"]));
+        w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Rabbit, [1, 0], 0, 0).unwrap();
+        w.step();
+        let ages: Vec<(u64, u32)> = w.animats().map(|a| (a.id, a.age)).collect();
+        assert_eq!(&ages[..2], &[(0, 1), (1, 1)]);
+        for &(id, age) in &ages[2..] {
+            assert!(id >= 2);
+            assert_eq!(age, 0, "newborn acted in its birth step");
+        }
+    }
+
+    #[test]
+    fn blocked_steps_stay_put() {
+        // Hunting fox whose step towards the rabbit is blocked by another rabbit.
+        let mut w = world(only(&["hunt"], &[]));
+        let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+        w.add(Rabbit, [1, 1], 0, 0).unwrap();
+        w.add(Rabbit, [5, 5], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.get(f).unwrap().pos, [0, 0]);
+        // Unblocked: it moves diagonally towards the rabbit.
+        let mut w = world(only(&["hunt"], &[]));
+        let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+        w.add(Rabbit, [5, 3], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.get(f).unwrap().pos, [1, 1]);
+        // A fleeing rabbit with its escape cell taken stays.
+        let mut w = world(only(&[], &["flee"]));
+        let r = w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [1, 0], 0, 0).unwrap();
+        w.add(Fox, [-1, 0], 0, 0).unwrap();
+        w.step();
+        // Nearest adjacent fox: both at d2 = 1, lower id (the one at [1, 0]); away is [-1, 0],
+        // occupied.
+        assert_eq!(w.get(r).unwrap().pos, [0, 0]);
+    }
+
+    #[test]
+    fn ties_go_to_the_lower_id() {
+        // Two rabbits equally near the fox, on opposite sides; the lower id wins.
+        for (first, second, want) in [([3, 0], [-3, 0], [1, 0]), ([-3, 0], [3, 0], [-1, 0])] {
+            let mut w = world(only(&["hunt"], &[]));
+            w.add(Rabbit, first, 0, 0).unwrap();
+            w.add(Rabbit, second, 0, 0).unwrap();
+            let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+            w.step();
+            assert_eq!(w.get(f).unwrap().pos, want);
+        }
+    }
+
+    #[test]
+    fn seek_mate_and_herd_step_towards_the_nearest() {
+        let mut w = world(only(&["seek_mate"], &["herd"]));
+        let f = w.add(Fox, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [0, 20], 0, 0).unwrap();
+        let r = w.add(Rabbit, [40, 0], 0, 0).unwrap();
+        w.add(Rabbit, [40, -10], 0, 0).unwrap();
+        w.step();
+        let fp = w.get(f).unwrap().pos;
+        assert!(fp == [0, 1] || fp == [0, 0], "{fp:?}");
+        let rp = w.get(r).unwrap().pos;
+        assert_eq!(rp, [40, -1]);
+        // Hungry foxes do not seek mates; out of vision nothing is seen.
+        let mut w = world(only(&["seek_mate"], &["herd"]));
+        let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+        w.add(Fox, [0, 20], 0, 0).unwrap();
+        let r = w.add(Rabbit, [1000, 0], 0, 0).unwrap();
+        w.step();
+        assert_eq!(w.get(f).unwrap().pos, [0, 0]);
+        assert_eq!(w.get(r).unwrap().pos, [1000, 0]);
+    }
+
+    #[test]
+    fn starvation_and_old_age() {
+        let p = Params {
+            starve: 3,
+            fox_max_age: 10,
+            rabbit_max_age: 2,
+            ..only(&[], &[])
+        };
+        let mut w = world(p);
+        w.add(Fox, [0, 0], 0, 2).unwrap();
+        w.add(Fox, [10, 0], 10, 0).unwrap();
+        w.add(Rabbit, [20, 0], 1, 0).unwrap();
+        w.step();
+        // hunger 3 (not > 3), age 11 > 10, age 2 (not > 2).
+        assert_eq!((w.foxes(), w.rabbits()), (1, 1));
+        w.step();
+        assert_eq!((w.foxes(), w.rabbits()), (0, 0));
+    }
+
+    #[test]
+    fn perception_is_lazy() {
+        // A hungry fox with a rabbit adjacent eats after exactly one query, even with foxes
+        // and rabbits all around.
+        let mut w = world(scene_params());
+        w.add(Fox, [0, 0], 0, 9).unwrap();
+        w.add(Rabbit, [1, 0], 0, 0).unwrap();
+        let q0 = w.queries();
+        let a = w.animats[0];
+        assert_eq!(w.decide(0), Action::Eat(1));
+        let q = w.queries();
+        assert_eq!(q.total() - q0.total(), 1);
+        assert_eq!(q.adjacent, 1);
+        assert_eq!(a.id, 0);
+
+        // A sated fox with no fox adjacent: breed asks one adjacency query and stops; hunt is
+        // skipped without a query (not hungry); seek_mate asks one nearest query and fires.
+        let mut w = world(scene_params());
+        w.add(Fox, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [0, 10], 0, 0).unwrap();
+        for x in 0..5 {
+            w.add(Rabbit, [20 + x, 0], 0, 0).unwrap();
+        }
+        assert_eq!(w.decide(0), Action::Step([0, 1]));
+        assert_eq!(
+            w.queries(),
+            QueryCounts {
+                adjacent: 1,
+                nearest: 1,
+                count: 0
+            }
+        );
+
+        // A rabbit with a fox adjacent flees after one query.
+        let mut w = world(scene_params());
+        w.add(Rabbit, [0, 0], 0, 0).unwrap();
+        w.add(Fox, [1, 0], 0, 0).unwrap();
+        w.add(Rabbit, [-1, 0], 0, 0).unwrap();
+        assert_eq!(w.decide(0), Action::Step([-1, 0]));
+        assert_eq!(w.queries().total(), 1);
+
+        // Over a whole step of a real run, fewer queries than the eager "ask everything"
+        // (5 per animat) would need.
+        let mut w = World::new(Params::default(), 3).unwrap();
+        let n = w.foxes() + w.rabbits();
+        w.step();
+        assert!(w.queries().total() < 5 * n);
+    }
+
+    #[test]
+    fn same_seed_same_run_and_seeds_differ() {
+        let p = Params {
+            foxes: 50,
+            rabbits: 300,
+            start_radius: 40,
+            ..Params::default()
+        };
+        let mut a = World::new(p.clone(), 5).unwrap();
+        let mut b = World::new(p.clone(), 5).unwrap();
+        let mut c = World::new(p, 6).unwrap();
+        a.run(50);
+        b.run(50);
+        c.run(50);
+        assert_eq!(a.state_hash(), b.state_hash());
+        assert_ne!(a.state_hash(), c.state_hash());
+    }
+
+    #[test]
+    fn start_is_on_distinct_cells_in_the_disc() {
+        let p = Params {
+            grid_box: GridBox::Side(7),
+            ..Params::default()
+        };
+        let w = World::new(p.clone(), 9).unwrap();
+        assert_eq!(w.foxes(), p.foxes);
+        assert_eq!(w.rabbits(), p.rabbits);
+        let mut cells: Vec<Pos> = w.animats().map(|a| a.pos).collect();
+        let r = p.start_radius;
+        assert!(cells.iter().all(|c| c[0] * c[0] + c[1] * c[1] <= r * r));
+        cells.sort();
+        cells.dedup();
+        assert_eq!(cells.len() as u64, p.foxes + p.rabbits);
+        w.grid().validate().unwrap();
+    }
+}
