@@ -12,10 +12,14 @@
 //!   far from the origin.
 //! - [`io`]: atomic file writes, the run manifest `run.json`, the checkpoint envelope, PNG and
 //!   CSV writers, and the stable state hash.
+//! - `cli` (feature `cli`): one-line argument errors with exit code 2, and logging set-up, for
+//!   the model binaries.
 //!
 //! Conventions (see `DESIGN.md`): a run is a pure function of its parameters and seed; bad input
 //! is a typed error, never a panic; every output file is written atomically.
 
+#[cfg(feature = "cli")]
+pub mod cli;
 pub mod io;
 pub mod lattice;
 pub mod rng;

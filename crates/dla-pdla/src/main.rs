@@ -108,52 +108,15 @@ fn params(cli: &Cli) -> Result<Params, String> {
     Ok(p)
 }
 
-fn init_logging(cli: &Cli) {
-    let default = if cli.quiet {
-        "warn"
-    } else {
-        match cli.verbose {
-            0 => "warn",
-            1 => "info",
-            _ => "debug",
-        }
-    };
-    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
-        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
-    let _ = tracing_subscriber::fmt()
-        .with_env_filter(filter)
-        .with_writer(std::io::stderr)
-        .try_init();
-}
-
-/// Print a one-line error and return exit code 2 (bad input; nothing written).
-fn usage_error(msg: &str) -> ExitCode {
-    eprintln!("dla: error: {msg}");
-    ExitCode::from(2)
-}
-
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli: Cli = match core_lattice::cli::parse_or_exit("dla") {
         Ok(cli) => cli,
-        Err(e) => {
-            use clap::error::ErrorKind;
-            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-                let _ = e.print();
-                return ExitCode::SUCCESS;
-            }
-            let text = e.to_string();
-            let message: Vec<&str> = text
-                .lines()
-                .take_while(|l| !l.trim().is_empty())
-                .map(str::trim)
-                .collect();
-            return usage_error(message.join(" ").trim_start_matches("error: "));
-        }
+        Err(code) => return code,
     };
-    init_logging(&cli);
+    core_lattice::cli::init_logging(cli.quiet, cli.verbose);
     let params = match params(&cli) {
         Ok(p) => p,
-        Err(msg) => return usage_error(&msg),
+        Err(msg) => return core_lattice::cli::usage_error("dla", &msg),
     };
     let result = match params.dim {
         2 => run::<2>(&cli, params),

@@ -1,0 +1,48 @@
+//! Command-line plumbing shared by the model binaries (feature `cli`): DESIGN.md's "Errors, not
+//! panics" for binaries (bad input is one line naming the value, exit code 2, nothing written)
+//! and its logging convention (`-v`, `RUST_LOG`, quiet by default).
+
+use std::process::ExitCode;
+
+/// Parse the command line into `C`. Help and version requests print and return
+/// `Err(ExitCode::SUCCESS)`; any parse error prints clap's message folded onto one line,
+/// prefixed by `program`, and returns `Err` with exit code 2.
+pub fn parse_or_exit<C: clap::Parser>(program: &str) -> Result<C, ExitCode> {
+    C::try_parse().map_err(|e| {
+        use clap::error::ErrorKind;
+        if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        // clap's message up to its blank line, folded onto one line.
+        let text = e.to_string();
+        let message: Vec<&str> = text
+            .lines()
+            .take_while(|l| !l.trim().is_empty())
+            .map(str::trim)
+            .collect();
+        usage_error(program, message.join(" ").trim_start_matches("error: "))
+    })
+}
+
+/// Print `program: error: msg` on one line and return exit code 2 (bad input).
+pub fn usage_error(program: &str, msg: &str) -> ExitCode {
+    eprintln!("{program}: error: {msg}");
+    ExitCode::from(2)
+}
+
+/// Log to stderr with `tracing`: warnings only when `quiet` or without `-v`, info with `-v`,
+/// debug with `-vv`; `RUST_LOG` overrides.
+pub fn init_logging(quiet: bool, verbose: u8) {
+    let default = match (quiet, verbose) {
+        (true, _) | (false, 0) => "warn",
+        (false, 1) => "info",
+        _ => "debug",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .try_init();
+}
