@@ -205,4 +205,24 @@ mod tests {
         }
         assert_eq!(RunManifest::read(dir.path().join("run.json")).unwrap(), m);
     }
+
+    /// Floats written to run.json read back bit-exact (serde_json's `float_roundtrip`); this
+    /// CPU-seconds value (102595 us times 1e-6) came back one ulp off with the default parser.
+    #[test]
+    fn floats_round_trip_exactly() {
+        for x in [
+            102_595.0f64 * 1e-6,
+            0.1 + 0.2,
+            1e-300,
+            123456.789e10,
+            f64::MIN_POSITIVE,
+        ] {
+            let text = serde_json::to_string(&x).unwrap();
+            assert_eq!(
+                serde_json::from_str::<f64>(&text).unwrap().to_bits(),
+                x.to_bits(),
+                "{text}"
+            );
+        }
+    }
 }
