@@ -121,22 +121,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
 }
 
 fn main() -> ExitCode {
-    let cli: Cli = match core_lattice::cli::parse_or_exit("animat") {
-        Ok(cli) => cli,
-        Err(code) => return code,
-    };
-    core_lattice::cli::init_logging(cli.quiet, cli.verbose);
-    let params = match params(&cli) {
-        Ok(p) => p,
-        Err(msg) => return core_lattice::cli::usage_error("animat", &msg),
-    };
-    match run(&cli, params) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("animat: error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    core_lattice::cli::main_with("animat", |c: &Cli| (c.quiet, c.verbose), params, run)
 }
 
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {

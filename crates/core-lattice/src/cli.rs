@@ -4,6 +4,36 @@
 
 use std::process::ExitCode;
 
+/// The whole life of a model binary: parse the flags (help, version and parse errors handled
+/// as in [`parse_or_exit`]), set up logging from the `quiet` and `verbose` flags that `logging`
+/// reads off them, turn the flags into validated parameters (an `Err` is bad input: one line,
+/// exit code 2, nothing written), then `run`; a run error prints its full chain on one line and
+/// exits with code 1.
+pub fn main_with<C: clap::Parser, P, E: std::fmt::Display>(
+    program: &str,
+    logging: impl FnOnce(&C) -> (bool, u8),
+    params: impl FnOnce(&C) -> Result<P, String>,
+    run: impl FnOnce(&C, P) -> Result<(), E>,
+) -> ExitCode {
+    let cli: C = match parse_or_exit(program) {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
+    let (quiet, verbose) = logging(&cli);
+    init_logging(quiet, verbose);
+    let params = match params(&cli) {
+        Ok(p) => p,
+        Err(msg) => return usage_error(program, &msg),
+    };
+    match run(&cli, params) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{program}: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 /// Parse the command line into `C`. Help and version requests print and return
 /// `Err(ExitCode::SUCCESS)`; any parse error prints clap's message folded onto one line,
 /// prefixed by `program`, and returns `Err` with exit code 2.

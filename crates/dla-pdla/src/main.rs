@@ -109,26 +109,15 @@ fn params(cli: &Cli) -> Result<Params, String> {
 }
 
 fn main() -> ExitCode {
-    let cli: Cli = match core_lattice::cli::parse_or_exit("dla") {
-        Ok(cli) => cli,
-        Err(code) => return code,
-    };
-    core_lattice::cli::init_logging(cli.quiet, cli.verbose);
-    let params = match params(&cli) {
-        Ok(p) => p,
-        Err(msg) => return core_lattice::cli::usage_error("dla", &msg),
-    };
-    let result = match params.dim {
-        2 => run::<2>(&cli, params),
-        _ => run::<3>(&cli, params),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("dla: error: {e:#}");
-            ExitCode::FAILURE
-        }
-    }
+    core_lattice::cli::main_with(
+        "dla",
+        |c: &Cli| (c.quiet, c.verbose),
+        params,
+        |cli, params: Params| match params.dim {
+            2 => run::<2>(cli, params),
+            _ => run::<3>(cli, params),
+        },
+    )
 }
 
 fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()> {
