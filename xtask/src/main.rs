@@ -2,12 +2,18 @@
 //!
 //! - `cargo xtask ci`: the checks CI runs: formatting, clippy with warnings denied, rustdoc with
 //!   warnings denied, and the test suite (the README's test command).
+//! - `cargo xtask scaling [--quick] [--only ...] [--out DIR]`: regenerate the papers' tables
+//!   and figures from our own runs (see `docs/results/README.md`).
+//! - `cargo xtask bench [--save FILE] [--against FILE]`: the headline speed and memory figures
+//!   as JSON, and their ratios to a saved baseline.
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::Command;
 use std::time::Instant;
+use xtask::scaling::{Experiment, Options, Scale};
+use xtask::{cargo, workspace_root};
 
 #[derive(Parser)]
 #[command(
@@ -27,6 +33,39 @@ enum Cmd {
         /// Skip the test suite (formatting, lints and docs only).
         #[arg(long)]
         no_tests: bool,
+    },
+    /// Regenerate the papers' tables and figures from our own runs, with fitted exponents and
+    /// error bars beside the published values: markdown, CSV and PNG under --out.
+    Scaling {
+        /// Smaller sizes, under 3 minutes on 2 cores; every table says so. Default output
+        /// directory: docs/results/quick/.
+        #[arg(long)]
+        quick: bool,
+        /// Only these experiments (repeat or comma-separate); default all.
+        #[arg(long, value_enum, value_delimiter = ',')]
+        only: Vec<Experiment>,
+        /// Output directory (default docs/results/, or docs/results/quick/ with --quick).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Base seed; the runs of an ensemble use seed, seed + 1, ...
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Run size: overrides --quick (`tiny` is the harness test's size).
+        #[arg(long, value_enum, hide = true)]
+        scale: Option<Scale>,
+    },
+    /// Run the headline workloads as release binaries and print JSON: seconds, peak RSS,
+    /// per-item rates.
+    Bench {
+        /// Write the JSON report to this file (a baseline for --against).
+        #[arg(long)]
+        save: Option<PathBuf>,
+        /// Compare with a saved report: prints now/baseline ratios (> 1 is slower).
+        #[arg(long)]
+        against: Option<PathBuf>,
+        /// Only workloads whose name contains this text.
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -68,18 +107,6 @@ const CI_STEPS: &[Step] = &[
     },
 ];
 
-fn workspace_root() -> PathBuf {
-    // xtask/ is one level below the workspace root.
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("xtask has a parent")
-        .to_path_buf()
-}
-
-fn cargo() -> String {
-    std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string())
-}
-
 fn run_step(step: &Step) -> Result<()> {
     eprintln!("==> {}: cargo {}", step.name, step.args.join(" "));
     let start = Instant::now();
@@ -114,6 +141,54 @@ fn ci(no_tests: bool) -> Result<()> {
 fn main() -> Result<()> {
     match Cli::parse().command {
         Cmd::Ci { no_tests } => ci(no_tests),
+        Cmd::Scaling {
+            quick,
+            only,
+            out,
+            seed,
+            scale,
+        } => {
+            let scale = scale.unwrap_or(if quick { Scale::Quick } else { Scale::Full });
+            let out = out.unwrap_or_else(|| {
+                let base = workspace_root().join("docs/results");
+                if scale == Scale::Full {
+                    base
+                } else {
+                    base.join("quick")
+                }
+            });
+            let command = std::iter::once("cargo xtask".to_string())
+                .chain(std::env::args().skip(1))
+                .collect::<Vec<_>>()
+                .join(" ");
+            let start = Instant::now();
+            let times = xtask::scaling::run(&Options {
+                scale,
+                only,
+                out: out.clone(),
+                seed,
+                command,
+            })?;
+            eprintln!(
+                "==> {} experiment(s) in {:.1} s; reports in {}",
+                times.len(),
+                start.elapsed().as_secs_f64(),
+                out.display()
+            );
+            Ok(())
+        }
+        Cmd::Bench {
+            save,
+            against,
+            only,
+        } => xtask::bench::run(
+            &workspace_root(),
+            &cargo(),
+            only.as_deref(),
+            save.as_deref(),
+            against.as_deref(),
+        )
+        .map(|_| ()),
     }
 }
 

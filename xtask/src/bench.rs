@@ -1,0 +1,410 @@
+//! `cargo xtask bench`: the headline workloads, each run as its own release-binary process so
+//! its peak RSS is its own, reported as JSON (seconds, peak RSS, per-item rates) and, with
+//! `--against`, as ratios to a saved baseline.
+
+use crate::report::{machine, utc_now};
+use anyhow::{Context, Result, bail};
+use core_lattice::io::{RunManifest, write_atomic};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// One headline workload: a binary and its arguments (without `--out`).
+#[derive(Debug, Clone)]
+pub struct Workload {
+    /// Stable name, used to match baselines.
+    pub name: &'static str,
+    /// Binary under `target/release`.
+    pub bin: &'static str,
+    /// Arguments.
+    pub args: &'static [&'static str],
+    /// What the rate counts.
+    pub unit: &'static str,
+}
+
+/// The workloads of issue 7, in the order they run.
+pub const WORKLOADS: &[Workload] = &[
+    Workload {
+        name: "dla-2d-1e6-1thread",
+        bin: "dla",
+        args: &[
+            "--dim",
+            "2",
+            "--particles",
+            "1000000",
+            "--threads",
+            "1",
+            "--seed",
+            "1",
+        ],
+        unit: "particles per second",
+    },
+    Workload {
+        name: "dla-2d-1e6-2threads",
+        bin: "dla",
+        args: &[
+            "--dim",
+            "2",
+            "--particles",
+            "1000000",
+            "--threads",
+            "2",
+            "--seed",
+            "1",
+        ],
+        unit: "particles per second",
+    },
+    Workload {
+        name: "dla-3d-1e5",
+        bin: "dla",
+        args: &["--dim", "3", "--particles", "100000", "--seed", "1"],
+        unit: "particles per second",
+    },
+    Workload {
+        name: "dlca-1024-50k-to-1",
+        bin: "dlca",
+        args: &[
+            "--size",
+            "1024",
+            "--particles",
+            "50000",
+            "--target-clusters",
+            "1",
+            "--seed",
+            "1",
+        ],
+        unit: "sweeps per second",
+    },
+    Workload {
+        name: "dlca-1024x512-5pct-to-100",
+        bin: "dlca",
+        args: &["--size", "1024x512", "--fill", "0.05", "--seed", "1"],
+        unit: "sweeps per second",
+    },
+    Workload {
+        name: "animat-1e5-100steps",
+        bin: "animat",
+        args: &[
+            "--foxes",
+            "13043",
+            "--rabbits",
+            "86957",
+            "--density",
+            "0.01",
+            "--steps",
+            "100",
+            "--seed",
+            "1",
+        ],
+        unit: "animat-steps per second",
+    },
+];
+
+/// The measured result of one workload.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Measurement {
+    /// Workload name.
+    pub name: String,
+    /// The command that ran (relative binary path).
+    pub command: String,
+    /// Wall seconds of the process.
+    pub wall_seconds: f64,
+    /// CPU seconds reported by the run (user + system).
+    pub cpu_seconds: Option<f64>,
+    /// Peak resident set size reported by the run.
+    pub peak_rss_bytes: Option<u64>,
+    /// Items per wall second.
+    pub rate: f64,
+    /// What the rate counts.
+    pub unit: String,
+    /// Bytes of peak RSS per item, where an item is a particle or an animat.
+    pub bytes_per_item: Option<f64>,
+    /// The run's state hash (equal for equal code and seeds).
+    pub state_hash: Option<String>,
+}
+
+/// A whole `cargo xtask bench` report.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct BenchReport {
+    /// When it ran.
+    pub date: String,
+    /// Where it ran.
+    pub machine: String,
+    /// The measurements.
+    pub workloads: Vec<Measurement>,
+    /// Ratios to a baseline (`--against`), if one was given.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub against: Vec<Ratio>,
+}
+
+/// This run against a baseline, for one workload: > 1 means slower / bigger now.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct Ratio {
+    /// Workload name.
+    pub name: String,
+    /// Wall seconds now / baseline.
+    pub wall_ratio: f64,
+    /// Peak RSS now / baseline.
+    pub rss_ratio: Option<f64>,
+    /// Whether the state hash changed (a different trajectory: the timing compares different
+    /// work).
+    pub hash_changed: bool,
+}
+
+fn target_dir(root: &Path) -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .map(|p| if p.is_absolute() { p } else { root.join(p) })
+        .unwrap_or_else(|| root.join("target"))
+}
+
+/// Build the release binaries the workloads need.
+fn build(root: &Path, cargo: &str) -> Result<()> {
+    eprintln!("==> building release binaries");
+    let status = Command::new(cargo)
+        .args([
+            "build",
+            "--release",
+            "-p",
+            "dla-pdla",
+            "-p",
+            "dlca",
+            "-p",
+            "animat",
+            "--bins",
+        ])
+        .current_dir(root)
+        .status()
+        .context("could not start cargo build")?;
+    if !status.success() {
+        bail!("cargo build failed ({status})");
+    }
+    Ok(())
+}
+
+/// Items the rate counts, from the run's outputs.
+fn items(w: &Workload, m: &RunManifest, dir: &Path) -> Result<(f64, Option<f64>)> {
+    let r = &m.results;
+    let num = |k: &str| r.get(k).and_then(|v| v.as_f64());
+    Ok(match w.bin {
+        "dla" => {
+            let n = num("particles").context("run.json has no particles")?;
+            (n, Some(n))
+        }
+        "dlca" => (
+            num("sweeps").context("run.json has no sweeps")?,
+            num("particles"),
+        ),
+        _ => {
+            // Animat-steps: the population at each step, summed, from populations.csv.
+            let text = std::fs::read_to_string(dir.join("populations.csv"))
+                .context("reading populations.csv")?;
+            let mut total = 0.0;
+            let mut peak: f64 = 0.0;
+            for line in text.lines().skip(1) {
+                let f: Vec<&str> = line.split(',').collect();
+                if f.len() >= 3 {
+                    let pop =
+                        f[1].parse::<f64>().unwrap_or(0.0) + f[2].parse::<f64>().unwrap_or(0.0);
+                    total += pop;
+                    peak = peak.max(pop);
+                }
+            }
+            (total, Some(peak))
+        }
+    })
+}
+
+/// Run one workload in a temporary directory.
+pub fn measure(w: &Workload, bin_dir: &Path) -> Result<Measurement> {
+    let out = tempfile::tempdir().context("creating a temporary output directory")?;
+    let bin = bin_dir.join(w.bin);
+    let command = format!("target/release/{} {} -q --out DIR", w.bin, w.args.join(" "));
+    eprintln!("==> {}: {command}", w.name);
+    let start = Instant::now();
+    let output = Command::new(&bin)
+        .args(w.args)
+        .arg("-q")
+        .arg("--out")
+        .arg(out.path())
+        .output()
+        .with_context(|| format!("could not run {}", bin.display()))?;
+    let wall = start.elapsed().as_secs_f64();
+    if !output.status.success() {
+        bail!(
+            "{} failed ({}): {}",
+            w.name,
+            output.status,
+            String::from_utf8_lossy(&output.stderr).trim()
+        );
+    }
+    let m = RunManifest::read(out.path().join("run.json")).context("reading run.json")?;
+    let (count, per) = items(w, &m, out.path())?;
+    let measurement = Measurement {
+        name: w.name.into(),
+        command,
+        wall_seconds: wall,
+        cpu_seconds: m.cpu_seconds,
+        peak_rss_bytes: m.peak_rss_bytes,
+        rate: count / m.wall_seconds.max(1e-9),
+        unit: w.unit.into(),
+        bytes_per_item: match (m.peak_rss_bytes, per) {
+            (Some(b), Some(n)) if n > 0.0 => Some(b as f64 / n),
+            _ => None,
+        },
+        state_hash: m
+            .results
+            .get("state_hash")
+            .and_then(|v| v.as_str())
+            .map(String::from),
+    };
+    eprintln!(
+        "    {:.2} s wall, {:.3e} {}, peak RSS {} MB",
+        wall,
+        measurement.rate,
+        w.unit,
+        m.peak_rss_bytes.map(|b| b / 1_000_000).unwrap_or(0)
+    );
+    Ok(measurement)
+}
+
+/// Ratios of `now` to `base` for the workloads both contain.
+pub fn compare(now: &[Measurement], base: &[Measurement]) -> Vec<Ratio> {
+    now.iter()
+        .filter_map(|n| {
+            let b = base.iter().find(|b| b.name == n.name)?;
+            Some(Ratio {
+                name: n.name.clone(),
+                wall_ratio: n.wall_seconds / b.wall_seconds,
+                rss_ratio: match (n.peak_rss_bytes, b.peak_rss_bytes) {
+                    (Some(x), Some(y)) if y > 0 => Some(x as f64 / y as f64),
+                    _ => None,
+                },
+                hash_changed: n.state_hash != b.state_hash,
+            })
+        })
+        .collect()
+}
+
+/// `cargo xtask bench`: build, run the workloads whose name contains `only` (all if `None`),
+/// print JSON, optionally save it and compare with a baseline.
+pub fn run(
+    root: &Path,
+    cargo: &str,
+    only: Option<&str>,
+    save: Option<&Path>,
+    against: Option<&Path>,
+) -> Result<BenchReport> {
+    let baseline: Option<BenchReport> = match against {
+        Some(p) => Some(
+            serde_json::from_slice(
+                &std::fs::read(p).with_context(|| format!("reading {}", p.display()))?,
+            )
+            .with_context(|| format!("{} is not a bench report", p.display()))?,
+        ),
+        None => None,
+    };
+    let chosen: Vec<&Workload> = WORKLOADS
+        .iter()
+        .filter(|w| only.is_none_or(|o| w.name.contains(o)))
+        .collect();
+    if chosen.is_empty() {
+        bail!(
+            "--only {} matches no workload; the workloads are: {}",
+            only.unwrap_or(""),
+            WORKLOADS
+                .iter()
+                .map(|w| w.name)
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    build(root, cargo)?;
+    let bin_dir = target_dir(root).join("release");
+    let mut workloads = Vec::new();
+    for w in chosen {
+        workloads.push(measure(w, &bin_dir)?);
+    }
+    let mut report = BenchReport {
+        date: utc_now(),
+        machine: machine(),
+        workloads,
+        against: Vec::new(),
+    };
+    if let Some(b) = &baseline {
+        report.against = compare(&report.workloads, &b.workloads);
+        eprintln!(
+            "==> against {} ({})",
+            against.expect("set").display(),
+            b.date
+        );
+        for r in &report.against {
+            eprintln!(
+                "    {:<28} wall x{:.3}{}{}",
+                r.name,
+                r.wall_ratio,
+                r.rss_ratio
+                    .map(|x| format!(", peak RSS x{x:.3}"))
+                    .unwrap_or_default(),
+                if r.hash_changed {
+                    " (state hash changed: different trajectory)"
+                } else {
+                    ""
+                }
+            );
+        }
+    }
+    let json = serde_json::to_string_pretty(&report)?;
+    println!("{json}");
+    if let Some(p) = save {
+        write_atomic(p, format!("{json}\n").as_bytes())
+            .with_context(|| format!("writing {}", p.display()))?;
+        eprintln!("==> saved to {}", p.display());
+    }
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn m(name: &str, wall: f64, rss: u64, hash: &str) -> Measurement {
+        Measurement {
+            name: name.into(),
+            command: String::new(),
+            wall_seconds: wall,
+            cpu_seconds: None,
+            peak_rss_bytes: Some(rss),
+            rate: 1.0,
+            unit: "x".into(),
+            bytes_per_item: None,
+            state_hash: Some(hash.into()),
+        }
+    }
+
+    #[test]
+    fn ratios_against_a_baseline() {
+        let base = vec![m("a", 2.0, 100, "h"), m("b", 1.0, 100, "h")];
+        let now = vec![m("a", 3.0, 50, "h"), m("c", 1.0, 1, "h")];
+        let r = compare(&now, &base);
+        assert_eq!(r.len(), 1);
+        assert_eq!(r[0].wall_ratio, 1.5);
+        assert_eq!(r[0].rss_ratio, Some(0.5));
+        assert!(!r[0].hash_changed);
+        let r = compare(&[m("b", 1.0, 100, "other")], &base);
+        assert!(r[0].hash_changed);
+    }
+
+    #[test]
+    fn report_round_trips() {
+        let r = BenchReport {
+            date: "d".into(),
+            machine: "m".into(),
+            workloads: vec![m("a", 1.0, 2, "h")],
+            against: Vec::new(),
+        };
+        let s = serde_json::to_string(&r).unwrap();
+        assert_eq!(serde_json::from_str::<BenchReport>(&s).unwrap(), r);
+    }
+}

@@ -1,0 +1,277 @@
+//! Tables (markdown and CSV), number formatting with error bars, and the provenance every result
+//! file carries: date, machine, command.
+
+use anyhow::{Context, Result};
+use core_lattice::io::write_atomic;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::{SystemTime, UNIX_EPOCH};
+
+/// A table written both as markdown (for the report) and as CSV (the data behind it).
+#[derive(Debug, Clone, Default)]
+pub struct Table {
+    /// Column names.
+    pub header: Vec<String>,
+    /// Rows of already formatted cells.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// An empty table with these columns.
+    pub fn new(header: &[&str]) -> Self {
+        Table {
+            header: header.iter().map(|s| s.to_string()).collect(),
+            rows: Vec::new(),
+        }
+    }
+
+    /// Append a row; it must have one cell per column.
+    pub fn row(&mut self, cells: Vec<String>) {
+        assert_eq!(
+            cells.len(),
+            self.header.len(),
+            "a row of {} cells in a table of {} columns",
+            cells.len(),
+            self.header.len()
+        );
+        self.rows.push(cells);
+    }
+
+    /// The table as GitHub markdown.
+    pub fn markdown(&self) -> String {
+        let mut s = String::new();
+        let line = |cells: &[String]| format!("| {} |\n", cells.join(" | "));
+        s.push_str(&line(&self.header));
+        s.push_str(&format!("|{}\n", "---|".repeat(self.header.len())));
+        for r in &self.rows {
+            s.push_str(&line(r));
+        }
+        s
+    }
+
+    /// The table as CSV (RFC 4180 quoting where a cell needs it).
+    pub fn csv(&self) -> String {
+        let mut s = String::new();
+        for r in std::iter::once(&self.header).chain(&self.rows) {
+            let cells: Vec<String> = r.iter().map(|c| csv_cell(c)).collect();
+            s.push_str(&cells.join(","));
+            s.push('\n');
+        }
+        s
+    }
+
+    /// Write the CSV atomically.
+    pub fn write_csv(&self, path: &Path) -> Result<()> {
+        write_atomic(path, self.csv().as_bytes())
+            .with_context(|| format!("writing {}", path.display()))
+    }
+}
+
+fn csv_cell(c: &str) -> String {
+    if c.contains([',', '"', '\n']) {
+        format!("\"{}\"", c.replace('"', "\"\""))
+    } else {
+        c.to_string()
+    }
+}
+
+/// Decimal places that show an uncertainty `err` with two significant digits.
+fn decimals_for(err: f64) -> usize {
+    if !(err.is_finite() && err > 0.0) {
+        return 3;
+    }
+    (1 - err.log10().floor() as i64).clamp(0, 9) as usize
+}
+
+/// `value ± err`, rounded to the error's second significant digit (`1.428 ± 0.023`).
+pub fn pm(value: f64, err: f64) -> String {
+    if !value.is_finite() {
+        return "n/a".to_string();
+    }
+    if !(err.is_finite() && err > 0.0) {
+        return sig(value, 4);
+    }
+    let d = decimals_for(err);
+    format!("{value:.d$} ± {err:.d$}")
+}
+
+/// A number with `digits` significant digits, in plain or scientific notation by magnitude.
+pub fn sig(v: f64, digits: usize) -> String {
+    if !v.is_finite() {
+        return "n/a".to_string();
+    }
+    if v == 0.0 {
+        return "0".to_string();
+    }
+    let mag = v.abs().log10().floor() as i32;
+    if !(-3..6).contains(&mag) {
+        return format!("{:.*e}", digits.saturating_sub(1), v);
+    }
+    let d = (digits as i32 - 1 - mag).max(0) as usize;
+    format!("{v:.d$}")
+}
+
+/// Mean and standard error of the mean (0 for a single value).
+pub fn mean_stderr(xs: &[f64]) -> (f64, f64) {
+    let n = xs.len() as f64;
+    if xs.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let m = xs.iter().sum::<f64>() / n;
+    if xs.len() < 2 {
+        return (m, 0.0);
+    }
+    let var = xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+/// Sample standard deviation (0 for fewer than two values).
+pub fn std_dev(xs: &[f64]) -> f64 {
+    let (_, se) = mean_stderr(xs);
+    se * (xs.len() as f64).sqrt()
+}
+
+/// Today's date and time in UTC, `YYYY-MM-DD HH:MM UTC`, from the system clock.
+pub fn utc_now() -> String {
+    let secs = SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    let (y, m, d) = civil_from_days(days as i64);
+    format!(
+        "{y:04}-{m:02}-{d:02} {:02}:{:02} UTC",
+        rem / 3600,
+        (rem % 3600) / 60
+    )
+}
+
+/// Proleptic Gregorian date of a day count since 1970-01-01 (H. Hinnant's algorithm).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (y, m, d)
+}
+
+/// One line describing the machine: CPU model, logical cores, memory, kernel, rustc.
+pub fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".to_string());
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
+    let mem = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("MemTotal"))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|kb| kb.parse::<f64>().ok())
+        })
+        .map(|kb| format!("{:.0} GiB", kb / 1024.0 / 1024.0))
+        .unwrap_or_else(|| "unknown memory".to_string());
+    let kernel = std::fs::read_to_string("/proc/sys/kernel/osrelease")
+        .map(|s| format!("Linux {}", s.trim()))
+        .unwrap_or_else(|_| std::env::consts::OS.to_string());
+    let rustc = std::process::Command::new(std::env::var("RUSTC").unwrap_or("rustc".into()))
+        .arg("-V")
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "rustc (version unknown)".to_string());
+    format!("{cpu}, {cores} logical cores, {mem}, {kernel}, {rustc}")
+}
+
+/// A markdown document under construction.
+#[derive(Debug, Default)]
+pub struct Doc {
+    text: String,
+}
+
+impl Doc {
+    /// A document with a level-1 title.
+    pub fn new(title: &str) -> Self {
+        Doc {
+            text: format!("# {title}\n\n"),
+        }
+    }
+
+    /// A level-2 heading.
+    pub fn h2(&mut self, title: &str) {
+        let _ = write!(self.text, "## {title}\n\n");
+    }
+
+    /// A paragraph.
+    pub fn p(&mut self, text: &str) {
+        let _ = write!(self.text, "{}\n\n", text.trim());
+    }
+
+    /// A table.
+    pub fn table(&mut self, t: &Table) {
+        let _ = writeln!(self.text, "{}", t.markdown());
+    }
+
+    /// An image link.
+    pub fn image(&mut self, alt: &str, file: &str) {
+        let _ = write!(self.text, "![{alt}]({file})\n\n");
+    }
+
+    /// The markdown text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Write atomically.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        write_atomic(path, self.text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_error_bars() {
+        assert_eq!(pm(1.42812, 0.0231), "1.428 ± 0.023");
+        assert_eq!(pm(73.4, 4.2), "73.4 ± 4.2");
+        assert_eq!(pm(1234.0, 150.0), "1234 ± 150");
+        assert_eq!(pm(2.0, 0.0), "2.000");
+        assert_eq!(sig(0.012345, 3), "0.0123");
+        assert_eq!(sig(1.5e-7, 2), "1.5e-7");
+    }
+
+    #[test]
+    fn dates() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(20_414), (2025, 11, 22));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+    }
+
+    #[test]
+    fn tables() {
+        let mut t = Table::new(&["a", "b"]);
+        t.row(vec!["1".into(), "x, y".into()]);
+        assert_eq!(t.csv(), "a,b\n1,\"x, y\"\n");
+        assert_eq!(t.markdown(), "| a | b |\n|---|---|\n| 1 | x, y |\n");
+        let (m, se) = mean_stderr(&[1.0, 2.0, 3.0]);
+        assert_eq!(m, 2.0);
+        assert!((se - (1.0f64 / 3.0).sqrt()).abs() < 1e-12);
+    }
+}
