@@ -101,8 +101,10 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         ctx.seed + e - 1
     ));
     let settings = settings();
-    let jobs: Vec<(usize, u64)> = (0..settings.len())
-        .flat_map(|i| (0..e).map(move |s| (i, s)))
+    // Seed-major order: each setting's runs are spread over the whole sweep, so a change of
+    // machine load during the sweep does not bias one setting's time.
+    let jobs: Vec<(usize, u64)> = (0..e)
+        .flat_map(|s| (0..settings.len()).map(move |i| (i, s)))
         .collect();
     ctx.log(&format!(
         "{} settings x {e} runs of N = {n}",
