@@ -104,6 +104,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "animat_fig9.png",
         "dla_fig3.png",
         "accuracy_pareto.png",
+        "accuracy_pareto_prefactor.png",
         "accuracy_vpdist.png",
     ] {
         check_png(d, png);
