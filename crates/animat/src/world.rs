@@ -1,6 +1,7 @@
 //! The animat world: animats on the unbounded plane, their rules, and one step of the model
 //! (MODELS.md section 3; seed 000, section II.B).
 
+use crate::cells::{CellIndex, WINDOW_MAX, encode, id_of, kind_of};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
@@ -28,6 +29,15 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
     [0, -1],
     [1, -1],
 ];
+
+/// Largest cell-ring radius the cell-index searches scan before handing a query to the grid.
+const RING_MAX: i64 = 8;
+const _: () = assert!(RING_MAX <= WINDOW_MAX);
+
+/// The 4 orthogonal neighbours (squared distance 1).
+const ORTHOGONAL: [[i64; 2]; 4] = [[1, 0], [0, 1], [-1, 0], [0, -1]];
+/// The 4 diagonal neighbours (squared distance 2).
+const DIAGONAL: [[i64; 2]; 4] = [[1, 1], [-1, 1], [-1, -1], [1, -1]];
 
 /// One animat.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,6 +122,15 @@ pub struct World {
     vision2: u64,
     crowd2: u64,
     grid: PlaneGrid<Species>,
+    /// Which animat stands on each cell (always maintained; read by perception when
+    /// `cell_search` is on).
+    cells: CellIndex,
+    /// Answer small-radius perception from the cell index before the grid boxes.
+    cell_search: bool,
+    /// Distance evaluations made by cell-index searches since the last step boundary.
+    cell_evals: u64,
+    /// Reused visiting-order buffer.
+    order: Vec<u32>,
     /// Live animats (and, during a step, the ones that died in it), sorted by id.
     animats: Vec<Animat>,
     next_id: u64,
@@ -157,7 +176,11 @@ impl World {
             rabbit_rules,
             vision2: v * v,
             crowd2: c * c,
+            cell_search: grid.box_size() != spatial::plane::BoxSize::None,
             grid,
+            cells: CellIndex::default(),
+            cell_evals: 0,
+            order: Vec::new(),
             animats: Vec::new(),
             next_id: 0,
             steps: 0,
@@ -199,7 +222,7 @@ impl World {
                 let x = rng.random_range(-r..=r);
                 let y = rng.random_range(-r..=r);
                 if (x as i128) * (x as i128) + (y as i128) * (y as i128) > r2
-                    || w.grid.is_occupied([x, y])
+                    || w.cells.get([x, y]) != 0
                 {
                     continue;
                 }
@@ -226,11 +249,12 @@ impl World {
         age: u32,
         hunger: u32,
     ) -> Result<u64, WorldError> {
-        if self.grid.is_occupied(pos) {
+        if self.cells.get(pos) != 0 {
             return Err(WorldError::Occupied(pos));
         }
         let id = self.next_id;
         self.grid.insert(id, pos, species)?;
+        self.cells.set(pos, encode(id, species == Species::Rabbit));
         self.next_id += 1;
         self.animats.push(Animat {
             id,
@@ -291,7 +315,23 @@ impl World {
 
     /// Distance evaluations of the search structure since the start.
     pub fn distance_evals(&self) -> u64 {
-        self.total_distance_evals + self.grid.distance_evals()
+        self.total_distance_evals + self.grid.distance_evals() + self.cell_evals
+    }
+
+    /// Whether small-radius perception reads the cell index first (see
+    /// [`World::set_cell_search`]).
+    pub fn cell_search(&self) -> bool {
+        self.cell_search
+    }
+
+    /// Turns the cell-index search on or off. On by default with grid boxes, off (and ignored)
+    /// in the exhaustive `none` mode, which stays the paper's "no grid" baseline. With it on,
+    /// adjacency and overcrowding tests read the cells around the animat directly, and nearest
+    /// and counting queries scan cell rings outward up to radius 8 before falling back to the
+    /// grid boxes; both give the exact answers, so the trajectory does not change. Turning it
+    /// off measures the grid boxes alone (seed 000's structure).
+    pub fn set_cell_search(&mut self, on: bool) {
+        self.cell_search = on && self.grid.box_size() != spatial::plane::BoxSize::None;
     }
 
     /// Measure the wall time of perception queries (`--timing`); off by default because the
@@ -336,11 +376,13 @@ impl World {
     /// hunger) grow by one and it dies if a fox's hunger exceeds `starve` or its age exceeds
     /// its species' `max_age`.
     pub fn step(&mut self) -> StepStats {
-        let evals_before = self.grid.take_distance_evals();
+        let evals_before = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals_before;
         self.search_seconds = 0.0;
         let n = self.animats.len();
-        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut order = std::mem::take(&mut self.order);
+        order.clear();
+        order.extend(0..n as u32);
         shuffle(&mut self.order_rng, &mut order);
         for &i in &order {
             let i = i as usize;
@@ -358,9 +400,10 @@ impl World {
             self.apply(i, action);
             self.age_and_die(i);
         }
+        self.order = order;
         self.animats.retain(|a| a.alive);
         self.steps += 1;
-        let evals = self.grid.take_distance_evals();
+        let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals;
         StepStats {
             search_seconds: self.search_seconds,
@@ -448,18 +491,99 @@ impl World {
     /// The nearest adjacent animat of `kind` (ties: lower id) and its position.
     fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<(u64, Pos)> {
         self.queries.adjacent += 1;
+        if self.cell_search {
+            if let Some(w) = self.cells.window(a.pos, 1) {
+                let kb = kind.code();
+                let [x, y] = a.pos;
+                let mut evals = 0;
+                // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
+                for group in [&ORTHOGONAL, &DIAGONAL] {
+                    let mut best: Option<(u64, Pos)> = None;
+                    for d in group {
+                        let c = w.at(x + d[0], y + d[1]);
+                        if c != 0 && kind_of(c) == kb {
+                            evals += 1;
+                            let id = id_of(c);
+                            if best.is_none_or(|(b, _)| id < b) {
+                                best = Some((id, [x + d[0], y + d[1]]));
+                            }
+                        }
+                    }
+                    if best.is_some() {
+                        self.cell_evals += evals;
+                        return best;
+                    }
+                }
+                self.cell_evals += evals;
+                return None;
+            }
+        }
         let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| (id, p))
     }
 
     fn adjacent(&mut self, a: &Animat, kind: Species) -> bool {
         self.queries.adjacent += 1;
+        if self.cell_search {
+            if let Some(w) = self.cells.window(a.pos, 1) {
+                let kb = kind.code();
+                let [x, y] = a.pos;
+                for d in DIRECTIONS {
+                    let c = w.at(x + d[0], y + d[1]);
+                    if c != 0 && kind_of(c) == kb {
+                        self.cell_evals += 1;
+                        return true;
+                    }
+                }
+                return false;
+            }
+        }
         self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
     }
 
     /// Position of the nearest animat of `kind` within vision (ties: lower id).
     fn nearest_seen(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
         self.queries.nearest += 1;
+        if self.cell_search {
+            let k_max = RING_MAX.min(self.params.vision);
+            if let Some(w) = self.cells.window(a.pos, k_max) {
+                let kb = kind.code();
+                let [x, y] = a.pos;
+                let v2 = self.vision2;
+                let mut evals = 0;
+                // Best as (d2, id, position).
+                let mut best: Option<(u64, u64, Pos)> = None;
+                let mut look = |dx: i64, dy: i64, best: &mut Option<(u64, u64, Pos)>| {
+                    let c = w.at(x + dx, y + dy);
+                    if c != 0 && kind_of(c) == kb {
+                        evals += 1;
+                        let d2 = (dx * dx + dy * dy) as u64;
+                        let id = id_of(c);
+                        if d2 <= v2 && best.is_none_or(|(bd, bi, _)| (d2, id) < (bd, bi)) {
+                            *best = Some((d2, id, [x + dx, y + dy]));
+                        }
+                    }
+                };
+                for k in 1..=k_max {
+                    for dx in -k..=k {
+                        look(dx, -k, &mut best);
+                        look(dx, k, &mut best);
+                    }
+                    for dy in (-k + 1)..k {
+                        look(-k, dy, &mut best);
+                        look(k, dy, &mut best);
+                    }
+                    // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
+                    // than that is final (an equally near one could still win on id).
+                    let next = ((k + 1) * (k + 1)) as u64;
+                    if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
+                        self.cell_evals += evals;
+                        return best.map(|(_, _, p)| p);
+                    }
+                }
+                self.cell_evals += evals;
+            }
+        }
         let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
@@ -468,6 +592,29 @@ impl World {
     fn overcrowded(&mut self, a: &Animat) -> bool {
         self.queries.count += 1;
         let n = self.params.crowd_max as usize + 1;
+        let r = self.params.crowd_radius;
+        if self.cell_search && r <= RING_MAX {
+            if let Some(w) = self.cells.window(a.pos, r) {
+                let [x, y] = a.pos;
+                let mut count = 0;
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        if (dx * dx + dy * dy) as u64 <= self.crowd2
+                            && (dx, dy) != (0, 0)
+                            && w.at(x + dx, y + dy) != 0
+                        {
+                            count += 1;
+                            if count >= n {
+                                self.cell_evals += count as u64;
+                                return true;
+                            }
+                        }
+                    }
+                }
+                self.cell_evals += count as u64;
+                return false;
+            }
+        }
         self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
     }
 
@@ -475,6 +622,42 @@ impl World {
     fn enough_prey(&mut self, a: &Animat) -> bool {
         self.queries.count += 1;
         let n = self.params.prey_needed as usize;
+        if self.cell_search && n > 0 {
+            let k_max = RING_MAX.min(self.params.vision);
+            if let Some(w) = self.cells.window(a.pos, k_max) {
+                let [x, y] = a.pos;
+                let v2 = self.vision2;
+                let kb = Species::Rabbit.code();
+                let mut count = 0usize;
+                let mut look = |dx: i64, dy: i64| -> bool {
+                    let c = w.at(x + dx, y + dy);
+                    if c != 0 && kind_of(c) == kb && (dx * dx + dy * dy) as u64 <= v2 {
+                        count += 1;
+                    }
+                    count >= n
+                };
+                let mut found = false;
+                'rings: for k in 1..=k_max {
+                    for dx in -k..=k {
+                        if look(dx, -k) || look(dx, k) {
+                            found = true;
+                            break 'rings;
+                        }
+                    }
+                    for dy in (-k + 1)..k {
+                        if look(-k, dy) || look(k, dy) {
+                            found = true;
+                            break 'rings;
+                        }
+                    }
+                }
+                self.cell_evals += count as u64;
+                // Rings 1..=k_max cover the whole vision disc when k_max = vision.
+                if found || k_max == self.params.vision {
+                    return found;
+                }
+            }
+        }
         self.grid
             .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
     }
@@ -486,12 +669,13 @@ impl World {
         }
         let a = self.animats[i];
         let Some(to) = offset(a.pos, d) else { return };
-        if self.grid.is_occupied(to) {
+        if self.cells.get(to) != 0 {
             return;
         }
         self.grid
             .move_to(a.id, to)
             .expect("a live animat is in the grid");
+        self.cells.relocate(a.pos, to);
         self.animats[i].pos = to;
     }
 
@@ -520,7 +704,7 @@ impl World {
                 let mut n = 0;
                 for d in DIRECTIONS {
                     if let Some(c) = offset(a.pos, d) {
-                        if !self.grid.is_occupied(c) {
+                        if self.cells.get(c) == 0 {
                             free[n] = c;
                             n += 1;
                         }
@@ -551,8 +735,9 @@ impl World {
             Species::Fox => self.foxes -= 1,
             Species::Rabbit => self.rabbits -= 1,
         }
-        let id = a.id;
+        let (id, pos) = (a.id, a.pos);
         self.grid.remove(id).expect("a live animat is in the grid");
+        self.cells.clear(pos);
     }
 
     fn age_and_die(&mut self, i: usize) {
