@@ -20,12 +20,13 @@ fn main() {
     let t = step_throughput(pop, density, grid, warmup, steps, seed).expect("valid parameters");
     println!(
         "animats {pop} grid {grid} density {density} steps {} animat-steps {} seconds {:.3} \
-         throughput {:.0} animat-steps/s ({:.1} ns each) hash {:016x}",
+         throughput {:.0} animat-steps/s ({:.1} ns each) cpu {:.1} ns each hash {:016x}",
         t.steps,
         t.animat_steps,
         t.seconds,
         t.animat_steps_per_second,
         1e9 / t.animat_steps_per_second,
+        t.cpu_seconds.unwrap_or(f64::NAN) * 1e9 / t.animat_steps as f64,
         t.state_hash
     );
 }

@@ -140,6 +140,10 @@ pub struct Throughput {
     pub seconds: f64,
     /// `animat_steps / seconds`.
     pub animat_steps_per_second: f64,
+    /// CPU seconds of the measuring thread over the measured steps, where the platform says
+    /// (Linux: `/proc/thread-self/schedstat`); on a loaded machine this is closer than
+    /// `seconds` to what an idle core would give (cache sharing still counts).
+    pub cpu_seconds: Option<f64>,
     /// State hash after the last step.
     pub state_hash: u64,
 }
@@ -161,6 +165,7 @@ pub fn step_throughput(
     w.run(warmup);
     let mut turns = 0u64;
     let mut done = 0u64;
+    let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
     for _ in 0..steps {
         let n = w.foxes() + w.rabbits();
@@ -172,7 +177,9 @@ pub fn step_throughput(
         done += 1;
     }
     let seconds = t.elapsed().as_secs_f64();
+    let cpu_seconds = thread_cpu_seconds().zip(cpu0).map(|(b, a)| b - a);
     Ok(Throughput {
+        cpu_seconds,
         animats: population,
         steps: done,
         animat_steps: turns,
@@ -184,6 +191,14 @@ pub fn step_throughput(
         },
         state_hash: u64::from_str_radix(&w.state_hash(), 16).unwrap_or(0),
     })
+}
+
+/// CPU time of the calling thread in seconds (Linux `/proc/thread-self/schedstat`, whose
+/// first field is nanoseconds on the CPU), or `None` where unavailable.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! The animat world: animats on the unbounded plane, their rules, and one step of the model
 //! (MODELS.md section 3; seed 000, section II.B).
 
-use crate::cells::{CellIndex, WINDOW_MAX, encode, id_of, kind_of};
+use crate::cells::{CellIndex, FREE, WINDOW_MAX, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
@@ -131,6 +131,8 @@ pub struct World {
     cell_evals: u64,
     /// Reused visiting-order buffer.
     order: Vec<u32>,
+    /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
+    crowd_offsets: Vec<[i64; 2]>,
     /// Live animats (and, during a step, the ones that died in it), sorted by id.
     animats: Vec<Animat>,
     next_id: u64,
@@ -181,6 +183,15 @@ impl World {
             cells: CellIndex::default(),
             cell_evals: 0,
             order: Vec::new(),
+            crowd_offsets: if params.crowd_radius <= RING_MAX {
+                let r = params.crowd_radius;
+                (-r..=r)
+                    .flat_map(|dy| (-r..=r).map(move |dx| [dx, dy]))
+                    .filter(|&[dx, dy]| (dx, dy) != (0, 0) && (dx * dx + dy * dy) as u64 <= c * c)
+                    .collect()
+            } else {
+                Vec::new()
+            },
             animats: Vec::new(),
             next_id: 0,
             steps: 0,
@@ -222,7 +233,7 @@ impl World {
                 let x = rng.random_range(-r..=r);
                 let y = rng.random_range(-r..=r);
                 if (x as i128) * (x as i128) + (y as i128) * (y as i128) > r2
-                    || w.cells.get([x, y]) != 0
+                    || w.cells.occupied([x, y])
                 {
                     continue;
                 }
@@ -249,12 +260,13 @@ impl World {
         age: u32,
         hunger: u32,
     ) -> Result<u64, WorldError> {
-        if self.cells.get(pos) != 0 {
+        if self.cells.occupied(pos) {
             return Err(WorldError::Occupied(pos));
         }
         let id = self.next_id;
         self.grid.insert(id, pos, species)?;
-        self.cells.set(pos, encode(id, species == Species::Rabbit));
+        self.cells
+            .set(pos, kind_byte(species == Species::Rabbit), id);
         self.next_id += 1;
         self.animats.push(Animat {
             id,
@@ -493,17 +505,16 @@ impl World {
         self.queries.adjacent += 1;
         if self.cell_search {
             if let Some(w) = self.cells.window(a.pos, 1) {
-                let kb = kind.code();
+                let kb = kind_byte(kind == Species::Rabbit);
                 let [x, y] = a.pos;
                 let mut evals = 0;
                 // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
                 for group in [&ORTHOGONAL, &DIAGONAL] {
                     let mut best: Option<(u64, Pos)> = None;
                     for d in group {
-                        let c = w.at(x + d[0], y + d[1]);
-                        if c != 0 && kind_of(c) == kb {
+                        if w.at(x + d[0], y + d[1]) == kb {
                             evals += 1;
-                            let id = id_of(c);
+                            let id = w.id(x + d[0], y + d[1]);
                             if best.is_none_or(|(b, _)| id < b) {
                                 best = Some((id, [x + d[0], y + d[1]]));
                             }
@@ -526,11 +537,10 @@ impl World {
         self.queries.adjacent += 1;
         if self.cell_search {
             if let Some(w) = self.cells.window(a.pos, 1) {
-                let kb = kind.code();
+                let kb = kind_byte(kind == Species::Rabbit);
                 let [x, y] = a.pos;
                 for d in DIRECTIONS {
-                    let c = w.at(x + d[0], y + d[1]);
-                    if c != 0 && kind_of(c) == kb {
+                    if w.at(x + d[0], y + d[1]) == kb {
                         self.cell_evals += 1;
                         return true;
                     }
@@ -547,19 +557,21 @@ impl World {
         if self.cell_search {
             let k_max = RING_MAX.min(self.params.vision);
             if let Some(w) = self.cells.window(a.pos, k_max) {
-                let kb = kind.code();
+                let kb = kind_byte(kind == Species::Rabbit);
                 let [x, y] = a.pos;
                 let v2 = self.vision2;
                 let mut evals = 0;
                 // Best as (d2, id, position).
                 let mut best: Option<(u64, u64, Pos)> = None;
                 let mut look = |dx: i64, dy: i64, best: &mut Option<(u64, u64, Pos)>| {
-                    let c = w.at(x + dx, y + dy);
-                    if c != 0 && kind_of(c) == kb {
+                    if w.at(x + dx, y + dy) == kb {
                         evals += 1;
                         let d2 = (dx * dx + dy * dy) as u64;
-                        let id = id_of(c);
-                        if d2 <= v2 && best.is_none_or(|(bd, bi, _)| (d2, id) < (bd, bi)) {
+                        if d2 > v2 || best.is_some_and(|(bd, _, _)| d2 > bd) {
+                            return;
+                        }
+                        let id = w.id(x + dx, y + dy);
+                        if best.is_none_or(|(bd, bi, _)| (d2, id) < (bd, bi)) {
                             *best = Some((d2, id, [x + dx, y + dy]));
                         }
                     }
@@ -597,22 +609,16 @@ impl World {
             if let Some(w) = self.cells.window(a.pos, r) {
                 let [x, y] = a.pos;
                 let mut count = 0;
-                for dy in -r..=r {
-                    for dx in -r..=r {
-                        if (dx * dx + dy * dy) as u64 <= self.crowd2
-                            && (dx, dy) != (0, 0)
-                            && w.at(x + dx, y + dy) != 0
-                        {
-                            count += 1;
-                            if count >= n {
-                                self.cell_evals += count as u64;
-                                return true;
-                            }
+                for d in &self.crowd_offsets {
+                    if w.at(x + d[0], y + d[1]) != FREE {
+                        count += 1;
+                        if count >= n {
+                            break;
                         }
                     }
                 }
                 self.cell_evals += count as u64;
-                return false;
+                return count >= n;
             }
         }
         self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
@@ -627,11 +633,10 @@ impl World {
             if let Some(w) = self.cells.window(a.pos, k_max) {
                 let [x, y] = a.pos;
                 let v2 = self.vision2;
-                let kb = Species::Rabbit.code();
+                let kb = kind_byte(true);
                 let mut count = 0usize;
                 let mut look = |dx: i64, dy: i64| -> bool {
-                    let c = w.at(x + dx, y + dy);
-                    if c != 0 && kind_of(c) == kb && (dx * dx + dy * dy) as u64 <= v2 {
+                    if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
                         count += 1;
                     }
                     count >= n
@@ -669,7 +674,7 @@ impl World {
         }
         let a = self.animats[i];
         let Some(to) = offset(a.pos, d) else { return };
-        if self.cells.get(to) != 0 {
+        if self.cells.occupied(to) {
             return;
         }
         self.grid
@@ -704,7 +709,7 @@ impl World {
                 let mut n = 0;
                 for d in DIRECTIONS {
                     if let Some(c) = offset(a.pos, d) {
-                        if self.cells.get(c) == 0 {
+                        if !self.cells.occupied(c) {
                             free[n] = c;
                             n += 1;
                         }
