@@ -37,8 +37,8 @@ pub fn kind_byte(rabbit: bool) -> u8 {
 
 #[derive(Debug, Clone)]
 struct Tile {
-    kinds: Box<[u8]>,
-    ids: Box<[u64]>,
+    kinds: Box<[u8; CELLS]>,
+    ids: Box<[u64; CELLS]>,
     count: u32,
 }
 
@@ -93,8 +93,14 @@ impl CellIndex {
                     Some(t) => t,
                     None => {
                         self.tiles.push(Tile {
-                            kinds: vec![FREE; CELLS].into_boxed_slice(),
-                            ids: vec![0u64; CELLS].into_boxed_slice(),
+                            kinds: vec![FREE; CELLS]
+                                .into_boxed_slice()
+                                .try_into()
+                                .expect("CELLS bytes"),
+                            ids: vec![0u64; CELLS]
+                                .into_boxed_slice()
+                                .try_into()
+                                .expect("CELLS ids"),
                             count: 0,
                         });
                         (self.tiles.len() - 1) as u32
@@ -169,7 +175,7 @@ impl CellIndex {
         let ty0 = (p[1] - k) >> SHIFT;
         let tx1 = (p[0] + k) >> SHIFT;
         let ty1 = (p[1] + k) >> SHIFT;
-        let fetch = |tx: i64, ty: i64| -> (&[u8], &[u64]) {
+        let fetch = |tx: i64, ty: i64| -> (&[u8; CELLS], &[u64; CELLS]) {
             match self.map.get(&[tx, ty]) {
                 Some(&t) => {
                     let t = &self.tiles[t as usize];
@@ -219,8 +225,8 @@ static EMPTY_IDS: [u64; CELLS] = [0; CELLS];
 pub struct Window<'a> {
     bx: i64,
     by: i64,
-    kinds: [&'a [u8]; 4],
-    ids: [&'a [u64]; 4],
+    kinds: [&'a [u8; CELLS]; 4],
+    ids: [&'a [u64; CELLS]; 4],
 }
 
 impl Window<'_> {

@@ -170,7 +170,8 @@ impl World {
         params.validate()?;
         let fox_rules = params.fox_rule_list()?;
         let rabbit_rules = params.rabbit_rule_list()?;
-        let grid = PlaneGrid::new(params.grid_box.box_size(params.vision))?;
+        // The cell index answers "is this cell free", so the grid need not count cells.
+        let grid = PlaneGrid::without_cell_counts(params.grid_box.box_size(params.vision))?;
         let v = params.vision as u64;
         let c = params.crowd_radius as u64;
         Ok(World {
