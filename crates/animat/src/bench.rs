@@ -3,7 +3,8 @@
 //! examples and benches all measure the same thing the same way.
 //!
 //! - [`search_scaling_point`]: neighbour-search time and distance evaluations per step for one
-//!   population at a fixed start density and one grid setting (one point of Fig. 9).
+//!   population at a fixed start density and one grid setting (one point of Fig. 9);
+//!   [`search_scaling_point_with`] also picks whether the cell-index search is used.
 //! - [`step_throughput`]: whole-step wall time with timing off, as animat-steps per second.
 //! - [`scaling_params`]: the parameters both use (defaults, with the population split between
 //!   the species in the default ratio and the start radius set by the density).
@@ -57,6 +58,8 @@ pub struct SearchCost {
     /// Grid setting, as given to `--grid-box`.
     #[serde(serialize_with = "ser_display")]
     pub grid: GridBox,
+    /// Whether the cell-index search was on ([`World::set_cell_search`]).
+    pub cell_search: bool,
     /// Steps measured.
     pub steps: u64,
     /// Animat turns taken over the measured steps (the population at the start of each step,
@@ -94,8 +97,26 @@ pub fn search_scaling_point(
     steps: u64,
     seed: u64,
 ) -> Result<SearchCost, WorldError> {
+    search_scaling_point_with(population, density, grid, steps, seed, true)
+}
+
+/// [`search_scaling_point`] with the cell-index search on or off
+/// ([`World::set_cell_search`]): off measures seed 000's structure, the grid boxes alone
+/// (`none` is always the exhaustive scan).
+///
+/// # Errors
+/// [`WorldError::Params`] if the parameters are invalid.
+pub fn search_scaling_point_with(
+    population: u64,
+    density: f64,
+    grid: GridBox,
+    steps: u64,
+    seed: u64,
+    cell_search: bool,
+) -> Result<SearchCost, WorldError> {
     let mut w = World::new(scaling_params(population, density, grid), seed)?;
     w.set_timing(true);
+    w.set_cell_search(cell_search);
     let (mut search, mut evals, mut turns, mut done) = (0.0, 0u64, 0u64, 0u64);
     let t = Instant::now();
     for _ in 0..steps {
@@ -115,6 +136,7 @@ pub fn search_scaling_point(
         animats: population,
         density,
         grid,
+        cell_search: w.cell_search(),
         steps: done,
         animat_steps: turns,
         search_seconds_per_step: per(search),
@@ -220,7 +242,10 @@ mod tests {
     fn grid_settings_measure_the_same_trajectory() {
         let a = search_scaling_point(800, 0.2, GridBox::Side(60), 4, 3).unwrap();
         let b = search_scaling_point(800, 0.2, GridBox::None, 4, 3).unwrap();
+        let c = search_scaling_point_with(800, 0.2, GridBox::Side(60), 4, 3, false).unwrap();
+        assert!(a.cell_search && !b.cell_search && !c.cell_search);
         assert_eq!(a.state_hash, b.state_hash);
+        assert_eq!(a.state_hash, c.state_hash);
         assert_eq!(a.animat_steps, b.animat_steps);
         assert_eq!(a.steps, 4);
         let t = step_throughput(800, 0.2, GridBox::Side(60), 1, 3, 3).unwrap();
