@@ -48,7 +48,11 @@ impl Series {
             .iter()
             .map(|c| c.animat_steps as f64 / c.steps as f64)
             .collect();
-        let y: Vec<f64> = self.points.iter().map(|c| c.search_seconds_per_step).collect();
+        let y: Vec<f64> = self
+            .points
+            .iter()
+            .map(|c| c.search_seconds_per_step)
+            .collect();
         LogLogFit::fit(&x, &y).ok()
     }
 }
@@ -101,7 +105,9 @@ fn main() {
     }
     all.push(run("none", GridBox::None, false, none_max.min(max)));
 
-    println!("| grid | N (start) | mean N | steps | search ms/step | search ns/animat | distance evals/animat | whole step ms |");
+    println!(
+        "| grid | N (start) | mean N | steps | search ms/step | search ns/animat | distance evals/animat | whole step ms |"
+    );
     println!("|---|---|---|---|---|---|---|---|");
     for s in &all {
         for c in &s.points {
