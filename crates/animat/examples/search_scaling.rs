@@ -70,7 +70,10 @@ fn run(label: &str, grid: GridBox, cells: bool, max: u64, repeats: u32) -> Serie
                 search_scaling_point_with(n, DENSITY, grid, steps_for(n), SEED, cells)
                     .expect("valid parameters")
             })
-            .min_by(|a, b| a.search_seconds_per_step.total_cmp(&b.search_seconds_per_step))
+            .min_by(|a, b| {
+                a.search_seconds_per_step
+                    .total_cmp(&b.search_seconds_per_step)
+            })
             .expect("at least one repeat");
         eprintln!(
             "{label}: N {n} mean {:.0} steps {} search {:.3} ms/step evals {:.0}/step step {:.3} ms",
@@ -116,7 +119,13 @@ fn main() {
             repeats,
         ));
     }
-    all.push(run("none", GridBox::None, false, none_max.min(max), repeats));
+    all.push(run(
+        "none",
+        GridBox::None,
+        false,
+        none_max.min(max),
+        repeats,
+    ));
 
     println!(
         "| grid | N (start) | mean N | steps | search ms/step | search ns/animat | distance evals/animat | whole step ms |"

@@ -1023,6 +1023,39 @@ mod tests {
     }
 
     #[test]
+    fn cell_search_and_grid_boxes_agree_on_hand_built_ties() {
+        // Orthogonal before diagonal, then lower id, through both paths.
+        for cells in [true, false] {
+            let mut w = world(only(&[], &["flee"]));
+            w.set_cell_search(cells);
+            let r = w.add(Rabbit, [0, 0], 0, 0).unwrap();
+            w.add(Fox, [1, 1], 0, 0).unwrap();
+            w.add(Fox, [0, -1], 0, 0).unwrap();
+            w.add(Fox, [-1, 0], 0, 0).unwrap();
+            w.step();
+            // [0, -1] (id 2) and [-1, 0] (id 3) both at d2 = 1: id 2 wins, flee to [0, 1].
+            assert_eq!(w.get(r).unwrap().pos, [0, 1], "cells {cells}");
+            // Nearest within vision: equal distance 9 + 16 = 25 on both sides, lower id wins;
+            // the one at d2 = 25 on ring 5 against one at d2 = 26 on ring 5 too.
+            let mut w = world(only(&["hunt"], &[]));
+            w.set_cell_search(cells);
+            w.add(Rabbit, [-5, 1], 0, 0).unwrap(); // d2 = 26
+            w.add(Rabbit, [4, -3], 0, 0).unwrap(); // d2 = 25, id 1
+            w.add(Rabbit, [-3, 4], 0, 0).unwrap(); // d2 = 25, id 2
+            let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+            w.step();
+            assert_eq!(w.get(f).unwrap().pos, [1, -1], "cells {cells}");
+            // Beyond the 8 rings: a rabbit at distance 20 is found through the grid.
+            let mut w = world(only(&["hunt"], &[]));
+            w.set_cell_search(cells);
+            w.add(Rabbit, [0, -20], 0, 0).unwrap();
+            let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+            w.step();
+            assert_eq!(w.get(f).unwrap().pos, [0, -1], "cells {cells}");
+        }
+    }
+
+    #[test]
     fn starvation_and_old_age() {
         let p = Params {
             starve: 3,
