@@ -325,7 +325,9 @@ impl World {
         self.queries
     }
 
-    /// The search structure (for work counters and diagnostics).
+    /// The search structure (for work counters and diagnostics). It is built with
+    /// [`PlaneGrid::without_cell_counts`] (the world's own cell index answers "is this cell
+    /// free"), so its `is_occupied` scans a box rather than doing one lookup.
     pub fn grid(&self) -> &PlaneGrid<Species> {
         &self.grid
     }
