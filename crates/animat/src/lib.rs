@@ -16,6 +16,8 @@
 //! assert_eq!(world.state_hash().len(), 16);
 //! ```
 
+pub mod bench;
+mod cells;
 pub mod config;
 pub mod output;
 pub mod params;

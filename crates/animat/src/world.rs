@@ -1,6 +1,7 @@
 //! The animat world: animats on the unbounded plane, their rules, and one step of the model
 //! (MODELS.md section 3; seed 000, section II.B).
 
+use crate::cells::{CellIndex, FREE, WINDOW_MAX, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
@@ -28,6 +29,19 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
     [0, -1],
     [1, -1],
 ];
+
+/// Largest cell-ring radius the cell-index searches scan before handing a query to the grid.
+const RING_MAX: i64 = 8;
+const _: () = assert!(RING_MAX <= WINDOW_MAX);
+
+/// How many turns ahead [`World::step`] reads the cells it will need (the records twice as
+/// far ahead).
+const LOOKAHEAD: usize = 8;
+
+/// The 4 orthogonal neighbours (squared distance 1).
+const ORTHOGONAL: [[i64; 2]; 4] = [[1, 0], [0, 1], [-1, 0], [0, -1]];
+/// The 4 diagonal neighbours (squared distance 2).
+const DIAGONAL: [[i64; 2]; 4] = [[1, 1], [-1, 1], [-1, -1], [1, -1]];
 
 /// One animat.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -112,6 +126,17 @@ pub struct World {
     vision2: u64,
     crowd2: u64,
     grid: PlaneGrid<Species>,
+    /// Which animat stands on each cell (always maintained; read by perception when
+    /// `cell_search` is on).
+    cells: CellIndex,
+    /// Answer small-radius perception from the cell index before the grid boxes.
+    cell_search: bool,
+    /// Distance evaluations made by cell-index searches since the last step boundary.
+    cell_evals: u64,
+    /// Reused visiting-order buffer.
+    order: Vec<u32>,
+    /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
+    crowd_offsets: Vec<[i64; 2]>,
     /// Live animats (and, during a step, the ones that died in it), sorted by id.
     animats: Vec<Animat>,
     next_id: u64,
@@ -149,7 +174,8 @@ impl World {
         params.validate()?;
         let fox_rules = params.fox_rule_list()?;
         let rabbit_rules = params.rabbit_rule_list()?;
-        let grid = PlaneGrid::new(params.grid_box.box_size(params.vision))?;
+        // The cell index answers "is this cell free", so the grid need not count cells.
+        let grid = PlaneGrid::without_cell_counts(params.grid_box.box_size(params.vision))?;
         let v = params.vision as u64;
         let c = params.crowd_radius as u64;
         Ok(World {
@@ -157,7 +183,20 @@ impl World {
             rabbit_rules,
             vision2: v * v,
             crowd2: c * c,
+            cell_search: grid.box_size() != spatial::plane::BoxSize::None,
             grid,
+            cells: CellIndex::default(),
+            cell_evals: 0,
+            order: Vec::new(),
+            crowd_offsets: if params.crowd_radius <= RING_MAX {
+                let r = params.crowd_radius;
+                (-r..=r)
+                    .flat_map(|dy| (-r..=r).map(move |dx| [dx, dy]))
+                    .filter(|&[dx, dy]| (dx, dy) != (0, 0) && (dx * dx + dy * dy) as u64 <= c * c)
+                    .collect()
+            } else {
+                Vec::new()
+            },
             animats: Vec::new(),
             next_id: 0,
             steps: 0,
@@ -199,7 +238,7 @@ impl World {
                 let x = rng.random_range(-r..=r);
                 let y = rng.random_range(-r..=r);
                 if (x as i128) * (x as i128) + (y as i128) * (y as i128) > r2
-                    || w.grid.is_occupied([x, y])
+                    || w.cells.occupied([x, y])
                 {
                     continue;
                 }
@@ -226,11 +265,13 @@ impl World {
         age: u32,
         hunger: u32,
     ) -> Result<u64, WorldError> {
-        if self.grid.is_occupied(pos) {
+        if self.cells.occupied(pos) {
             return Err(WorldError::Occupied(pos));
         }
         let id = self.next_id;
         self.grid.insert(id, pos, species)?;
+        self.cells
+            .set(pos, kind_byte(species == Species::Rabbit), id);
         self.next_id += 1;
         self.animats.push(Animat {
             id,
@@ -284,14 +325,32 @@ impl World {
         self.queries
     }
 
-    /// The search structure (for work counters and diagnostics).
+    /// The search structure (for work counters and diagnostics). It is built with
+    /// [`PlaneGrid::without_cell_counts`] (the world's own cell index answers "is this cell
+    /// free"), so its `is_occupied` scans a box rather than doing one lookup.
     pub fn grid(&self) -> &PlaneGrid<Species> {
         &self.grid
     }
 
     /// Distance evaluations of the search structure since the start.
     pub fn distance_evals(&self) -> u64 {
-        self.total_distance_evals + self.grid.distance_evals()
+        self.total_distance_evals + self.grid.distance_evals() + self.cell_evals
+    }
+
+    /// Whether small-radius perception reads the cell index first (see
+    /// [`World::set_cell_search`]).
+    pub fn cell_search(&self) -> bool {
+        self.cell_search
+    }
+
+    /// Turns the cell-index search on or off. On by default with grid boxes, off (and ignored)
+    /// in the exhaustive `none` mode, which stays the paper's "no grid" baseline. With it on,
+    /// adjacency and overcrowding tests read the cells around the animat directly, and nearest
+    /// and counting queries scan cell rings outward up to radius 8 before falling back to the
+    /// grid boxes; both give the exact answers, so the trajectory does not change. Turning it
+    /// off measures the grid boxes alone (seed 000's structure).
+    pub fn set_cell_search(&mut self, on: bool) {
+        self.cell_search = on && self.grid.box_size() != spatial::plane::BoxSize::None;
     }
 
     /// Measure the wall time of perception queries (`--timing`); off by default because the
@@ -336,13 +395,26 @@ impl World {
     /// hunger) grow by one and it dies if a fox's hunger exceeds `starve` or its age exceeds
     /// its species' `max_age`.
     pub fn step(&mut self) -> StepStats {
-        let evals_before = self.grid.take_distance_evals();
+        let evals_before = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals_before;
         self.search_seconds = 0.0;
         let n = self.animats.len();
-        let mut order: Vec<u32> = (0..n as u32).collect();
+        let mut order = std::mem::take(&mut self.order);
+        order.clear();
+        order.extend(0..n as u32);
         shuffle(&mut self.order_rng, &mut order);
-        for &i in &order {
+        // The visiting order is random, so a turn's first reads of its animat's record and of
+        // the cells around it miss the caches. Reading them a few turns ahead starts those
+        // misses early, overlapped with the turns in between; the reads change nothing (they
+        // only feed black_box).
+        let mut touch = 0u64;
+        for (j, &i) in order.iter().enumerate() {
+            if let Some(&k) = order.get(j + 2 * LOOKAHEAD) {
+                touch ^= self.animats[k as usize].pos[0] as u64;
+            }
+            if let Some(&k) = order.get(j + LOOKAHEAD) {
+                touch ^= u64::from(self.cells.kind(self.animats[k as usize].pos));
+            }
             let i = i as usize;
             if !self.animats[i].alive {
                 continue;
@@ -358,9 +430,11 @@ impl World {
             self.apply(i, action);
             self.age_and_die(i);
         }
+        std::hint::black_box(touch);
+        self.order = order;
         self.animats.retain(|a| a.alive);
         self.steps += 1;
-        let evals = self.grid.take_distance_evals();
+        let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals;
         StepStats {
             search_seconds: self.search_seconds,
@@ -448,18 +522,99 @@ impl World {
     /// The nearest adjacent animat of `kind` (ties: lower id) and its position.
     fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<(u64, Pos)> {
         self.queries.adjacent += 1;
+        if self.cell_search {
+            if let Some(w) = self.cells.window(a.pos, 1) {
+                let kb = kind_byte(kind == Species::Rabbit);
+                let [x, y] = a.pos;
+                let mut evals = 0;
+                // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
+                for group in [&ORTHOGONAL, &DIAGONAL] {
+                    let mut best: Option<(u64, Pos)> = None;
+                    for d in group {
+                        if w.at(x + d[0], y + d[1]) == kb {
+                            evals += 1;
+                            let id = w.id(x + d[0], y + d[1]);
+                            if best.is_none_or(|(b, _)| id < b) {
+                                best = Some((id, [x + d[0], y + d[1]]));
+                            }
+                        }
+                    }
+                    if best.is_some() {
+                        self.cell_evals += evals;
+                        return best;
+                    }
+                }
+                self.cell_evals += evals;
+                return None;
+            }
+        }
         let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| (id, p))
     }
 
     fn adjacent(&mut self, a: &Animat, kind: Species) -> bool {
         self.queries.adjacent += 1;
+        if self.cell_search {
+            if let Some(w) = self.cells.window(a.pos, 1) {
+                let kb = kind_byte(kind == Species::Rabbit);
+                let [x, y] = a.pos;
+                for d in DIRECTIONS {
+                    if w.at(x + d[0], y + d[1]) == kb {
+                        self.cell_evals += 1;
+                        return true;
+                    }
+                }
+                return false;
+            }
+        }
         self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
     }
 
     /// Position of the nearest animat of `kind` within vision (ties: lower id).
     fn nearest_seen(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
         self.queries.nearest += 1;
+        if self.cell_search {
+            let k_max = RING_MAX.min(self.params.vision);
+            if let Some(w) = self.cells.window(a.pos, k_max) {
+                let kb = kind_byte(kind == Species::Rabbit);
+                let [x, y] = a.pos;
+                let v2 = self.vision2;
+                let mut evals = 0;
+                // Best as (d2, id, position).
+                let mut best: Option<(u64, u64, Pos)> = None;
+                let mut look = |dx: i64, dy: i64, best: &mut Option<(u64, u64, Pos)>| {
+                    if w.at(x + dx, y + dy) == kb {
+                        evals += 1;
+                        let d2 = (dx * dx + dy * dy) as u64;
+                        if d2 > v2 || best.is_some_and(|(bd, _, _)| d2 > bd) {
+                            return;
+                        }
+                        let id = w.id(x + dx, y + dy);
+                        if best.is_none_or(|(bd, bi, _)| (d2, id) < (bd, bi)) {
+                            *best = Some((d2, id, [x + dx, y + dy]));
+                        }
+                    }
+                };
+                for k in 1..=k_max {
+                    for dx in -k..=k {
+                        look(dx, -k, &mut best);
+                        look(dx, k, &mut best);
+                    }
+                    for dy in (-k + 1)..k {
+                        look(-k, dy, &mut best);
+                        look(k, dy, &mut best);
+                    }
+                    // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
+                    // than that is final (an equally near one could still win on id).
+                    let next = ((k + 1) * (k + 1)) as u64;
+                    if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
+                        self.cell_evals += evals;
+                        return best.map(|(_, _, p)| p);
+                    }
+                }
+                self.cell_evals += evals;
+            }
+        }
         let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
@@ -468,6 +623,23 @@ impl World {
     fn overcrowded(&mut self, a: &Animat) -> bool {
         self.queries.count += 1;
         let n = self.params.crowd_max as usize + 1;
+        let r = self.params.crowd_radius;
+        if self.cell_search && r <= RING_MAX {
+            if let Some(w) = self.cells.window(a.pos, r) {
+                let [x, y] = a.pos;
+                let mut count = 0;
+                for d in &self.crowd_offsets {
+                    if w.at(x + d[0], y + d[1]) != FREE {
+                        count += 1;
+                        if count >= n {
+                            break;
+                        }
+                    }
+                }
+                self.cell_evals += count as u64;
+                return count >= n;
+            }
+        }
         self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
     }
 
@@ -475,6 +647,41 @@ impl World {
     fn enough_prey(&mut self, a: &Animat) -> bool {
         self.queries.count += 1;
         let n = self.params.prey_needed as usize;
+        if self.cell_search && n > 0 {
+            let k_max = RING_MAX.min(self.params.vision);
+            if let Some(w) = self.cells.window(a.pos, k_max) {
+                let [x, y] = a.pos;
+                let v2 = self.vision2;
+                let kb = kind_byte(true);
+                let mut count = 0usize;
+                let mut look = |dx: i64, dy: i64| -> bool {
+                    if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
+                        count += 1;
+                    }
+                    count >= n
+                };
+                let mut found = false;
+                'rings: for k in 1..=k_max {
+                    for dx in -k..=k {
+                        if look(dx, -k) || look(dx, k) {
+                            found = true;
+                            break 'rings;
+                        }
+                    }
+                    for dy in (-k + 1)..k {
+                        if look(-k, dy) || look(k, dy) {
+                            found = true;
+                            break 'rings;
+                        }
+                    }
+                }
+                self.cell_evals += count as u64;
+                // Rings 1..=k_max cover the whole vision disc when k_max = vision.
+                if found || k_max == self.params.vision {
+                    return found;
+                }
+            }
+        }
         self.grid
             .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
     }
@@ -486,12 +693,13 @@ impl World {
         }
         let a = self.animats[i];
         let Some(to) = offset(a.pos, d) else { return };
-        if self.grid.is_occupied(to) {
+        if self.cells.occupied(to) {
             return;
         }
         self.grid
             .move_to(a.id, to)
             .expect("a live animat is in the grid");
+        self.cells.relocate(a.pos, to);
         self.animats[i].pos = to;
     }
 
@@ -520,7 +728,7 @@ impl World {
                 let mut n = 0;
                 for d in DIRECTIONS {
                     if let Some(c) = offset(a.pos, d) {
-                        if !self.grid.is_occupied(c) {
+                        if !self.cells.occupied(c) {
                             free[n] = c;
                             n += 1;
                         }
@@ -551,8 +759,9 @@ impl World {
             Species::Fox => self.foxes -= 1,
             Species::Rabbit => self.rabbits -= 1,
         }
-        let id = a.id;
+        let (id, pos) = (a.id, a.pos);
         self.grid.remove(id).expect("a live animat is in the grid");
+        self.cells.clear(pos);
     }
 
     fn age_and_die(&mut self, i: usize) {
@@ -813,6 +1022,39 @@ mod tests {
         w.step();
         assert_eq!(w.get(f).unwrap().pos, [0, 0]);
         assert_eq!(w.get(r).unwrap().pos, [1000, 0]);
+    }
+
+    #[test]
+    fn cell_search_and_grid_boxes_agree_on_hand_built_ties() {
+        // Orthogonal before diagonal, then lower id, through both paths.
+        for cells in [true, false] {
+            let mut w = world(only(&[], &["flee"]));
+            w.set_cell_search(cells);
+            let r = w.add(Rabbit, [0, 0], 0, 0).unwrap();
+            w.add(Fox, [1, 1], 0, 0).unwrap();
+            w.add(Fox, [0, -1], 0, 0).unwrap();
+            w.add(Fox, [-1, 0], 0, 0).unwrap();
+            w.step();
+            // [0, -1] (id 2) and [-1, 0] (id 3) both at d2 = 1: id 2 wins, flee to [0, 1].
+            assert_eq!(w.get(r).unwrap().pos, [0, 1], "cells {cells}");
+            // Nearest within vision: equal distance 9 + 16 = 25 on both sides, lower id wins;
+            // the one at d2 = 25 on ring 5 against one at d2 = 26 on ring 5 too.
+            let mut w = world(only(&["hunt"], &[]));
+            w.set_cell_search(cells);
+            w.add(Rabbit, [-5, 1], 0, 0).unwrap(); // d2 = 26
+            w.add(Rabbit, [4, -3], 0, 0).unwrap(); // d2 = 25, id 1
+            w.add(Rabbit, [-3, 4], 0, 0).unwrap(); // d2 = 25, id 2
+            let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+            w.step();
+            assert_eq!(w.get(f).unwrap().pos, [1, -1], "cells {cells}");
+            // Beyond the 8 rings: a rabbit at distance 20 is found through the grid.
+            let mut w = world(only(&["hunt"], &[]));
+            w.set_cell_search(cells);
+            w.add(Rabbit, [0, -20], 0, 0).unwrap();
+            let f = w.add(Fox, [0, 0], 0, 9).unwrap();
+            w.step();
+            assert_eq!(w.get(f).unwrap().pos, [0, -1], "cells {cells}");
+        }
     }
 
     #[test]

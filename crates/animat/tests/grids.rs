@@ -64,3 +64,74 @@ fn every_grid_setting_gives_the_same_trajectory() {
 fn full_length() {
     check_all_settings(&[1, 2, 3], 500);
 }
+
+/// Final state hash and population series with the cell-index search on or off.
+fn run_cells(p: &Params, seed: u64, steps: u64, cells: bool) -> (Vec<(u64, u64)>, String) {
+    let mut w = World::new(p.clone(), seed).unwrap();
+    w.set_cell_search(cells);
+    assert_eq!(w.cell_search(), cells && p.grid_box != GridBox::None);
+    let mut series = vec![(w.foxes(), w.rabbits())];
+    for _ in 0..steps {
+        w.step();
+        series.push((w.foxes(), w.rabbits()));
+    }
+    (series, w.state_hash())
+}
+
+/// The cell-index search (on by default with boxes) gives the trajectory of the grid boxes
+/// alone and of the exhaustive search, also where its ring limit is reached (vision larger
+/// than 8 but only a few cells: rings run out and the boxes finish the query) and where it
+/// is not used (crowding radius beyond the ring limit), and with a vision of at most 8 (the
+/// rings cover the whole disc).
+#[test]
+fn cell_search_matches_the_grid_boxes() {
+    let base = Params {
+        foxes: 150,
+        rabbits: 900,
+        start_radius: 60,
+        ..Params::default()
+    };
+    let variants = [
+        base.clone(),
+        Params {
+            vision: 6,
+            prey_needed: 3,
+            ..base.clone()
+        },
+        Params {
+            vision: 12,
+            crowd_radius: 9,
+            crowd_max: 6,
+            start_radius: 90,
+            ..base.clone()
+        },
+    ];
+    for (v, p) in variants.iter().enumerate() {
+        let seed = 10 + v as u64;
+        let want = run_cells(
+            &Params {
+                grid_box: GridBox::None,
+                ..p.clone()
+            },
+            seed,
+            40,
+            true,
+        );
+        for g in [GridBox::Side(7), GridBox::Side(60)] {
+            let q = Params {
+                grid_box: g,
+                ..p.clone()
+            };
+            assert_eq!(
+                run_cells(&q, seed, 40, true),
+                want,
+                "variant {v}, grid {g}, cells on"
+            );
+            assert_eq!(
+                run_cells(&q, seed, 40, false),
+                want,
+                "variant {v}, grid {g}, cells off"
+            );
+        }
+    }
+}

@@ -510,6 +510,8 @@ pub struct PlaneGrid<K> {
     boxes: FxHashMap<[i64; 2], Vec<Entry<K>>>,
     slots: FxHashMap<u64, Slot<K>>,
     cells: FxHashMap<Pos, u32>,
+    /// Whether `cells` is maintained (see [`PlaneGrid::without_cell_counts`]).
+    track_cells: bool,
     spare: Vec<Vec<Entry<K>>>,
     stats: Counters,
 }
@@ -523,6 +525,7 @@ impl<K: Copy> Clone for PlaneGrid<K> {
             boxes: self.boxes.clone(),
             slots: self.slots.clone(),
             cells: self.cells.clone(),
+            track_cells: self.track_cells,
             spare: Vec::new(),
             stats: Counters::from(self.stats.load()),
         }
@@ -541,9 +544,31 @@ impl<K: Copy + Eq> PlaneGrid<K> {
             boxes: FxHashMap::default(),
             slots: FxHashMap::default(),
             cells: FxHashMap::default(),
+            track_cells: true,
             spare: Vec::new(),
             stats: Counters::default(),
         })
+    }
+
+    /// An empty grid that does not keep the per-cell counts behind
+    /// [`is_occupied`](Self::is_occupied): for callers that track occupancy themselves (the
+    /// animat model keeps a dense cell index). Every answer is the same; `insert`, `remove`
+    /// and `move_to` skip two hash-map updates, while [`is_occupied`](Self::is_occupied),
+    /// [`occupancy`](Self::occupancy) and [`items_at`](Self::items_at) scan the cell's box
+    /// instead of one lookup (O(N) in [`BoxSize::None`] mode).
+    ///
+    /// # Errors
+    /// [`PlaneError::BadBoxSide`] if the side is zero or negative.
+    pub fn without_cell_counts(size: BoxSize) -> Result<Self, PlaneError> {
+        let mut g = Self::new(size)?;
+        g.track_cells = false;
+        Ok(g)
+    }
+
+    /// Whether the grid keeps per-cell counts (false for
+    /// [`without_cell_counts`](Self::without_cell_counts)).
+    pub fn tracks_cells(&self) -> bool {
+        self.track_cells
     }
 
     /// An empty grid with boxes of side `a` cells (seed 000, section II.B).
@@ -562,6 +587,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
             boxes: FxHashMap::default(),
             slots: FxHashMap::default(),
             cells: FxHashMap::default(),
+            track_cells: true,
             spare: Vec::new(),
             stats: Counters::default(),
         }
@@ -649,7 +675,9 @@ impl<K: Copy + Eq> PlaneGrid<K> {
         let index = list.len();
         list.push(Entry { pos, id, kind });
         vacant.insert(Slot { pos, kind, index });
-        *self.cells.entry(pos).or_insert(0) += 1;
+        if self.track_cells {
+            *self.cells.entry(pos).or_insert(0) += 1;
+        }
         Ok(())
     }
 
@@ -662,7 +690,9 @@ impl<K: Copy + Eq> PlaneGrid<K> {
         let slot = self.slots.remove(&id).ok_or(PlaneError::UnknownId(id))?;
         let key = self.box_key(slot.pos);
         self.detach(key, slot.index);
-        self.cell_dec(slot.pos);
+        if self.track_cells {
+            self.cell_dec(slot.pos);
+        }
         Ok((slot.pos, slot.kind))
     }
 
@@ -704,8 +734,10 @@ impl<K: Copy + Eq> PlaneGrid<K> {
                 s.index = new_index;
             }
         }
-        self.cell_dec(from);
-        *self.cells.entry(to).or_insert(0) += 1;
+        if self.track_cells {
+            self.cell_dec(from);
+            *self.cells.entry(to).or_insert(0) += 1;
+        }
         Ok(from)
     }
 
@@ -756,12 +788,22 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// Whether any item is on cell `p` (the model's "is this cell free" test). O(1) in every
     /// mode.
     pub fn is_occupied(&self, p: Pos) -> bool {
-        self.cells.contains_key(&p)
+        if self.track_cells {
+            self.cells.contains_key(&p)
+        } else {
+            self.occupancy(p) > 0
+        }
     }
 
     /// Number of items on cell `p`. O(1).
     pub fn occupancy(&self, p: Pos) -> usize {
-        self.cells.get(&p).map_or(0, |&c| c as usize)
+        if self.track_cells {
+            self.cells.get(&p).map_or(0, |&c| c as usize)
+        } else {
+            self.boxes
+                .get(&self.box_key(p))
+                .map_or(0, |list| list.iter().filter(|e| e.pos == p).count())
+        }
     }
 
     /// Ids and kinds of the items on cell `p`, sorted by id. O(1) when the cell is free,
@@ -978,7 +1020,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
                 self.slots.len()
             ));
         }
-        if cells != self.cells {
+        if self.track_cells && cells != self.cells {
             return Err("cell occupancy counts disagree with the items".to_string());
         }
         Ok(())
@@ -1505,5 +1547,35 @@ mod tests {
     fn grid_is_send_and_sync() {
         fn check<T: Send + Sync>() {}
         check::<PlaneGrid<Species>>();
+    }
+
+    #[test]
+    fn without_cell_counts_answers_the_same() {
+        for size in [BoxSize::None, BoxSize::Side(3), BoxSize::Side(60)] {
+            let mut a: PlaneGrid<u8> = PlaneGrid::new(size).unwrap();
+            let mut b: PlaneGrid<u8> = PlaneGrid::without_cell_counts(size).unwrap();
+            assert!(a.tracks_cells() && !b.tracks_cells());
+            let pts: [Pos; 6] = [[0, 0], [0, 0], [-1, 5], [7, -3], [100, 100], [-50, 2]];
+            for (id, &p) in pts.iter().enumerate() {
+                a.insert(id as u64, p, (id % 2) as u8).unwrap();
+                b.insert(id as u64, p, (id % 2) as u8).unwrap();
+            }
+            for g in [&mut a, &mut b] {
+                g.move_to(2, [-1, 6]).unwrap();
+                g.move_to(4, [-3, 1]).unwrap();
+                g.remove(1).unwrap();
+                g.validate().unwrap();
+            }
+            for x in -4..9 {
+                for y in -4..9 {
+                    let p = [x, y];
+                    assert_eq!(a.is_occupied(p), b.is_occupied(p));
+                    assert_eq!(a.occupancy(p), b.occupancy(p));
+                    assert_eq!(a.items_at(p), b.items_at(p));
+                    assert_eq!(a.nearest(p, 1, 400, None), b.nearest(p, 1, 400, None));
+                }
+            }
+            assert!(b.clone().validate().is_ok());
+        }
     }
 }
