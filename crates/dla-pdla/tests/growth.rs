@@ -131,3 +131,45 @@ fn growth_samples_are_log_spaced_and_end_at_n() {
     assert_eq!(s.last().unwrap().n, 20_000);
     assert!(s.windows(2).all(|w| w[1].n > w[0].n));
 }
+
+#[test]
+fn discard_guard_fails_loudly_instead_of_spinning() {
+    use dla_pdla::SimError;
+    use dla_pdla::sim::{DiscardGuard, MAX_CONSECUTIVE_DISCARDS};
+    let mut g = DiscardGuard::default();
+    for _ in 0..10 {
+        g.record(true).unwrap();
+    }
+    g.record(false).unwrap();
+    assert_eq!((g.total, g.consecutive), (10, 0));
+    for _ in 1..MAX_CONSECUTIVE_DISCARDS {
+        g.record(true).unwrap();
+    }
+    let e = g.record(true).unwrap_err();
+    assert!(
+        matches!(e, SimError::DiscardLivelock { consecutive, .. } if consecutive == MAX_CONSECUTIVE_DISCARDS)
+    );
+    assert!(e.to_string().contains("livelock"), "{e}");
+}
+
+#[test]
+fn pdla_counts_every_walker_and_keeps_the_tree_complete() {
+    let params = Params {
+        particles: 5000,
+        threads: 2,
+        serial_until: 100,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let mut sim = Simulation::<2>::new(params, 9).unwrap();
+    sim.run().unwrap();
+    assert_eq!(sim.particles(), 5000);
+    assert_eq!(sim.tree().len(), 5000);
+    assert_eq!(sim.positions().unwrap().len(), 5000);
+    // The tree holds exactly the recorded positions.
+    let mut a: Vec<[f64; 2]> = sim.tree().iter().collect();
+    let mut b = sim.positions().unwrap().to_vec();
+    a.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    b.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    assert_eq!(a, b);
+}
