@@ -60,6 +60,11 @@ struct Cli {
     #[arg(long, default_value_t = 2.0)]
     precision: f64,
 
+    /// Side of the orthtree's leaf cells in diameters (power of two, 1 to 64): speed and
+    /// memory only, not the physics.
+    #[arg(long, default_value_t = dla_pdla::params::DEFAULT_LEAF_SIDE)]
+    leaf_side: f64,
+
     /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -103,6 +108,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         serial_until: cli.serial_until,
         fit_from: cli.fit_from,
         keep_positions: cli.png || cli.positions != PositionsFormat::None,
+        leaf_side: cli.leaf_side,
     };
     p.validate().map_err(|e| e.to_string())?;
     Ok(p)

@@ -518,7 +518,7 @@ impl<const D: usize> Simulation<D> {
         if params.dim != D {
             return Err(SimError::DimMismatch(D, params.dim));
         }
-        let mut tree = Orthtree::new();
+        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
         let mut growth = Growth::new(&params);
         growth.add(&mut tree, [0.0; D], params.particles)?;
         Ok(Simulation {
