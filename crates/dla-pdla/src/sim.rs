@@ -9,7 +9,7 @@ use core_lattice::{Gyration, LogLogFit};
 use parking_lot::Mutex;
 use serde::Serialize;
 use spatial::orthtree::{Orthtree, OrthtreeError};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Stream purpose of the serial walker (`stream_id(PURPOSE_WALK, 0)`).
@@ -371,8 +371,10 @@ struct Replica<const D: usize> {
     tree: Orthtree<D>,
     /// Largest centre distance over the applied particles.
     r_ext: f64,
-    /// Particles applied (an absolute log index).
+    /// Particles taken from the log (an absolute log index).
     applied: usize,
+    /// Taken from the log but not yet inserted (filled under the lock, inserted after it).
+    pending: Vec<[f64; D]>,
     index: usize,
 }
 
@@ -384,21 +386,46 @@ struct Ctx<'a, const D: usize> {
     applied: &'a [AtomicUsize],
     stop: &'a AtomicBool,
     target: u64,
+    /// Nanoseconds threads spent waiting for the log's mutex (summed over threads).
+    wait_nanos: &'a AtomicU64,
 }
 
 /// Log entries are dropped once every thread has applied them and this many have piled up.
 const LOG_TRIM: usize = 4096;
 
 impl<const D: usize> Ctx<'_, D> {
-    /// Applies the log entries `rep` has not seen (the caller holds the lock).
-    fn apply(&self, log: &Log<D>, rep: &mut Replica<D>) -> Result<(), OrthtreeError> {
-        for q in &log.points[rep.applied - log.base..] {
-            rep.tree.insert(*q)?;
-            rep.r_ext = rep.r_ext.max(norm(q));
+    /// Takes the log's mutex, timing the wait when it is contended.
+    #[inline]
+    fn lock(&self) -> parking_lot::MutexGuard<'_, Log<D>> {
+        if let Some(g) = self.log.try_lock() {
+            return g;
         }
+        let t = Instant::now();
+        let g = self.log.lock();
+        self.wait_nanos
+            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        g
+    }
+
+    /// Copies the log entries `rep` has not seen into `rep.pending` (the caller holds the
+    /// lock; inserting them into the replica happens after it is released).
+    fn take_pending(&self, log: &Log<D>, rep: &mut Replica<D>) {
+        rep.pending
+            .extend_from_slice(&log.points[rep.applied - log.base..]);
         rep.applied = log.base + log.points.len();
         self.applied[rep.index].store(rep.applied, Ordering::Relaxed);
-        Ok(())
+    }
+
+    /// Inserts `rep.pending` into the replica, in log order (no lock held).
+    fn insert_pending(&self, rep: &mut Replica<D>) -> bool {
+        for q in rep.pending.drain(..) {
+            if let Err(e) = rep.tree.insert(q) {
+                self.fail(&mut self.lock(), e.into());
+                return false;
+            }
+            rep.r_ext = rep.r_ext.max(norm(&q));
+        }
+        true
     }
 
     /// Brings `rep` up to date if another thread stored particles; `false` to stop.
@@ -410,12 +437,12 @@ impl<const D: usize> Ctx<'_, D> {
         if self.published.load(Ordering::Acquire) == rep.applied {
             return true;
         }
-        let mut log = self.log.lock();
-        if let Err(e) = self.apply(&log, rep) {
-            self.fail(&mut log, e.into());
-            return false;
-        }
-        log.growth.n < self.target
+        let done = {
+            let log = self.lock();
+            self.take_pending(&log, rep);
+            log.growth.n >= self.target
+        };
+        self.insert_pending(rep) && !done
     }
 
     fn fail(&self, log: &mut Log<D>, e: SimError) {
@@ -446,32 +473,47 @@ impl<const D: usize> Ctx<'_, D> {
                     return;
                 }
             };
-            let mut log = self.log.lock();
-            if log.growth.n >= self.target || self.stop.load(Ordering::Relaxed) {
-                return;
-            }
-            if let Err(e) = self.apply(&log, rep) {
-                return self.fail(&mut log, e.into());
-            }
-            // Re-check under the lock (seed 002, section 3.4): a particle stored by another
-            // thread since this walker's last move may overlap it.
+            let q = match rep.tree.stored_position(&stick) {
+                Ok(q) => q,
+                Err(e) => return self.fail(&mut self.lock(), e.into()),
+            };
+            // A jump or step made on the replica can end inside a particle another thread
+            // stored meanwhile; once that particle is applied the next move sticks at once,
+            // overlapping it. So the sticking point is checked against the replica (private,
+            // no lock needed) and, under the lock, against the particles stored since.
             let mut overlap = false;
             rep.tree
                 .for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
-            if let Err(e) = log.guard.record(overlap) {
-                return self.fail(&mut log, e);
+            let mut guard = self.lock();
+            if guard.growth.n >= self.target || self.stop.load(Ordering::Relaxed) {
+                return;
+            }
+            self.take_pending(&guard, rep);
+            // Re-check under the lock (seed 002, section 3.4) against the particles other
+            // threads stored since the walker's last move (now in `pending`, a handful at most).
+            let r_sq = OVERLAP_DISTANCE * OVERLAP_DISTANCE;
+            overlap |= rep.pending.iter().any(|x| {
+                let mut d2 = 0.0;
+                for i in 0..D {
+                    let e = stick[i] - x[i];
+                    d2 += e * e;
+                }
+                d2 <= r_sq
+            });
+            if let Err(e) = guard.guard.record(overlap) {
+                return self.fail(&mut guard, e);
             }
             if overlap {
+                drop(guard);
+                if !self.insert_pending(rep) {
+                    return;
+                }
                 continue;
             }
-            let q = match rep.tree.insert(stick) {
-                Ok(q) => q,
-                Err(e) => return self.fail(&mut log, e.into()),
-            };
-            rep.r_ext = rep.r_ext.max(norm(&q));
-            let log = &mut *log;
+            let log = &mut *guard;
             log.growth.account(q, self.target);
             log.points.push(q);
+            rep.pending.push(q);
             rep.applied += 1;
             self.applied[rep.index].store(rep.applied, Ordering::Relaxed);
             self.published.store(rep.applied, Ordering::Release);
@@ -491,6 +533,10 @@ impl<const D: usize> Ctx<'_, D> {
                     log.base = oldest;
                 }
             }
+            drop(guard);
+            if !self.insert_pending(rep) {
+                return;
+            }
         }
     }
 }
@@ -506,6 +552,8 @@ pub struct Simulation<const D: usize> {
     rng: SimRng,
     discarded: u64,
     walk: WalkState,
+    parallel_seconds: f64,
+    lock_wait_seconds: f64,
 }
 
 /// The fitted fractal dimension (`log N = D log R_g + c`).
@@ -529,6 +577,8 @@ impl<const D: usize> Simulation<D> {
             growth,
             discarded: 0,
             walk: WalkState::new(),
+            parallel_seconds: 0.0,
+            lock_wait_seconds: 0.0,
         })
     }
 
@@ -578,13 +628,16 @@ impl<const D: usize> Simulation<D> {
 
     /// PDLA: `params.threads` walkers at once. Each thread walks on its own replica of the
     /// orthtree, so walking takes no lock and touches no shared cache line but one atomic
-    /// counter; stuck particles go through a shared log (a mutex held only to re-check, append
-    /// and account for one particle). Before every move a thread applies the particles other
-    /// threads appended since its last move, so it walks on the cluster as it was at most one
-    /// move ago, as in the paper's shared tree. At sticking it re-checks, under the log's lock
-    /// and after applying every pending particle, that no centre lies within
-    /// [`OVERLAP_DISTANCE`] (seed 002, section 3.4); if one does the walker is discarded and
-    /// counted. The replicas receive the same points in the same order, so they are identical;
+    /// counter; stuck particles go through a shared log (a mutex held only to copy the new
+    /// entries, re-check against them, append and account for one particle; inserting into the
+    /// replica happens after the mutex is released). Before every move a thread applies the
+    /// particles other threads appended since its last move, so it walks on the cluster as it
+    /// was at most one move ago, as in the paper's shared tree. At sticking it re-checks, under
+    /// the log's lock, that none of the particles stored since its last move lies within
+    /// [`OVERLAP_DISTANCE`] (seed 002, section 3.4), and against its replica before taking the
+    /// lock (a move can end inside a particle stored during it); if one does the walker is
+    /// discarded and counted. The replicas receive the same points in the same order, so they
+    /// are identical;
     /// thread 0's becomes the simulation's tree.
     fn run_parallel(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), SimError> {
         let params = &self.params;
@@ -606,12 +659,15 @@ impl<const D: usize> Simulation<D> {
         let r_ext0 = log.lock().growth.r_ext;
         let mut replicas: Vec<Orthtree<D>> = (1..threads).map(|_| self.tree.clone()).collect();
         replicas.insert(0, std::mem::take(&mut self.tree));
+        let wait_nanos = AtomicU64::new(0);
+        let started = Instant::now();
         let ctx = Ctx {
             log: &log,
             published: &published,
             applied: &applied,
             stop: &stop,
             target,
+            wait_nanos: &wait_nanos,
         };
         let mut trees: Vec<Orthtree<D>> = std::thread::scope(|s| {
             let handles: Vec<_> = replicas
@@ -623,10 +679,13 @@ impl<const D: usize> Simulation<D> {
                             tree,
                             r_ext: r_ext0,
                             applied: start,
+                            pending: Vec::new(),
                             index: t,
                         };
                         let mut rng = stream(seed, stream_id(PURPOSE_PDLA, t as u32));
                         ctx.walk(&mut rep, params, &mut rng, progress);
+                        // Whatever was taken from the log is counted as applied.
+                        ctx.insert_pending(&mut rep);
                         rep.tree
                     })
                 })
@@ -636,6 +695,8 @@ impl<const D: usize> Simulation<D> {
                 .map(|h| h.join().expect("a PDLA thread panicked"))
                 .collect()
         });
+        self.parallel_seconds += started.elapsed().as_secs_f64();
+        self.lock_wait_seconds += wait_nanos.into_inner() as f64 * 1e-9;
         let mut log = log.into_inner();
         let mut tree = trees.swap_remove(0);
         drop(trees);
@@ -681,6 +742,17 @@ impl<const D: usize> Simulation<D> {
     /// PDLA walkers discarded at the re-check (0 for one thread).
     pub fn discarded_walkers(&self) -> u64 {
         self.discarded
+    }
+
+    /// Wall seconds of the parallel (PDLA) phase; 0 for one thread.
+    pub fn parallel_seconds(&self) -> f64 {
+        self.parallel_seconds
+    }
+
+    /// Seconds PDLA threads spent waiting for the shared log's mutex, summed over threads (the
+    /// serialised part of PDLA; 0 for one thread).
+    pub fn lock_wait_seconds(&self) -> f64 {
+        self.lock_wait_seconds
     }
 
     /// Hash of the stored positions in arrival order (f64 bits): equal runs, equal hashes.
