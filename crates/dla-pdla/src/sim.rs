@@ -7,7 +7,7 @@ use core_lattice::io::StateHasher;
 use core_lattice::rng::{Rng, SimRng, stream, stream_id, uniform01, unit_vector};
 use core_lattice::{Gyration, LogLogFit};
 use parking_lot::Mutex;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use spatial::orthtree::{Orthtree, OrthtreeError};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -35,6 +35,13 @@ pub enum SimError {
     /// The orthtree refused a particle (coordinate range or capacity).
     #[error("storing a particle: {0}")]
     Tree(#[from] OrthtreeError),
+    /// A checkpoint could not be written or read.
+    #[error("checkpoint: {0}")]
+    Checkpoint(#[from] core_lattice::io::CheckpointError),
+    /// Checkpoints need one thread and the positions kept in memory; or a checkpoint does not
+    /// match the run it should continue.
+    #[error("checkpoint: {0}")]
+    CheckpointUsage(String),
     /// PDLA discarded [`MAX_CONSECUTIVE_DISCARDS`] walkers in a row without storing one.
     #[error(
         "PDLA livelock: {consecutive} walkers in a row discarded at the re-check ({total} in all); \
@@ -49,7 +56,7 @@ pub enum SimError {
 }
 
 /// One row of `growth.csv`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Sample {
     /// Particles in the cluster.
     pub n: u64,
@@ -541,6 +548,23 @@ impl<const D: usize> Ctx<'_, D> {
     }
 }
 
+/// Model name in the checkpoint envelope.
+pub const CHECKPOINT_MODEL: &str = "dla";
+
+/// The state a checkpoint holds (bincode 2 in the `AGGSIMCK` envelope).
+#[derive(Serialize, Deserialize)]
+struct Snapshot {
+    params: Params,
+    seed: u64,
+    rng: SimRng,
+    /// Positions in arrival order, `D` coordinates each.
+    positions: Vec<f64>,
+    samples: Vec<Sample>,
+    next_sample: u64,
+    /// Wall seconds of growth so far (the `seconds` column of `growth.csv` continues).
+    seconds: f64,
+}
+
 /// A DLA/PDLA run in `D` dimensions (2 or 3), a pure function of `(Params, seed)` for one
 /// thread.
 #[derive(Debug)]
@@ -602,6 +626,105 @@ impl<const D: usize> Simulation<D> {
         }
         progress(self.growth.n);
         Ok(())
+    }
+
+    /// Serial DLA with a checkpoint written to `path` every `every` particles (and at the
+    /// end), atomically, in the `AGGSIMCK` envelope (model `dla`). Needs `threads == 1` and
+    /// `keep_positions` (the checkpoint holds every position in arrival order, from which
+    /// [`resume`](Self::resume) rebuilds the tree, `R_g`, `R_ext` and the state hash exactly).
+    /// A resumed run ends with the same `state_hash` as an uninterrupted one.
+    pub fn run_checkpointed(
+        &mut self,
+        every: u64,
+        path: &std::path::Path,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(), SimError> {
+        if self.params.threads != 1 || self.growth.positions.is_none() || every == 0 {
+            return Err(SimError::CheckpointUsage(format!(
+                "checkpoints need --threads 1, kept positions and every >= 1 (got threads {}, every {every})",
+                self.params.threads
+            )));
+        }
+        let target = self.params.particles;
+        while self.growth.n < target {
+            self.add_one()?;
+            if self.growth.n % 1024 == 0 {
+                progress(self.growth.n);
+            }
+            if self.growth.n % every == 0 && self.growth.n < target {
+                self.write_checkpoint(path)?;
+            }
+        }
+        self.write_checkpoint(path)?;
+        progress(self.growth.n);
+        Ok(())
+    }
+
+    /// Writes the run's state to `path` (see [`run_checkpointed`](Self::run_checkpointed)).
+    pub fn write_checkpoint(&self, path: &std::path::Path) -> Result<(), SimError> {
+        let positions = self.growth.positions.as_ref().ok_or_else(|| {
+            SimError::CheckpointUsage("a checkpoint needs the positions kept in memory".into())
+        })?;
+        if self.params.threads != 1 {
+            return Err(SimError::CheckpointUsage(
+                "checkpoints are for one thread (PDLA is not deterministic)".into(),
+            ));
+        }
+        let snap = Snapshot {
+            params: self.params.clone(),
+            seed: self.seed,
+            rng: self.rng.clone(),
+            positions: positions.iter().flatten().copied().collect(),
+            samples: self.growth.samples.clone(),
+            next_sample: self.growth.next_sample,
+            seconds: self.growth.started.elapsed().as_secs_f64(),
+        };
+        core_lattice::io::write_checkpoint(path, CHECKPOINT_MODEL, &snap)?;
+        Ok(())
+    }
+
+    /// Continues a run from a checkpoint written by
+    /// [`run_checkpointed`](Self::run_checkpointed): the tree, `R_g`, `R_ext` and the state
+    /// hash are rebuilt by storing the checkpointed positions again in arrival order, so they
+    /// are bit-identical to those of the run that wrote it.
+    pub fn resume(path: &std::path::Path) -> Result<Self, SimError> {
+        let snap: Snapshot = core_lattice::io::read_checkpoint(path, CHECKPOINT_MODEL)?;
+        snap.params.validate()?;
+        if snap.params.dim != D {
+            return Err(SimError::DimMismatch(D, snap.params.dim));
+        }
+        if snap.positions.len() % D != 0 || snap.positions.is_empty() {
+            return Err(SimError::CheckpointUsage(format!(
+                "{} coordinates is not a whole number of {D}D positions",
+                snap.positions.len()
+            )));
+        }
+        let params = snap.params;
+        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
+        let mut growth = Growth::new(&params);
+        for c in snap.positions.chunks_exact(D) {
+            let mut p = [0.0; D];
+            p.copy_from_slice(c);
+            growth.add(&mut tree, p, params.particles)?;
+        }
+        growth.samples = snap.samples;
+        growth.next_sample = snap.next_sample;
+        if let Some(t) = Instant::now().checked_sub(std::time::Duration::from_secs_f64(
+            snap.seconds.clamp(0.0, 1e9),
+        )) {
+            growth.started = t;
+        }
+        Ok(Simulation {
+            params,
+            seed: snap.seed,
+            tree,
+            growth,
+            rng: snap.rng,
+            discarded: 0,
+            walk: WalkState::new(),
+            parallel_seconds: 0.0,
+            lock_wait_seconds: 0.0,
+        })
     }
 
     /// Grow to `params.particles` without progress reports.

@@ -173,3 +173,81 @@ fn pdla_counts_every_walker_and_keeps_the_tree_complete() {
     b.sort_by(|x, y| x.partial_cmp(y).unwrap());
     assert_eq!(a, b);
 }
+
+#[test]
+fn checkpoint_and_resume_give_the_uninterrupted_state_hash() {
+    for dim in [2usize, 3] {
+        let params = Params {
+            dim,
+            particles: 3000,
+            keep_positions: true,
+            ..Params::default()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("checkpoint.bin");
+        if dim == 2 {
+            let mut a = Simulation::<2>::new(params.clone(), 21).unwrap();
+            a.run().unwrap();
+            let mut b = Simulation::<2>::new(params.clone(), 21).unwrap();
+            for _ in 0..1234 {
+                b.add_one().unwrap();
+            }
+            b.write_checkpoint(&path).unwrap();
+            drop(b);
+            let mut c = Simulation::<2>::resume(&path).unwrap();
+            assert_eq!(c.particles(), 1235);
+            c.run().unwrap();
+            assert_eq!(c.state_hash(), a.state_hash());
+            assert_eq!(c.positions(), a.positions());
+            assert_eq!(c.radius_of_gyration(), a.radius_of_gyration());
+            // run_checkpointed ends with the same hash and leaves a final checkpoint.
+            let mut d = Simulation::<2>::new(params.clone(), 21).unwrap();
+            d.run_checkpointed(1000, &path, &|_| {}).unwrap();
+            assert_eq!(d.state_hash(), a.state_hash());
+            assert_eq!(
+                Simulation::<2>::resume(&path).unwrap().state_hash(),
+                a.state_hash()
+            );
+        } else {
+            let mut a = Simulation::<3>::new(params.clone(), 21).unwrap();
+            a.run().unwrap();
+            let mut b = Simulation::<3>::new(params.clone(), 21).unwrap();
+            for _ in 0..999 {
+                b.add_one().unwrap();
+            }
+            b.write_checkpoint(&path).unwrap();
+            let mut c = Simulation::<3>::resume(&path).unwrap();
+            c.run().unwrap();
+            assert_eq!(c.state_hash(), a.state_hash());
+            // A checkpoint of the wrong dimension is refused.
+            assert!(Simulation::<2>::resume(&path).is_err());
+        }
+    }
+}
+
+#[test]
+fn checkpoints_refuse_pdla_and_missing_positions() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("checkpoint.bin");
+    let mut s = Simulation::<2>::new(
+        Params {
+            particles: 100,
+            ..Params::default()
+        },
+        1,
+    )
+    .unwrap();
+    assert!(s.run_checkpointed(10, &path, &|_| {}).is_err());
+    let mut t = Simulation::<2>::new(
+        Params {
+            particles: 100,
+            threads: 2,
+            keep_positions: true,
+            ..Params::default()
+        },
+        1,
+    )
+    .unwrap();
+    assert!(t.run_checkpointed(10, &path, &|_| {}).is_err());
+    assert!(!path.exists());
+}
