@@ -60,6 +60,11 @@ struct Cli {
     #[arg(long, default_value_t = 2.0)]
     precision: f64,
 
+    /// Side of the orthtree's leaf cells in diameters (power of two, 1 to 64): speed and
+    /// memory only, not the physics.
+    #[arg(long, default_value_t = dla_pdla::params::DEFAULT_LEAF_SIDE)]
+    leaf_side: f64,
+
     /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -76,6 +81,17 @@ struct Cli {
     /// (keeps 8 bytes per coordinate per particle in memory).
     #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
     positions: PositionsFormat,
+
+    /// Write DIR/checkpoint.bin (DIR = --out) every N particles and at the end, atomically;
+    /// needs --threads 1 and keeps the positions in memory (8 bytes per coordinate per
+    /// particle). A run continued with --resume ends with the same state_hash.
+    #[arg(long, value_name = "N")]
+    checkpoint_every: Option<u64>,
+
+    /// Continue the run checkpointed in DIR/checkpoint.bin. The run flags (and --seed) must be
+    /// those of the checkpointed run; outputs go to --out as usual.
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
 
     /// Write dla.png: the cluster shaded by arrival order (3D: projected on x, y).
     #[arg(long)]
@@ -102,9 +118,20 @@ fn params(cli: &Cli) -> Result<Params, String> {
         threads: cli.threads,
         serial_until: cli.serial_until,
         fit_from: cli.fit_from,
-        keep_positions: cli.png || cli.positions != PositionsFormat::None,
+        keep_positions: cli.png
+            || cli.positions != PositionsFormat::None
+            || cli.checkpoint_every.is_some(),
+        leaf_side: cli.leaf_side,
     };
     p.validate().map_err(|e| e.to_string())?;
+    if let Some(n) = cli.checkpoint_every {
+        if n == 0 || p.threads != 1 {
+            return Err(format!(
+                "--checkpoint-every {n} with --threads {} is outside the accepted range: N >= 1 and --threads 1",
+                p.threads
+            ));
+        }
+    }
     Ok(p)
 }
 
@@ -126,7 +153,25 @@ fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()> {
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     let total = params.particles;
     tracing::info!(?params, seed = cli.seed, "starting growth");
-    let mut sim = Simulation::<D>::new(params, cli.seed).context("setting up the run")?;
+    let mut sim = match &cli.resume {
+        None => Simulation::<D>::new(params, cli.seed).context("setting up the run")?,
+        Some(dir) => {
+            let path = dir.join("checkpoint.bin");
+            let sim = Simulation::<D>::resume(&path)
+                .with_context(|| format!("resuming from {}", path.display()))?;
+            let mut same = sim.params().clone();
+            same.keep_positions = params.keep_positions;
+            anyhow::ensure!(
+                same == params && sim.seed() == cli.seed,
+                "--resume {}: the flags differ from the checkpointed run's ({:?}, seed {})",
+                dir.display(),
+                sim.params(),
+                sim.seed()
+            );
+            tracing::info!(particles = sim.particles(), "resumed");
+            sim
+        }
+    };
     let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
         let bar = indicatif::ProgressBar::new(total);
         bar.set_style(
@@ -137,11 +182,15 @@ fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()> {
         );
         bar
     });
-    sim.run_with(&|n| {
+    let progress = |n| {
         if let Some(bar) = &bar {
             bar.set_position(n);
         }
-    })?;
+    };
+    match cli.checkpoint_every {
+        Some(every) => sim.run_checkpointed(every, &cli.out.join("checkpoint.bin"), &progress)?,
+        None => sim.run_with(&progress)?,
+    }
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

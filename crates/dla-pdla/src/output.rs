@@ -98,6 +98,8 @@ pub fn write_outputs<const D: usize>(
         .set_result("radius_of_gyration", sim.radius_of_gyration())
         .set_result("r_ext", sim.r_ext())
         .set_result("discarded_walkers", sim.discarded_walkers())
+        .set_result("pdla_parallel_seconds", sim.parallel_seconds())
+        .set_result("pdla_lock_wait_seconds", sim.lock_wait_seconds())
         .set_result("state_hash", sim.state_hash())
         .set_result("tree_memory_bytes", sim.tree().memory_bytes() as u64)
         .set_result("bytes_per_particle", bpp);

@@ -50,6 +50,19 @@ pub struct Params {
     /// Keep every position in arrival order (needed for position files and pictures). Costs
     /// `8 D` bytes per particle; off by default.
     pub keep_positions: bool,
+    /// Side of the orthtree's leaf cells in diameters, a power of two in [1, 64]
+    /// (`--leaf-side`, default [`DEFAULT_LEAF_SIDE`]). Changes speed and memory, not the
+    /// physics: see `docs/dla.md`.
+    #[serde(default = "default_leaf_side")]
+    pub leaf_side: f64,
+}
+
+/// Default leaf side of the orthtree for DLA: 8 diameters (measured faster than 4 in 2D and 3D,
+/// and smaller: about 10 instead of 12 bytes per particle in 2D; `docs/benchmarks.md`).
+pub const DEFAULT_LEAF_SIDE: f64 = 8.0;
+
+fn default_leaf_side() -> f64 {
+    DEFAULT_LEAF_SIDE
 }
 
 impl Default for Params {
@@ -66,6 +79,7 @@ impl Default for Params {
             serial_until: 0,
             fit_from: 1000,
             keep_positions: false,
+            leaf_side: DEFAULT_LEAF_SIDE,
         }
     }
 }
@@ -96,6 +110,9 @@ pub enum ParamsError {
     /// `precision` not > 1/2 (vpdist needs kappa > 1/2 to be useful).
     #[error("--precision {0} is outside the accepted range (0.5, inf] (inf = exact search)")]
     Precision(f64),
+    /// `leaf_side` not a power of two in [1, 64].
+    #[error("--leaf-side {0} is outside the accepted range {{1, 2, 4, 8, 16, 32, 64}}")]
+    LeafSide(f64),
     /// `threads` is 0 or absurd.
     #[error("--threads {0} is outside the accepted range 1..=1024")]
     Threads(usize),
@@ -124,6 +141,10 @@ impl Params {
         }
         if self.threads == 0 || self.threads > 1024 {
             return Err(ParamsError::Threads(self.threads));
+        }
+        let l = self.leaf_side;
+        if !((1.0..=64.0).contains(&l) && l.log2().fract() == 0.0) {
+            return Err(ParamsError::LeafSide(l));
         }
         Ok(())
     }
@@ -171,6 +192,14 @@ mod tests {
             },
             Params {
                 death_ratio: 1.0,
+                ..Params::default()
+            },
+            Params {
+                leaf_side: 3.0,
+                ..Params::default()
+            },
+            Params {
+                leaf_side: 128.0,
                 ..Params::default()
             },
         ];

@@ -4,12 +4,12 @@
 use crate::farfield::{norm, return_to_sphere};
 use crate::params::{FarField, Params, ParamsError};
 use core_lattice::io::StateHasher;
-use core_lattice::rng::{Rng, SimRng, stream, stream_id, unit_vector};
+use core_lattice::rng::{Rng, SimRng, stream, stream_id, uniform01, unit_vector};
 use core_lattice::{Gyration, LogLogFit};
-use parking_lot::{Mutex, RwLock, RwLockReadGuard};
-use serde::Serialize;
+use parking_lot::Mutex;
+use serde::{Deserialize, Serialize};
 use spatial::orthtree::{Orthtree, OrthtreeError};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
 /// Stream purpose of the serial walker (`stream_id(PURPOSE_WALK, 0)`).
@@ -35,10 +35,28 @@ pub enum SimError {
     /// The orthtree refused a particle (coordinate range or capacity).
     #[error("storing a particle: {0}")]
     Tree(#[from] OrthtreeError),
+    /// A checkpoint could not be written or read.
+    #[error("checkpoint: {0}")]
+    Checkpoint(#[from] core_lattice::io::CheckpointError),
+    /// Checkpoints need one thread and the positions kept in memory; or a checkpoint does not
+    /// match the run it should continue.
+    #[error("checkpoint: {0}")]
+    CheckpointUsage(String),
+    /// PDLA discarded [`MAX_CONSECUTIVE_DISCARDS`] walkers in a row without storing one.
+    #[error(
+        "PDLA livelock: {consecutive} walkers in a row discarded at the re-check ({total} in all); \
+         the contact or re-check is broken"
+    )]
+    DiscardLivelock {
+        /// Discarded in a row.
+        consecutive: u64,
+        /// Discarded in all.
+        total: u64,
+    },
 }
 
 /// One row of `growth.csv`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Sample {
     /// Particles in the cluster.
     pub n: u64,
@@ -87,6 +105,12 @@ impl<const D: usize> Growth<D> {
         target: u64,
     ) -> Result<[f64; D], OrthtreeError> {
         let q = tree.insert(p)?;
+        self.account(q, target);
+        Ok(q)
+    }
+
+    /// Accounts for a particle already stored at `q`.
+    fn account(&mut self, q: [f64; D], target: u64) {
         self.n += 1;
         self.r_ext = self.r_ext.max(norm(&q));
         self.gyration.push(&q);
@@ -105,7 +129,6 @@ impl<const D: usize> Growth<D> {
             });
             self.next_sample = (self.n + 1).max((self.n as f64 * self.ratio).ceil() as u64);
         }
-        Ok(q)
     }
 }
 
@@ -119,7 +142,7 @@ pub struct Walker<const D: usize> {
 impl<const D: usize> Walker<D> {
     /// A walker born uniformly on the sphere of radius `r_b`.
     pub fn born<R: Rng + ?Sized>(r_b: f64, rng: &mut R) -> Self {
-        let mut p = unit_vector::<D, _>(rng);
+        let mut p = direction::<D, _>(rng);
         p.iter_mut().for_each(|x| *x *= r_b);
         Walker { p }
     }
@@ -134,12 +157,27 @@ impl<const D: usize> Walker<D> {
         params: &Params,
         rng: &mut R,
     ) -> Option<[f64; D]> {
+        self.advance(&mut WalkState::new(), tree, r_ext, params, rng)
+    }
+
+    /// [`step`](Self::step) with the walker's memory `state` (reset it for each new walker):
+    /// an upper bound of its distance to the cluster, so the tree query starts from the few
+    /// nodes covering that ball ([`Orthtree::vpdist_bounded`]) rather than from the root.
+    pub(crate) fn advance<R: Rng + ?Sized>(
+        &mut self,
+        state: &mut WalkState,
+        tree: &Orthtree<D>,
+        r_ext: f64,
+        params: &Params,
+        rng: &mut R,
+    ) -> Option<[f64; D]> {
         let r_b = r_ext + params.birth_gap;
         let r = norm(&self.p);
         // Far field. The margin keeps a walker just returned to the birth sphere (whose norm
         // may round to slightly above r_b) in the near field, which is valid everywhere;
         // without it a walker at r_b (1 + 1e-16) would be "returned" to itself forever.
         if r > r_b * FAR_FIELD_MARGIN {
+            state.upper = f64::INFINITY;
             match params.far_field {
                 FarField::Return => self.p = return_to_sphere(&self.p, r_b, rng),
                 FarField::Jump => {
@@ -155,14 +193,20 @@ impl<const D: usize> Walker<D> {
             return None;
         }
         // Near field: a lower bound on the distance to the nearest centre.
-        let delta = tree
-            .vpdist(&self.p, params.precision)
+        let est = tree
+            .vpdist_bounded(&self.p, params.precision, state.upper)
             .expect("the cluster is never empty");
+        let delta = est.distance;
+        // The exact distance is at most delta + 2 r (the gap of a far node's bound), with a
+        // relative margin for the rounding of that bound.
+        state.upper = (delta + 2.0 * est.half_diagonal.unwrap_or(0.0)) * (1.0 + 1e-9) + 1e-9;
         if delta - 1.0 > params.step_min {
             self.jump(delta - 1.0, rng);
+            state.upper += (delta - 1.0) * (1.0 + 1e-9);
             return None;
         }
-        let u = unit_vector::<D, _>(rng);
+        state.upper += params.step_min * (1.0 + 1e-9);
+        let u = direction::<D, _>(rng);
         let t = first_contact(tree, &self.p, &u, params.step_min);
         if let Some(t) = t {
             let mut q = self.p;
@@ -178,11 +222,49 @@ impl<const D: usize> Walker<D> {
     }
 
     fn jump<R: Rng + ?Sized>(&mut self, len: f64, rng: &mut R) {
-        let u = unit_vector::<D, _>(rng);
+        let u = direction::<D, _>(rng);
         for i in 0..D {
             self.p[i] += len * u[i];
         }
     }
+}
+
+/// A uniformly random unit vector in `D = 2` or 3 dimensions, without trigonometric functions:
+/// a point uniform in the unit disk by rejection from the square (two 32-bit uniforms from one
+/// 64-bit draw, accepted with probability pi/4), normalised; in 3D, `z` uniform in `[-1, 1]`
+/// (Archimedes) and the azimuth from such a disk point. Isotropic exactly up to the 2^-31
+/// granularity of the disk point.
+#[inline]
+pub fn direction<const D: usize, R: Rng + ?Sized>(rng: &mut R) -> [f64; D] {
+    const SCALE: f64 = 1.0 / 2_147_483_648.0;
+    let disk = |rng: &mut R| loop {
+        let b = rng.next_u64();
+        let x = ((b >> 32) as u32 as i32) as f64 * SCALE;
+        let y = (b as u32 as i32) as f64 * SCALE;
+        let s = x * x + y * y;
+        if s <= 1.0 && s > 1e-12 {
+            let inv = 1.0 / s.sqrt();
+            return (x * inv, y * inv);
+        }
+    };
+    let mut v = [0.0; D];
+    match D {
+        2 => {
+            let (c, s) = disk(rng);
+            v[0] = c;
+            v[1] = s;
+        }
+        3 => {
+            let z = 2.0 * uniform01(rng) - 1.0;
+            let rho = (1.0 - z * z).max(0.0).sqrt();
+            let (c, s) = disk(rng);
+            v[0] = rho * c;
+            v[1] = rho * s;
+            v[2] = z;
+        }
+        _ => v = unit_vector::<D, _>(rng),
+    }
+    v
 }
 
 /// Smallest `t` in `[0, len]` with `|p + t u - q| = 1` over every stored centre `q` (`u` a unit
@@ -195,30 +277,292 @@ pub fn first_contact<const D: usize>(
     len: f64,
 ) -> Option<f64> {
     let mut best = f64::INFINITY;
-    tree.for_each_within(p, len + 1.0, |q| {
-        let mut b = 0.0;
-        let mut w2 = 0.0;
-        for i in 0..D {
-            let w = p[i] - q[i];
-            b += w * u[i];
-            w2 += w * w;
+    tree.for_each_within(p, len + 1.0, |q| contact(p, u, &q, &mut best));
+    (best <= len).then_some(best)
+}
+
+/// Lowers `best` to the contact time with centre `q` along `p + t u`, if there is one.
+#[inline(always)]
+fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut f64) {
+    let mut b = 0.0;
+    let mut w2 = 0.0;
+    for i in 0..D {
+        let w = p[i] - q[i];
+        b += w * u[i];
+        w2 += w * w;
+    }
+    let c = w2 - 1.0;
+    let t = if c <= 0.0 {
+        0.0
+    } else {
+        let disc = b * b - c;
+        if disc < 0.0 || b >= 0.0 {
+            return;
         }
-        let c = w2 - 1.0;
-        let t = if c <= 0.0 {
-            0.0
+        // Stable form of -b - sqrt(disc) (b < 0): c / (-b + sqrt(disc)).
+        c / (-b + disc.sqrt())
+    };
+    if t < *best {
+        *best = t;
+    }
+}
+
+/// What a walker remembers between moves: an upper bound of its exact distance to the
+/// nearest centre (`+inf` when unknown). It stays valid while particles are only added, so
+/// PDLA threads keep it when other threads store particles.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct WalkState {
+    upper: f64,
+}
+
+impl WalkState {
+    pub(crate) fn new() -> Self {
+        WalkState {
+            upper: f64::INFINITY,
+        }
+    }
+
+    /// A new walker: nothing known.
+    pub(crate) fn reset(&mut self) {
+        self.upper = f64::INFINITY;
+    }
+}
+
+/// Consecutive discarded walkers (with no particle stored in between) after which a PDLA run
+/// stops with [`SimError::DiscardLivelock`]. With exact contact a discard needs another thread
+/// to have stored a particle within one diameter of the sticking point during the walker's
+/// last move, so a handful in a row is already rare; this many means a bug, not bad luck.
+pub const MAX_CONSECUTIVE_DISCARDS: u64 = 100_000;
+
+/// Counts discarded PDLA walkers and stops a run that only discards (a livelock).
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub struct DiscardGuard {
+    /// All discarded walkers.
+    pub total: u64,
+    /// Discarded since the last stored particle.
+    pub consecutive: u64,
+}
+
+impl DiscardGuard {
+    /// Records one walker at the re-check: discarded or stored.
+    pub fn record(&mut self, discarded: bool) -> Result<(), SimError> {
+        if discarded {
+            self.total += 1;
+            self.consecutive += 1;
+            if self.consecutive >= MAX_CONSECUTIVE_DISCARDS {
+                return Err(SimError::DiscardLivelock {
+                    consecutive: self.consecutive,
+                    total: self.total,
+                });
+            }
         } else {
-            let disc = b * b - c;
-            if disc < 0.0 || b >= 0.0 {
+            self.consecutive = 0;
+        }
+        Ok(())
+    }
+}
+
+/// The shared side of PDLA: stored particles in order, and everything a stored particle changes.
+struct Log<const D: usize> {
+    /// Stored positions from absolute index `base` on (older ones every thread has applied are
+    /// dropped).
+    points: Vec<[f64; D]>,
+    base: usize,
+    growth: Growth<D>,
+    guard: DiscardGuard,
+    error: Option<SimError>,
+}
+
+/// One thread's copy of the cluster.
+struct Replica<const D: usize> {
+    tree: Orthtree<D>,
+    /// Largest centre distance over the applied particles.
+    r_ext: f64,
+    /// Particles taken from the log (an absolute log index).
+    applied: usize,
+    /// Taken from the log but not yet inserted (filled under the lock, inserted after it).
+    pending: Vec<[f64; D]>,
+    index: usize,
+}
+
+/// References shared by the PDLA threads.
+#[derive(Clone, Copy)]
+struct Ctx<'a, const D: usize> {
+    log: &'a Mutex<Log<D>>,
+    published: &'a AtomicUsize,
+    applied: &'a [AtomicUsize],
+    stop: &'a AtomicBool,
+    target: u64,
+    /// Nanoseconds threads spent waiting for the log's mutex (summed over threads).
+    wait_nanos: &'a AtomicU64,
+}
+
+/// Log entries are dropped once every thread has applied them and this many have piled up.
+const LOG_TRIM: usize = 4096;
+
+impl<const D: usize> Ctx<'_, D> {
+    /// Takes the log's mutex, timing the wait when it is contended.
+    #[inline]
+    fn lock(&self) -> parking_lot::MutexGuard<'_, Log<D>> {
+        if let Some(g) = self.log.try_lock() {
+            return g;
+        }
+        let t = Instant::now();
+        let g = self.log.lock();
+        self.wait_nanos
+            .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+        g
+    }
+
+    /// Copies the log entries `rep` has not seen into `rep.pending` (the caller holds the
+    /// lock; inserting them into the replica happens after it is released).
+    fn take_pending(&self, log: &Log<D>, rep: &mut Replica<D>) {
+        rep.pending
+            .extend_from_slice(&log.points[rep.applied - log.base..]);
+        rep.applied = log.base + log.points.len();
+        self.applied[rep.index].store(rep.applied, Ordering::Relaxed);
+    }
+
+    /// Inserts `rep.pending` into the replica, in log order (no lock held).
+    fn insert_pending(&self, rep: &mut Replica<D>) -> bool {
+        for q in rep.pending.drain(..) {
+            if let Err(e) = rep.tree.insert(q) {
+                self.fail(&mut self.lock(), e.into());
+                return false;
+            }
+            rep.r_ext = rep.r_ext.max(norm(&q));
+        }
+        true
+    }
+
+    /// Brings `rep` up to date if another thread stored particles; `false` to stop.
+    #[inline]
+    fn sync(&self, rep: &mut Replica<D>) -> bool {
+        if self.stop.load(Ordering::Relaxed) {
+            return false;
+        }
+        if self.published.load(Ordering::Acquire) == rep.applied {
+            return true;
+        }
+        let done = {
+            let log = self.lock();
+            self.take_pending(&log, rep);
+            log.growth.n >= self.target
+        };
+        self.insert_pending(rep) && !done
+    }
+
+    fn fail(&self, log: &mut Log<D>, e: SimError) {
+        log.error.get_or_insert(e);
+        self.stop.store(true, Ordering::Relaxed);
+    }
+
+    /// One thread's walkers until the cluster is complete or the run fails.
+    fn walk<R: Rng + ?Sized>(
+        &self,
+        rep: &mut Replica<D>,
+        params: &Params,
+        rng: &mut R,
+        progress: &(dyn Fn(u64) + Sync),
+    ) {
+        let state = &mut WalkState::new();
+        loop {
+            if !self.sync(rep) {
                 return;
             }
-            // Stable form of -b - sqrt(disc) (b < 0): c / (-b + sqrt(disc)).
-            c / (-b + disc.sqrt())
-        };
-        if t < best {
-            best = t;
+            let mut w = Walker::born(rep.r_ext + params.birth_gap, rng);
+            state.reset();
+            let stick = loop {
+                if let Some(p) = w.advance(state, &rep.tree, rep.r_ext, params, rng) {
+                    break p;
+                }
+                if !self.sync(rep) {
+                    return;
+                }
+            };
+            let q = match rep.tree.stored_position(&stick) {
+                Ok(q) => q,
+                Err(e) => return self.fail(&mut self.lock(), e.into()),
+            };
+            // A jump or step made on the replica can end inside a particle another thread
+            // stored meanwhile; once that particle is applied the next move sticks at once,
+            // overlapping it. So the sticking point is checked against the replica (private,
+            // no lock needed) and, under the lock, against the particles stored since.
+            let mut overlap = false;
+            rep.tree
+                .for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
+            let mut guard = self.lock();
+            if guard.growth.n >= self.target || self.stop.load(Ordering::Relaxed) {
+                return;
+            }
+            self.take_pending(&guard, rep);
+            // Re-check under the lock (seed 002, section 3.4) against the particles other
+            // threads stored since the walker's last move (now in `pending`, a handful at most).
+            let r_sq = OVERLAP_DISTANCE * OVERLAP_DISTANCE;
+            overlap |= rep.pending.iter().any(|x| {
+                let mut d2 = 0.0;
+                for i in 0..D {
+                    let e = stick[i] - x[i];
+                    d2 += e * e;
+                }
+                d2 <= r_sq
+            });
+            if let Err(e) = guard.guard.record(overlap) {
+                return self.fail(&mut guard, e);
+            }
+            if overlap {
+                drop(guard);
+                if !self.insert_pending(rep) {
+                    return;
+                }
+                continue;
+            }
+            let log = &mut *guard;
+            log.growth.account(q, self.target);
+            log.points.push(q);
+            rep.pending.push(q);
+            rep.applied += 1;
+            self.applied[rep.index].store(rep.applied, Ordering::Relaxed);
+            self.published.store(rep.applied, Ordering::Release);
+            if log.growth.n % 1024 == 0 {
+                progress(log.growth.n);
+            }
+            if log.points.len() >= 2 * LOG_TRIM {
+                let oldest = self
+                    .applied
+                    .iter()
+                    .map(|a| a.load(Ordering::Relaxed))
+                    .min()
+                    .unwrap_or(log.base);
+                let drop = oldest - log.base;
+                if drop >= LOG_TRIM {
+                    log.points.drain(..drop);
+                    log.base = oldest;
+                }
+            }
+            drop(guard);
+            if !self.insert_pending(rep) {
+                return;
+            }
         }
-    });
-    (best <= len).then_some(best)
+    }
+}
+
+/// Model name in the checkpoint envelope.
+pub const CHECKPOINT_MODEL: &str = "dla";
+
+/// The state a checkpoint holds (bincode 2 in the `AGGSIMCK` envelope).
+#[derive(Serialize, Deserialize)]
+struct Snapshot {
+    params: Params,
+    seed: u64,
+    rng: SimRng,
+    /// Positions in arrival order, `D` coordinates each.
+    positions: Vec<f64>,
+    samples: Vec<Sample>,
+    next_sample: u64,
+    /// Wall seconds of growth so far (the `seconds` column of `growth.csv` continues).
+    seconds: f64,
 }
 
 /// A DLA/PDLA run in `D` dimensions (2 or 3), a pure function of `(Params, seed)` for one
@@ -231,6 +575,9 @@ pub struct Simulation<const D: usize> {
     growth: Growth<D>,
     rng: SimRng,
     discarded: u64,
+    walk: WalkState,
+    parallel_seconds: f64,
+    lock_wait_seconds: f64,
 }
 
 /// The fitted fractal dimension (`log N = D log R_g + c`).
@@ -243,7 +590,7 @@ impl<const D: usize> Simulation<D> {
         if params.dim != D {
             return Err(SimError::DimMismatch(D, params.dim));
         }
-        let mut tree = Orthtree::new();
+        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
         let mut growth = Growth::new(&params);
         growth.add(&mut tree, [0.0; D], params.particles)?;
         Ok(Simulation {
@@ -253,6 +600,9 @@ impl<const D: usize> Simulation<D> {
             tree,
             growth,
             discarded: 0,
+            walk: WalkState::new(),
+            parallel_seconds: 0.0,
+            lock_wait_seconds: 0.0,
         })
     }
 
@@ -278,6 +628,105 @@ impl<const D: usize> Simulation<D> {
         Ok(())
     }
 
+    /// Serial DLA with a checkpoint written to `path` every `every` particles (and at the
+    /// end), atomically, in the `AGGSIMCK` envelope (model `dla`). Needs `threads == 1` and
+    /// `keep_positions` (the checkpoint holds every position in arrival order, from which
+    /// [`resume`](Self::resume) rebuilds the tree, `R_g`, `R_ext` and the state hash exactly).
+    /// A resumed run ends with the same `state_hash` as an uninterrupted one.
+    pub fn run_checkpointed(
+        &mut self,
+        every: u64,
+        path: &std::path::Path,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(), SimError> {
+        if self.params.threads != 1 || self.growth.positions.is_none() || every == 0 {
+            return Err(SimError::CheckpointUsage(format!(
+                "checkpoints need --threads 1, kept positions and every >= 1 (got threads {}, every {every})",
+                self.params.threads
+            )));
+        }
+        let target = self.params.particles;
+        while self.growth.n < target {
+            self.add_one()?;
+            if self.growth.n % 1024 == 0 {
+                progress(self.growth.n);
+            }
+            if self.growth.n % every == 0 && self.growth.n < target {
+                self.write_checkpoint(path)?;
+            }
+        }
+        self.write_checkpoint(path)?;
+        progress(self.growth.n);
+        Ok(())
+    }
+
+    /// Writes the run's state to `path` (see [`run_checkpointed`](Self::run_checkpointed)).
+    pub fn write_checkpoint(&self, path: &std::path::Path) -> Result<(), SimError> {
+        let positions = self.growth.positions.as_ref().ok_or_else(|| {
+            SimError::CheckpointUsage("a checkpoint needs the positions kept in memory".into())
+        })?;
+        if self.params.threads != 1 {
+            return Err(SimError::CheckpointUsage(
+                "checkpoints are for one thread (PDLA is not deterministic)".into(),
+            ));
+        }
+        let snap = Snapshot {
+            params: self.params.clone(),
+            seed: self.seed,
+            rng: self.rng.clone(),
+            positions: positions.iter().flatten().copied().collect(),
+            samples: self.growth.samples.clone(),
+            next_sample: self.growth.next_sample,
+            seconds: self.growth.started.elapsed().as_secs_f64(),
+        };
+        core_lattice::io::write_checkpoint(path, CHECKPOINT_MODEL, &snap)?;
+        Ok(())
+    }
+
+    /// Continues a run from a checkpoint written by
+    /// [`run_checkpointed`](Self::run_checkpointed): the tree, `R_g`, `R_ext` and the state
+    /// hash are rebuilt by storing the checkpointed positions again in arrival order, so they
+    /// are bit-identical to those of the run that wrote it.
+    pub fn resume(path: &std::path::Path) -> Result<Self, SimError> {
+        let snap: Snapshot = core_lattice::io::read_checkpoint(path, CHECKPOINT_MODEL)?;
+        snap.params.validate()?;
+        if snap.params.dim != D {
+            return Err(SimError::DimMismatch(D, snap.params.dim));
+        }
+        if snap.positions.len() % D != 0 || snap.positions.is_empty() {
+            return Err(SimError::CheckpointUsage(format!(
+                "{} coordinates is not a whole number of {D}D positions",
+                snap.positions.len()
+            )));
+        }
+        let params = snap.params;
+        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
+        let mut growth = Growth::new(&params);
+        for c in snap.positions.chunks_exact(D) {
+            let mut p = [0.0; D];
+            p.copy_from_slice(c);
+            growth.add(&mut tree, p, params.particles)?;
+        }
+        growth.samples = snap.samples;
+        growth.next_sample = snap.next_sample;
+        if let Some(t) = Instant::now().checked_sub(std::time::Duration::from_secs_f64(
+            snap.seconds.clamp(0.0, 1e9),
+        )) {
+            growth.started = t;
+        }
+        Ok(Simulation {
+            params,
+            seed: snap.seed,
+            tree,
+            growth,
+            rng: snap.rng,
+            discarded: 0,
+            walk: WalkState::new(),
+            parallel_seconds: 0.0,
+            lock_wait_seconds: 0.0,
+        })
+    }
+
     /// Grow to `params.particles` without progress reports.
     pub fn run(&mut self) -> Result<(), SimError> {
         self.run_with(&|_| {})
@@ -286,85 +735,104 @@ impl<const D: usize> Simulation<D> {
     /// Release one walker and grow the cluster by the particle it becomes (serial DLA).
     pub fn add_one(&mut self) -> Result<[f64; D], SimError> {
         let mut w = Walker::born(self.growth.r_ext + self.params.birth_gap, &mut self.rng);
+        self.walk.reset();
         loop {
-            if let Some(p) = w.step(&self.tree, self.growth.r_ext, &self.params, &mut self.rng) {
+            if let Some(p) = w.advance(
+                &mut self.walk,
+                &self.tree,
+                self.growth.r_ext,
+                &self.params,
+                &mut self.rng,
+            ) {
                 return Ok(self.growth.add(&mut self.tree, p, self.params.particles)?);
             }
         }
     }
 
+    /// PDLA: `params.threads` walkers at once. Each thread walks on its own replica of the
+    /// orthtree, so walking takes no lock and touches no shared cache line but one atomic
+    /// counter; stuck particles go through a shared log (a mutex held only to copy the new
+    /// entries, re-check against them, append and account for one particle; inserting into the
+    /// replica happens after the mutex is released). Before every move a thread applies the
+    /// particles other threads appended since its last move, so it walks on the cluster as it
+    /// was at most one move ago, as in the paper's shared tree. At sticking it re-checks, under
+    /// the log's lock, that none of the particles stored since its last move lies within
+    /// [`OVERLAP_DISTANCE`] (seed 002, section 3.4), and against its replica before taking the
+    /// lock (a move can end inside a particle stored during it); if one does the walker is
+    /// discarded and counted. The replicas receive the same points in the same order, so they
+    /// are identical;
+    /// thread 0's becomes the simulation's tree.
     fn run_parallel(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), SimError> {
-        struct Shared<const D: usize> {
-            tree: Orthtree<D>,
-            growth: Growth<D>,
-        }
         let params = &self.params;
         let target = params.particles;
-        let shared = RwLock::new(Shared {
-            tree: std::mem::take(&mut self.tree),
+        let threads = params.threads;
+        let start = self.growth.n as usize;
+        let log = Mutex::new(Log {
+            points: Vec::new(),
+            base: start,
             growth: std::mem::replace(&mut self.growth, Growth::new(params)),
+            guard: DiscardGuard::default(),
+            error: None,
         });
-        let discarded = AtomicU64::new(0);
+        // Particles stored so far (log positions are absolute: the serial ones come first).
+        let published = AtomicUsize::new(start);
+        let applied: Vec<AtomicUsize> = (0..threads).map(|_| AtomicUsize::new(start)).collect();
         let stop = AtomicBool::new(false);
-        let error: Mutex<Option<OrthtreeError>> = Mutex::new(None);
         let seed = self.seed;
-        std::thread::scope(|s| {
-            for t in 0..params.threads {
-                let (shared, discarded, stop, error) = (&shared, &discarded, &stop, &error);
-                s.spawn(move || {
-                    let mut rng = stream(seed, stream_id(PURPOSE_PDLA, t as u32));
-                    'walkers: loop {
-                        let mut g = shared.read();
-                        if g.growth.n >= target || stop.load(Ordering::Relaxed) {
-                            break;
-                        }
-                        let mut w = Walker::born(g.growth.r_ext + params.birth_gap, &mut rng);
-                        let mut moves = 0u32;
-                        let stick = loop {
-                            if let Some(p) = w.step(&g.tree, g.growth.r_ext, params, &mut rng) {
-                                break p;
-                            }
-                            moves = moves.wrapping_add(1);
-                            if moves % 64 == 0 {
-                                RwLockReadGuard::bump(&mut g);
-                                if g.growth.n >= target || stop.load(Ordering::Relaxed) {
-                                    break 'walkers;
-                                }
-                            }
+        let r_ext0 = log.lock().growth.r_ext;
+        let mut replicas: Vec<Orthtree<D>> = (1..threads).map(|_| self.tree.clone()).collect();
+        replicas.insert(0, std::mem::take(&mut self.tree));
+        let wait_nanos = AtomicU64::new(0);
+        let started = Instant::now();
+        let ctx = Ctx {
+            log: &log,
+            published: &published,
+            applied: &applied,
+            stop: &stop,
+            target,
+            wait_nanos: &wait_nanos,
+        };
+        let mut trees: Vec<Orthtree<D>> = std::thread::scope(|s| {
+            let handles: Vec<_> = replicas
+                .into_iter()
+                .enumerate()
+                .map(|(t, tree)| {
+                    s.spawn(move || {
+                        let mut rep = Replica {
+                            tree,
+                            r_ext: r_ext0,
+                            applied: start,
+                            pending: Vec::new(),
+                            index: t,
                         };
-                        drop(g);
-                        let mut g = shared.write();
-                        if g.growth.n >= target {
-                            break;
-                        }
-                        // Re-check under the write lock (seed 002, section 3.4): particles
-                        // stored since the walker's last query may overlap it.
-                        let mut overlap = false;
-                        g.tree
-                            .for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
-                        if overlap {
-                            discarded.fetch_add(1, Ordering::Relaxed);
-                            continue;
-                        }
-                        let Shared { tree, growth } = &mut *g;
-                        if let Err(e) = growth.add(tree, stick, target) {
-                            *error.lock() = Some(e);
-                            stop.store(true, Ordering::Relaxed);
-                            break;
-                        }
-                        if growth.n % 1024 == 0 {
-                            progress(growth.n);
-                        }
-                    }
-                });
-            }
+                        let mut rng = stream(seed, stream_id(PURPOSE_PDLA, t as u32));
+                        ctx.walk(&mut rep, params, &mut rng, progress);
+                        // Whatever was taken from the log is counted as applied.
+                        ctx.insert_pending(&mut rep);
+                        rep.tree
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("a PDLA thread panicked"))
+                .collect()
         });
-        let Shared { tree, growth } = shared.into_inner();
+        self.parallel_seconds += started.elapsed().as_secs_f64();
+        self.lock_wait_seconds += wait_nanos.into_inner() as f64 * 1e-9;
+        let mut log = log.into_inner();
+        let mut tree = trees.swap_remove(0);
+        drop(trees);
+        // Thread 0 may have stopped before applying the last particles of the others.
+        let done = applied[0].load(Ordering::Relaxed);
+        for q in &log.points[done - log.base..] {
+            tree.insert(*q)?;
+        }
         self.tree = tree;
-        self.growth = growth;
-        self.discarded += discarded.into_inner();
-        match error.into_inner() {
-            Some(e) => Err(e.into()),
+        self.discarded += log.guard.total;
+        self.growth = log.growth;
+        match log.error.take() {
+            Some(e) => Err(e),
             None => Ok(()),
         }
     }
@@ -397,6 +865,17 @@ impl<const D: usize> Simulation<D> {
     /// PDLA walkers discarded at the re-check (0 for one thread).
     pub fn discarded_walkers(&self) -> u64 {
         self.discarded
+    }
+
+    /// Wall seconds of the parallel (PDLA) phase; 0 for one thread.
+    pub fn parallel_seconds(&self) -> f64 {
+        self.parallel_seconds
+    }
+
+    /// Seconds PDLA threads spent waiting for the shared log's mutex, summed over threads (the
+    /// serialised part of PDLA; 0 for one thread).
+    pub fn lock_wait_seconds(&self) -> f64 {
+        self.lock_wait_seconds
     }
 
     /// Hash of the stored positions in arrival order (f64 bits): equal runs, equal hashes.

@@ -71,6 +71,9 @@ fn bad_flags_exit_2_and_write_nothing() {
         &["--step-min", "-1"],
         &["--threads", "0"],
         &["--far-field", "teleport"],
+        &["--leaf-side", "3"],
+        &["--checkpoint-every", "0"],
+        &["--checkpoint-every", "100", "--threads", "2"],
     ] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
@@ -104,4 +107,36 @@ fn same_seed_same_state_hash_through_the_cli() {
     };
     assert_eq!(hash("9"), hash("9"));
     assert_ne!(hash("9"), hash("10"));
+}
+
+#[test]
+fn checkpointed_and_resumed_runs_end_with_the_same_state_hash() {
+    let run = |out: &std::path::Path, extra: &[&str]| {
+        let st = dla()
+            .args(["--particles", "1500", "--quiet", "--seed", "4", "--out"])
+            .arg(out)
+            .args(extra)
+            .status()
+            .unwrap();
+        assert!(st.success(), "{extra:?}");
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        m["results"]["state_hash"].as_str().unwrap().to_string()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let plain = run(&dir.path().join("a"), &[]);
+    let ck = dir.path().join("b");
+    assert_eq!(run(&ck, &["--checkpoint-every", "400"]), plain);
+    assert!(ck.join("checkpoint.bin").exists());
+    let resumed = run(&dir.path().join("c"), &["--resume", ck.to_str().unwrap()]);
+    assert_eq!(resumed, plain);
+    // Different flags are refused.
+    let o = dla()
+        .args(["--particles", "1600", "--quiet", "--seed", "4", "--resume"])
+        .arg(&ck)
+        .arg("--out")
+        .arg(dir.path().join("d"))
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
 }

@@ -131,3 +131,123 @@ fn growth_samples_are_log_spaced_and_end_at_n() {
     assert_eq!(s.last().unwrap().n, 20_000);
     assert!(s.windows(2).all(|w| w[1].n > w[0].n));
 }
+
+#[test]
+fn discard_guard_fails_loudly_instead_of_spinning() {
+    use dla_pdla::SimError;
+    use dla_pdla::sim::{DiscardGuard, MAX_CONSECUTIVE_DISCARDS};
+    let mut g = DiscardGuard::default();
+    for _ in 0..10 {
+        g.record(true).unwrap();
+    }
+    g.record(false).unwrap();
+    assert_eq!((g.total, g.consecutive), (10, 0));
+    for _ in 1..MAX_CONSECUTIVE_DISCARDS {
+        g.record(true).unwrap();
+    }
+    let e = g.record(true).unwrap_err();
+    assert!(
+        matches!(e, SimError::DiscardLivelock { consecutive, .. } if consecutive == MAX_CONSECUTIVE_DISCARDS)
+    );
+    assert!(e.to_string().contains("livelock"), "{e}");
+}
+
+#[test]
+fn pdla_counts_every_walker_and_keeps_the_tree_complete() {
+    let params = Params {
+        particles: 5000,
+        threads: 2,
+        serial_until: 100,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let mut sim = Simulation::<2>::new(params, 9).unwrap();
+    sim.run().unwrap();
+    assert_eq!(sim.particles(), 5000);
+    assert_eq!(sim.tree().len(), 5000);
+    assert_eq!(sim.positions().unwrap().len(), 5000);
+    // The tree holds exactly the recorded positions.
+    let mut a: Vec<[f64; 2]> = sim.tree().iter().collect();
+    let mut b = sim.positions().unwrap().to_vec();
+    a.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    b.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    assert_eq!(a, b);
+}
+
+#[test]
+fn checkpoint_and_resume_give_the_uninterrupted_state_hash() {
+    for dim in [2usize, 3] {
+        let params = Params {
+            dim,
+            particles: 3000,
+            keep_positions: true,
+            ..Params::default()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("checkpoint.bin");
+        if dim == 2 {
+            let mut a = Simulation::<2>::new(params.clone(), 21).unwrap();
+            a.run().unwrap();
+            let mut b = Simulation::<2>::new(params.clone(), 21).unwrap();
+            for _ in 0..1234 {
+                b.add_one().unwrap();
+            }
+            b.write_checkpoint(&path).unwrap();
+            drop(b);
+            let mut c = Simulation::<2>::resume(&path).unwrap();
+            assert_eq!(c.particles(), 1235);
+            c.run().unwrap();
+            assert_eq!(c.state_hash(), a.state_hash());
+            assert_eq!(c.positions(), a.positions());
+            assert_eq!(c.radius_of_gyration(), a.radius_of_gyration());
+            // run_checkpointed ends with the same hash and leaves a final checkpoint.
+            let mut d = Simulation::<2>::new(params.clone(), 21).unwrap();
+            d.run_checkpointed(1000, &path, &|_| {}).unwrap();
+            assert_eq!(d.state_hash(), a.state_hash());
+            assert_eq!(
+                Simulation::<2>::resume(&path).unwrap().state_hash(),
+                a.state_hash()
+            );
+        } else {
+            let mut a = Simulation::<3>::new(params.clone(), 21).unwrap();
+            a.run().unwrap();
+            let mut b = Simulation::<3>::new(params.clone(), 21).unwrap();
+            for _ in 0..999 {
+                b.add_one().unwrap();
+            }
+            b.write_checkpoint(&path).unwrap();
+            let mut c = Simulation::<3>::resume(&path).unwrap();
+            c.run().unwrap();
+            assert_eq!(c.state_hash(), a.state_hash());
+            // A checkpoint of the wrong dimension is refused.
+            assert!(Simulation::<2>::resume(&path).is_err());
+        }
+    }
+}
+
+#[test]
+fn checkpoints_refuse_pdla_and_missing_positions() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("checkpoint.bin");
+    let mut s = Simulation::<2>::new(
+        Params {
+            particles: 100,
+            ..Params::default()
+        },
+        1,
+    )
+    .unwrap();
+    assert!(s.run_checkpointed(10, &path, &|_| {}).is_err());
+    let mut t = Simulation::<2>::new(
+        Params {
+            particles: 100,
+            threads: 2,
+            keep_positions: true,
+            ..Params::default()
+        },
+        1,
+    )
+    .unwrap();
+    assert!(t.run_checkpointed(10, &path, &|_| {}).is_err());
+    assert!(!path.exists());
+}

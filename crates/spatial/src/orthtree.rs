@@ -583,6 +583,18 @@ impl<const D: usize> Orthtree<D> {
         Ok(stored)
     }
 
+    /// The position [`insert`](Self::insert) would store for `p` (its fixed-point rounding),
+    /// without inserting it: PDLA computes it outside the tree's writer (seed 002, section
+    /// 3.4). Fails as `insert` would on a non-finite or out-of-range coordinate.
+    pub fn stored_position(&self, p: &[f64; D]) -> Result<[f64; D], OrthtreeError> {
+        let (k, code) = self.locate(p)?;
+        let mut stored = [0.0; D];
+        for i in 0..D {
+            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
+        }
+        Ok(stored)
+    }
+
     /// Iterates over the stored positions of all points, leaf by leaf (seed 002, section 3.3:
     /// base coordinates are rebuilt while traversing the tree).
     pub fn iter(&self) -> Points<'_, D> {

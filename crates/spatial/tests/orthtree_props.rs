@@ -124,6 +124,40 @@ fn check<const D: usize>(
                     );
                 }
             }
+            // The bounded walk: with a true upper bound (tight, loose, or the exact distance
+            // itself) or a wrong one, never above the exact distance, within the relative bound,
+            // and an approximate answer always comes from a far node.
+            for upper in [
+                d,
+                d * 1.5 + 0.25,
+                d + 2.0 * leaf_side,
+                0.5 * d,
+                0.0,
+                f64::INFINITY,
+            ] {
+                let b = tree.vpdist_bounded(q, kappa, upper).unwrap();
+                prop_assert!(
+                    b.distance <= d
+                        && (!kappa.is_finite()
+                            || b.distance
+                                >= d * (2.0 * kappa - 1.0) / (2.0 * kappa + 1.0) * (1.0 - TOL)),
+                    "kappa {}, upper {}: bounded {} vs vpdist {} exact {} at {:?}",
+                    kappa,
+                    upper,
+                    b.distance,
+                    v,
+                    d,
+                    q
+                );
+                match b.half_diagonal {
+                    None => prop_assert_eq!(b.distance, d),
+                    Some(r) => prop_assert!(
+                        kappa.is_finite()
+                            && b.distance + r > 2.0 * kappa * r * (1.0 - TOL)
+                            && d - b.distance <= 2.0 * r * (1.0 + TOL) + TOL * d
+                    ),
+                }
+            }
             if kappa.is_finite() {
                 // Relative bound.
                 let ratio = (2.0 * kappa - 1.0) / (2.0 * kappa + 1.0);

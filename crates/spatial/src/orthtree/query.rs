@@ -153,11 +153,165 @@ impl<const D: usize> Orthtree<D> {
             return;
         }
         let r_sq = r * r;
-        let (c, half) = self.root_geometry();
-        if box_dist_sq(p, &c, half) > r_sq {
+        self.for_each_cover_cell(p, r, |tree, node, level, c, half| {
+            if box_dist_sq(p, &c, half) > r_sq {
+                return;
+            }
+            if level == 0 {
+                tree.range_leaf(p, r_sq, node, c, half, &mut f);
+            } else {
+                tree.range_node(p, r_sq, node, level, c, half, &mut f);
+            }
+        });
+    }
+
+    /// [`vpdist_detailed`](Self::vpdist_detailed) given an upper bound `upper` of the exact
+    /// nearest distance (for example the last answer's `distance + 2 half_diagonal` plus the
+    /// distance moved since; the bound stays valid while points are only added).
+    ///
+    /// The walk starts from the at most `2^D` nodes of side `>= 2 upper` that cover the ball
+    /// of radius `upper` around `p` (found by descending along their cells' paths, with no
+    /// distance tests), instead of from the root, and prunes every node farther than `upper`
+    /// from the start. The answer keeps every guarantee of [`vpdist`](Self::vpdist): it is at
+    /// most the exact distance (even if `upper` is wrong: every point outside the searched
+    /// nodes is farther than `upper`, and if nothing nearer than `upper` is found the query
+    /// falls back to the walk from the root), and an approximate answer comes from a far node
+    /// whose half diagonal is reported, so the relative gap stays below `2 / (2 kappa + 1)`
+    /// and the answer is exact within `(kappa - 1/2) DIAGONAL(leaf)`. It may differ from
+    /// `vpdist` either way (nodes are met in another order, so other far nodes give the
+    /// bound). `upper` infinite or NaN: same as
+    /// [`vpdist_detailed`](Self::vpdist_detailed).
+    pub fn vpdist_bounded(&self, p: &[f64; D], kappa: f64, upper: f64) -> Option<VpEstimate> {
+        if self.root == EMPTY {
+            return None;
+        }
+        if !(0.0..f64::INFINITY).contains(&upper) {
+            return self.vpdist_detailed(p, kappa);
+        }
+        let s = if kappa == f64::INFINITY || kappa.is_nan() {
+            self.walk_bounded::<false>(p, f64::INFINITY, upper)
+        } else {
+            self.walk_bounded::<true>(p, far_factor::<D>(kappa), upper)
+        };
+        match s {
+            Some(s) => Some(VpEstimate {
+                distance: s.best,
+                half_diagonal: (s.source > 0.0).then_some(s.source),
+            }),
+            None => self.vpdist_detailed(p, kappa),
+        }
+    }
+
+    /// The walk of [`vpdist_bounded`](Self::vpdist_bounded); `None` if nothing nearer than
+    /// `upper` was found.
+    fn walk_bounded<const APPROX: bool>(
+        &self,
+        p: &[f64; D],
+        far_factor: f64,
+        upper: f64,
+    ) -> Option<Search<D>> {
+        let mut s = Search {
+            p: *p,
+            far_factor,
+            best: upper,
+            best_sq: upper * upper,
+            source: 0.0,
+            point: [f64::NAN; D],
+        };
+        self.for_each_cover_cell(p, upper, |tree, node, level, c, half| {
+            if box_dist_sq(p, &c, half) >= s.best_sq {
+                return;
+            }
+            if level == 0 {
+                tree.visit_leaf::<APPROX, false>(&mut s, node, c, half);
+            } else {
+                tree.visit::<APPROX, false>(&mut s, node, level, c, half);
+            }
+        });
+        (s.best < upper).then_some(s)
+    }
+
+    /// Calls `f(tree, node, level, centre, half side)` for each existing node of a set of at
+    /// most `2^D` nodes, all at one level, whose cells cover the ball of radius `r` around `p`
+    /// (with a relative margin against rounding): the nodes of the smallest level whose side
+    /// is at least `2 r`, or the root if that level is not below the root. `level == 0` means
+    /// `node` is a leaf index. Finding the nodes costs one descent per node with no distance
+    /// computation (the range and bounded queries then start there, not at the root).
+    #[inline]
+    fn for_each_cover_cell<F: FnMut(&Self, u32, u32, [f64; D], f64)>(
+        &self,
+        p: &[f64; D],
+        r: f64,
+        mut f: F,
+    ) {
+        let mut pmax: f64 = 0.0;
+        for x in p {
+            pmax = pmax.max(x.abs());
+        }
+        // Rounding of p +- r and of the divisions below is far below this margin.
+        let r = r + (1.0 + r + pmax) * 1e-9;
+        let side_leaves = (r + r) / self.leaf_side;
+        // Smallest level whose side (2^level leaf sides) is >= 2 r.
+        let level = if side_leaves <= 1.0 {
+            0
+        } else if side_leaves.is_finite() && side_leaves < (1u64 << 62) as f64 {
+            64 - ((side_leaves.ceil() as u64) - 1).leading_zeros()
+        } else {
+            u32::MAX
+        };
+        if level >= self.root_level || !p.iter().all(|x| x.is_finite()) {
+            let (c, half) = self.root_geometry();
+            f(self, self.root, self.root_level, c, half);
             return;
         }
-        self.range_node(p, r_sq, self.root, self.root_level, c, half, &mut f);
+        // Cells of this level are aligned on the root's corner: index them from it.
+        let cells = (1u64 << level) as f64;
+        let r_leaves = r / self.leaf_side;
+        let last = (1u64 << (self.root_level - level)) as f64 - 1.0;
+        let mut lo = [0i64; D];
+        let mut two = [false; D];
+        let mut home = 0usize;
+        for i in 0..D {
+            let u = p[i] / self.leaf_side - self.root_origin[i] as f64;
+            let a = floor((u - r_leaves) / cells);
+            let b = floor((u + r_leaves) / cells);
+            if b < 0.0 || a > last {
+                return;
+            }
+            let a = a.max(0.0);
+            let b = b.min(last);
+            lo[i] = a as i64;
+            two[i] = b > a;
+            if two[i] && u >= b * cells {
+                // p lies in the upper of the two cells.
+                home |= 1 << i;
+            }
+        }
+        let half = self.leaf_side * cells * 0.5;
+        // p's own cell first, then by number of flipped axes (good bounds early).
+        'cells: for &m in &CHILD_ORDER[D][..Self::FANOUT] {
+            let combo = home ^ m as usize;
+            let mut k = [0i64; D];
+            for i in 0..D {
+                let bit = (combo >> i) & 1;
+                if bit == 1 && !two[i] {
+                    continue 'cells;
+                }
+                k[i] = self.root_origin[i] + ((lo[i] + bit as i64) << level);
+            }
+            let mut node = self.root;
+            let mut l = self.root_level;
+            while l > level {
+                let child = self.children[node as usize * Self::FANOUT + self.child_index(&k, l)];
+                if child == EMPTY {
+                    continue 'cells;
+                }
+                node = child;
+                l -= 1;
+            }
+            let c = k.map(|x| x as f64 * self.leaf_side + half);
+            f(self, node, level, c, half);
+        }
     }
 
     /// Centre and half side of the root.
@@ -232,10 +386,18 @@ impl<const D: usize> Orthtree<D> {
         }
         let q = half * 0.5;
         let mut home = 0usize;
+        // Per axis, the squared distance from p to the lower and the upper half of the node:
+        // the faces c - half, c, c + half are those of the children's boxes, so summing these
+        // gives each child's `box_dist_sq` bit for bit, at 2 D instead of 2^D D evaluations.
+        let mut slab = [[0.0f64; 2]; D];
         for i in 0..D {
-            if s.p[i] >= c[i] {
+            let x = s.p[i];
+            if x >= c[i] {
                 home |= 1 << i;
             }
+            let lo = (c[i] - half - x).max(x - c[i]).max(0.0);
+            let hi = (c[i] - x).max(x - (c[i] + half)).max(0.0);
+            slab[i] = [lo * lo, hi * hi];
         }
         let base = node as usize * Self::FANOUT;
         let kids = &self.children[base..base + Self::FANOUT];
@@ -245,6 +407,14 @@ impl<const D: usize> Orthtree<D> {
             if child == EMPTY {
                 continue;
             }
+            // Listing 1, lines 25, 28, 31: INTERSECTS(CIRCLE(p, min_dist), sibling).
+            let mut d2 = 0.0;
+            for i in 0..D {
+                d2 += slab[i][ci >> i & 1];
+            }
+            if d2 >= s.best_sq {
+                continue;
+            }
             let mut cc = c;
             for (i, x) in cc.iter_mut().enumerate() {
                 if ci >> i & 1 == 1 {
@@ -252,10 +422,6 @@ impl<const D: usize> Orthtree<D> {
                 } else {
                     *x -= q;
                 }
-            }
-            // Listing 1, lines 25, 28, 31: INTERSECTS(CIRCLE(p, min_dist), sibling).
-            if box_dist_sq(&s.p, &cc, q) >= s.best_sq {
-                continue;
             }
             if level == 1 {
                 self.visit_leaf::<APPROX, TRACK>(s, child, cc, q);
@@ -337,21 +503,37 @@ impl<const D: usize> Orthtree<D> {
                 continue;
             }
             if level == 1 {
-                let origin = cc.map(|x| x - q);
-                for code in self.pool.points(self.leaves[child as usize]) {
-                    let mut x = [0.0; D];
-                    let mut d2 = 0.0;
-                    for i in 0..D {
-                        x[i] = decode(origin[i], code[i], self.step);
-                        let e = p[i] - x[i];
-                        d2 += e * e;
-                    }
-                    if d2 <= r_sq {
-                        f(x);
-                    }
-                }
+                self.range_leaf(p, r_sq, child, cc, q, f);
             } else {
                 self.range_node(p, r_sq, child, level - 1, cc, q, f);
+            }
+        }
+    }
+}
+
+impl<const D: usize> Orthtree<D> {
+    /// Range query inside a leaf (centre `c`, half side `half`).
+    #[inline]
+    fn range_leaf<F: FnMut([f64; D])>(
+        &self,
+        p: &[f64; D],
+        r_sq: f64,
+        leaf: u32,
+        c: [f64; D],
+        half: f64,
+        f: &mut F,
+    ) {
+        let origin = c.map(|x| x - half);
+        for code in self.pool.points(self.leaves[leaf as usize]) {
+            let mut x = [0.0; D];
+            let mut d2 = 0.0;
+            for i in 0..D {
+                x[i] = decode(origin[i], code[i], self.step);
+                let e = p[i] - x[i];
+                d2 += e * e;
+            }
+            if d2 <= r_sq {
+                f(x);
             }
         }
     }
@@ -366,6 +548,14 @@ fn far_factor<const D: usize>(kappa: f64) -> f64 {
     } else {
         0.0
     }
+}
+
+/// `x.floor()` without a library call on targets without SSE4.1 (`x` finite; values beyond
+/// `i64` saturate, which the callers clamp anyway).
+#[inline(always)]
+fn floor(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x { t - 1.0 } else { t }
 }
 
 /// Squared distance summed axis by axis from 0 (the order a brute-force loop uses).
@@ -388,13 +578,9 @@ fn box_dist_sq<const D: usize>(p: &[f64; D], c: &[f64; D], half: f64) -> f64 {
     for i in 0..D {
         let lo = c[i] - half;
         let hi = c[i] + half;
-        let e = if p[i] < lo {
-            lo - p[i]
-        } else if p[i] > hi {
-            p[i] - hi
-        } else {
-            0.0
-        };
+        // Same value as the three-way branch `p < lo`, `p > hi`, inside (one of the two
+        // differences is <= 0 whenever the other is positive), without branches.
+        let e = (lo - p[i]).max(p[i] - hi).max(0.0);
         d2 += e * e;
     }
     d2
