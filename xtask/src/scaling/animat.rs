@@ -80,16 +80,32 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         vec![1000, 3000, 10_000, 30_000, 100_000],
         vec![1000, 3000, 10_000, 30_000, 100_000, 300_000, 1_000_000],
     );
-    let none_max = ctx.scale.pick(3000, 10_000, 30_000);
     let steps = ctx.scale.pick(2, 3, 5);
-    // (grid, cell index): the paper's grid boxes alone, the exhaustive scan, and our default
-    // (grid boxes behind the dense cell index).
+    // (grid, cell index, largest population): the paper's grid boxes alone, the exhaustive
+    // scan, and our default (grid boxes behind the dense cell index). The slow structures stop
+    // where a step takes seconds (see docs/benchmarks.md, "Animats").
     let configs = [
-        (GridBox::Side(60), false),
-        (GridBox::Side(120), false),
-        (GridBox::Side(240), false),
-        (GridBox::None, false),
-        (GridBox::Side(60), true),
+        (
+            GridBox::Side(60),
+            false,
+            ctx.scale.pick(3000, 100_000, 1_000_000),
+        ),
+        (
+            GridBox::Side(120),
+            false,
+            ctx.scale.pick(3000, 100_000, 300_000),
+        ),
+        (
+            GridBox::Side(240),
+            false,
+            ctx.scale.pick(3000, 30_000, 100_000),
+        ),
+        (GridBox::None, false, ctx.scale.pick(3000, 10_000, 30_000)),
+        (
+            GridBox::Side(60),
+            true,
+            ctx.scale.pick(3000, 100_000, 1_000_000),
+        ),
     ];
     let mut doc =
         ctx.doc("Seed 000: animats, neighbour-search cost against population (Fig. 9, Table I)");
@@ -123,17 +139,14 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         "gradient (seed 000, Table I)",
     ]);
     let mut series = Vec::new();
-    for (grid, cells) in configs {
+    for (grid, cells, max_n) in configs {
         let structure = match (grid, cells) {
             (GridBox::None, _) => "exhaustive scan",
             (_, false) => "boxes",
             _ => "cells + boxes (default)",
         };
         let mut pts = Vec::new();
-        for &n in ladder
-            .iter()
-            .filter(|&&n| grid != GridBox::None || n <= none_max)
-        {
+        for &n in ladder.iter().filter(|&&n| n <= max_n) {
             ctx.log(&format!(
                 "grid {}, {structure}: {n} animats",
                 grid_name(grid)

@@ -153,8 +153,8 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
 }
 
 fn table2(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
-    let n2 = ctx.scale.pick(2_000, 20_000, 200_000);
-    let n3 = ctx.scale.pick(1_000, 5_000, 50_000);
+    let n2 = ctx.scale.pick(2_000, 20_000, 500_000);
+    let n3 = ctx.scale.pick(1_000, 5_000, 100_000);
     let e = ctx.scale.pick(2u64, 4, 10);
     doc.h2("Table 2: fractal dimensions of DLA and PDLA clusters");
     let mut table = Table::new(&[
