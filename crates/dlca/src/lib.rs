@@ -24,6 +24,7 @@ pub mod analysis;
 pub mod output;
 pub mod params;
 pub mod record;
+mod rigid;
 pub mod sim;
 
 pub use params::{Init, ParamError, Params, Search};

@@ -87,7 +87,7 @@ fn every_strategy_gives_the_same_trajectory() {
                 ("grid", run(params, seed, Search::Grid, None, false)),
                 ("grid A=1", run(params, seed, Search::Grid, Some(1), false)),
                 ("grid A=2", run(params, seed, Search::Grid, Some(2), false)),
-                ("lattice", run(params, seed, Search::Lattice, None, false)),
+                ("lattice", run(params, seed, Search::Lattice, None, true)),
                 ("auto", run(params, seed, Search::Auto, None, false)),
             ];
             for (name, o) in &others {

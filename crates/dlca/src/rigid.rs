@@ -1,0 +1,605 @@
+//! The `lattice` strategy's cluster store: rigid clusters as an origin plus relative sites, with
+//! per-direction face and probe lists, over an occupancy lattice of labels.
+//!
+//! A DLCA cluster never changes shape between merges, it only translates. So each cluster keeps
+//! its particles as coordinates *relative* to an origin, and a move changes the origin alone
+//! (O(1)) instead of rewriting every particle's k-index. What the occupancy lattice and the
+//! contact query need from a move by the unit vector `e` depends only on the shape `C` and `e`,
+//! so it is worked out once per shape (at the start and after each merge, N - 1 times in a
+//! run) and kept per direction:
+//!
+//! - the *face* `F(e) = {s in C : s + e not in C}`. A move by `e` covers exactly the sites
+//!   `F(e)` (in the new frame) and vacates exactly `F(-e)` (in the old frame): only those
+//!   occupancy cells are written; interior particles keep their label.
+//! - the *probes* `P(e) = {q in N(C) : q + e not in C or N(C)}`, where `N(C)` is the set of
+//!   sites face-adjacent to `C` and outside it. Before a move no other cluster is in `C` or
+//!   `N(C)` (clusters merge as soon as they touch), so after it the only sites that can hold a
+//!   cluster in contact are the new neighbours, `P(e)` in the new frame: one lookup each, each
+//!   such site once.
+//!
+//! On a fractal DLCA cluster about half the particles are on each face, and the probes number
+//! about as many, so a move costs a fraction of the particles in memory traffic and nothing
+//! per interior particle.
+//!
+//! Coordinates: along a periodic axis relative coordinates of particles lie in `[0, L)` (taken
+//! modulo `L`) and absolute ones are `origin + relative` reduced modulo `L`; along a wall axis
+//! they are plain differences (the cluster cannot wrap) and the origin is one of the cluster's
+//! own particles, so it stays on the lattice. Neighbour and probe coordinates reach one step
+//! beyond a particle's, so a probe can fall beyond a wall; such probes are skipped. Wall
+//! blocking is O(1) from the cluster's extent along the axis.
+
+use core_lattice::{Blocked, Boundary, Direction, Lattice};
+use spatial::lattice::{ItemId, SiteSets};
+
+/// Marks an empty site.
+const EMPTY: u32 = u32::MAX;
+
+/// Largest side length this store handles (relative coordinates are `i32` with a margin).
+pub(crate) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
+
+/// One rigid cluster in `D` dimensions.
+#[derive(Debug, Clone)]
+struct Cluster<const D: usize> {
+    /// Absolute coordinates of relative position 0, each in `[0, L)`.
+    origin: [i64; D],
+    /// Relative coordinates of the particles.
+    sites: Vec<[i32; D]>,
+    /// Faces by direction index, then probes by direction index, concatenated.
+    lists: Vec<[i32; D]>,
+    /// `lists[starts[i]..starts[i + 1]]` is face `i` (for `i < 2D`) or probe list `i - 2D`.
+    starts: Vec<u32>,
+    /// Smallest and largest relative coordinate per axis (used on wall axes).
+    lo: [i32; D],
+    hi: [i32; D],
+    /// Size when the sites were last sorted into memory order.
+    sorted_len: usize,
+}
+
+impl<const D: usize> Default for Cluster<D> {
+    fn default() -> Self {
+        Cluster {
+            origin: [0; D],
+            sites: Vec::new(),
+            lists: Vec::new(),
+            starts: Vec::new(),
+            lo: [0; D],
+            hi: [0; D],
+            sorted_len: 0,
+        }
+    }
+}
+
+impl<const D: usize> Cluster<D> {
+    #[inline]
+    fn list(&self, i: usize) -> &[[i32; D]] {
+        &self.lists[self.starts[i] as usize..self.starts[i + 1] as usize]
+    }
+}
+
+/// The lattice geometry with the arithmetic the store needs.
+#[derive(Debug, Clone)]
+struct Geometry<const D: usize> {
+    size: [i64; D],
+    stride: [u64; D],
+    periodic: [bool; D],
+    /// Extended lattice for marking neighbour sites: one extra layer beyond each wall.
+    ext_stride: [u64; D],
+    ext_volume: u64,
+}
+
+impl<const D: usize> Geometry<D> {
+    fn new(lattice: &Lattice) -> Self {
+        assert_eq!(lattice.dim(), D);
+        let mut g = Geometry {
+            size: [0; D],
+            stride: [0; D],
+            periodic: [false; D],
+            ext_stride: [0; D],
+            ext_volume: 1,
+        };
+        for a in 0..D {
+            g.size[a] = lattice.size(a) as i64;
+            g.stride[a] = lattice.stride(a);
+            g.periodic[a] = lattice.boundary(a) == Boundary::Periodic;
+            g.ext_stride[a] = g.ext_volume;
+            g.ext_volume *= lattice.size(a) + if g.periodic[a] { 0 } else { 2 };
+        }
+        g
+    }
+
+    /// k-index of a particle (a site known to be on the lattice) at `r` relative to `o`.
+    #[inline(always)]
+    fn site(&self, o: &[i64; D], r: &[i32; D]) -> usize {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                if x >= self.size[a] {
+                    x -= self.size[a];
+                } else if x < 0 {
+                    x += self.size[a];
+                }
+            }
+            k += x as u64 * self.stride[a];
+        }
+        k as usize
+    }
+
+    /// k-index of the site at `r` relative to `o` (`r` at most one step beyond a particle's
+    /// relative coordinates), or `None` beyond a wall.
+    #[inline(always)]
+    fn probe(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                if x >= self.size[a] {
+                    x -= self.size[a];
+                } else if x < 0 {
+                    x += self.size[a];
+                }
+            } else if x < 0 || x >= self.size[a] {
+                return None;
+            }
+            k += x as u64 * self.stride[a];
+        }
+        Some(k as usize)
+    }
+
+    /// Like [`Geometry::probe`] for any relative position (full modular reduction).
+    fn any(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                x = x.rem_euclid(self.size[a]);
+            } else if x < 0 || x >= self.size[a] {
+                return None;
+            }
+            k += x as u64 * self.stride[a];
+        }
+        Some(k as usize)
+    }
+
+    /// Index in the extended lattice (one layer beyond each wall) of the site at `r` relative
+    /// to `o`, or `None` further out.
+    fn ext(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                x = x.rem_euclid(self.size[a]);
+            } else if x < -1 || x > self.size[a] {
+                return None;
+            } else {
+                x += 1;
+            }
+            k += x as u64 * self.ext_stride[a];
+        }
+        Some(k as usize)
+    }
+
+    /// Relative coordinates of absolute coordinates `x` in the frame with origin `o`.
+    fn relative(&self, o: &[i64; D], x: &[i64; D]) -> [i32; D] {
+        let mut r = [0; D];
+        for a in 0..D {
+            let d = x[a] - o[a];
+            r[a] = if self.periodic[a] {
+                d.rem_euclid(self.size[a])
+            } else {
+                d
+            } as i32;
+        }
+        r
+    }
+
+    /// Absolute coordinates of the particle at `r` relative to `o`.
+    fn absolute(&self, o: &[i64; D], r: &[i32; D]) -> [i64; D] {
+        let mut x = [0; D];
+        for a in 0..D {
+            x[a] = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                x[a] = x[a].rem_euclid(self.size[a]);
+            }
+        }
+        x
+    }
+}
+
+#[inline(always)]
+fn step<const D: usize>(r: &[i32; D], dir: usize) -> [i32; D] {
+    let mut q = *r;
+    q[dir >> 1] += if dir & 1 == 1 { 1 } else { -1 };
+    q
+}
+
+/// Clusters, the occupancy lattice and the scratch space of the `lattice` strategy, in `D`
+/// dimensions.
+#[derive(Debug, Clone)]
+pub(crate) struct Rigid<const D: usize> {
+    geo: Geometry<D>,
+    lattice: Lattice,
+    /// Label of the cluster on each site, or `EMPTY`.
+    cells: Vec<u32>,
+    /// Label carried by each cluster's sites, indexed by id; a merge relabels only the smaller
+    /// part and points the larger part's label at the survivor.
+    label_of: Vec<u32>,
+    /// Cluster owning each label.
+    id_of: Vec<ItemId>,
+    clusters: Vec<Cluster<D>>,
+    live: Vec<ItemId>,
+    position: Vec<u32>,
+    /// Scratch for rebuilding face and probe lists.
+    marks: Vec<u64>,
+    hood: Vec<([i32; D], usize)>,
+    scratch: Vec<Vec<[i32; D]>>,
+}
+
+const DEAD: u32 = u32::MAX;
+
+impl<const D: usize> Rigid<D> {
+    /// The store for the clusters of `sets` (ids kept), with their occupancy lattice.
+    fn new(sets: &SiteSets) -> Self {
+        let lattice = sets.lattice().clone();
+        let geo = Geometry::<D>::new(&lattice);
+        let n = sets.id_bound();
+        let mut r = Rigid {
+            cells: vec![EMPTY; lattice.volume() as usize],
+            label_of: (0..n as u32).collect(),
+            id_of: (0..n as ItemId).collect(),
+            clusters: vec![Cluster::default(); n],
+            live: Vec::new(),
+            position: vec![DEAD; n],
+            marks: Vec::new(),
+            hood: Vec::new(),
+            scratch: vec![Vec::new(); 4 * D],
+            geo,
+            lattice,
+        };
+        let mut ids: Vec<ItemId> = sets.live().to_vec();
+        ids.sort_unstable();
+        for id in ids {
+            let sites = sets.sites(id);
+            let coords = |k: u64| -> [i64; D] {
+                let x = r.lattice.coords_array(k);
+                std::array::from_fn(|a| x[a] as i64)
+            };
+            let origin = coords(sites[0]);
+            let c = &mut r.clusters[id as usize];
+            c.origin = origin;
+            c.sites = sites
+                .iter()
+                .map(|&k| r.geo.relative(&origin, &coords(k)))
+                .collect();
+            for &k in sites {
+                r.cells[k as usize] = id;
+            }
+            r.position[id as usize] = r.live.len() as u32;
+            r.live.push(id);
+        }
+        for i in 0..r.live.len() {
+            let id = r.live[i];
+            r.finish(id);
+        }
+        r
+    }
+
+    fn len_of(&self, id: ItemId) -> usize {
+        self.clusters[id as usize].sites.len()
+    }
+
+    fn contains(&self, id: ItemId) -> bool {
+        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+    }
+
+    /// Move cluster `id` by `dir`: all or nothing (a wall blocks it). On success the clusters
+    /// now in contact with it are written to `out`, in increasing id.
+    fn try_move(
+        &mut self,
+        id: ItemId,
+        dir: Direction,
+        out: &mut Vec<ItemId>,
+    ) -> Result<(), Blocked> {
+        out.clear();
+        let Rigid {
+            geo,
+            cells,
+            label_of,
+            id_of,
+            clusters,
+            ..
+        } = self;
+        let c = &mut clusters[id as usize];
+        let (axis, d) = (dir.axis(), dir.index());
+        if !geo.periodic[axis] {
+            let blocked = if dir.is_positive() {
+                c.origin[axis] + i64::from(c.hi[axis]) + 1 >= geo.size[axis]
+            } else {
+                c.origin[axis] + i64::from(c.lo[axis]) <= 0
+            };
+            if blocked {
+                return Err(Blocked);
+            }
+        }
+        let label = label_of[id as usize];
+        // Vacate the trailing face (in the old frame).
+        for r in c.list(d ^ 1) {
+            cells[geo.site(&c.origin, r)] = EMPTY;
+        }
+        let o = &mut c.origin[axis];
+        *o += if dir.is_positive() { 1 } else { -1 };
+        if *o >= geo.size[axis] {
+            *o -= geo.size[axis];
+        } else if *o < 0 {
+            *o += geo.size[axis];
+        }
+        // Cover the leading face (in the new frame).
+        for r in c.list(d) {
+            let k = geo.site(&c.origin, r);
+            debug_assert_eq!(cells[k], EMPTY, "clusters overlap");
+            cells[k] = label;
+        }
+        // Look at the new neighbours only.
+        for q in c.list(2 * D + d) {
+            if let Some(k) = geo.probe(&c.origin, q) {
+                let l = cells[k];
+                if l != EMPTY && l != label {
+                    let other = id_of[l as usize];
+                    if !out.contains(&other) {
+                        out.push(other);
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+        Ok(())
+    }
+
+    /// Merge cluster `from` into `into` (which keeps its id). Call [`Rigid::finish`] on `into`
+    /// after the last merge of a move.
+    fn merge(&mut self, into: ItemId, from: ItemId) {
+        let (ni, nf) = (self.len_of(into), self.len_of(from));
+        let (li, lf) = (self.label_of[into as usize], self.label_of[from as usize]);
+        // Relabel the smaller part only.
+        let (small, label) = if nf <= ni { (from, li) } else { (into, lf) };
+        let c = &self.clusters[small as usize];
+        for r in &c.sites {
+            self.cells[self.geo.site(&c.origin, r)] = label;
+        }
+        if nf > ni {
+            self.label_of[into as usize] = lf;
+            self.id_of[lf as usize] = into;
+        }
+        // Keep the larger part's frame and append the smaller part's sites.
+        let mut other = std::mem::take(&mut self.clusters[from as usize]);
+        if nf > ni {
+            std::mem::swap(&mut self.clusters[into as usize], &mut other);
+        }
+        let target = &mut self.clusters[into as usize];
+        let geo = &self.geo;
+        target.sites.extend(
+            other
+                .sites
+                .iter()
+                .map(|r| geo.relative(&target.origin, &geo.absolute(&other.origin, r))),
+        );
+        // Unlink `from`.
+        let p = self.position[from as usize] as usize;
+        self.live.swap_remove(p);
+        if let Some(&moved) = self.live.get(p) {
+            self.position[moved as usize] = p as u32;
+        }
+        self.position[from as usize] = DEAD;
+    }
+
+    /// Recompute the extent, and the face and probe lists, of cluster `id` from its sites and
+    /// the occupancy lattice. O(size); once per merge.
+    fn finish(&mut self, id: ItemId) {
+        if self.marks.is_empty() {
+            self.marks = vec![0; self.geo.ext_volume.div_ceil(64) as usize];
+        }
+        let mut c = std::mem::take(&mut self.clusters[id as usize]);
+        // Large clusters are kept in memory order (re-sorted when they double), so their lists
+        // walk the occupancy lattice in order.
+        if c.sites.len() >= 64 && c.sites.len() >= 2 * c.sorted_len {
+            let (geo, o) = (&self.geo, c.origin);
+            c.sites.sort_by_cached_key(|r| geo.site(&o, r));
+            c.sorted_len = c.sites.len();
+        }
+        self.build_lists(&mut c, self.label_of[id as usize]);
+        self.clusters[id as usize] = c;
+    }
+
+    fn build_lists(&mut self, c: &mut Cluster<D>, label: u32) {
+        let Rigid {
+            geo,
+            cells,
+            marks,
+            hood,
+            scratch,
+            ..
+        } = self;
+        let o = c.origin;
+        let in_c = |r: &[i32; D]| geo.any(&o, r).is_some_and(|k| cells[k] == label);
+        scratch.iter_mut().for_each(Vec::clear);
+        hood.clear();
+        c.lo = [i32::MAX; D];
+        c.hi = [i32::MIN; D];
+        for s in &c.sites {
+            for a in 0..D {
+                c.lo[a] = c.lo[a].min(s[a]);
+                c.hi[a] = c.hi[a].max(s[a]);
+            }
+            for d in 0..2 * D {
+                let q = step(s, d);
+                if in_c(&q) {
+                    continue;
+                }
+                scratch[d].push(*s);
+                // A neighbour site (possibly one step beyond a wall), each once.
+                let e = geo.ext(&o, &q).expect("one step from a particle");
+                let (w, b) = (e / 64, 1u64 << (e % 64));
+                if marks[w] & b == 0 {
+                    marks[w] |= b;
+                    hood.push((q, e));
+                }
+            }
+        }
+        for (q, _) in hood.iter() {
+            for d in 0..2 * D {
+                let n = step(q, d);
+                let near = in_c(&n)
+                    || geo
+                        .ext(&o, &n)
+                        .is_some_and(|e| marks[e / 64] & (1u64 << (e % 64)) != 0);
+                if !near {
+                    scratch[2 * D + d].push(*q);
+                }
+            }
+        }
+        for (_, e) in hood.iter() {
+            marks[e / 64] &= !(1u64 << (e % 64));
+        }
+        c.lists.clear();
+        c.starts.clear();
+        c.starts.push(0);
+        for list in scratch.iter() {
+            c.lists.extend_from_slice(list);
+            c.starts.push(c.lists.len() as u32);
+        }
+    }
+
+    /// Absolute k-indices of the particles of `id`.
+    fn sites(&self, id: ItemId) -> Vec<u64> {
+        let c = &self.clusters[id as usize];
+        c.sites
+            .iter()
+            .map(|r| self.geo.site(&c.origin, r) as u64)
+            .collect()
+    }
+
+    /// Panic unless the occupancy lattice holds exactly the clusters' particles and every
+    /// cluster's lists match a fresh computation. For tests.
+    fn check(&mut self) {
+        let mut total = 0;
+        for i in 0..self.live.len() {
+            let id = self.live[i];
+            let label = self.label_of[id as usize];
+            assert_eq!(self.id_of[label as usize], id, "label table");
+            for k in self.sites(id) {
+                assert_eq!(self.cells[k as usize], label, "occupancy of cluster {id}");
+                total += 1;
+            }
+            let mut fresh = self.clusters[id as usize].clone();
+            self.build_lists(&mut fresh, label);
+            let c = &self.clusters[id as usize];
+            assert_eq!((&fresh.lists, &fresh.starts), (&c.lists, &c.starts));
+            assert_eq!((fresh.lo, fresh.hi), (c.lo, c.hi));
+        }
+        let filled = self.cells.iter().filter(|&&l| l != EMPTY).count();
+        assert_eq!(filled, total, "occupancy holds stray labels");
+    }
+
+    fn to_sets(&self) -> SiteSets {
+        let mut sets = SiteSets::new(self.lattice.clone());
+        for id in 0..self.clusters.len() as ItemId {
+            sets.push(if self.contains(id) {
+                self.sites(id)
+            } else {
+                Vec::new()
+            });
+        }
+        for id in 0..self.clusters.len() as ItemId {
+            if !self.contains(id) {
+                sets.remove(id);
+            }
+        }
+        sets
+    }
+}
+
+/// [`Rigid`] for the dimension of the lattice (1 to 5).
+#[derive(Debug, Clone)]
+pub(crate) enum RigidStore {
+    D1(Rigid<1>),
+    D2(Rigid<2>),
+    D3(Rigid<3>),
+    D4(Rigid<4>),
+    D5(Rigid<5>),
+}
+
+macro_rules! each {
+    ($self:expr, $r:ident => $e:expr) => {
+        match $self {
+            RigidStore::D1($r) => $e,
+            RigidStore::D2($r) => $e,
+            RigidStore::D3($r) => $e,
+            RigidStore::D4($r) => $e,
+            RigidStore::D5($r) => $e,
+        }
+    };
+}
+
+impl RigidStore {
+    /// The store for the clusters of `sets` (same ids). `None` when the dimension is outside
+    /// 1..=5 or a side is larger than [`MAX_SIDE`].
+    pub(crate) fn new(sets: &SiteSets) -> Option<Self> {
+        let l = sets.lattice();
+        if l.sizes().iter().any(|&s| s > MAX_SIDE) {
+            return None;
+        }
+        Some(match l.dim() {
+            1 => RigidStore::D1(Rigid::new(sets)),
+            2 => RigidStore::D2(Rigid::new(sets)),
+            3 => RigidStore::D3(Rigid::new(sets)),
+            4 => RigidStore::D4(Rigid::new(sets)),
+            5 => RigidStore::D5(Rigid::new(sets)),
+            _ => return None,
+        })
+    }
+
+    /// Live cluster ids.
+    pub(crate) fn live(&self) -> &[ItemId] {
+        each!(self, r => &r.live)
+    }
+
+    /// Number of particles of cluster `id`.
+    pub(crate) fn len_of(&self, id: ItemId) -> usize {
+        each!(self, r => r.len_of(id))
+    }
+
+    /// Whether `id` is live.
+    pub(crate) fn contains(&self, id: ItemId) -> bool {
+        each!(self, r => r.contains(id))
+    }
+
+    /// See [`Rigid::try_move`].
+    pub(crate) fn try_move(
+        &mut self,
+        id: ItemId,
+        dir: Direction,
+        out: &mut Vec<ItemId>,
+    ) -> Result<(), Blocked> {
+        each!(self, r => r.try_move(id, dir, out))
+    }
+
+    /// See [`Rigid::merge`].
+    pub(crate) fn merge(&mut self, into: ItemId, from: ItemId) {
+        each!(self, r => r.merge(into, from))
+    }
+
+    /// See [`Rigid::finish`].
+    pub(crate) fn finish(&mut self, id: ItemId) {
+        each!(self, r => r.finish(id))
+    }
+
+    /// Panic unless the store is consistent (see [`Rigid::check`]).
+    pub(crate) fn check(&mut self) {
+        each!(self, r => r.check())
+    }
+
+    /// The clusters as k-index arrays (absolute sites), with the same ids.
+    pub(crate) fn to_sets(&self) -> SiteSets {
+        each!(self, r => r.to_sets())
+    }
+}
