@@ -30,6 +30,8 @@
 
 use core_lattice::{Blocked, Boundary, Direction, Lattice};
 use spatial::lattice::{ItemId, SiteSets};
+use std::fmt::Debug;
+use std::sync::Arc;
 
 /// Marks an empty site.
 const EMPTY: u32 = u32::MAX;
@@ -37,17 +39,31 @@ const EMPTY: u32 = u32::MAX;
 /// Largest side length this store handles (relative coordinates are `i32` with a margin).
 pub(crate) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
 
-/// One rigid cluster in `D` dimensions.
+/// The face and probe lists of one cluster shape, in a frame's entry format.
+#[derive(Debug, Clone, PartialEq)]
+struct Lists<E> {
+    /// Faces by direction index, then probes by direction index, concatenated.
+    entries: Vec<E>,
+    /// `entries[starts[i]..starts[i + 1]]` is face `i` (for `i < 2D`) or probe list `i - 2D`.
+    starts: Vec<u32>,
+}
+
+impl<E> Lists<E> {
+    #[inline]
+    fn list(&self, i: usize) -> &[E] {
+        &self.entries[self.starts[i] as usize..self.starts[i + 1] as usize]
+    }
+}
+
+/// One rigid cluster in `D` dimensions, its lists in the entry format of frame `F`.
 #[derive(Debug, Clone)]
-struct Cluster<const D: usize> {
+struct Cluster<const D: usize, F: Frame<D>> {
     /// Absolute coordinates of relative position 0, each in `[0, L)`.
     origin: [i64; D],
     /// Relative coordinates of the particles.
     sites: Vec<[i32; D]>,
-    /// Faces by direction index, then probes by direction index, concatenated.
-    lists: Vec<[i32; D]>,
-    /// `lists[starts[i]..starts[i + 1]]` is face `i` (for `i < 2D`) or probe list `i - 2D`.
-    starts: Vec<u32>,
+    /// Face and probe lists; single particles all share one.
+    lists: Arc<Lists<F::Entry>>,
     /// Smallest and largest relative coordinate per axis (used on wall axes).
     lo: [i32; D],
     hi: [i32; D],
@@ -55,13 +71,15 @@ struct Cluster<const D: usize> {
     sorted_len: usize,
 }
 
-impl<const D: usize> Default for Cluster<D> {
+impl<const D: usize, F: Frame<D>> Default for Cluster<D, F> {
     fn default() -> Self {
         Cluster {
             origin: [0; D],
             sites: Vec::new(),
-            lists: Vec::new(),
-            starts: Vec::new(),
+            lists: Arc::new(Lists {
+                entries: Vec::new(),
+                starts: Vec::new(),
+            }),
             lo: [0; D],
             hi: [0; D],
             sorted_len: 0,
@@ -69,16 +87,106 @@ impl<const D: usize> Default for Cluster<D> {
     }
 }
 
-impl<const D: usize> Cluster<D> {
-    #[inline]
-    fn list(&self, i: usize) -> &[[i32; D]] {
-        &self.lists[self.starts[i] as usize..self.starts[i + 1] as usize]
+/// How list entries are stored and turned into k-indices.
+pub(crate) trait Frame<const D: usize>: Debug + Clone {
+    /// A relative position as stored in the lists.
+    type Entry: Copy + Debug + PartialEq;
+    /// An origin in the form the entries are added to.
+    type Origin: Copy;
+    /// The frame for geometry `geo`, if it applies.
+    fn new(geo: &Geometry<D>) -> Option<Self>;
+    /// Origin coordinates `o` in this frame's form.
+    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> Self::Origin;
+    /// Relative coordinates `r` (at most two steps beyond a particle's) as an entry.
+    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> Self::Entry;
+    /// k-index of a particle site.
+    fn site(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> usize;
+    /// k-index of a probe site, or `None` beyond a wall.
+    fn probe(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> Option<usize>;
+}
+
+/// Any lattice: entries are relative coordinates, wrapped or bounds-checked axis by axis.
+#[derive(Debug, Clone)]
+pub(crate) struct AnyFrame;
+
+impl<const D: usize> Frame<D> for AnyFrame {
+    type Entry = [i32; D];
+    type Origin = [i64; D];
+    fn new(_: &Geometry<D>) -> Option<Self> {
+        Some(AnyFrame)
+    }
+    #[inline(always)]
+    fn origin(&self, _: &Geometry<D>, o: &[i64; D]) -> [i64; D] {
+        *o
+    }
+    fn entry(&self, _: &Geometry<D>, r: &[i32; D]) -> [i32; D] {
+        *r
+    }
+    #[inline(always)]
+    fn site(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> usize {
+        geo.site(&o, &e)
+    }
+    #[inline(always)]
+    fn probe(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> Option<usize> {
+        geo.probe(&o, &e)
+    }
+}
+
+/// Periodic lattices whose sides are all powers of two with at most 2^32 sites: an entry is
+/// the k-index of the relative position reduced modulo the sides, and the k-index of a site is
+/// the sum of origin and entry computed field by field (each axis a bit field of the k-index)
+/// with the carry between fields suppressed (SIMD within a register): four operations,
+/// whatever the dimension.
+#[derive(Debug, Clone)]
+pub(crate) struct Pow2Frame {
+    /// The top bit of every axis's field.
+    high: u32,
+}
+
+impl Pow2Frame {
+    #[inline(always)]
+    fn add(&self, a: u32, b: u32) -> u32 {
+        ((a & !self.high).wrapping_add(b & !self.high)) ^ ((a ^ b) & self.high)
+    }
+}
+
+impl<const D: usize> Frame<D> for Pow2Frame {
+    type Entry = u32;
+    type Origin = u32;
+    fn new(geo: &Geometry<D>) -> Option<Self> {
+        let fits = geo.size.iter().product::<i64>() <= 1 << 32;
+        let pow2 = geo.size.iter().all(|&l| (l as u64).is_power_of_two());
+        if !(fits && pow2 && geo.periodic.iter().all(|&p| p)) {
+            return None;
+        }
+        let mut high = 0;
+        for a in 0..D {
+            if geo.size[a] > 1 {
+                high |= ((geo.size[a] as u64 / 2) * geo.stride[a]) as u32;
+            }
+        }
+        Some(Pow2Frame { high })
+    }
+    #[inline(always)]
+    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {
+        (0..D).map(|a| o[a] as u64 * geo.stride[a]).sum::<u64>() as u32
+    }
+    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> u32 {
+        geo.any(&[0; D], r).expect("periodic") as u32
+    }
+    #[inline(always)]
+    fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
+        self.add(o, e) as usize
+    }
+    #[inline(always)]
+    fn probe(&self, _: &Geometry<D>, o: u32, e: u32) -> Option<usize> {
+        Some(self.add(o, e) as usize)
     }
 }
 
 /// The lattice geometry with the arithmetic the store needs.
 #[derive(Debug, Clone)]
-struct Geometry<const D: usize> {
+pub(crate) struct Geometry<const D: usize> {
     size: [i64; D],
     stride: [u64; D],
     periodic: [bool; D],
@@ -206,6 +314,28 @@ impl<const D: usize> Geometry<D> {
     }
 }
 
+/// A bitset over the lattice sites.
+#[derive(Debug, Clone)]
+struct Bits(Vec<u64>);
+
+impl Bits {
+    fn new(n: usize) -> Self {
+        Bits(vec![0; n.div_ceil(64)])
+    }
+    #[inline(always)]
+    fn get(&self, k: usize) -> bool {
+        self.0[k >> 6] & (1 << (k & 63)) != 0
+    }
+    #[inline(always)]
+    fn set(&mut self, k: usize) {
+        self.0[k >> 6] |= 1 << (k & 63);
+    }
+    #[inline(always)]
+    fn clear(&mut self, k: usize) {
+        self.0[k >> 6] &= !(1 << (k & 63));
+    }
+}
+
 #[inline(always)]
 fn step<const D: usize>(r: &[i32; D], dir: usize) -> [i32; D] {
     let mut q = *r;
@@ -216,17 +346,23 @@ fn step<const D: usize>(r: &[i32; D], dir: usize) -> [i32; D] {
 /// Clusters, the occupancy lattice and the scratch space of the `lattice` strategy, in `D`
 /// dimensions.
 #[derive(Debug, Clone)]
-pub(crate) struct Rigid<const D: usize> {
+pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     geo: Geometry<D>,
+    frame: F,
+    /// The lists of a single particle, shared by all single particles.
+    single: Option<Arc<Lists<F::Entry>>>,
     lattice: Lattice,
-    /// Label of the cluster on each site, or `EMPTY`.
+    /// Which sites hold a particle, one bit a site: small enough to stay in cache where the
+    /// label array does not, and all a contact probe reads unless it finds a particle.
+    occupied: Bits,
+    /// Label of the cluster on each occupied site (stale on empty sites).
     cells: Vec<u32>,
     /// Label carried by each cluster's sites, indexed by id; a merge relabels only the smaller
     /// part and points the larger part's label at the survivor.
     label_of: Vec<u32>,
     /// Cluster owning each label.
     id_of: Vec<ItemId>,
-    clusters: Vec<Cluster<D>>,
+    clusters: Vec<Cluster<D, F>>,
     live: Vec<ItemId>,
     position: Vec<u32>,
     /// Scratch for rebuilding face and probe lists.
@@ -237,13 +373,18 @@ pub(crate) struct Rigid<const D: usize> {
 
 const DEAD: u32 = u32::MAX;
 
-impl<const D: usize> Rigid<D> {
-    /// The store for the clusters of `sets` (ids kept), with their occupancy lattice.
-    fn new(sets: &SiteSets) -> Self {
+impl<const D: usize, F: Frame<D>> Rigid<D, F> {
+    /// The store for the clusters of `sets` (ids kept), with their occupancy lattice, or `None`
+    /// if frame `F` does not apply to the lattice.
+    fn new(sets: &SiteSets) -> Option<Self> {
         let lattice = sets.lattice().clone();
         let geo = Geometry::<D>::new(&lattice);
+        let frame = F::new(&geo)?;
         let n = sets.id_bound();
         let mut r = Rigid {
+            frame,
+            single: None,
+            occupied: Bits::new(lattice.volume() as usize),
             cells: vec![EMPTY; lattice.volume() as usize],
             label_of: (0..n as u32).collect(),
             id_of: (0..n as ItemId).collect(),
@@ -273,6 +414,7 @@ impl<const D: usize> Rigid<D> {
                 .collect();
             for &k in sites {
                 r.cells[k as usize] = id;
+                r.occupied.set(k as usize);
             }
             r.position[id as usize] = r.live.len() as u32;
             r.live.push(id);
@@ -281,7 +423,7 @@ impl<const D: usize> Rigid<D> {
             let id = r.live[i];
             r.finish(id);
         }
-        r
+        Some(r)
     }
 
     fn len_of(&self, id: ItemId) -> usize {
@@ -303,6 +445,8 @@ impl<const D: usize> Rigid<D> {
         out.clear();
         let Rigid {
             geo,
+            frame,
+            occupied,
             cells,
             label_of,
             id_of,
@@ -322,28 +466,35 @@ impl<const D: usize> Rigid<D> {
             }
         }
         let label = label_of[id as usize];
-        // Vacate the trailing face (in the old frame).
-        for r in c.list(d ^ 1) {
-            cells[geo.site(&c.origin, r)] = EMPTY;
+        // Vacate the trailing face (in the old frame); labels of empty sites are never read.
+        let mut o = c.origin;
+        let lists = &*c.lists;
+        let fo = frame.origin(geo, &o);
+        for &e in lists.list(d ^ 1) {
+            occupied.clear(frame.site(geo, fo, e));
         }
-        let o = &mut c.origin[axis];
-        *o += if dir.is_positive() { 1 } else { -1 };
-        if *o >= geo.size[axis] {
-            *o -= geo.size[axis];
-        } else if *o < 0 {
-            *o += geo.size[axis];
+        o[axis] += if dir.is_positive() { 1 } else { -1 };
+        if o[axis] >= geo.size[axis] {
+            o[axis] -= geo.size[axis];
+        } else if o[axis] < 0 {
+            o[axis] += geo.size[axis];
         }
+        c.origin = o;
+        let fo = frame.origin(geo, &o);
         // Cover the leading face (in the new frame).
-        for r in c.list(d) {
-            let k = geo.site(&c.origin, r);
-            debug_assert_eq!(cells[k], EMPTY, "clusters overlap");
+        for &e in lists.list(d) {
+            let k = frame.site(geo, fo, e);
+            debug_assert!(!occupied.get(k), "clusters overlap");
+            occupied.set(k);
             cells[k] = label;
         }
         // Look at the new neighbours only.
-        for q in c.list(2 * D + d) {
-            if let Some(k) = geo.probe(&c.origin, q) {
+        for &e in lists.list(2 * D + d) {
+            if let Some(k) = frame.probe(geo, fo, e)
+                && occupied.get(k)
+            {
                 let l = cells[k];
-                if l != EMPTY && l != label {
+                if l != label {
                     let other = id_of[l as usize];
                     if !out.contains(&other) {
                         out.push(other);
@@ -406,13 +557,22 @@ impl<const D: usize> Rigid<D> {
             c.sites.sort_by_cached_key(|r| geo.site(&o, r));
             c.sorted_len = c.sites.len();
         }
-        self.build_lists(&mut c, self.label_of[id as usize]);
+        c.lists = match &self.single {
+            Some(single) if c.sites.len() == 1 => single.clone(),
+            _ => Arc::new(self.build_lists(&mut c, self.label_of[id as usize])),
+        };
+        if c.sites.len() == 1 && self.single.is_none() {
+            self.single = Some(c.lists.clone());
+        }
         self.clusters[id as usize] = c;
     }
 
-    fn build_lists(&mut self, c: &mut Cluster<D>, label: u32) {
+    /// The extent and the lists of `c` (with label `label` in the occupancy lattice).
+    fn build_lists(&mut self, c: &mut Cluster<D, F>, label: u32) -> Lists<F::Entry> {
         let Rigid {
             geo,
+            frame,
+            occupied,
             cells,
             marks,
             hood,
@@ -420,7 +580,10 @@ impl<const D: usize> Rigid<D> {
             ..
         } = self;
         let o = c.origin;
-        let in_c = |r: &[i32; D]| geo.any(&o, r).is_some_and(|k| cells[k] == label);
+        let in_c = |r: &[i32; D]| {
+            geo.any(&o, r)
+                .is_some_and(|k| occupied.get(k) && cells[k] == label)
+        };
         scratch.iter_mut().for_each(Vec::clear);
         hood.clear();
         c.lo = [i32::MAX; D];
@@ -460,13 +623,17 @@ impl<const D: usize> Rigid<D> {
         for (_, e) in hood.iter() {
             marks[e / 64] &= !(1u64 << (e % 64));
         }
-        c.lists.clear();
-        c.starts.clear();
-        c.starts.push(0);
+        let mut lists = Lists {
+            entries: Vec::with_capacity(scratch.iter().map(Vec::len).sum()),
+            starts: vec![0],
+        };
         for list in scratch.iter() {
-            c.lists.extend_from_slice(list);
-            c.starts.push(c.lists.len() as u32);
+            lists
+                .entries
+                .extend(list.iter().map(|r| frame.entry(geo, r)));
+            lists.starts.push(lists.entries.len() as u32);
         }
+        lists
     }
 
     /// Absolute k-indices of the particles of `id`.
@@ -487,16 +654,22 @@ impl<const D: usize> Rigid<D> {
             let label = self.label_of[id as usize];
             assert_eq!(self.id_of[label as usize], id, "label table");
             for k in self.sites(id) {
+                assert!(
+                    self.occupied.get(k as usize),
+                    "site {k} of cluster {id} not marked"
+                );
                 assert_eq!(self.cells[k as usize], label, "occupancy of cluster {id}");
                 total += 1;
             }
             let mut fresh = self.clusters[id as usize].clone();
-            self.build_lists(&mut fresh, label);
+            let lists = self.build_lists(&mut fresh, label);
             let c = &self.clusters[id as usize];
-            assert_eq!((&fresh.lists, &fresh.starts), (&c.lists, &c.starts));
+            assert_eq!(&lists, &*c.lists);
             assert_eq!((fresh.lo, fresh.hi), (c.lo, c.hi));
         }
-        let filled = self.cells.iter().filter(|&&l| l != EMPTY).count();
+        let filled = (0..self.cells.len())
+            .filter(|&k| self.occupied.get(k))
+            .count();
         assert_eq!(filled, total, "occupancy holds stray labels");
     }
 
@@ -521,11 +694,16 @@ impl<const D: usize> Rigid<D> {
 /// [`Rigid`] for the dimension of the lattice (1 to 5).
 #[derive(Debug, Clone)]
 pub(crate) enum RigidStore {
-    D1(Rigid<1>),
-    D2(Rigid<2>),
-    D3(Rigid<3>),
-    D4(Rigid<4>),
-    D5(Rigid<5>),
+    D1(Rigid<1, AnyFrame>),
+    D2(Rigid<2, AnyFrame>),
+    D3(Rigid<3, AnyFrame>),
+    D4(Rigid<4, AnyFrame>),
+    D5(Rigid<5, AnyFrame>),
+    P1(Rigid<1, Pow2Frame>),
+    P2(Rigid<2, Pow2Frame>),
+    P3(Rigid<3, Pow2Frame>),
+    P4(Rigid<4, Pow2Frame>),
+    P5(Rigid<5, Pow2Frame>),
 }
 
 macro_rules! each {
@@ -536,6 +714,11 @@ macro_rules! each {
             RigidStore::D3($r) => $e,
             RigidStore::D4($r) => $e,
             RigidStore::D5($r) => $e,
+            RigidStore::P1($r) => $e,
+            RigidStore::P2($r) => $e,
+            RigidStore::P3($r) => $e,
+            RigidStore::P4($r) => $e,
+            RigidStore::P5($r) => $e,
         }
     };
 }
@@ -548,14 +731,25 @@ impl RigidStore {
         if l.sizes().iter().any(|&s| s > MAX_SIDE) {
             return None;
         }
-        Some(match l.dim() {
-            1 => RigidStore::D1(Rigid::new(sets)),
-            2 => RigidStore::D2(Rigid::new(sets)),
-            3 => RigidStore::D3(Rigid::new(sets)),
-            4 => RigidStore::D4(Rigid::new(sets)),
-            5 => RigidStore::D5(Rigid::new(sets)),
-            _ => return None,
-        })
+        // The power-of-two frame where it applies, else the general one.
+        match l.dim() {
+            1 => Rigid::new(sets)
+                .map(RigidStore::P1)
+                .or_else(|| Rigid::new(sets).map(RigidStore::D1)),
+            2 => Rigid::new(sets)
+                .map(RigidStore::P2)
+                .or_else(|| Rigid::new(sets).map(RigidStore::D2)),
+            3 => Rigid::new(sets)
+                .map(RigidStore::P3)
+                .or_else(|| Rigid::new(sets).map(RigidStore::D3)),
+            4 => Rigid::new(sets)
+                .map(RigidStore::P4)
+                .or_else(|| Rigid::new(sets).map(RigidStore::D4)),
+            5 => Rigid::new(sets)
+                .map(RigidStore::P5)
+                .or_else(|| Rigid::new(sets).map(RigidStore::D5)),
+            _ => None,
+        }
     }
 
     /// Live cluster ids.
