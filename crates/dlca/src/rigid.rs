@@ -39,52 +39,56 @@ const EMPTY: u32 = u32::MAX;
 /// Largest side length this store handles (relative coordinates are `i32` with a margin).
 pub(crate) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
 
-/// The face and probe lists of one cluster shape, in a frame's entry format.
-#[derive(Debug, Clone, PartialEq)]
-struct Lists<E> {
-    /// Faces by direction index, then probes by direction index, concatenated.
-    entries: Vec<E>,
-    /// `entries[starts[i]..starts[i + 1]]` is face `i` (for `i < 2D`) or probe list `i - 2D`.
-    starts: Vec<u32>,
+/// The face and probe lists of one cluster shape, in one allocation (so a move follows one
+/// pointer from the cluster): `4d + 1` header entries holding the starts of the lists (encoded
+/// by [`Frame::start`]), then the faces by direction index, then the probes by direction index.
+/// List `i` is `lists[start(i)..start(i + 1)]`: face `i` for `i < 2d`, else probes `i - 2d`.
+type Lists<E> = Arc<[E]>;
+
+#[inline(always)]
+fn list<const D: usize, F: Frame<D>>(lists: &[F::Entry], i: usize) -> &[F::Entry] {
+    &lists[F::start_of(lists[i])..F::start_of(lists[i + 1])]
 }
 
-impl<E> Lists<E> {
-    #[inline]
-    fn list(&self, i: usize) -> &[E] {
-        &self.entries[self.starts[i] as usize..self.starts[i + 1] as usize]
-    }
-}
-
-/// One rigid cluster in `D` dimensions, its lists in the entry format of frame `F`.
+/// What a move of one rigid cluster in `D` dimensions reads, in one small record (its lists in
+/// the entry format of frame `F`). Early in a run most clusters are a few particles and a move
+/// costs little more than the cache misses on its data, so everything is one record away.
 #[derive(Debug, Clone)]
 struct Cluster<const D: usize, F: Frame<D>> {
     /// Absolute coordinates of relative position 0, each in `[0, L)`.
     origin: [i64; D],
-    /// Relative coordinates of the particles.
-    sites: Vec<[i32; D]>,
     /// Face and probe lists; single particles all share one.
-    lists: Arc<Lists<F::Entry>>,
+    lists: Lists<F::Entry>,
     /// Smallest and largest relative coordinate per axis (used on wall axes).
     lo: [i32; D],
     hi: [i32; D],
-    /// Size when the sites were last sorted into memory order.
-    sorted_len: usize,
+    /// Number of particles (0 for a cluster merged away).
+    len: u32,
+    /// Label of its sites in the occupancy lattice; a merge relabels only the smaller part and
+    /// gives the survivor the larger part's label.
+    label: u32,
 }
 
 impl<const D: usize, F: Frame<D>> Default for Cluster<D, F> {
     fn default() -> Self {
         Cluster {
             origin: [0; D],
-            sites: Vec::new(),
-            lists: Arc::new(Lists {
-                entries: Vec::new(),
-                starts: Vec::new(),
-            }),
+            lists: Arc::new([]),
             lo: [0; D],
             hi: [0; D],
-            sorted_len: 0,
+            len: 0,
+            label: 0,
         }
     }
+}
+
+/// The particles of a cluster, needed only at merges and for output.
+#[derive(Debug, Clone, Default)]
+struct Cold<const D: usize> {
+    /// Relative coordinates of the particles.
+    sites: Vec<[i32; D]>,
+    /// Size when the sites were last sorted into memory order.
+    sorted_len: usize,
 }
 
 /// How list entries are stored and turned into k-indices.
@@ -99,6 +103,10 @@ pub(crate) trait Frame<const D: usize>: Debug + Clone {
     fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> Self::Origin;
     /// Relative coordinates `r` (at most two steps beyond a particle's) as an entry.
     fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> Self::Entry;
+    /// A list start stored as an entry (see [`Lists`]).
+    fn start(i: usize) -> Self::Entry;
+    /// The list start stored in `e`.
+    fn start_of(e: Self::Entry) -> usize;
     /// k-index of a particle site.
     fn site(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> usize;
     /// k-index of a probe site, or `None` beyond a wall.
@@ -121,6 +129,15 @@ impl<const D: usize> Frame<D> for AnyFrame {
     }
     fn entry(&self, _: &Geometry<D>, r: &[i32; D]) -> [i32; D] {
         *r
+    }
+    fn start(i: usize) -> [i32; D] {
+        let mut e = [0; D];
+        e[0] = i32::try_from(i).expect("lists shorter than 2^31");
+        e
+    }
+    #[inline(always)]
+    fn start_of(e: [i32; D]) -> usize {
+        e[0] as usize
     }
     #[inline(always)]
     fn site(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> usize {
@@ -173,6 +190,13 @@ impl<const D: usize> Frame<D> for Pow2Frame {
     }
     fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> u32 {
         geo.any(&[0; D], r).expect("periodic") as u32
+    }
+    fn start(i: usize) -> u32 {
+        u32::try_from(i).expect("lists shorter than 2^32")
+    }
+    #[inline(always)]
+    fn start_of(e: u32) -> usize {
+        e as usize
     }
     #[inline(always)]
     fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
@@ -350,19 +374,17 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     geo: Geometry<D>,
     frame: F,
     /// The lists of a single particle, shared by all single particles.
-    single: Option<Arc<Lists<F::Entry>>>,
+    single: Option<Lists<F::Entry>>,
     lattice: Lattice,
     /// Which sites hold a particle, one bit a site: small enough to stay in cache where the
     /// label array does not, and all a contact probe reads unless it finds a particle.
     occupied: Bits,
     /// Label of the cluster on each occupied site (stale on empty sites).
     cells: Vec<u32>,
-    /// Label carried by each cluster's sites, indexed by id; a merge relabels only the smaller
-    /// part and points the larger part's label at the survivor.
-    label_of: Vec<u32>,
     /// Cluster owning each label.
     id_of: Vec<ItemId>,
     clusters: Vec<Cluster<D, F>>,
+    cold: Vec<Cold<D>>,
     live: Vec<ItemId>,
     position: Vec<u32>,
     /// Scratch for rebuilding face and probe lists.
@@ -386,9 +408,9 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             single: None,
             occupied: Bits::new(lattice.volume() as usize),
             cells: vec![EMPTY; lattice.volume() as usize],
-            label_of: (0..n as u32).collect(),
             id_of: (0..n as ItemId).collect(),
             clusters: vec![Cluster::default(); n],
+            cold: vec![Cold::default(); n],
             live: Vec::new(),
             position: vec![DEAD; n],
             marks: Vec::new(),
@@ -408,7 +430,9 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             let origin = coords(sites[0]);
             let c = &mut r.clusters[id as usize];
             c.origin = origin;
-            c.sites = sites
+            c.len = sites.len() as u32;
+            c.label = id;
+            r.cold[id as usize].sites = sites
                 .iter()
                 .map(|&k| r.geo.relative(&origin, &coords(k)))
                 .collect();
@@ -426,12 +450,14 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         Some(r)
     }
 
+    #[inline]
     fn len_of(&self, id: ItemId) -> usize {
-        self.clusters[id as usize].sites.len()
+        self.clusters[id as usize].len as usize
     }
 
+    #[inline]
     fn contains(&self, id: ItemId) -> bool {
-        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+        self.clusters.get(id as usize).is_some_and(|c| c.len != 0)
     }
 
     /// Move cluster `id` by `dir`: all or nothing (a wall blocks it). On success the clusters
@@ -448,7 +474,6 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             frame,
             occupied,
             cells,
-            label_of,
             id_of,
             clusters,
             ..
@@ -465,12 +490,12 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 return Err(Blocked);
             }
         }
-        let label = label_of[id as usize];
+        let label = c.label;
         // Vacate the trailing face (in the old frame); labels of empty sites are never read.
         let mut o = c.origin;
         let lists = &*c.lists;
         let fo = frame.origin(geo, &o);
-        for &e in lists.list(d ^ 1) {
+        for &e in list::<D, F>(lists, d ^ 1) {
             occupied.clear(frame.site(geo, fo, e));
         }
         o[axis] += if dir.is_positive() { 1 } else { -1 };
@@ -482,14 +507,14 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         c.origin = o;
         let fo = frame.origin(geo, &o);
         // Cover the leading face (in the new frame).
-        for &e in lists.list(d) {
+        for &e in list::<D, F>(lists, d) {
             let k = frame.site(geo, fo, e);
             debug_assert!(!occupied.get(k), "clusters overlap");
             occupied.set(k);
             cells[k] = label;
         }
         // Look at the new neighbours only.
-        for &e in lists.list(2 * D + d) {
+        for &e in list::<D, F>(lists, 2 * D + d) {
             if let Some(k) = frame.probe(geo, fo, e)
                 && occupied.get(k)
             {
@@ -510,26 +535,30 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     /// after the last merge of a move.
     fn merge(&mut self, into: ItemId, from: ItemId) {
         let (ni, nf) = (self.len_of(into), self.len_of(from));
-        let (li, lf) = (self.label_of[into as usize], self.label_of[from as usize]);
+        let lf = self.clusters[from as usize].label;
         // Relabel the smaller part only.
-        let (small, label) = if nf <= ni { (from, li) } else { (into, lf) };
-        let c = &self.clusters[small as usize];
-        for r in &c.sites {
-            self.cells[self.geo.site(&c.origin, r)] = label;
+        let (small, large) = if nf <= ni { (from, into) } else { (into, from) };
+        let label = self.clusters[large as usize].label;
+        let origin = self.clusters[small as usize].origin;
+        for r in &self.cold[small as usize].sites {
+            self.cells[self.geo.site(&origin, r)] = label;
         }
         if nf > ni {
-            self.label_of[into as usize] = lf;
             self.id_of[lf as usize] = into;
         }
         // Keep the larger part's frame and append the smaller part's sites.
         let mut other = std::mem::take(&mut self.clusters[from as usize]);
+        let mut other_cold = std::mem::take(&mut self.cold[from as usize]);
         if nf > ni {
             std::mem::swap(&mut self.clusters[into as usize], &mut other);
+            std::mem::swap(&mut self.cold[into as usize], &mut other_cold);
         }
         let target = &mut self.clusters[into as usize];
+        target.len = (ni + nf) as u32;
+        target.label = label;
         let geo = &self.geo;
-        target.sites.extend(
-            other
+        self.cold[into as usize].sites.extend(
+            other_cold
                 .sites
                 .iter()
                 .map(|r| geo.relative(&target.origin, &geo.absolute(&other.origin, r))),
@@ -550,25 +579,28 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             self.marks = vec![0; self.geo.ext_volume.div_ceil(64) as usize];
         }
         let mut c = std::mem::take(&mut self.clusters[id as usize]);
+        let mut cold = std::mem::take(&mut self.cold[id as usize]);
         // Large clusters are kept in memory order (re-sorted when they double), so their lists
         // walk the occupancy lattice in order.
-        if c.sites.len() >= 64 && c.sites.len() >= 2 * c.sorted_len {
+        if cold.sites.len() >= 64 && cold.sites.len() >= 2 * cold.sorted_len {
             let (geo, o) = (&self.geo, c.origin);
-            c.sites.sort_by_cached_key(|r| geo.site(&o, r));
-            c.sorted_len = c.sites.len();
+            cold.sites.sort_by_cached_key(|r| geo.site(&o, r));
+            cold.sorted_len = cold.sites.len();
         }
         c.lists = match &self.single {
-            Some(single) if c.sites.len() == 1 => single.clone(),
-            _ => Arc::new(self.build_lists(&mut c, self.label_of[id as usize])),
+            Some(single) if cold.sites.len() == 1 => single.clone(),
+            _ => self.build_lists(&mut c, &cold.sites),
         };
-        if c.sites.len() == 1 && self.single.is_none() {
+        if cold.sites.len() == 1 && self.single.is_none() {
             self.single = Some(c.lists.clone());
         }
         self.clusters[id as usize] = c;
+        self.cold[id as usize] = cold;
     }
 
-    /// The extent and the lists of `c` (with label `label` in the occupancy lattice).
-    fn build_lists(&mut self, c: &mut Cluster<D, F>, label: u32) -> Lists<F::Entry> {
+    /// The extent and the lists of `c`, whose particles are `sites`.
+    fn build_lists(&mut self, c: &mut Cluster<D, F>, sites: &[[i32; D]]) -> Lists<F::Entry> {
+        let label = c.label;
         let Rigid {
             geo,
             frame,
@@ -588,7 +620,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         hood.clear();
         c.lo = [i32::MAX; D];
         c.hi = [i32::MIN; D];
-        for s in &c.sites {
+        for s in sites {
             for a in 0..D {
                 c.lo[a] = c.lo[a].min(s[a]);
                 c.hi[a] = c.hi[a].max(s[a]);
@@ -623,23 +655,25 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         for (_, e) in hood.iter() {
             marks[e / 64] &= !(1u64 << (e % 64));
         }
-        let mut lists = Lists {
-            entries: Vec::with_capacity(scratch.iter().map(Vec::len).sum()),
-            starts: vec![0],
-        };
+        let head = 4 * D + 1;
+        let mut lists = Vec::with_capacity(head + scratch.iter().map(Vec::len).sum::<usize>());
+        lists.push(F::start(head));
+        let mut end = head;
         for list in scratch.iter() {
-            lists
-                .entries
-                .extend(list.iter().map(|r| frame.entry(geo, r)));
-            lists.starts.push(lists.entries.len() as u32);
+            end += list.len();
+            lists.push(F::start(end));
         }
-        lists
+        for list in scratch.iter() {
+            lists.extend(list.iter().map(|r| frame.entry(geo, r)));
+        }
+        lists.into()
     }
 
     /// Absolute k-indices of the particles of `id`.
     fn sites(&self, id: ItemId) -> Vec<u64> {
         let c = &self.clusters[id as usize];
-        c.sites
+        self.cold[id as usize]
+            .sites
             .iter()
             .map(|r| self.geo.site(&c.origin, r) as u64)
             .collect()
@@ -651,8 +685,9 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         let mut total = 0;
         for i in 0..self.live.len() {
             let id = self.live[i];
-            let label = self.label_of[id as usize];
+            let label = self.clusters[id as usize].label;
             assert_eq!(self.id_of[label as usize], id, "label table");
+            assert_eq!(self.len_of(id), self.cold[id as usize].sites.len());
             for k in self.sites(id) {
                 assert!(
                     self.occupied.get(k as usize),
@@ -662,9 +697,10 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 total += 1;
             }
             let mut fresh = self.clusters[id as usize].clone();
-            let lists = self.build_lists(&mut fresh, label);
+            let sites = self.cold[id as usize].sites.clone();
+            let lists = self.build_lists(&mut fresh, &sites);
             let c = &self.clusters[id as usize];
-            assert_eq!(&lists, &*c.lists);
+            assert_eq!(&*lists, &*c.lists);
             assert_eq!((fresh.lo, fresh.hi), (c.lo, c.hi));
         }
         let filled = (0..self.cells.len())
