@@ -59,6 +59,8 @@ struct Cluster<const D: usize, F: Frame<D>> {
     origin: [i64; D],
     /// Face and probe lists; single particles all share one.
     lists: Lists<F::Entry>,
+    /// Clusters merged in since the lists were last computed, each with its own lists.
+    parts: Vec<Part<D, F>>,
     /// Smallest and largest relative coordinate per axis (used on wall axes).
     lo: [i32; D],
     hi: [i32; D],
@@ -74,12 +76,29 @@ impl<const D: usize, F: Frame<D>> Default for Cluster<D, F> {
         Cluster {
             origin: [0; D],
             lists: Arc::new([]),
+            parts: Vec::new(),
             lo: [0; D],
             hi: [0; D],
             len: 0,
             label: 0,
         }
     }
+}
+
+/// A cluster merged into a larger one, kept with its own lists until the parts merged in
+/// since the last computation of the lists hold as many particles as the lists cover (then the
+/// lists are computed afresh). So a large cluster absorbing small ones does not recompute its
+/// lists at every merge, and each particle is in O(log N) computations over a run. Moving
+/// the parts one after the other is exact: all parts vacate their trailing faces before any
+/// covers its leading face, and a probe that lands on another part of the same cluster sees
+/// the cluster's own label.
+#[derive(Debug, Clone)]
+struct Part<const D: usize, F: Frame<D>> {
+    /// Its origin relative to the cluster's.
+    offset: [i32; D],
+    lists: Lists<F::Entry>,
+    /// Particles its lists cover.
+    len: u32,
 }
 
 /// The particles of a cluster, needed only at merges and for output.
@@ -311,6 +330,19 @@ impl<const D: usize> Geometry<D> {
         Some(k as usize)
     }
 
+    /// The origin of a part at `offset` from origin `o`.
+    #[inline(always)]
+    fn shifted(&self, o: &[i64; D], offset: &[i32; D]) -> [i64; D] {
+        let mut x = [0; D];
+        for a in 0..D {
+            x[a] = o[a] + i64::from(offset[a]);
+            if self.periodic[a] && x[a] >= self.size[a] {
+                x[a] -= self.size[a];
+            }
+        }
+        x
+    }
+
     /// Relative coordinates of absolute coordinates `x` in the frame with origin `o`.
     fn relative(&self, o: &[i64; D], x: &[i64; D]) -> [i32; D] {
         let mut r = [0; D];
@@ -498,6 +530,12 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         for &e in list::<D, F>(lists, d ^ 1) {
             occupied.clear(frame.site(geo, fo, e));
         }
+        for p in &c.parts {
+            let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
+            for &e in list::<D, F>(&p.lists, d ^ 1) {
+                occupied.clear(frame.site(geo, po, e));
+            }
+        }
         o[axis] += if dir.is_positive() { 1 } else { -1 };
         if o[axis] >= geo.size[axis] {
             o[axis] -= geo.size[axis];
@@ -509,23 +547,37 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         // Cover the leading face (in the new frame).
         for &e in list::<D, F>(lists, d) {
             let k = frame.site(geo, fo, e);
-            debug_assert!(!occupied.get(k), "clusters overlap");
+            debug_assert!(!occupied.get(k) || !c.parts.is_empty(), "clusters overlap");
             occupied.set(k);
             cells[k] = label;
         }
+        for p in &c.parts {
+            let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
+            for &e in list::<D, F>(&p.lists, d) {
+                let k = frame.site(geo, po, e);
+                occupied.set(k);
+                cells[k] = label;
+            }
+        }
         // Look at the new neighbours only.
-        for &e in list::<D, F>(lists, 2 * D + d) {
-            if let Some(k) = frame.probe(geo, fo, e)
-                && occupied.get(k)
-            {
-                let l = cells[k];
-                if l != label {
-                    let other = id_of[l as usize];
-                    if !out.contains(&other) {
-                        out.push(other);
+        let mut probe = |fo: F::Origin, lists: &[F::Entry]| {
+            for &e in list::<D, F>(lists, 2 * D + d) {
+                if let Some(k) = frame.probe(geo, fo, e)
+                    && occupied.get(k)
+                {
+                    let l = cells[k];
+                    if l != label {
+                        let other = id_of[l as usize];
+                        if !out.contains(&other) {
+                            out.push(other);
+                        }
                     }
                 }
             }
+        };
+        probe(fo, lists);
+        for p in &c.parts {
+            probe(frame.origin(geo, &geo.shifted(&o, &p.offset)), &p.lists);
         }
         out.sort_unstable();
         Ok(())
@@ -557,6 +609,25 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         target.len = (ni + nf) as u32;
         target.label = label;
         let geo = &self.geo;
+        // The smaller cluster and its parts become parts of the union.
+        let extra: u32 = other.parts.iter().map(|p| p.len).sum();
+        let off = geo.relative(&target.origin, &other.origin);
+        for a in 0..D {
+            target.lo[a] = target.lo[a].min(off[a] + other.lo[a]);
+            target.hi[a] = target.hi[a].max(off[a] + other.hi[a]);
+        }
+        target.parts.push(Part {
+            offset: off,
+            lists: other.lists.clone(),
+            len: other.len - extra,
+        });
+        for p in &other.parts {
+            target.parts.push(Part {
+                offset: geo.relative(&target.origin, &geo.absolute(&other.origin, &p.offset)),
+                lists: p.lists.clone(),
+                len: p.len,
+            });
+        }
         self.cold[into as usize].sites.extend(
             other_cold
                 .sites
@@ -572,9 +643,15 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         self.position[from as usize] = DEAD;
     }
 
-    /// Recompute the extent, and the face and probe lists, of cluster `id` from its sites and
-    /// the occupancy lattice. O(size); once per merge.
+    /// After merges into cluster `id`: recompute its extent and its face and probe lists from
+    /// its sites and the occupancy lattice (O(size)) if the parts merged in since the last time
+    /// hold as many particles as the lists cover; otherwise keep the parts (see [`Part`]).
     fn finish(&mut self, id: ItemId) {
+        let c = &self.clusters[id as usize];
+        let extra: u32 = c.parts.iter().map(|p| p.len).sum();
+        if !c.parts.is_empty() && 2 * extra < c.len {
+            return;
+        }
         if self.marks.is_empty() {
             self.marks = vec![0; self.geo.ext_volume.div_ceil(64) as usize];
         }
@@ -587,6 +664,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             cold.sites.sort_by_cached_key(|r| geo.site(&o, r));
             cold.sorted_len = cold.sites.len();
         }
+        c.parts.clear();
         c.lists = match &self.single {
             Some(single) if cold.sites.len() == 1 => single.clone(),
             _ => self.build_lists(&mut c, &cold.sites),
@@ -700,8 +778,14 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             let sites = self.cold[id as usize].sites.clone();
             let lists = self.build_lists(&mut fresh, &sites);
             let c = &self.clusters[id as usize];
-            assert_eq!(&*lists, &*c.lists);
-            assert_eq!((fresh.lo, fresh.hi), (c.lo, c.hi));
+            if c.parts.is_empty() {
+                assert_eq!(&*lists, &*c.lists);
+            }
+            let extra: u32 = c.parts.iter().map(|p| p.len).sum();
+            assert!(2 * extra < c.len, "parts not consolidated");
+            for a in (0..D).filter(|&a| !self.geo.periodic[a]) {
+                assert_eq!((fresh.lo[a], fresh.hi[a]), (c.lo[a], c.hi[a]), "extent");
+            }
         }
         let filled = (0..self.cells.len())
             .filter(|&k| self.occupied.get(k))
