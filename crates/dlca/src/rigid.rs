@@ -811,19 +811,15 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     }
 }
 
-/// [`Rigid`] for the dimension of the lattice (1 to 5).
+/// [`Rigid`] for the dimension of the lattice (1 to 3; see `RIGID_MAX_DIM` in `sim.rs`).
 #[derive(Debug, Clone)]
 pub(crate) enum RigidStore {
     D1(Rigid<1, AnyFrame>),
     D2(Rigid<2, AnyFrame>),
     D3(Rigid<3, AnyFrame>),
-    D4(Rigid<4, AnyFrame>),
-    D5(Rigid<5, AnyFrame>),
     P1(Rigid<1, Pow2Frame>),
     P2(Rigid<2, Pow2Frame>),
     P3(Rigid<3, Pow2Frame>),
-    P4(Rigid<4, Pow2Frame>),
-    P5(Rigid<5, Pow2Frame>),
 }
 
 macro_rules! each {
@@ -832,20 +828,16 @@ macro_rules! each {
             RigidStore::D1($r) => $e,
             RigidStore::D2($r) => $e,
             RigidStore::D3($r) => $e,
-            RigidStore::D4($r) => $e,
-            RigidStore::D5($r) => $e,
             RigidStore::P1($r) => $e,
             RigidStore::P2($r) => $e,
             RigidStore::P3($r) => $e,
-            RigidStore::P4($r) => $e,
-            RigidStore::P5($r) => $e,
         }
     };
 }
 
 impl RigidStore {
     /// The store for the clusters of `sets` (same ids). `None` when the dimension is outside
-    /// 1..=5 or a side is larger than [`MAX_SIDE`].
+    /// 1..=3 or a side is larger than [`MAX_SIDE`].
     pub(crate) fn new(sets: &SiteSets) -> Option<Self> {
         let l = sets.lattice();
         if l.sizes().iter().any(|&s| s > MAX_SIDE) {
@@ -862,12 +854,6 @@ impl RigidStore {
             3 => Rigid::new(sets)
                 .map(RigidStore::P3)
                 .or_else(|| Rigid::new(sets).map(RigidStore::D3)),
-            4 => Rigid::new(sets)
-                .map(RigidStore::P4)
-                .or_else(|| Rigid::new(sets).map(RigidStore::D4)),
-            5 => Rigid::new(sets)
-                .map(RigidStore::P5)
-                .or_else(|| Rigid::new(sets).map(RigidStore::D5)),
             _ => None,
         }
     }

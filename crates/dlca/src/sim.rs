@@ -21,7 +21,16 @@ enum Engine {
     AllPairs(AllPairs),
     Grid(Box<LatticeGridBoxes>),
     Lattice(Box<RigidStore>),
+    /// The `lattice` strategy in 4 and 5 dimensions (see [`RIGID_MAX_DIM`]).
+    Occupancy(Occupancy),
 }
+
+/// Highest dimension in which the `lattice` strategy uses rigid clusters. Beyond it a fractal
+/// cluster has nearly every particle on every face and about `2d - 1` probes per particle and
+/// direction, so the lists cost more than moving every particle: measured in 5D (L = 24, 1%
+/// fill) 2.9 s and 470 MB with rigid clusters against 1.6 s and 47 MB with the plain
+/// occupancy lattice (k-index arrays, leading-particle contact checks).
+const RIGID_MAX_DIM: usize = 3;
 
 impl Engine {
     fn search(&mut self) -> &mut dyn ContactSearch {
@@ -29,13 +38,14 @@ impl Engine {
             Engine::AllPairs(s) => s,
             Engine::Grid(s) => s.as_mut(),
             Engine::Lattice(_) => unreachable!("the lattice strategy keeps its own clusters"),
+            Engine::Occupancy(s) => s,
         }
     }
     fn kind(&self) -> Search {
         match self {
             Engine::AllPairs(_) => Search::AllPairs,
             Engine::Grid(_) => Search::Grid,
-            Engine::Lattice(_) => Search::Lattice,
+            Engine::Lattice(_) | Engine::Occupancy(_) => Search::Lattice,
         }
     }
 }
@@ -156,9 +166,19 @@ impl Simulation {
                 if too_large_for(&self.lattice, self.params.max_memory) {
                     return Err(too_large);
                 }
-                let store = RigidStore::new(&self.sets).ok_or(too_large)?;
-                self.sets = SiteSets::new(self.lattice.clone());
-                Engine::Lattice(Box::new(store))
+                if self.lattice.dim() <= RIGID_MAX_DIM {
+                    let store = RigidStore::new(&self.sets).ok_or(too_large)?;
+                    self.sets = SiteSets::new(self.lattice.clone());
+                    Engine::Lattice(Box::new(store))
+                } else {
+                    // Clusters merge as soon as they touch, so they are separated before every
+                    // move.
+                    Engine::Occupancy(
+                        Occupancy::new(&self.lattice, self.params.max_memory)
+                            .map_err(|_| too_large)?
+                            .with_separated_items(true),
+                    )
+                }
             }
             Search::AllPairs | Search::Auto => Engine::AllPairs(AllPairs::new()),
             Search::Grid => {
@@ -194,7 +214,7 @@ impl Simulation {
                 }
             }
         };
-        if matches!(self.engine, Engine::AllPairs(_)) {
+        if matches!(self.engine, Engine::AllPairs(_) | Engine::Occupancy(_)) {
             let ids: Vec<ItemId> = self.sets.live().to_vec();
             for id in ids {
                 self.engine.search().insert(&self.sets, id);
