@@ -26,7 +26,8 @@ pub enum GridError {
 /// particles, so items larger than a box span several boxes. A contact query gathers the items
 /// registered in the mover's boxes and their `3^d` neighbourhood (the *halo*; wrapping on
 /// periodic axes, stopping at walls), reports each candidate once, and tests candidates
-/// particle by particle. Since two face-adjacent sites are at most one box apart on each axis,
+/// particle by particle (pairwise for small movers; for movers of more than 16 particles by
+/// looking up each candidate particle's neighbours among the mover's sorted sites). Since two face-adjacent sites are at most one box apart on each axis,
 /// every item in contact with the mover is among the candidates: the search is exact, only
 /// faster than [`super::AllPairs`].
 ///
