@@ -54,13 +54,14 @@ fn list<const D: usize, F: Frame<D>>(lists: &[F::Entry], i: usize) -> &[F::Entry
 /// the entry format of frame `F`). Early in a run most clusters are a few particles and a move
 /// costs little more than the cache misses on its data, so everything is one record away.
 #[derive(Debug, Clone)]
+#[repr(align(64))]
 struct Cluster<const D: usize, F: Frame<D>> {
     /// Absolute coordinates of relative position 0, each in `[0, L)`.
     origin: [i64; D],
     /// Face and probe lists; single particles all share one.
     lists: Lists<F::Entry>,
     /// Clusters merged in since the lists were last computed, each with its own lists.
-    parts: Vec<Part<D, F>>,
+    parts: Parts<D, F>,
     /// Smallest and largest relative coordinate per axis (used on wall axes).
     lo: [i32; D],
     hi: [i32; D],
@@ -76,7 +77,7 @@ impl<const D: usize, F: Frame<D>> Default for Cluster<D, F> {
         Cluster {
             origin: [0; D],
             lists: Arc::new([]),
-            parts: Vec::new(),
+            parts: Parts(None),
             lo: [0; D],
             hi: [0; D],
             len: 0,
@@ -99,6 +100,28 @@ struct Part<const D: usize, F: Frame<D>> {
     lists: Lists<F::Entry>,
     /// Particles its lists cover.
     len: u32,
+}
+
+/// The parts of a cluster, boxed so that a cluster without parts (nearly all of them) keeps a
+/// small record.
+#[derive(Debug, Clone)]
+struct Parts<const D: usize, F: Frame<D>>(Option<Box<Vec<Part<D, F>>>>);
+
+impl<const D: usize, F: Frame<D>> Parts<D, F> {
+    #[inline]
+    fn as_slice(&self) -> &[Part<D, F>] {
+        self.0.as_deref().map_or(&[], Vec::as_slice)
+    }
+    fn push(&mut self, p: Part<D, F>) {
+        self.0.get_or_insert_with(Default::default).push(p);
+    }
+    fn clear(&mut self) {
+        self.0 = None;
+    }
+    #[inline]
+    fn is_empty(&self) -> bool {
+        self.0.is_none()
+    }
 }
 
 /// The particles of a cluster, needed only at merges and for output.
@@ -530,7 +553,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         for &e in list::<D, F>(lists, d ^ 1) {
             occupied.clear(frame.site(geo, fo, e));
         }
-        for p in &c.parts {
+        for p in c.parts.as_slice() {
             let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
             for &e in list::<D, F>(&p.lists, d ^ 1) {
                 occupied.clear(frame.site(geo, po, e));
@@ -551,7 +574,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             occupied.set(k);
             cells[k] = label;
         }
-        for p in &c.parts {
+        for p in c.parts.as_slice() {
             let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
             for &e in list::<D, F>(&p.lists, d) {
                 let k = frame.site(geo, po, e);
@@ -576,7 +599,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             }
         };
         probe(fo, lists);
-        for p in &c.parts {
+        for p in c.parts.as_slice() {
             probe(frame.origin(geo, &geo.shifted(&o, &p.offset)), &p.lists);
         }
         out.sort_unstable();
@@ -610,7 +633,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         target.label = label;
         let geo = &self.geo;
         // The smaller cluster and its parts become parts of the union.
-        let extra: u32 = other.parts.iter().map(|p| p.len).sum();
+        let extra: u32 = other.parts.as_slice().iter().map(|p| p.len).sum();
         let off = geo.relative(&target.origin, &other.origin);
         for a in 0..D {
             target.lo[a] = target.lo[a].min(off[a] + other.lo[a]);
@@ -621,7 +644,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             lists: other.lists.clone(),
             len: other.len - extra,
         });
-        for p in &other.parts {
+        for p in other.parts.as_slice() {
             target.parts.push(Part {
                 offset: geo.relative(&target.origin, &geo.absolute(&other.origin, &p.offset)),
                 lists: p.lists.clone(),
@@ -648,7 +671,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     /// hold as many particles as the lists cover; otherwise keep the parts (see [`Part`]).
     fn finish(&mut self, id: ItemId) {
         let c = &self.clusters[id as usize];
-        let extra: u32 = c.parts.iter().map(|p| p.len).sum();
+        let extra: u32 = c.parts.as_slice().iter().map(|p| p.len).sum();
         if !c.parts.is_empty() && 2 * extra < c.len {
             return;
         }
@@ -781,7 +804,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             if c.parts.is_empty() {
                 assert_eq!(&*lists, &*c.lists);
             }
-            let extra: u32 = c.parts.iter().map(|p| p.len).sum();
+            let extra: u32 = c.parts.as_slice().iter().map(|p| p.len).sum();
             assert!(2 * extra < c.len, "parts not consolidated");
             for a in (0..D).filter(|&a| !self.geo.periodic[a]) {
                 assert_eq!((fresh.lo[a], fresh.hi[a]), (c.lo[a], c.hi[a]), "extent");
