@@ -28,4 +28,4 @@ mod rigid;
 pub mod sim;
 
 pub use params::{Init, ParamError, Params, Search};
-pub use sim::Simulation;
+pub use sim::{Simulation, Snapshot};

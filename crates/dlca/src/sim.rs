@@ -62,12 +62,60 @@ struct BBox {
 }
 
 /// Something that happened to the search during the run, for logs and `run.json`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SearchEvent {
     /// Sweep during which it happened (0: at start).
     pub sweep: u64,
     /// What happened.
     pub what: String,
+}
+
+/// The state of a run between two sweeps, for checkpoints (`--checkpoint-every`, `--resume`):
+/// [`Simulation::restore`] continues it to the same final state as an uninterrupted run.
+/// Serialisable with serde (the `dlca` binary writes it in `core_lattice::io`'s checkpoint
+/// envelope).
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct Snapshot {
+    params: Params,
+    seed: u64,
+    sweep: u64,
+    rng: SimRng,
+    /// Live clusters in increasing id, with their sites (k-indices).
+    clusters: Vec<(ItemId, Vec<u64>)>,
+    /// One more than the largest cluster id.
+    id_bound: u64,
+    particles: u64,
+    largest: u64,
+    /// The search in use, and the grid box side if it is the grid.
+    strategy: Search,
+    grid_side: Option<u64>,
+    strategy_reason: String,
+    events: Vec<SearchEvent>,
+    records: Records,
+}
+
+impl Snapshot {
+    /// The parameters of the saved run.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The seed of the saved run.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Sweeps done when it was saved.
+    pub fn sweeps(&self) -> u64 {
+        self.sweep
+    }
+
+    /// Change where the resumed run stops (`--target-clusters`, `--max-sweeps`): the only
+    /// parameters that may differ from the saved run's.
+    pub fn set_stop(&mut self, target_clusters: u64, max_sweeps: Option<u64>) {
+        self.params.target_clusters = target_clusters;
+        self.params.max_sweeps = max_sweeps;
+    }
 }
 
 /// A DLCA run: the lattice, the clusters, the search, the random stream and the records.
@@ -76,6 +124,7 @@ pub struct SearchEvent {
 /// strategy (tests check bit-identical state hashes across strategies).
 pub struct Simulation {
     params: Params,
+    seed: u64,
     lattice: Lattice,
     /// The clusters as k-index arrays, for the all-pairs and grid searches. Empty while the
     /// `lattice` strategy, which keeps the clusters itself, is in use.
@@ -130,6 +179,7 @@ impl Simulation {
         let mut sim = Simulation {
             records: Records::new(&params),
             params,
+            seed,
             lattice,
             sets,
             materialized: OnceLock::new(),
@@ -151,6 +201,91 @@ impl Simulation {
         sim.sorted_size = vec![0; sim.sets.id_bound()];
         sim.install(kind)?;
         sim.records.record_sweep(0, sim.clusters(), largest, None);
+        Ok(sim)
+    }
+
+    /// The state of the run now, to continue later with [`Simulation::restore`].
+    pub fn snapshot(&self) -> Snapshot {
+        let sets = self.sets();
+        let mut ids = sets.live().to_vec();
+        ids.sort_unstable();
+        Snapshot {
+            params: self.params.clone(),
+            seed: self.seed,
+            sweep: self.sweep,
+            rng: self.rng.clone(),
+            clusters: ids
+                .into_iter()
+                .map(|id| (id, sets.sites(id).to_vec()))
+                .collect(),
+            id_bound: sets.id_bound() as u64,
+            particles: self.particles,
+            largest: self.largest,
+            strategy: self.strategy(),
+            grid_side: match &self.engine {
+                Engine::Grid(g) => Some(g.side()),
+                _ => None,
+            },
+            strategy_reason: self.strategy_reason.clone(),
+            events: self.events.clone(),
+            records: self.records.clone(),
+        }
+    }
+
+    /// Continue the run saved in `snapshot`: it reaches the same final state (the same
+    /// `state_hash` and per-sweep records) as the run that was never interrupted.
+    pub fn restore(snapshot: Snapshot) -> Result<Self, ParamError> {
+        let s = snapshot;
+        s.params.validate()?;
+        let lattice = s.params.lattice()?;
+        let directions =
+            DirectionSampler::gravity(lattice.dim(), s.params.gravity).expect("gravity validated");
+        let mut sets = SiteSets::new(lattice.clone());
+        let mut clusters = s.clusters.into_iter().peekable();
+        let mut dead = Vec::new();
+        for id in 0..s.id_bound {
+            match clusters.next_if(|(c, _)| u64::from(*c) == id) {
+                Some((_, sites)) => sets.push(sites),
+                None => {
+                    dead.push(sets.push(Vec::new()));
+                    0
+                }
+            };
+        }
+        for id in dead {
+            sets.remove(id);
+        }
+        let mut sim = Simulation {
+            records: s.records,
+            params: s.params,
+            seed: s.seed,
+            lattice,
+            sets,
+            materialized: OnceLock::new(),
+            engine: Engine::AllPairs(AllPairs::new()),
+            strategy_reason: s.strategy_reason,
+            bbox: Vec::new(),
+            rng: s.rng,
+            directions,
+            particles: s.particles,
+            sweep: s.sweep,
+            largest: s.largest,
+            events: Vec::new(),
+            check_invariants: false,
+            sorted_size: Vec::new(),
+            old: Vec::new(),
+            contacts: Vec::new(),
+            order: Vec::new(),
+        };
+        sim.sorted_size = vec![0; sim.sets.id_bound()];
+        // The grid resumes with the box side it had (the parameters stay as given).
+        let grid_box = sim.params.grid_box;
+        if s.strategy == Search::Grid {
+            sim.params.grid_box = s.grid_side;
+        }
+        sim.install(s.strategy)?;
+        sim.params.grid_box = grid_box;
+        sim.events = s.events;
         Ok(sim)
     }
 
@@ -506,6 +641,11 @@ impl Simulation {
     /// The parameters.
     pub fn params(&self) -> &Params {
         &self.params
+    }
+
+    /// The seed the run was built from.
+    pub fn seed(&self) -> u64 {
+        self.seed
     }
 
     /// The lattice.
