@@ -36,6 +36,9 @@ use std::sync::Arc;
 /// Marks an empty site.
 const EMPTY: u32 = u32::MAX;
 
+/// Clusters of at most this many particles never keep parts (see [`Part`]).
+const SMALL: u32 = 64;
+
 /// Largest side length this store handles (relative coordinates are `i32` with a margin).
 pub(crate) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
 
@@ -673,7 +676,9 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     fn finish(&mut self, id: ItemId) {
         let c = &self.clusters[id as usize];
         let extra: u32 = c.parts.as_slice().iter().map(|p| p.len).sum();
-        if !c.parts.is_empty() && 2 * extra < c.len {
+        // Small clusters are recomputed at once: cheap, and it spares their moves the parts'
+        // extra pointers.
+        if !c.parts.is_empty() && 2 * extra < c.len && c.len > SMALL {
             return;
         }
         if self.marks.is_empty() {
@@ -806,7 +811,10 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 assert_eq!(&*lists, &*c.lists);
             }
             let extra: u32 = c.parts.as_slice().iter().map(|p| p.len).sum();
-            assert!(2 * extra < c.len, "parts not consolidated");
+            assert!(
+                c.parts.is_empty() || (2 * extra < c.len && c.len > SMALL),
+                "parts not consolidated"
+            );
             for a in (0..D).filter(|&a| !self.geo.periodic[a]) {
                 assert_eq!((fresh.lo[a], fresh.hi[a]), (c.lo[a], c.hi[a]), "extent");
             }
