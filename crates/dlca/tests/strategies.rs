@@ -186,8 +186,10 @@ fn initial_adjacent_particles_form_one_cluster() {
 fn power_of_two_periodic_lattices_match_all_pairs() {
     // All-periodic power-of-two lattices take the lattice strategy's bit-field frame; sides of
     // 1 and 2 are the edge cases of its field arithmetic.
-    let sizes: [&[u64]; 6] = [
+    let sizes: [&[u64]; 7] = [
         &[256],
+        // Large enough for clusters of more than 64 particles absorbing small ones (parts).
+        &[64, 48],
         &[32, 16],
         &[2, 64],
         &[16, 1, 8],
