@@ -24,7 +24,8 @@ pub mod analysis;
 pub mod output;
 pub mod params;
 pub mod record;
+mod rigid;
 pub mod sim;
 
 pub use params::{Init, ParamError, Params, Search};
-pub use sim::Simulation;
+pub use sim::{Simulation, Snapshot};

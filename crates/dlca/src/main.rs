@@ -6,7 +6,11 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
 use core_lattice::io::RunClock;
-use dlca::{Init, Params, Search, Simulation};
+use core_lattice::io::{read_checkpoint, write_checkpoint};
+use dlca::{Init, Params, Search, Simulation, Snapshot};
+
+/// File name of checkpoints in the output directory.
+const CHECKPOINT: &str = "checkpoint.bin";
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -43,6 +47,16 @@ struct Cli {
     /// Output directory (created if missing; nothing is written on bad input).
     #[arg(long)]
     out: PathBuf,
+
+    /// Save the run's state to OUT/checkpoint.bin every N sweeps (atomically), for --resume.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    checkpoint_every: Option<u64>,
+
+    /// Continue the run saved in DIR/checkpoint.bin (by --checkpoint-every) to the same final
+    /// state as an uninterrupted run. The other flags must be those of the saved run, except
+    /// --target-clusters and --max-sweeps.
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
 
     /// Boundaries: `periodic` or `wall` for every axis, or one per axis separated by commas
     /// (`periodic,wall`).
@@ -242,7 +256,22 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     std::fs::create_dir_all(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     let target = params.target_clusters;
-    let mut sim = Simulation::new(params, cli.seed).context("setting up the run")?;
+    let mut sim = match &cli.resume {
+        Some(dir) => {
+            let path = dir.join(CHECKPOINT);
+            let mut snapshot: Snapshot = read_checkpoint(&path, "dlca")
+                .with_context(|| format!("reading checkpoint {}", path.display()))?;
+            snapshot.set_stop(params.target_clusters, params.max_sweeps);
+            anyhow::ensure!(
+                snapshot.params() == &params && snapshot.seed() == cli.seed,
+                "--resume: {} holds a different run (its parameters or seed differ from these flags; only --target-clusters and --max-sweeps may change)",
+                path.display()
+            );
+            tracing::info!("resuming after sweep {}", snapshot.sweeps());
+            Simulation::restore(snapshot).context("restoring the checkpoint")?
+        }
+        None => Simulation::new(params, cli.seed).context("setting up the run")?,
+    };
     tracing::info!("{}", sim.strategy_reason());
     let initial = sim.clusters();
     let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
@@ -255,7 +284,15 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         );
         bar
     });
+    let mut saved = Ok(());
     sim.run_with(|s| {
+        if let Some(n) = cli.checkpoint_every
+            && s.sweeps() % n == 0
+            && !s.is_done()
+            && saved.is_ok()
+        {
+            saved = write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot());
+        }
         if let Some(bar) = &bar {
             if s.sweeps() % 16 == 0 || s.is_done() {
                 bar.set_position(initial - s.clusters().max(target).min(initial));
@@ -266,6 +303,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
+    saved.context("writing a checkpoint")?;
     let m = dlca::output::write_outputs(&sim, cli.seed, &clock, &cli.out, cli.png)?;
     if !cli.quiet {
         eprintln!(

@@ -7,7 +7,7 @@ use crate::params::Params;
 use core_lattice::IntHistogram;
 
 /// One row of `sweeps.csv`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SweepRecord {
     /// Sweep number (0: the initial state).
     pub sweep: u64,
@@ -20,7 +20,7 @@ pub struct SweepRecord {
 }
 
 /// The records of a run.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Records {
     sweeps: Vec<SweepRecord>,
     histogram_sweeps: Vec<u64>,

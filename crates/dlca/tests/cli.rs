@@ -185,3 +185,50 @@ fn bad_input_is_one_line_exit_2_and_writes_nothing() {
         assert!(!out.exists(), "{args:?} wrote {}", out.display());
     }
 }
+
+#[test]
+fn resume_from_a_checkpoint_ends_like_the_uninterrupted_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = |name: &str| tmp.path().join(name).to_str().unwrap().to_string();
+    let common = [
+        "--size",
+        "96x64",
+        "--fill",
+        "0.04",
+        "--seed",
+        "3",
+        "--target-clusters",
+        "2",
+        "--quiet",
+    ];
+    let with = |extra: &[&str]| {
+        let mut args: Vec<&str> = common.to_vec();
+        args.extend_from_slice(extra);
+        let o = dlca(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let (whole, cut, resumed) = (dir("whole"), dir("cut"), dir("resumed"));
+    with(&["--out", &whole]);
+    // Interrupted after 150 sweeps, with a checkpoint every 40 (the last at sweep 120).
+    with(&[
+        "--max-sweeps",
+        "150",
+        "--checkpoint-every",
+        "40",
+        "--out",
+        &cut,
+    ]);
+    assert!(Path::new(&cut).join("checkpoint.bin").exists());
+    with(&["--resume", &cut, "--out", &resumed]);
+    let (a, b) = (run_json(Path::new(&whole)), run_json(Path::new(&resumed)));
+    assert_eq!(a["results"]["state_hash"], b["results"]["state_hash"]);
+    assert_eq!(a["results"]["sweeps"], b["results"]["sweeps"]);
+    let sweeps = |d: &str| std::fs::read_to_string(Path::new(d).join("sweeps.csv")).unwrap();
+    assert_eq!(sweeps(&whole), sweeps(&resumed));
+    // A checkpoint of another run is refused.
+    let mut args: Vec<&str> = common.to_vec();
+    args[5] = "4";
+    let other = dir("other");
+    args.extend_from_slice(&["--resume", &cut, "--out", &other]);
+    assert!(!dlca(&args).status.success());
+}

@@ -26,7 +26,8 @@ pub enum GridError {
 /// particles, so items larger than a box span several boxes. A contact query gathers the items
 /// registered in the mover's boxes and their `3^d` neighbourhood (the *halo*; wrapping on
 /// periodic axes, stopping at walls), reports each candidate once, and tests candidates
-/// particle by particle. Since two face-adjacent sites are at most one box apart on each axis,
+/// particle by particle (pairwise for small movers; for movers of more than 16 particles by
+/// looking up each candidate particle's neighbours among the mover's sorted sites). Since two face-adjacent sites are at most one box apart on each axis,
 /// every item in contact with the mover is among the candidates: the search is exact, only
 /// faster than [`super::AllPairs`].
 ///
@@ -53,7 +54,14 @@ pub struct LatticeGridBoxes {
     candidates: Vec<ItemId>,
     halo: Vec<u32>,
     coords: Vec<[u64; MAX_DIM]>,
+    /// The mover's sites, sorted, for the test of large movers.
+    sorted: Vec<u64>,
 }
+
+/// Movers with more particles than this test candidates by looking up each candidate
+/// particle's neighbours among the mover's sorted sites (O(s' d log s)) rather than comparing
+/// every pair of particles (O(s s')).
+const PAIRWISE_MAX: usize = 16;
 
 impl LatticeGridBoxes {
     /// Empty grid boxes of side `side` (a power of two) over `lattice`.
@@ -71,6 +79,7 @@ impl LatticeGridBoxes {
             candidates: Vec::new(),
             halo: Vec::new(),
             coords: Vec::new(),
+            sorted: Vec::new(),
         };
         g.layout(side)?;
         Ok(g)
@@ -296,18 +305,32 @@ impl ContactSearch for LatticeGridBoxes {
     fn contacts(&mut self, sets: &SiteSets, id: ItemId, out: &mut Vec<ItemId>) -> usize {
         out.clear();
         let lattice = sets.lattice();
+        let mine = sets.sites(id);
         let mut coords = std::mem::take(&mut self.coords);
+        let mut sorted = std::mem::take(&mut self.sorted);
         coords.clear();
-        coords.extend(sets.sites(id).iter().map(|&k| coords_of(lattice, k)));
+        sorted.clear();
+        if mine.len() <= PAIRWISE_MAX {
+            coords.extend(mine.iter().map(|&k| coords_of(lattice, k)));
+        } else {
+            sorted.extend_from_slice(mine);
+            sorted.sort_unstable();
+        }
         let candidates = self.halo_candidates(id);
         let examined = candidates.len();
-        out.extend(
-            candidates
-                .iter()
-                .copied()
-                .filter(|&c| touches(lattice, &coords, sets.sites(c))),
-        );
+        out.extend(candidates.iter().copied().filter(|&c| {
+            if sorted.is_empty() {
+                touches(lattice, &coords, sets.sites(c))
+            } else {
+                sets.sites(c).iter().any(|&k| {
+                    lattice
+                        .neighbours(k)
+                        .any(|n| sorted.binary_search(&n).is_ok())
+                })
+            }
+        }));
         self.coords = coords;
+        self.sorted = sorted;
         out.sort_unstable();
         examined
     }
