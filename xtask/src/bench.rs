@@ -91,7 +91,7 @@ pub const WORKLOADS: &[Workload] = &[
             "--rabbits",
             "86957",
             "--density",
-            "0.01",
+            "0.2",
             "--steps",
             "100",
             "--seed",

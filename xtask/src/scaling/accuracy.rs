@@ -46,6 +46,7 @@ pub fn settings() -> Vec<Setting> {
     };
     let (ret, jump) = (FarField::Return, FarField::Jump);
     vec![
+        s(f64::INFINITY, 0.05, ret),
         s(f64::INFINITY, 0.1, ret),
         s(1.0, 0.5, ret),
         s(2.0, 0.5, ret),
@@ -94,7 +95,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     doc.p(&format!(
         "Every setting grows {e} clusters of N = {n} particles in 2D (seeds {}..{}), the same \
          seeds for every setting. The reference is the most exact setting: exact nearest-\
-         distance search (`--precision inf`), the shortest near-field step (`--step-min 0.1`) \
+         distance search (`--precision inf`), the shortest near-field step (`--step-min 0.05`) \
          and the exact far-field return. Runs go two at a time, one per core, so every \
          setting is timed under the same load.",
         ctx.seed,
