@@ -44,6 +44,8 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Drawing style.
     pub style: Style,
+    /// Optional text drawn next to each point (same length as `points`).
+    pub labels: Option<Vec<String>>,
 }
 
 impl Series {
@@ -53,7 +55,15 @@ impl Series {
             name: name.into(),
             points,
             style,
+            labels: None,
         }
+    }
+
+    /// The same series with a text label beside each point.
+    pub fn with_labels(mut self, labels: Vec<String>) -> Self {
+        assert_eq!(labels.len(), self.points.len(), "one label per point");
+        self.labels = Some(labels);
+        self
     }
 }
 
@@ -188,6 +198,26 @@ macro_rules! draw_chart {
                         Circle::new((x + 10, y), 6, legend_color.stroke_width(2))
                     });
                 }
+            }
+        }
+        for s in spec.series.iter() {
+            if let Some(labels) = &s.labels {
+                ctx.draw_series(
+                    s.points
+                        .iter()
+                        .zip(labels)
+                        .filter(|((x, y), _)| {
+                            x.is_finite()
+                                && y.is_finite()
+                                && (!spec.log_x || *x > 0.0)
+                                && (!spec.log_y || *y > 0.0)
+                        })
+                        .map(|(&p, l)| {
+                            EmptyElement::at(p)
+                                + Text::new(l.clone(), (6, -14), ("sans-serif", 12).into_font())
+                        }),
+                )
+                .map_err(|e| anyhow!("{e}"))?;
             }
         }
         ctx.configure_series_labels()

@@ -23,6 +23,20 @@ pub struct Setting {
 }
 
 impl Setting {
+    /// `k2 s0.5 ret`: a point label for the plots.
+    fn short(&self) -> String {
+        let k = if self.precision.is_finite() {
+            format!("{}", self.precision)
+        } else {
+            "inf".into()
+        };
+        let ff = match self.far_field {
+            FarField::Return => "",
+            FarField::Jump => " jump",
+        };
+        format!("k{k} s{}{ff}", self.step_min)
+    }
+
     fn label(&self) -> String {
         let k = if self.precision.is_finite() {
             format!("{}", self.precision)
@@ -248,11 +262,13 @@ pub fn run(ctx: &Ctx) -> Result<()> {
          [`accuracy.csv`](accuracy.csv)."
     ));
     let default = measured.iter().position(|m| is_default(&m.setting));
+    let short: Vec<String> = measured.iter().map(|m| m.setting.short()).collect();
     pareto_chart(
         ctx,
         &format!("2D DLA, N = {n}: cost against error of D"),
         "|D - D_ref|",
         &points.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
+        &short,
         default,
         "accuracy_pareto.png",
     )?;
@@ -261,6 +277,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         &format!("2D DLA, N = {n}: cost against error of the R_g prefactor"),
         "|relative error of the R_g prefactor|",
         &points.iter().map(|p| (p.0, p.2)).collect::<Vec<_>>(),
+        &short,
         default,
         "accuracy_pareto_prefactor.png",
     )?;
@@ -280,6 +297,7 @@ fn pareto_chart(
     title: &str,
     y_label: &str,
     pts: &[(f64, f64)],
+    labels: &[String],
     default: Option<usize>,
     file: &str,
 ) -> Result<()> {
@@ -288,7 +306,8 @@ fn pareto_chart(
     let mut fp: Vec<(f64, f64)> = pareto(pts).into_iter().map(at).collect();
     fp.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut series = vec![
-        Series::new("settings", (0..pts.len()).map(at).collect(), Style::Points),
+        Series::new("settings", (0..pts.len()).map(at).collect(), Style::Points)
+            .with_labels(labels.to_vec()),
         Series::new("Pareto front", fp, Style::Line),
     ];
     if let Some(i) = default {
@@ -308,7 +327,7 @@ fn pareto_chart(
             title: title.into(),
             x_label: "microseconds per particle".into(),
             y_label: y_label.into(),
-            log_x: true,
+            log_x: false,
             log_y: true,
             series,
         },

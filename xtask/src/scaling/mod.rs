@@ -194,27 +194,44 @@ fn write_index(
     host: &str,
     command: &str,
 ) -> Result<()> {
-    let mut doc = Doc::new("Scaling results: index of the last run");
+    let path = out.join("index.md");
+    // Rows of experiments this invocation did not run are kept from the previous index, marked
+    // with the date and command that made them.
+    let previous = std::fs::read_to_string(&path).unwrap_or_default();
+    let mut doc = Doc::new("Scaling results: index");
+    let mut t = Table::new(&["experiment", "report", "seconds", "made by", "date"]);
+    for e in Experiment::ALL {
+        if let Some((_, s)) = times.iter().find(|(x, _)| *x == e) {
+            t.row(vec![
+                e.name().to_string(),
+                format!("[{0}.md]({0}.md)", e.name()),
+                sig(*s, 3),
+                format!("`{command}`"),
+                date.to_string(),
+            ]);
+        } else if let Some(row) = previous_row(&previous, e) {
+            t.row(row);
+        }
+    }
     doc.p(&format!(
-        "Command: `{command}`. Date: {date}. Machine: {host}. Scale: {}.",
+        "Last command: `{command}`. Date: {date}. Machine: {host}. Scale: {}. Each report \
+         states the command, date and machine that made it.",
         ctx.scale.name()
     ));
-    doc.p(
-        "A run with `--only` rewrites only its own reports and this index; reports of other \
-         experiments in this directory may come from an earlier run (each states its own date).",
-    );
-    let mut t = Table::new(&["experiment", "report", "seconds"]);
-    let total: f64 = times.iter().map(|t| t.1).sum();
-    for (e, s) in times {
-        t.row(vec![
-            e.name().to_string(),
-            format!("[{0}.md]({0}.md)", e.name()),
-            sig(*s, 3),
-        ]);
-    }
-    t.row(vec!["total".into(), String::new(), sig(total, 3)]);
     doc.table(&t);
-    doc.write(&out.join("index.md"))
+    doc.write(&path)
+}
+
+/// The row of `e` in a previous index written by [`write_index`], if any.
+fn previous_row(index: &str, e: Experiment) -> Option<Vec<String>> {
+    let prefix = format!("| {} | ", e.name());
+    let line = index.lines().find(|l| l.starts_with(&prefix))?;
+    let cells: Vec<String> = line
+        .trim_matches('|')
+        .split(" | ")
+        .map(|c| c.trim().to_string())
+        .collect();
+    (cells.len() == 5).then_some(cells)
 }
 
 /// Apply `f` to every item on all cores (work-stealing by index); results keep the items'
@@ -275,6 +292,37 @@ mod tests {
             par_map(&v, |x| x * 2),
             (0..100).map(|x| x * 2).collect::<Vec<_>>()
         );
+    }
+
+    #[test]
+    fn index_keeps_rows_of_experiments_not_rerun() {
+        let dir = tempfile::tempdir().unwrap();
+        let ctx = Ctx {
+            scale: Scale::Tiny,
+            out: dir.path().to_path_buf(),
+            seed: 1,
+            provenance: String::new(),
+        };
+        write_index(
+            &ctx,
+            dir.path(),
+            &[(Experiment::Dlca, 1.0), (Experiment::Dla, 2.0)],
+            "d1",
+            "m",
+            "c1",
+        )
+        .unwrap();
+        write_index(&ctx, dir.path(), &[(Experiment::Dla, 3.0)], "d2", "m", "c2").unwrap();
+        let text = std::fs::read_to_string(dir.path().join("index.md")).unwrap();
+        assert!(
+            text.contains("| dlca | [dlca.md](dlca.md) | 1.00 | `c1` | d1 |"),
+            "{text}"
+        );
+        assert!(
+            text.contains("| dla | [dla.md](dla.md) | 3.00 | `c2` | d2 |"),
+            "{text}"
+        );
+        assert!(!text.contains("animat"));
     }
 
     #[test]
