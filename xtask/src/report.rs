@@ -2,6 +2,7 @@
 //! file carries: date, machine, command.
 
 use anyhow::{Context, Result};
+use core_lattice::Welford;
 use core_lattice::io::write_atomic;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -111,24 +112,26 @@ pub fn sig(v: f64, digits: usize) -> String {
     format!("{v:.d$}")
 }
 
-/// Mean and standard error of the mean (0 for a single value).
-pub fn mean_stderr(xs: &[f64]) -> (f64, f64) {
-    let n = xs.len() as f64;
-    if xs.is_empty() {
-        return (f64::NAN, f64::NAN);
-    }
-    let m = xs.iter().sum::<f64>() / n;
-    if xs.len() < 2 {
-        return (m, 0.0);
-    }
-    let var = xs.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    (m, (var / n).sqrt())
+fn welford(xs: &[f64]) -> Welford {
+    let mut w = Welford::new();
+    xs.iter().for_each(|&x| w.push(x));
+    w
 }
 
-/// Sample standard deviation (0 for fewer than two values).
+/// Mean and standard error of the mean (0 for a single value, NaN for none), from
+/// `core_lattice`'s Welford accumulator.
+pub fn mean_stderr(xs: &[f64]) -> (f64, f64) {
+    let w = welford(xs);
+    (w.mean(), if xs.len() == 1 { 0.0 } else { w.std_error() })
+}
+
+/// Sample standard deviation (0 for a single value).
 pub fn std_dev(xs: &[f64]) -> f64 {
-    let (_, se) = mean_stderr(xs);
-    se * (xs.len() as f64).sqrt()
+    if xs.len() == 1 {
+        0.0
+    } else {
+        welford(xs).std_dev()
+    }
 }
 
 /// Today's date and time in UTC, `YYYY-MM-DD HH:MM UTC`, from the system clock.
