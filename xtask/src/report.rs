@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use core_lattice::Welford;
-use core_lattice::io::write_atomic;
+use core_lattice::io::{CsvField, CsvWriter, write_atomic};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::{SystemTime, UNIX_EPOCH};
@@ -50,29 +50,19 @@ impl Table {
         s
     }
 
-    /// The table as CSV (RFC 4180 quoting where a cell needs it).
-    pub fn csv(&self) -> String {
-        let mut s = String::new();
-        for r in std::iter::once(&self.header).chain(&self.rows) {
-            let cells: Vec<String> = r.iter().map(|c| csv_cell(c)).collect();
-            s.push_str(&cells.join(","));
-            s.push('\n');
-        }
-        s
-    }
-
-    /// Write the CSV atomically.
+    /// Write the table as CSV, atomically, through core-lattice's [`CsvWriter`] (which quotes
+    /// cells that need it).
     pub fn write_csv(&self, path: &Path) -> Result<()> {
-        write_atomic(path, self.csv().as_bytes())
+        let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
+        let mut w = CsvWriter::create(path, &header)
+            .with_context(|| format!("writing {}", path.display()))?;
+        for r in &self.rows {
+            let fields: Vec<&dyn CsvField> = r.iter().map(|c| c as &dyn CsvField).collect();
+            w.row(&fields)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+        w.finish()
             .with_context(|| format!("writing {}", path.display()))
-    }
-}
-
-fn csv_cell(c: &str) -> String {
-    if c.contains([',', '"', '\n']) {
-        format!("\"{}\"", c.replace('"', "\"\""))
-    } else {
-        c.to_string()
     }
 }
 
@@ -271,7 +261,10 @@ mod tests {
     fn tables() {
         let mut t = Table::new(&["a", "b"]);
         t.row(vec!["1".into(), "x, y".into()]);
-        assert_eq!(t.csv(), "a,b\n1,\"x, y\"\n");
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.csv");
+        t.write_csv(&path).unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "a,b\n1,\"x, y\"\n");
         assert_eq!(t.markdown(), "| a | b |\n|---|---|\n| 1 | x, y |\n");
         let (m, se) = mean_stderr(&[1.0, 2.0, 3.0]);
         assert_eq!(m, 2.0);

@@ -152,17 +152,14 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     Ok(())
 }
 
-struct Timed {
-    sweeps: Vec<SweepRecord>,
-}
-
+/// The per-sweep records of a run stopped only by `max_sweeps`, with sweep timing on.
 fn timed_run(
     size: [u64; 2],
     fill: f64,
     search: Search,
     max_sweeps: u64,
     seed: u64,
-) -> Result<Timed> {
+) -> Result<Vec<SweepRecord>> {
     let p = Params {
         max_sweeps: Some(max_sweeps),
         timing: true,
@@ -172,9 +169,7 @@ fn timed_run(
     };
     let mut sim = Simulation::new(p, seed)?;
     sim.run();
-    Ok(Timed {
-        sweeps: sim.records().sweeps().to_vec(),
-    })
+    Ok(sim.records().sweeps().to_vec())
 }
 
 /// Fig. 6: time per sweep over clusters, for each strategy, and the speed-up.
@@ -220,7 +215,7 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         for (s, n) in strategies {
             runs.push((s, timed_run(size, fill, s, n, ctx.seed)?));
         }
-        let reference = &runs[0].1.sweeps;
+        let reference = &runs[0].1;
         let common = |r: &[SweepRecord]| -> Vec<SweepRecord> {
             r.iter()
                 .filter(|s| s.sweep >= 1 && s.sweep <= ap_sweeps)
@@ -230,7 +225,7 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         let ap: Vec<SweepRecord> = common(reference);
         let ap_total: f64 = ap.iter().filter_map(|s| s.seconds).sum();
         for (strategy, run) in &runs {
-            for s in run.sweeps.iter().filter(|s| s.sweep >= 1) {
+            for s in run.iter().filter(|s| s.sweep >= 1) {
                 let secs = s.seconds.unwrap_or(f64::NAN);
                 data.row(vec![
                     fill.to_string(),
@@ -243,8 +238,7 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             }
             series.push(Series::new(
                 format!("{} fill, {}", pct(fill), strategy.name()),
-                run.sweeps
-                    .iter()
+                run.iter()
                     .filter(|s| s.sweep >= 1)
                     .map(|s| {
                         (
@@ -255,7 +249,7 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                     .collect(),
                 Style::Line,
             ));
-            let mine = common(&run.sweeps);
+            let mine = common(run);
             let same = mine.len() == ap.len()
                 && mine
                     .iter()
@@ -462,7 +456,6 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             let run = timed_run(size, fill, strategy, k, ctx.seed)?;
             let n = (fill * (l * l / 2) as f64).round();
             let secs: Vec<f64> = run
-                .sweeps
                 .iter()
                 .filter(|s| s.sweep >= 1)
                 .filter_map(|s| s.seconds)
