@@ -16,10 +16,12 @@
 //! # Ok::<(), dla_pdla::SimError>(())
 //! ```
 
+pub mod cluster;
 pub mod farfield;
 pub mod output;
 pub mod params;
 pub mod sim;
 
+pub use cluster::Cluster;
 pub use params::{FarField, Params, ParamsError};
 pub use sim::{Sample, SimError, Simulation, Walker};

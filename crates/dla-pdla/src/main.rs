@@ -65,6 +65,12 @@ struct Cli {
     #[arg(long, default_value_t = dla_pdla::params::DEFAULT_LEAF_SIDE)]
     leaf_side: f64,
 
+    /// The coarse distance map in front of the orthtree (one byte per 8 x 8 cell, about 1
+    /// byte per particle): walkers far from the cluster jump by its bound without a tree
+    /// query. Speed and memory only, not the physics; `off` is the paper's tree-only walk.
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    distance_map: Toggle,
+
     /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -106,6 +112,13 @@ struct Cli {
     verbose: u8,
 }
 
+/// An on/off switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Toggle {
+    On,
+    Off,
+}
+
 fn params(cli: &Cli) -> Result<Params, String> {
     let p = Params {
         dim: cli.dim,
@@ -122,6 +135,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             || cli.positions != PositionsFormat::None
             || cli.checkpoint_every.is_some(),
         leaf_side: cli.leaf_side,
+        distance_map: cli.distance_map == Toggle::On,
     };
     p.validate().map_err(|e| e.to_string())?;
     if let Some(n) = cli.checkpoint_every {

@@ -102,6 +102,10 @@ pub fn write_outputs<const D: usize>(
         .set_result("pdla_lock_wait_seconds", sim.lock_wait_seconds())
         .set_result("state_hash", sim.state_hash())
         .set_result("tree_memory_bytes", sim.tree().memory_bytes() as u64)
+        .set_result(
+            "distance_map_bytes",
+            (sim.cluster().memory_bytes() - sim.tree().memory_bytes()) as u64,
+        )
         .set_result("bytes_per_particle", bpp);
     match fit {
         Ok(f) => {

@@ -55,6 +55,15 @@ pub struct Params {
     /// physics: see `docs/dla.md`.
     #[serde(default = "default_leaf_side")]
     pub leaf_side: f64,
+    /// Put the coarse distance map in front of the orthtree (`--distance-map`, default on).
+    /// Changes speed and memory, not the physics (every jump stays within a lower bound of the
+    /// distance to the cluster), but it changes the random trajectory: see `docs/dla.md`.
+    #[serde(default = "default_distance_map")]
+    pub distance_map: bool,
+}
+
+fn default_distance_map() -> bool {
+    true
 }
 
 /// Default leaf side of the orthtree for DLA: 8 diameters (measured faster than 4 in 2D and 3D,
@@ -80,6 +89,7 @@ impl Default for Params {
             fit_from: 1000,
             keep_positions: false,
             leaf_side: DEFAULT_LEAF_SIDE,
+            distance_map: true,
         }
     }
 }

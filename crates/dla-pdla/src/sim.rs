@@ -1,6 +1,7 @@
 //! The growth of one cluster: walkers, sticking, observables (MODELS.md section 2; seed 002,
 //! sections 3.2 to 3.4).
 
+use crate::cluster::Cluster;
 use crate::farfield::{norm, return_to_sphere};
 use crate::params::{FarField, Params, ParamsError};
 use core_lattice::io::StateHasher;
@@ -8,6 +9,7 @@ use core_lattice::rng::{Rng, SimRng, stream, stream_id, uniform01, unit_vector};
 use core_lattice::{Gyration, LogLogFit};
 use parking_lot::Mutex;
 use serde::{Deserialize, Serialize};
+use spatial::distmap::DistanceMapError;
 use spatial::orthtree::{Orthtree, OrthtreeError};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -18,6 +20,9 @@ pub const PURPOSE_WALK: u32 = 1;
 pub const PURPOSE_PDLA: u32 = 2;
 /// PDLA re-check: a new particle closer than this to a stored one is discarded (MODELS.md).
 pub const OVERLAP_DISTANCE: f64 = 1.0 - 1e-6;
+/// A walker jumps by the distance map's bound `lb` when `lb - 1` exceeds this (diameters);
+/// closer to the cluster the tree's sharper bound pays for its cost.
+pub const MAP_JUMP_MIN: f64 = 2.0;
 /// The far field starts at `|p| > r_b * FAR_FIELD_MARGIN`.
 pub const FAR_FIELD_MARGIN: f64 = 1.0 + 1e-9;
 /// Number of log-spaced growth samples aimed at.
@@ -35,6 +40,9 @@ pub enum SimError {
     /// The orthtree refused a particle (coordinate range or capacity).
     #[error("storing a particle: {0}")]
     Tree(#[from] OrthtreeError),
+    /// The distance map refused a particle (too large a cluster for its memory).
+    #[error("distance map: {0}")]
+    Map(#[from] DistanceMapError),
     /// A checkpoint could not be written or read.
     #[error("checkpoint: {0}")]
     Checkpoint(#[from] core_lattice::io::CheckpointError),
@@ -97,14 +105,14 @@ impl<const D: usize> Growth<D> {
         }
     }
 
-    /// Store `p` in the tree and account for it; returns the stored position.
+    /// Store `p` in the cluster and account for it; returns the stored position.
     fn add(
         &mut self,
-        tree: &mut Orthtree<D>,
+        cluster: &mut Cluster<D>,
         p: [f64; D],
         target: u64,
-    ) -> Result<[f64; D], OrthtreeError> {
-        let q = tree.insert(p)?;
+    ) -> Result<[f64; D], SimError> {
+        let q = cluster.insert(p)?;
         self.account(q, target);
         Ok(q)
     }
@@ -152,12 +160,12 @@ impl<const D: usize> Walker<D> {
     /// the move ends in contact.
     pub fn step<R: Rng + ?Sized>(
         &mut self,
-        tree: &Orthtree<D>,
+        cluster: &Cluster<D>,
         r_ext: f64,
         params: &Params,
         rng: &mut R,
     ) -> Option<[f64; D]> {
-        self.advance(&mut WalkState::new(), tree, r_ext, params, rng)
+        self.advance(&mut WalkState::new(), cluster, r_ext, params, rng)
     }
 
     /// [`step`](Self::step) with the walker's memory `state` (reset it for each new walker):
@@ -166,7 +174,7 @@ impl<const D: usize> Walker<D> {
     pub(crate) fn advance<R: Rng + ?Sized>(
         &mut self,
         state: &mut WalkState,
-        tree: &Orthtree<D>,
+        cluster: &Cluster<D>,
         r_ext: f64,
         params: &Params,
         rng: &mut R,
@@ -192,7 +200,17 @@ impl<const D: usize> Walker<D> {
             }
             return None;
         }
-        // Near field: a lower bound on the distance to the nearest centre.
+        // Near field. First the distance map: one byte read bounds the distance to the
+        // cluster from below; a walker at least a few diameters out jumps by it.
+        if let Some(lb) = cluster.map_bound(&self.p) {
+            if lb - 1.0 > MAP_JUMP_MIN {
+                self.jump(lb - 1.0, rng);
+                state.upper += (lb - 1.0) * (1.0 + 1e-9);
+                return None;
+            }
+        }
+        // Then the tree: a lower bound on the distance to the nearest centre.
+        let tree = cluster.tree();
         let est = tree
             .vpdist_bounded(&self.p, params.precision, state.upper)
             .expect("the cluster is never empty");
@@ -375,7 +393,7 @@ struct Log<const D: usize> {
 
 /// One thread's copy of the cluster.
 struct Replica<const D: usize> {
-    tree: Orthtree<D>,
+    cluster: Cluster<D>,
     /// Largest centre distance over the applied particles.
     r_ext: f64,
     /// Particles taken from the log (an absolute log index).
@@ -426,8 +444,8 @@ impl<const D: usize> Ctx<'_, D> {
     /// Inserts `rep.pending` into the replica, in log order (no lock held).
     fn insert_pending(&self, rep: &mut Replica<D>) -> bool {
         for q in rep.pending.drain(..) {
-            if let Err(e) = rep.tree.insert(q) {
-                self.fail(&mut self.lock(), e.into());
+            if let Err(e) = rep.cluster.insert(q) {
+                self.fail(&mut self.lock(), e);
                 return false;
             }
             rep.r_ext = rep.r_ext.max(norm(&q));
@@ -473,14 +491,14 @@ impl<const D: usize> Ctx<'_, D> {
             let mut w = Walker::born(rep.r_ext + params.birth_gap, rng);
             state.reset();
             let stick = loop {
-                if let Some(p) = w.advance(state, &rep.tree, rep.r_ext, params, rng) {
+                if let Some(p) = w.advance(state, &rep.cluster, rep.r_ext, params, rng) {
                     break p;
                 }
                 if !self.sync(rep) {
                     return;
                 }
             };
-            let q = match rep.tree.stored_position(&stick) {
+            let q = match rep.cluster.tree().stored_position(&stick) {
                 Ok(q) => q,
                 Err(e) => return self.fail(&mut self.lock(), e.into()),
             };
@@ -489,7 +507,8 @@ impl<const D: usize> Ctx<'_, D> {
             // overlapping it. So the sticking point is checked against the replica (private,
             // no lock needed) and, under the lock, against the particles stored since.
             let mut overlap = false;
-            rep.tree
+            rep.cluster
+                .tree()
                 .for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
             let mut guard = self.lock();
             if guard.growth.n >= self.target || self.stop.load(Ordering::Relaxed) {
@@ -571,7 +590,7 @@ struct Snapshot {
 pub struct Simulation<const D: usize> {
     params: Params,
     seed: u64,
-    tree: Orthtree<D>,
+    cluster: Cluster<D>,
     growth: Growth<D>,
     rng: SimRng,
     discarded: u64,
@@ -590,14 +609,14 @@ impl<const D: usize> Simulation<D> {
         if params.dim != D {
             return Err(SimError::DimMismatch(D, params.dim));
         }
-        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
+        let mut cluster = Cluster::new(&params)?;
         let mut growth = Growth::new(&params);
-        growth.add(&mut tree, [0.0; D], params.particles)?;
+        growth.add(&mut cluster, [0.0; D], params.particles)?;
         Ok(Simulation {
             rng: stream(seed, stream_id(PURPOSE_WALK, 0)),
             params,
             seed,
-            tree,
+            cluster,
             growth,
             discarded: 0,
             walk: WalkState::new(),
@@ -700,12 +719,12 @@ impl<const D: usize> Simulation<D> {
             )));
         }
         let params = snap.params;
-        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
+        let mut cluster = Cluster::new(&params)?;
         let mut growth = Growth::new(&params);
         for c in snap.positions.chunks_exact(D) {
             let mut p = [0.0; D];
             p.copy_from_slice(c);
-            growth.add(&mut tree, p, params.particles)?;
+            growth.add(&mut cluster, p, params.particles)?;
         }
         growth.samples = snap.samples;
         growth.next_sample = snap.next_sample;
@@ -717,7 +736,7 @@ impl<const D: usize> Simulation<D> {
         Ok(Simulation {
             params,
             seed: snap.seed,
-            tree,
+            cluster,
             growth,
             rng: snap.rng,
             discarded: 0,
@@ -739,12 +758,12 @@ impl<const D: usize> Simulation<D> {
         loop {
             if let Some(p) = w.advance(
                 &mut self.walk,
-                &self.tree,
+                &self.cluster,
                 self.growth.r_ext,
                 &self.params,
                 &mut self.rng,
             ) {
-                return Ok(self.growth.add(&mut self.tree, p, self.params.particles)?);
+                return self.growth.add(&mut self.cluster, p, self.params.particles);
             }
         }
     }
@@ -780,8 +799,8 @@ impl<const D: usize> Simulation<D> {
         let stop = AtomicBool::new(false);
         let seed = self.seed;
         let r_ext0 = log.lock().growth.r_ext;
-        let mut replicas: Vec<Orthtree<D>> = (1..threads).map(|_| self.tree.clone()).collect();
-        replicas.insert(0, std::mem::take(&mut self.tree));
+        let mut replicas: Vec<Cluster<D>> = (1..threads).map(|_| self.cluster.clone()).collect();
+        replicas.insert(0, std::mem::take(&mut self.cluster));
         let wait_nanos = AtomicU64::new(0);
         let started = Instant::now();
         let ctx = Ctx {
@@ -792,14 +811,14 @@ impl<const D: usize> Simulation<D> {
             target,
             wait_nanos: &wait_nanos,
         };
-        let mut trees: Vec<Orthtree<D>> = std::thread::scope(|s| {
+        let mut clusters: Vec<Cluster<D>> = std::thread::scope(|s| {
             let handles: Vec<_> = replicas
                 .into_iter()
                 .enumerate()
-                .map(|(t, tree)| {
+                .map(|(t, cluster)| {
                     s.spawn(move || {
                         let mut rep = Replica {
-                            tree,
+                            cluster,
                             r_ext: r_ext0,
                             applied: start,
                             pending: Vec::new(),
@@ -809,7 +828,7 @@ impl<const D: usize> Simulation<D> {
                         ctx.walk(&mut rep, params, &mut rng, progress);
                         // Whatever was taken from the log is counted as applied.
                         ctx.insert_pending(&mut rep);
-                        rep.tree
+                        rep.cluster
                     })
                 })
                 .collect();
@@ -821,14 +840,14 @@ impl<const D: usize> Simulation<D> {
         self.parallel_seconds += started.elapsed().as_secs_f64();
         self.lock_wait_seconds += wait_nanos.into_inner() as f64 * 1e-9;
         let mut log = log.into_inner();
-        let mut tree = trees.swap_remove(0);
-        drop(trees);
+        let mut cluster = clusters.swap_remove(0);
+        drop(clusters);
         // Thread 0 may have stopped before applying the last particles of the others.
         let done = applied[0].load(Ordering::Relaxed);
         for q in &log.points[done - log.base..] {
-            tree.insert(*q)?;
+            cluster.insert(*q)?;
         }
-        self.tree = tree;
+        self.cluster = cluster;
         self.discarded += log.guard.total;
         self.growth = log.growth;
         match log.error.take() {
@@ -895,7 +914,12 @@ impl<const D: usize> Simulation<D> {
 
     /// The spatial structure holding the cluster.
     pub fn tree(&self) -> &Orthtree<D> {
-        &self.tree
+        self.cluster.tree()
+    }
+
+    /// The cluster (orthtree and distance map).
+    pub fn cluster(&self) -> &Cluster<D> {
+        &self.cluster
     }
 
     /// Fractal dimension from `log N = D log R_g + c` over the samples with `N >= fit_from`.

@@ -12,6 +12,15 @@ use core_lattice::Welford;
 use dla_pdla::{Params, Simulation};
 
 fn dims<const D: usize>(n: u64, seeds: std::ops::Range<u64>, precision: f64) -> Welford {
+    dims_with::<D>(n, seeds, precision, true)
+}
+
+fn dims_with<const D: usize>(
+    n: u64,
+    seeds: std::ops::Range<u64>,
+    precision: f64,
+    distance_map: bool,
+) -> Welford {
     let mut w = Welford::new();
     for seed in seeds {
         let params = Params {
@@ -19,6 +28,7 @@ fn dims<const D: usize>(n: u64, seeds: std::ops::Range<u64>, precision: f64) -> 
             particles: n,
             precision,
             fit_from: 1000,
+            distance_map,
             ..Params::default()
         };
         let mut sim = Simulation::<D>::new(params, seed).unwrap();
@@ -71,4 +81,36 @@ fn exact_and_vpdist_agree() {
         ex.mean()
     );
     assert!((ex.mean() - 1.71).abs() <= 0.05);
+}
+
+/// The distance map only changes which lower bound a jump uses, never the physics: the
+/// ensembles with and without it agree within their errors (and the tree-only walk is the
+/// paper's).
+#[test]
+fn distance_map_on_and_off_agree() {
+    let on = dims_with::<2>(20_000, 300..308, 2.0, true);
+    let off = dims_with::<2>(20_000, 400..408, 2.0, false);
+    let se = (on.std_error().powi(2) + off.std_error().powi(2)).sqrt();
+    eprintln!(
+        "map on {} +- {}, off {} +- {}",
+        on.mean(),
+        on.std_error(),
+        off.mean(),
+        off.std_error()
+    );
+    assert!(
+        (on.mean() - off.mean()).abs() <= 3.0 * se,
+        "map on {} off {} (se {se})",
+        on.mean(),
+        off.mean()
+    );
+    let on3 = dims_with::<3>(5_000, 300..308, 2.0, true);
+    let off3 = dims_with::<3>(5_000, 400..408, 2.0, false);
+    let se3 = (on3.std_error().powi(2) + off3.std_error().powi(2)).sqrt();
+    assert!(
+        (on3.mean() - off3.mean()).abs() <= 3.0 * se3,
+        "3D map on {} off {} (se {se3})",
+        on3.mean(),
+        off3.mean()
+    );
 }

@@ -3,12 +3,21 @@
 use dla_pdla::{FarField, Params, Simulation};
 
 fn grow<const D: usize>(n: u64, seed: u64, threads: usize) -> Simulation<D> {
+    grow_with(
+        Params {
+            dim: D,
+            particles: n,
+            threads,
+            ..Params::default()
+        },
+        seed,
+    )
+}
+
+fn grow_with<const D: usize>(params: Params, seed: u64) -> Simulation<D> {
     let params = Params {
-        dim: D,
-        particles: n,
-        threads,
         keep_positions: true,
-        ..Params::default()
+        ..params
     };
     let mut sim = Simulation::<D>::new(params, seed).unwrap();
     sim.run().unwrap();
@@ -34,8 +43,21 @@ fn check_contacts<const D: usize>(pos: &[[f64; D]]) -> (f64, f64) {
 }
 
 fn contacts<const D: usize>(threads: usize) {
+    contacts_with::<D>(threads, true);
+}
+
+fn contacts_with<const D: usize>(threads: usize, distance_map: bool) {
     let n = 20_000;
-    let sim = grow::<D>(n, 11, threads);
+    let sim = grow_with::<D>(
+        Params {
+            dim: D,
+            particles: n,
+            threads,
+            distance_map,
+            ..Params::default()
+        },
+        11,
+    );
     let pos = sim.positions().unwrap();
     assert_eq!(pos.len() as u64, n);
     let (min_pair, max_contact) = check_contacts(pos);
@@ -56,6 +78,12 @@ fn contacts<const D: usize>(threads: usize) {
 #[test]
 fn contacts_2d_one_thread() {
     contacts::<2>(1);
+}
+
+#[test]
+fn contacts_without_the_distance_map() {
+    contacts_with::<2>(1, false);
+    contacts_with::<3>(2, false);
 }
 
 #[test]

@@ -1,0 +1,172 @@
+//! The stored particles as the walkers see them: the orthtree (seed 002: `vpdist`, exact
+//! first contact) and, in front of it, the coarse distance map of [`spatial::distmap`] that
+//! lets a walker a few diameters or more from the cluster jump without a tree query.
+
+use crate::params::Params;
+use crate::sim::SimError;
+use spatial::distmap::DistanceMap;
+use spatial::orthtree::Orthtree;
+
+/// The distance maps, finest first, as `(cell side, cap distance)` in diameters, in `dim`
+/// dimensions: a fine map for walkers up to the cap from the cluster and a coarse one beyond
+/// it (a walker in a capped fine cell asks the coarse map). An insert lowers every cell whose
+/// centre lies within the cap, `(pi / 4) (2 cap / cell)^2` cells in 2D and `(pi / 6) (2 cap /
+/// cell)^3` in 3D: about 200 per map in 2D and 270 per map in 3D with these values. Chosen
+/// by measurement (`docs/benchmarks.md`): in 2D a fine map with 4-diameter cells costs more
+/// memory than it saves time, a coarse cap of 1024 costs more per insert, and coarse cells of
+/// 32 or 64 diameters are within noise of each other (64 is smaller and cheaper to update).
+pub fn map_levels(dim: usize) -> &'static [(f64, f64)] {
+    if dim <= 2 {
+        &[(8.0, 64.0), (64.0, 512.0)]
+    } else {
+        &[(8.0, 32.0), (32.0, 128.0)]
+    }
+}
+
+/// The cluster: its orthtree and, when `params.distance_map` is on, the distance maps, always
+/// holding the same particles.
+#[derive(Debug, Clone, Default)]
+pub struct Cluster<const D: usize> {
+    tree: Orthtree<D>,
+    maps: Vec<DistanceMap<D>>,
+}
+
+impl<const D: usize> Cluster<D> {
+    /// An empty cluster for `params` (leaf side, distance map on or off).
+    pub fn new(params: &Params) -> Result<Self, SimError> {
+        Ok(Cluster {
+            tree: Orthtree::with_leaf_side(params.leaf_side)?,
+            maps: if params.distance_map {
+                map_levels(D)
+                    .iter()
+                    .map(|&(cell, cap)| DistanceMap::new(cell, cap))
+                    .collect::<Result<_, _>>()?
+            } else {
+                Vec::new()
+            },
+        })
+    }
+
+    /// Stores a particle at `p`; returns its stored position (the orthtree's fixed-point
+    /// rounding of `p`, which is what the distance map and every observable see).
+    pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], SimError> {
+        let q = self.tree.insert(p)?;
+        for map in &mut self.maps {
+            map.insert(&q)?;
+        }
+        Ok(q)
+    }
+
+    /// The orthtree.
+    pub fn tree(&self) -> &Orthtree<D> {
+        &self.tree
+    }
+
+    /// The distance maps, finest first (empty when off).
+    pub fn maps(&self) -> &[DistanceMap<D>] {
+        &self.maps
+    }
+
+    /// A lower bound of the distance from `p` to the nearest particle from the distance maps:
+    /// the finest map that covers `p` with a cell that is not capped, or else the last capped
+    /// bound found. `None` when the maps are off or none covers `p`.
+    #[inline]
+    pub fn map_bound(&self, p: &[f64; D]) -> Option<f64> {
+        let mut best = None;
+        for map in &self.maps {
+            if let Some((lb, capped)) = map.lower_bound(p) {
+                best = Some(lb);
+                if !capped {
+                    break;
+                }
+            }
+        }
+        best
+    }
+
+    /// Particles stored.
+    pub fn len(&self) -> usize {
+        self.tree.len()
+    }
+
+    /// Whether no particle is stored.
+    pub fn is_empty(&self) -> bool {
+        self.tree.is_empty()
+    }
+
+    /// Heap bytes of the tree and the map.
+    pub fn memory_bytes(&self) -> usize {
+        self.tree.memory_bytes()
+            + self
+                .maps
+                .iter()
+                .map(DistanceMap::memory_bytes)
+                .sum::<usize>()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Simulation;
+
+    /// The walker's bound from the maps never exceeds the exact distance to the nearest
+    /// particle (brute force), and the maps follow the tree through PDLA-free growth.
+    fn bound_is_below_exact<const D: usize>(n: u64) {
+        let params = Params {
+            dim: D,
+            particles: n,
+            keep_positions: true,
+            ..Params::default()
+        };
+        let mut sim = Simulation::<D>::new(params, 5).unwrap();
+        sim.run().unwrap();
+        let cluster = sim.cluster();
+        assert_eq!(cluster.maps().len(), 2);
+        assert!(cluster.maps().iter().all(|m| m.len() == n));
+        let pos = sim.positions().unwrap();
+        let r = sim.r_ext() + 80.0;
+        let mut rng = core_lattice::rng::stream(9, 0);
+        let mut used = 0;
+        for _ in 0..4000 {
+            let mut p = [0.0; D];
+            for x in &mut p {
+                *x = (2.0 * core_lattice::rng::uniform01(&mut rng) - 1.0) * r;
+            }
+            let exact = pos
+                .iter()
+                .map(|q| (0..D).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt())
+                .fold(f64::INFINITY, f64::min);
+            if let Some(lb) = cluster.map_bound(&p) {
+                assert!(
+                    lb <= exact,
+                    "{D}D: map bound {lb} above exact {exact} at {p:?}"
+                );
+                used += 1;
+            }
+        }
+        assert!(
+            used > 3000,
+            "the maps cover the birth region ({used} of 4000)"
+        );
+    }
+
+    #[test]
+    fn map_bound_is_below_the_exact_distance() {
+        bound_is_below_exact::<2>(3000);
+        bound_is_below_exact::<3>(1500);
+    }
+
+    #[test]
+    fn map_off_has_no_maps() {
+        let params = Params {
+            distance_map: false,
+            ..Params::default()
+        };
+        let mut c = Cluster::<2>::new(&params).unwrap();
+        c.insert([0.0, 0.0]).unwrap();
+        assert!(c.maps().is_empty() && c.map_bound(&[3.0, 0.0]).is_none());
+        assert_eq!(c.len(), 1);
+        assert!(!c.is_empty() && c.memory_bytes() > 0);
+    }
+}
