@@ -20,6 +20,8 @@ pub struct Setting {
     pub step_min: f64,
     /// `--far-field`.
     pub far_field: FarField,
+    /// `--distance-map`.
+    pub distance_map: bool,
 }
 
 impl Setting {
@@ -34,7 +36,8 @@ impl Setting {
             FarField::Return => "",
             FarField::Jump => " jump",
         };
-        format!("k{k} s{}{ff}", self.step_min)
+        let map = if self.distance_map { "" } else { " no map" };
+        format!("k{k} s{}{ff}{map}", self.step_min)
     }
 
     fn label(&self) -> String {
@@ -44,9 +47,14 @@ impl Setting {
             "inf".into()
         };
         format!(
-            "precision {k}, step {}, {}",
+            "precision {k}, step {}, {}{}",
             self.step_min,
-            self.far_field.name()
+            self.far_field.name(),
+            if self.distance_map {
+                ""
+            } else {
+                ", distance map off"
+            }
         )
     }
 }
@@ -57,6 +65,7 @@ pub fn settings() -> Vec<Setting> {
         precision,
         step_min,
         far_field,
+        distance_map: true,
     };
     let (ret, jump) = (FarField::Return, FarField::Jump);
     vec![
@@ -72,12 +81,19 @@ pub fn settings() -> Vec<Setting> {
         s(2.0, 0.1, ret),
         s(1.0, 1.0, ret),
         s(2.0, 0.5, jump),
+        Setting {
+            distance_map: false,
+            ..s(2.0, 0.5, ret)
+        },
     ]
 }
 
 fn is_default(s: &Setting) -> bool {
     let d = Params::default();
-    s.precision == d.precision && s.step_min == d.step_min && s.far_field == d.far_field
+    s.precision == d.precision
+        && s.step_min == d.step_min
+        && s.far_field == d.far_field
+        && s.distance_map == d.distance_map
 }
 
 /// Per setting: time and the two accuracy measures, from an ensemble of runs.
@@ -132,6 +148,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
             precision: st.precision,
             step_min: st.step_min,
             far_field: st.far_field,
+            distance_map: st.distance_map,
             fit_from: from,
             ..Params::default()
         };
@@ -200,6 +217,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         "precision",
         "step_min",
         "far_field",
+        "distance_map",
         "us_per_particle",
         "us_per_particle_se",
         "d",
@@ -233,6 +251,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
             m.setting.precision.to_string(),
             m.setting.step_min.to_string(),
             m.setting.far_field.name().into(),
+            m.setting.distance_map.to_string(),
             m.us_per_particle.0.to_string(),
             m.us_per_particle.1.to_string(),
             dm.to_string(),
