@@ -444,7 +444,7 @@ impl<const D: usize> Ctx<'_, D> {
     /// Inserts `rep.pending` into the replica, in log order (no lock held).
     fn insert_pending(&self, rep: &mut Replica<D>) -> bool {
         for q in rep.pending.drain(..) {
-            if let Err(e) = rep.cluster.insert(q) {
+            if let Err(e) = rep.cluster.insert_tree(q) {
                 self.fail(&mut self.lock(), e);
                 return false;
             }
@@ -560,6 +560,12 @@ impl<const D: usize> Ctx<'_, D> {
                 }
             }
             drop(guard);
+            // The stuck particle lowers the shared distance maps once, atomically; until it
+            // has, another thread's walker may jump by a stale bound, which the re-check at
+            // its sticking catches like any move made before a particle was applied.
+            if let Err(e) = rep.cluster.update_maps(&q) {
+                return self.fail(&mut self.lock(), e);
+            }
             if !self.insert_pending(rep) {
                 return;
             }
@@ -799,6 +805,11 @@ impl<const D: usize> Simulation<D> {
         let stop = AtomicBool::new(false);
         let seed = self.seed;
         let r_ext0 = log.lock().growth.r_ext;
+        // The replicas share one set of distance maps, sized for the final cluster now (they
+        // cannot grow once shared).
+        self.cluster.reserve_maps(
+            crate::cluster::expected_r_ext(D, target).max(r_ext0) + params.birth_gap,
+        )?;
         let mut replicas: Vec<Cluster<D>> = (1..threads).map(|_| self.cluster.clone()).collect();
         replicas.insert(0, std::mem::take(&mut self.cluster));
         let wait_nanos = AtomicU64::new(0);
@@ -845,7 +856,8 @@ impl<const D: usize> Simulation<D> {
         // Thread 0 may have stopped before applying the last particles of the others.
         let done = applied[0].load(Ordering::Relaxed);
         for q in &log.points[done - log.base..] {
-            cluster.insert(*q)?;
+            // Their threads lowered the shared maps already.
+            cluster.insert_tree(*q)?;
         }
         self.cluster = cluster;
         self.discarded += log.guard.total;

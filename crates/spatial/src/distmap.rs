@@ -41,6 +41,7 @@
 //!   cluster of 1e6 particles (radius about 3 000 diameters, `c = 8`) about 0.7 MB.
 
 use std::fmt;
+use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Largest stored value: the cell is at least `cap` from every point.
 const CAPPED: u8 = u8::MAX;
@@ -76,7 +77,6 @@ pub enum DistanceMapError {
 }
 
 /// The coarse distance map (see the module docs).
-#[derive(Clone)]
 pub struct DistanceMap<const D: usize> {
     cell: f64,
     inv_cell: f64,
@@ -87,11 +87,34 @@ pub struct DistanceMap<const D: usize> {
     half: i64,
     /// `2 * half`: cells per axis.
     side: usize,
-    values: Vec<u8>,
+    /// One byte per cell, axis 0 fastest. Atomic so that PDLA threads can share one map
+    /// ([`DistanceMap::insert_shared`]); relaxed loads and stores are plain moves.
+    values: Vec<AtomicU8>,
     points: u64,
     /// `below[v]`: a squared distance below which a cell holding `v` may be lowered,
     /// `(v u)^2` widened by a relative `2^-40` (so rounding never skips a lowering).
     below: Box<[f64; 256]>,
+}
+
+impl<const D: usize> Clone for DistanceMap<D> {
+    fn clone(&self) -> Self {
+        DistanceMap {
+            cell: self.cell,
+            inv_cell: self.inv_cell,
+            cap: self.cap,
+            quantum: self.quantum,
+            inv_quantum: self.inv_quantum,
+            half: self.half,
+            side: self.side,
+            values: self
+                .values
+                .iter()
+                .map(|v| AtomicU8::new(v.load(Ordering::Relaxed)))
+                .collect(),
+            points: self.points,
+            below: self.below.clone(),
+        }
+    }
 }
 
 impl<const D: usize> fmt::Debug for DistanceMap<D> {
@@ -191,7 +214,7 @@ impl<const D: usize> DistanceMap<D> {
     #[inline]
     pub fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
         let (idx, z) = self.index(p)?;
-        let v = self.values[idx];
+        let v = self.values[idx].load(Ordering::Relaxed);
         let mut e2 = 0.0;
         for i in 0..D {
             let e = p[i] - z[i];
@@ -206,30 +229,71 @@ impl<const D: usize> DistanceMap<D> {
 
     /// The stored byte of the cell holding `p` (for tests and diagnostics).
     pub fn value(&self, p: &[f64; D]) -> Option<u8> {
-        self.index(p).map(|(i, _)| self.values[i])
+        self.index(p)
+            .map(|(i, _)| self.values[i].load(Ordering::Relaxed))
     }
 
     /// Adds the point `q`: lowers every cell whose centre lies within `cap` of it, growing the
     /// map first if `q` comes within `cap + c` of its edge.
     pub fn insert(&mut self, q: &[f64; D]) -> Result<(), DistanceMapError> {
-        let mut need = 0.0f64;
-        for (axis, &x) in q.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(DistanceMapError::NonFinite { axis, value: x });
-            }
-            need = need.max(x.abs());
-        }
-        let need = need + self.cap + self.cell;
+        let need = finite_max_norm(q)? + self.cap + self.cell;
         if need >= self.reach() {
             self.grow(need)?;
         }
         self.points += 1;
-        // Cell ranges per axis: centres (k + 1/2) c within cap of q.
+        // Exclusive access: plain loads and stores (relaxed atomics compile to plain moves).
+        self.lower_rows(q, |v, w| {
+            if w < v.load(Ordering::Relaxed) {
+                v.store(w, Ordering::Relaxed);
+            }
+        });
+        Ok(())
+    }
+
+    /// Adds the point `q` through a shared reference, for several threads adding points to one
+    /// map while others read it (PDLA): every cell is lowered with an atomic `fetch_min`, so
+    /// concurrent inserts never undo each other. The map does not grow: cells outside it are
+    /// skipped (every stored cell stays a valid bound; positions outside simply get no bound).
+    /// Returns `false` when part of `q`'s disk fell outside the map. [`len`](Self::len) does
+    /// not count these points.
+    pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
+        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
+        self.lower_rows(q, |v, w| {
+            if w < v.load(Ordering::Relaxed) {
+                v.fetch_min(w, Ordering::Relaxed);
+            }
+        });
+        Ok(inside)
+    }
+
+    /// Grows the map (if needed) so that it covers `|x_i| < reach`.
+    pub fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
+        if !reach.is_finite() {
+            return Err(DistanceMapError::NonFinite {
+                axis: 0,
+                value: reach,
+            });
+        }
+        if reach >= self.reach() {
+            self.grow(reach)?;
+        }
+        Ok(())
+    }
+
+    /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of `q`,
+    /// with `w` the quantised distance from the centre to `q`, whenever `w` could be below the
+    /// stored value (`(w u)^2` under the table's threshold for that value).
+    #[inline]
+    fn lower_rows(&self, q: &[f64; D], mut lower: impl FnMut(&AtomicU8, u8)) {
+        // Cell ranges per axis: centres (k + 1/2) c within cap of q, clipped to the map.
         let mut lo = [0i64; D];
         let mut hi = [0i64; D];
         for i in 0..D {
-            lo[i] = ceil((q[i] - self.cap) * self.inv_cell - 0.5) as i64;
-            hi[i] = floor((q[i] + self.cap) * self.inv_cell - 0.5) as i64;
+            lo[i] = (ceil((q[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
+            hi[i] = (floor((q[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
+            if lo[i] > hi[i] {
+                return;
+            }
         }
         // Odometer over axes 1..D; axis 0 is a contiguous row whose range is solved for.
         let mut k = lo;
@@ -249,19 +313,19 @@ impl<const D: usize> DistanceMap<D> {
                 let a = (ceil((q[0] - w) * self.inv_cell - 0.5) as i64).max(lo[0]);
                 let b = (floor((q[0] + w) * self.inv_cell - 0.5) as i64).min(hi[0]);
                 if a <= b {
-                    let row = &mut self.values
+                    let row = &self.values
                         [base + (a + self.half) as usize..=base + (b + self.half) as usize];
                     let x0 = (a as f64 + 0.5) * self.cell - q[0];
-                    for (j, v) in row.iter_mut().enumerate() {
+                    for (j, v) in row.iter().enumerate() {
                         // Most cells are already nearer another point: one table read and a
-                        // compare, no square root.
-                        // (Rows are far shorter than 2^31 cells; i32 converts in one instruction.)
+                        // compare, no square root. (Rows are far shorter than 2^31 cells; i32
+                        // converts in one instruction.)
                         let x = x0 + f64::from(j as i32) * self.cell;
                         let d2 = x * x + s;
-                        if d2 < self.below[usize::from(*v)] {
+                        if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
                             let d = d2.sqrt() * self.inv_quantum;
                             if d < f64::from(CAPPED) {
-                                *v = (*v).min(d as u8);
+                                lower(v, d as u8);
                             }
                         }
                     }
@@ -271,7 +335,7 @@ impl<const D: usize> DistanceMap<D> {
             let mut axis = 1;
             loop {
                 if axis >= D {
-                    return Ok(());
+                    return;
                 }
                 if k[axis] < hi[axis] {
                     k[axis] += 1;
@@ -300,7 +364,8 @@ impl<const D: usize> DistanceMap<D> {
         }
         let half = cells as i64;
         let side = side as usize;
-        let mut values = vec![CAPPED; total as usize];
+        let mut values: Vec<AtomicU8> =
+            (0..total as usize).map(|_| AtomicU8::new(CAPPED)).collect();
         if self.side > 0 {
             let off = (half - self.half) as usize;
             // Copy old rows (along axis 0) into the new array.
@@ -314,8 +379,12 @@ impl<const D: usize> DistanceMap<D> {
                     rem /= self.side;
                     stride *= side;
                 }
-                values[base..base + self.side]
-                    .copy_from_slice(&self.values[r * self.side..(r + 1) * self.side]);
+                for (new, old) in values[base..base + self.side]
+                    .iter_mut()
+                    .zip(&self.values[r * self.side..(r + 1) * self.side])
+                {
+                    *new.get_mut() = old.load(Ordering::Relaxed);
+                }
             }
         }
         self.values = values;
@@ -323,6 +392,18 @@ impl<const D: usize> DistanceMap<D> {
         self.side = side;
         Ok(())
     }
+}
+
+/// The largest `|x_i|`, or the first non-finite coordinate as an error.
+fn finite_max_norm<const D: usize>(q: &[f64; D]) -> Result<f64, DistanceMapError> {
+    let mut m = 0.0f64;
+    for (axis, &x) in q.iter().enumerate() {
+        if !x.is_finite() {
+            return Err(DistanceMapError::NonFinite { axis, value: x });
+        }
+        m = m.max(x.abs());
+    }
+    Ok(m)
 }
 
 /// `x.floor()` without a library call on targets without SSE4.1 (`x` finite and well inside
@@ -412,6 +493,56 @@ mod tests {
         ) {
             check(cell, cap, &pts, &probes);
         }
+    }
+
+    /// A cell's value is a minimum over the points, independent of their order: two threads
+    /// adding halves of a point set to one reserved map through `insert_shared` leave exactly
+    /// the bytes of the sequential map; points beyond the map are clipped, never wrong.
+    #[test]
+    fn shared_inserts_from_two_threads_equal_sequential_inserts() {
+        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let pts: Vec<[f64; 2]> = (0..4000)
+            .map(|_| [next() * 400.0 - 200.0, next() * 400.0 - 200.0])
+            .collect();
+        let mut seq = DistanceMap::<2>::new(8.0, 64.0).unwrap();
+        for q in &pts {
+            seq.insert(q).unwrap();
+        }
+        let mut shared = DistanceMap::<2>::new(8.0, 64.0).unwrap();
+        shared.reserve(seq.reach()).unwrap();
+        assert_eq!(shared.reach(), seq.reach());
+        let (a, b) = pts.split_at(pts.len() / 2);
+        std::thread::scope(|s| {
+            for half in [a, b] {
+                let map = &shared;
+                s.spawn(move || {
+                    for q in half {
+                        assert!(map.insert_shared(q).unwrap());
+                    }
+                });
+            }
+        });
+        for x in (-260..260).step_by(3) {
+            for y in (-260..260).step_by(5) {
+                let p = [x as f64, y as f64];
+                assert_eq!(seq.value(&p), shared.value(&p), "{p:?}");
+            }
+        }
+        // A point beyond the map: clipped, reported, and the stored cells stay valid bounds.
+        let far = [seq.reach() - 10.0, 0.0];
+        assert!(!shared.insert_shared(&far).unwrap());
+        let mut all = pts.clone();
+        all.push(far);
+        let p = [seq.reach() - 30.0, 3.0];
+        let (lb, _) = shared.lower_bound(&p).unwrap();
+        assert!(lb <= brute(&all, &p));
+        assert!(shared.insert_shared(&[f64::NAN, 0.0]).is_err());
     }
 
     #[test]
