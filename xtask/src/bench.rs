@@ -62,6 +62,12 @@ pub const WORKLOADS: &[Workload] = &[
         unit: "particles per second",
     },
     Workload {
+        name: "dla-3d-1e6",
+        bin: "dla",
+        args: &["--dim", "3", "--particles", "1000000", "--seed", "1"],
+        unit: "particles per second",
+    },
+    Workload {
         name: "dlca-1024-50k-to-1",
         bin: "dlca",
         args: &[
