@@ -65,9 +65,10 @@ struct Cli {
     #[arg(long, default_value_t = dla_pdla::params::DEFAULT_LEAF_SIDE)]
     leaf_side: f64,
 
-    /// The coarse distance map in front of the orthtree (one byte per 8 x 8 cell, about 1
-    /// byte per particle): walkers far from the cluster jump by its bound without a tree
-    /// query. Speed and memory only, not the physics; `off` is the paper's tree-only walk.
+    /// The coarse distance maps in front of the orthtree (one byte per cell of side 8
+    /// diameters plus a coarser map; under 1 byte per particle at 1e6 in 2D): walkers away from
+    /// the cluster jump by their bound without a tree query. Speed and memory only, not the
+    /// physics (but another trajectory and state hash); `off` is the paper's tree-only walk.
     #[arg(long, value_enum, default_value_t = Toggle::On)]
     distance_map: Toggle,
 
