@@ -34,8 +34,7 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
 const RING_MAX: i64 = 8;
 const _: () = assert!(RING_MAX <= WINDOW_MAX);
 
-/// How many turns ahead [`World::step`] reads the cells it will need (the records twice as
-/// far ahead).
+/// How many turns ahead [`World::step`] reads the cells it will need.
 const LOOKAHEAD: usize = 8;
 
 /// The 4 orthogonal neighbours (squared distance 1).
@@ -43,7 +42,7 @@ const ORTHOGONAL: [[i64; 2]; 4] = [[1, 0], [0, 1], [-1, 0], [0, -1]];
 /// The 4 diagonal neighbours (squared distance 2).
 const DIAGONAL: [[i64; 2]; 4] = [[1, 1], [-1, 1], [-1, -1], [1, -1]];
 
-/// One animat.
+/// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Animat {
     /// Unique id; ids increase with creation and are never reused.
@@ -56,8 +55,29 @@ pub struct Animat {
     pub age: u32,
     /// Foxes: steps since the fox last ate. Always 0 for rabbits.
     pub hunger: u32,
-    /// False once dead (eaten, starved, too old) until removed at the end of the step.
-    alive: bool,
+}
+
+/// The stored state of an animat apart from its species and liveness (kept in
+/// [`World::flags`]): 32 bytes, half a cache line.
+#[derive(Debug, Clone, Copy)]
+struct Rec {
+    pos: Pos,
+    id: u64,
+    age: u32,
+    hunger: u32,
+}
+
+/// Flag bit: the animat is a rabbit (else a fox).
+const RABBIT: u8 = 1;
+/// Flag bit: the animat died in the current step (removed at its end).
+const DEAD: u8 = 2;
+
+fn species_of(flags: u8) -> Species {
+    if flags & RABBIT != 0 {
+        Species::Rabbit
+    } else {
+        Species::Fox
+    }
 }
 
 /// Perception queries asked, by kind (for the lazy-perception tests and diagnostics).
@@ -81,8 +101,8 @@ impl QueryCounts {
 /// What an animat decided to do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Action {
-    /// Eat this rabbit.
-    Eat(u64),
+    /// Eat this rabbit (id, cell).
+    Eat(u64, Pos),
     /// Breed (the probability is drawn when applied).
     Breed,
     /// Step by this unit vector (blocked steps stay put).
@@ -137,8 +157,15 @@ pub struct World {
     order: Vec<u32>,
     /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
     crowd_offsets: Vec<[i64; 2]>,
-    /// Live animats (and, during a step, the ones that died in it), sorted by id.
-    animats: Vec<Animat>,
+    /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
+    /// by id. During a step the records of the animats alive at its start are stale: their
+    /// current state is in `hot`, and is copied back at the end of the step.
+    recs: Vec<Rec>,
+    /// [`RABBIT`] and [`DEAD`] bits of each record of `recs` (same index).
+    flags: Vec<u8>,
+    /// During a step: the records of the animats alive at its start, in visiting order
+    /// (`hot[j]` is `recs[order[j]]`).
+    hot: Vec<Rec>,
     next_id: u64,
     steps: u64,
     order_rng: SimRng,
@@ -197,7 +224,9 @@ impl World {
             } else {
                 Vec::new()
             },
-            animats: Vec::new(),
+            recs: Vec::new(),
+            flags: Vec::new(),
+            hot: Vec::new(),
             next_id: 0,
             steps: 0,
             order_rng: stream(seed, stream_id(STREAM_ORDER, 0)),
@@ -273,14 +302,14 @@ impl World {
         self.cells
             .set(pos, kind_byte(species == Species::Rabbit), id);
         self.next_id += 1;
-        self.animats.push(Animat {
-            id,
-            species,
+        self.recs.push(Rec {
             pos,
+            id,
             age,
             hunger: if species == Species::Fox { hunger } else { 0 },
-            alive: true,
         });
+        self.flags
+            .push(if species == Species::Rabbit { RABBIT } else { 0 });
         match species {
             Species::Fox => self.foxes += 1,
             Species::Rabbit => self.rabbits += 1,
@@ -309,15 +338,26 @@ impl World {
     }
 
     /// Live animats, sorted by id (between steps).
-    pub fn animats(&self) -> impl Iterator<Item = &Animat> + '_ {
-        self.animats.iter().filter(|a| a.alive)
+    pub fn animats(&self) -> impl Iterator<Item = Animat> + '_ {
+        (0..self.recs.len()).filter_map(|i| self.animat_at(i))
     }
 
     /// A live animat by id.
-    pub fn get(&self, id: u64) -> Option<&Animat> {
-        self.index_of(id)
-            .map(|i| &self.animats[i])
-            .filter(|a| a.alive)
+    pub fn get(&self, id: u64) -> Option<Animat> {
+        self.index_of(id).and_then(|i| self.animat_at(i))
+    }
+
+    /// The animat of record `i`, if alive (between steps).
+    fn animat_at(&self, i: usize) -> Option<Animat> {
+        let f = self.flags[i];
+        let r = self.recs[i];
+        (f & DEAD == 0).then_some(Animat {
+            id: r.id,
+            species: species_of(f),
+            pos: r.pos,
+            age: r.age,
+            hunger: r.hunger,
+        })
     }
 
     /// Perception queries asked so far.
@@ -375,13 +415,13 @@ impl World {
     }
 
     fn index_of(&self, id: u64) -> Option<usize> {
-        self.animats.binary_search_by_key(&id, |a| a.id).ok()
+        self.recs.binary_search_by_key(&id, |a| a.id).ok()
     }
 
     /// Runs `n` steps (stopping early if every animat has died).
     pub fn run(&mut self, n: u64) {
         for _ in 0..n {
-            if self.animats.is_empty() {
+            if self.recs.is_empty() {
                 break;
             }
             self.step();
@@ -398,41 +438,73 @@ impl World {
         let evals_before = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals_before;
         self.search_seconds = 0.0;
-        let n = self.animats.len();
+        let n = self.recs.len();
         let mut order = std::mem::take(&mut self.order);
         order.clear();
         order.extend(0..n as u32);
         shuffle(&mut self.order_rng, &mut order);
-        // The visiting order is random, so a turn's first reads of its animat's record and of
-        // the cells around it miss the caches. Reading them a few turns ahead starts those
-        // misses early, overlapped with the turns in between; the reads change nothing (they
-        // only feed black_box).
+        // The visiting order is random, so reading each turn's record where it is stored (id
+        // order) would start every turn with a cache miss that nothing overlaps. Copying the
+        // records into visiting order first is a loop of independent loads that the CPU
+        // overlaps; the turns then read their records in sequence.
+        let mut hot = std::mem::take(&mut self.hot);
+        hot.clear();
+        hot.extend(order.iter().map(|&k| self.recs[k as usize]));
+        // A turn's first read of the cells around its animat misses the caches too; reading
+        // them a few turns ahead starts that miss early. The reads change nothing (they only
+        // feed black_box).
         let mut touch = 0u64;
-        for (j, &i) in order.iter().enumerate() {
-            if let Some(&k) = order.get(j + 2 * LOOKAHEAD) {
-                touch ^= self.animats[k as usize].pos[0] as u64;
+        for j in 0..n {
+            if let Some(h) = hot.get(j + LOOKAHEAD) {
+                touch ^= u64::from(self.cells.kind(h.pos));
             }
-            if let Some(&k) = order.get(j + LOOKAHEAD) {
-                touch ^= u64::from(self.cells.kind(self.animats[k as usize].pos));
-            }
-            let i = i as usize;
-            if !self.animats[i].alive {
+            let k = order[j] as usize;
+            let f = self.flags[k];
+            if f & DEAD != 0 {
                 continue;
             }
+            let r = hot[j];
+            let mut a = Animat {
+                id: r.id,
+                species: species_of(f),
+                pos: r.pos,
+                age: r.age,
+                hunger: r.hunger,
+            };
             let action = if self.timing {
                 let t = Instant::now();
-                let a = self.decide(i);
+                let act = self.decide(&a);
                 self.search_seconds += t.elapsed().as_secs_f64();
-                a
+                act
             } else {
-                self.decide(i)
+                self.decide(&a)
             };
-            self.apply(i, action);
-            self.age_and_die(i);
+            self.apply(&mut a, action);
+            self.age_and_die(k, &mut a);
+            hot[j] = Rec {
+                pos: a.pos,
+                id: a.id,
+                age: a.age,
+                hunger: a.hunger,
+            };
         }
         std::hint::black_box(touch);
+        for (&k, r) in order.iter().zip(&hot) {
+            self.recs[k as usize] = *r;
+        }
         self.order = order;
-        self.animats.retain(|a| a.alive);
+        self.hot = hot;
+        let mut w = 0;
+        for i in 0..self.recs.len() {
+            let f = self.flags[i];
+            if f & DEAD == 0 {
+                self.recs[w] = self.recs[i];
+                self.flags[w] = f;
+                w += 1;
+            }
+        }
+        self.recs.truncate(w);
+        self.flags.truncate(w);
         self.steps += 1;
         let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals;
@@ -444,13 +516,12 @@ impl World {
 
     /// Chooses the action of animat `i`: the first rule whose condition holds. Asks only the
     /// queries each condition needs, in priority order.
-    fn decide(&mut self, i: usize) -> Action {
-        let a = self.animats[i];
+    fn decide(&mut self, a: &Animat) -> Action {
         match a.species {
             Species::Fox => {
                 let hungry = a.hunger >= self.params.hungry_at;
                 for k in 0..self.fox_rules.len() {
-                    if let Some(act) = self.fox_rule(self.fox_rules[k], &a, hungry) {
+                    if let Some(act) = self.fox_rule(self.fox_rules[k], a, hungry) {
                         return act;
                     }
                 }
@@ -458,7 +529,7 @@ impl World {
             }
             Species::Rabbit => {
                 for k in 0..self.rabbit_rules.len() {
-                    if let Some(act) = self.rabbit_rule(self.rabbit_rules[k], &a) {
+                    if let Some(act) = self.rabbit_rule(self.rabbit_rules[k], a) {
                         return act;
                     }
                 }
@@ -474,7 +545,7 @@ impl World {
                     return None;
                 }
                 self.nearest_adjacent(a, Species::Rabbit)
-                    .map(|(id, _)| Action::Eat(id))
+                    .map(|(id, p)| Action::Eat(id, p))
             }
             FoxRule::Breed => (!hungry
                 && self.adjacent(a, Species::Fox)
@@ -686,12 +757,11 @@ impl World {
             .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
     }
 
-    /// Moves animat `i` one step by `d` unless the target cell is occupied.
-    fn try_step(&mut self, i: usize, d: [i64; 2]) {
+    /// Moves animat `a` one step by `d` unless the target cell is occupied.
+    fn try_step(&mut self, a: &mut Animat, d: [i64; 2]) {
         if d == [0, 0] {
             return;
         }
-        let a = self.animats[i];
         let Some(to) = offset(a.pos, d) else { return };
         if self.cells.occupied(to) {
             return;
@@ -700,23 +770,24 @@ impl World {
             .move_to(a.id, to)
             .expect("a live animat is in the grid");
         self.cells.relocate(a.pos, to);
-        self.animats[i].pos = to;
+        a.pos = to;
     }
 
-    fn apply(&mut self, i: usize, action: Action) {
+    fn apply(&mut self, a: &mut Animat, action: Action) {
         match action {
             Action::Stay => {}
-            Action::Step(d) => self.try_step(i, d),
+            Action::Step(d) => self.try_step(a, d),
             Action::Wander => {
                 let d = DIRECTIONS[self.action_rng.random_range(0..8usize)];
-                self.try_step(i, d);
+                self.try_step(a, d);
             }
-            Action::Eat(rabbit) => {
-                self.kill_id(rabbit);
-                self.animats[i].hunger = 0;
+            Action::Eat(rabbit, pos) => {
+                if let Some(j) = self.index_of(rabbit) {
+                    self.kill(j, rabbit, pos);
+                }
+                a.hunger = 0;
             }
             Action::Breed => {
-                let a = self.animats[i];
                 let p = match a.species {
                     Species::Fox => self.params.fox_breed_p,
                     Species::Rabbit => self.params.rabbit_breed_p,
@@ -743,29 +814,23 @@ impl World {
         }
     }
 
-    fn kill_id(&mut self, id: u64) {
-        if let Some(j) = self.index_of(id) {
-            self.kill(j);
-        }
-    }
-
-    fn kill(&mut self, j: usize) {
-        let a = &mut self.animats[j];
-        if !a.alive {
+    /// Marks record `k` (animat `id` on cell `pos`) dead and takes it off the plane.
+    fn kill(&mut self, k: usize, id: u64, pos: Pos) {
+        let f = self.flags[k];
+        if f & DEAD != 0 {
             return;
         }
-        a.alive = false;
-        match a.species {
+        self.flags[k] = f | DEAD;
+        match species_of(f) {
             Species::Fox => self.foxes -= 1,
             Species::Rabbit => self.rabbits -= 1,
         }
-        let (id, pos) = (a.id, a.pos);
         self.grid.remove(id).expect("a live animat is in the grid");
         self.cells.clear(pos);
     }
 
-    fn age_and_die(&mut self, i: usize) {
-        let a = &mut self.animats[i];
+    /// Ages the animat `a` of record `k` and kills it if it is too old or has starved.
+    fn age_and_die(&mut self, k: usize, a: &mut Animat) {
         a.age = a.age.saturating_add(1);
         let dies = match a.species {
             Species::Fox => {
@@ -775,7 +840,7 @@ impl World {
             Species::Rabbit => a.age > self.params.rabbit_max_age,
         };
         if dies {
-            self.kill(i);
+            self.kill(k, a.id, a.pos);
         }
     }
 }
@@ -934,7 +999,7 @@ mod tests {
         w.add(Rabbit, [1, 1], 0, 0).unwrap();
         w.add(Rabbit, [2, 1], 0, 0).unwrap();
         w.add(Rabbit, [0, -2], 0, 0).unwrap();
-        let a = *w.get(me).unwrap();
+        let a = w.get(me).unwrap();
         assert!(!w.overcrowded(&a));
         w.add(Fox, [-1, 0], 0, 0).unwrap();
         assert!(w.overcrowded(&a));
@@ -943,7 +1008,7 @@ mod tests {
         let f = w.add(Fox, [0, 0], 0, 0).unwrap();
         w.add(Rabbit, [60, 0], 0, 0).unwrap();
         w.add(Rabbit, [43, 43], 0, 0).unwrap(); // d2 = 3698 > 3600: unseen
-        let a = *w.get(f).unwrap();
+        let a = w.get(f).unwrap();
         assert!(!w.enough_prey(&a));
         w.add(Rabbit, [0, -60], 0, 0).unwrap();
         assert!(w.enough_prey(&a));
@@ -1084,8 +1149,8 @@ mod tests {
         w.add(Fox, [0, 0], 0, 9).unwrap();
         w.add(Rabbit, [1, 0], 0, 0).unwrap();
         let q0 = w.queries();
-        let a = w.animats[0];
-        assert_eq!(w.decide(0), Action::Eat(1));
+        let a = w.get(0).unwrap();
+        assert_eq!(w.decide(&a), Action::Eat(1, [1, 0]));
         let q = w.queries();
         assert_eq!(q.total() - q0.total(), 1);
         assert_eq!(q.adjacent, 1);
@@ -1099,7 +1164,7 @@ mod tests {
         for x in 0..5 {
             w.add(Rabbit, [20 + x, 0], 0, 0).unwrap();
         }
-        assert_eq!(w.decide(0), Action::Step([0, 1]));
+        assert_eq!(w.decide(&w.get(0).unwrap()), Action::Step([0, 1]));
         assert_eq!(
             w.queries(),
             QueryCounts {
@@ -1114,7 +1179,7 @@ mod tests {
         w.add(Rabbit, [0, 0], 0, 0).unwrap();
         w.add(Fox, [1, 0], 0, 0).unwrap();
         w.add(Rabbit, [-1, 0], 0, 0).unwrap();
-        assert_eq!(w.decide(0), Action::Step([-1, 0]));
+        assert_eq!(w.decide(&w.get(0).unwrap()), Action::Step([-1, 0]));
         assert_eq!(w.queries().total(), 1);
 
         // Over a whole step of a real run, fewer queries than the eager "ask everything"
