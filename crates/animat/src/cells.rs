@@ -154,7 +154,7 @@ impl CellIndex {
     }
 
     /// Id of the animat on the occupied cell `p`.
-    fn id(&self, p: [i64; 2]) -> u64 {
+    pub fn id(&self, p: [i64; 2]) -> u64 {
         let (key, off) = split(p);
         self.map
             .get(&key)

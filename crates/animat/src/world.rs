@@ -6,6 +6,7 @@ use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
 use spatial::plane::{PlaneError, PlaneGrid, Pos};
+use rustc_hash::FxHashSet;
 use std::time::Instant;
 
 /// Random stream purposes of a run (each its own stream of the run seed).
@@ -101,8 +102,8 @@ impl QueryCounts {
 /// What an animat decided to do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Action {
-    /// Eat this rabbit (id, cell).
-    Eat(u64, Pos),
+    /// Eat the rabbit on this cell.
+    Eat(Pos),
     /// Breed (the probability is drawn when applied).
     Breed,
     /// Step by this unit vector (blocked steps stay put).
@@ -163,6 +164,9 @@ pub struct World {
     recs: Vec<Rec>,
     /// [`RABBIT`] and [`DEAD`] bits of each record of `recs` (same index).
     flags: Vec<u8>,
+    /// Ids of the rabbits eaten in the current step (their records are dead, though their
+    /// [`DEAD`] bits are not set: finding a record by id would cost a search).
+    eaten: FxHashSet<u64>,
     /// During a step: the records of the animats alive at its start, in visiting order
     /// (`hot[j]` is `recs[order[j]]`).
     hot: Vec<Rec>,
@@ -226,6 +230,7 @@ impl World {
             },
             recs: Vec::new(),
             flags: Vec::new(),
+            eaten: FxHashSet::default(),
             hot: Vec::new(),
             next_id: 0,
             steps: 0,
@@ -464,6 +469,9 @@ impl World {
                 continue;
             }
             let r = hot[j];
+            if f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&r.id) {
+                continue;
+            }
             let mut a = Animat {
                 id: r.id,
                 species: species_of(f),
@@ -497,7 +505,9 @@ impl World {
         let mut w = 0;
         for i in 0..self.recs.len() {
             let f = self.flags[i];
-            if f & DEAD == 0 {
+            let eaten =
+                f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&self.recs[i].id);
+            if f & DEAD == 0 && !eaten {
                 self.recs[w] = self.recs[i];
                 self.flags[w] = f;
                 w += 1;
@@ -505,6 +515,7 @@ impl World {
         }
         self.recs.truncate(w);
         self.flags.truncate(w);
+        self.eaten.clear();
         self.steps += 1;
         let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals;
@@ -545,7 +556,7 @@ impl World {
                     return None;
                 }
                 self.nearest_adjacent(a, Species::Rabbit)
-                    .map(|(id, p)| Action::Eat(id, p))
+                    .map(Action::Eat)
             }
             FoxRule::Breed => (!hungry
                 && self.adjacent(a, Species::Fox)
@@ -572,7 +583,7 @@ impl World {
 
     fn rabbit_rule(&mut self, rule: RabbitRule, a: &Animat) -> Option<Action> {
         match rule {
-            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox).map(|(_, f)| {
+            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox).map(|f| {
                 let t = self.towards(a.pos, f);
                 Action::Step([-t[0], -t[1]])
             }),
@@ -590,8 +601,8 @@ impl World {
         [sign_towards(from[0], to[0]), sign_towards(from[1], to[1])]
     }
 
-    /// The nearest adjacent animat of `kind` (ties: lower id) and its position.
-    fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<(u64, Pos)> {
+    /// The position of the nearest adjacent animat of `kind` (ties: lower id).
+    fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
         self.queries.adjacent += 1;
         if self.cell_search {
             if let Some(w) = self.cells.window(a.pos, 1) {
@@ -599,14 +610,24 @@ impl World {
                 let [x, y] = a.pos;
                 let mut evals = 0;
                 // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
+                // Ids are read only to break a tie (they live in a larger array that is
+                // rarely in cache).
                 for group in [&ORTHOGONAL, &DIAGONAL] {
-                    let mut best: Option<(u64, Pos)> = None;
+                    let mut best: Option<Pos> = None;
+                    let mut best_id: Option<u64> = None;
                     for d in group {
-                        if w.at(x + d[0], y + d[1]) == kb {
+                        let c = [x + d[0], y + d[1]];
+                        if w.at(c[0], c[1]) == kb {
                             evals += 1;
-                            let id = w.id(x + d[0], y + d[1]);
-                            if best.is_none_or(|(b, _)| id < b) {
-                                best = Some((id, [x + d[0], y + d[1]]));
+                            if let Some(b) = best {
+                                let bi = *best_id.get_or_insert_with(|| w.id(b[0], b[1]));
+                                let id = w.id(c[0], c[1]);
+                                if id < bi {
+                                    best = Some(c);
+                                    best_id = Some(id);
+                                }
+                            } else {
+                                best = Some(c);
                             }
                         }
                     }
@@ -620,7 +641,7 @@ impl World {
             }
         }
         let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
-        self.grid.get(id).map(|(p, _)| (id, p))
+        self.grid.get(id).map(|(p, _)| p)
     }
 
     fn adjacent(&mut self, a: &Animat, kind: Species) -> bool {
@@ -651,18 +672,29 @@ impl World {
                 let [x, y] = a.pos;
                 let v2 = self.vision2;
                 let mut evals = 0;
-                // Best as (d2, id, position).
-                let mut best: Option<(u64, u64, Pos)> = None;
-                let mut look = |dx: i64, dy: i64, best: &mut Option<(u64, u64, Pos)>| {
+                // Best as (d2, position, id once read): ids are read only to break a tie of
+                // distances (they live in a larger array that is rarely in cache).
+                type Best = Option<(u64, Pos, Option<u64>)>;
+                let mut best: Best = None;
+                let mut look = |dx: i64, dy: i64, best: &mut Best| {
                     if w.at(x + dx, y + dy) == kb {
                         evals += 1;
                         let d2 = (dx * dx + dy * dy) as u64;
-                        if d2 > v2 || best.is_some_and(|(bd, _, _)| d2 > bd) {
-                            return;
-                        }
-                        let id = w.id(x + dx, y + dy);
-                        if best.is_none_or(|(bd, bi, _)| (d2, id) < (bd, bi)) {
-                            *best = Some((d2, id, [x + dx, y + dy]));
+                        let c = [x + dx, y + dy];
+                        match best {
+                            _ if d2 > v2 => {}
+                            None => *best = Some((d2, c, None)),
+                            Some((bd, bp, bid)) => {
+                                if d2 < *bd {
+                                    *best = Some((d2, c, None));
+                                } else if d2 == *bd {
+                                    let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
+                                    let id = w.id(c[0], c[1]);
+                                    if id < bi {
+                                        *best = Some((d2, c, Some(id)));
+                                    }
+                                }
+                            }
                         }
                     }
                 };
@@ -680,7 +712,7 @@ impl World {
                     let next = ((k + 1) * (k + 1)) as u64;
                     if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
                         self.cell_evals += evals;
-                        return best.map(|(_, _, p)| p);
+                        return best.map(|(_, p, _)| p);
                     }
                 }
                 self.cell_evals += evals;
@@ -781,10 +813,16 @@ impl World {
                 let d = DIRECTIONS[self.action_rng.random_range(0..8usize)];
                 self.try_step(a, d);
             }
-            Action::Eat(rabbit, pos) => {
-                if let Some(j) = self.index_of(rabbit) {
-                    self.kill(j, rabbit, pos);
-                }
+            Action::Eat(pos) => {
+                // The rabbit's record is found (and dropped) at the end of the step; until
+                // then the set of eaten ids marks it dead.
+                let rabbit = self.cells.id(pos);
+                self.eaten.insert(rabbit);
+                self.rabbits -= 1;
+                self.grid
+                    .remove(rabbit)
+                    .expect("a live animat is in the grid");
+                self.cells.clear(pos);
                 a.hunger = 0;
             }
             Action::Breed => {
@@ -1150,7 +1188,7 @@ mod tests {
         w.add(Rabbit, [1, 0], 0, 0).unwrap();
         let q0 = w.queries();
         let a = w.get(0).unwrap();
-        assert_eq!(w.decide(&a), Action::Eat(1, [1, 0]));
+        assert_eq!(w.decide(&a), Action::Eat([1, 0]));
         let q = w.queries();
         assert_eq!(q.total() - q0.total(), 1);
         assert_eq!(q.adjacent, 1);
