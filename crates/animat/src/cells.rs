@@ -45,10 +45,23 @@ struct Tile {
 /// The cell index; see the module documentation.
 #[derive(Debug, Clone, Default)]
 pub struct CellIndex {
+    /// Every tile's slot by tile coordinates.
     map: FxHashMap<[i64; 2], u32>,
     tiles: Vec<Tile>,
     free: Vec<u32>,
+    /// Dense directory of the tiles in the rectangle of tile coordinates `[dx0, dx0 + dw) x
+    /// [dy0, dy0 + dh)`: slot + 1, or 0 for no tile. Complete for its rectangle (a lookup
+    /// there never needs the map).
+    dir: Vec<u32>,
+    dx0: i64,
+    dy0: i64,
+    dw: u64,
+    dh: u64,
 }
+
+/// Largest number of entries of the dense tile directory (1 MiB); tiles beyond the rectangle
+/// it can cover are found through the hash map alone.
+const DIR_MAX: u64 = 1 << 18;
 
 const CELLS: usize = (TILE * TILE) as usize;
 
@@ -66,12 +79,70 @@ fn split(p: [i64; 2]) -> ([i64; 2], usize) {
 }
 
 impl CellIndex {
+    /// The slot of the tile with coordinates `key`, if there is one.
+    #[inline(always)]
+    fn slot(&self, key: [i64; 2]) -> Option<u32> {
+        let u = key[0].wrapping_sub(self.dx0) as u64;
+        let v = key[1].wrapping_sub(self.dy0) as u64;
+        if u < self.dw && v < self.dh {
+            self.dir[(v * self.dw + u) as usize].checked_sub(1)
+        } else {
+            self.map.get(&key).copied()
+        }
+    }
+
+    /// Whether tile coordinates `key` lie in the directory's rectangle.
+    fn in_dir(&self, key: [i64; 2]) -> Option<usize> {
+        let u = key[0].wrapping_sub(self.dx0) as u64;
+        let v = key[1].wrapping_sub(self.dy0) as u64;
+        (u < self.dw && v < self.dh).then_some((v * self.dw + u) as usize)
+    }
+
+    /// Records a new tile `t` at `key` in the map and, growing the directory's rectangle
+    /// (with a margin) when it stays within [`DIR_MAX`] entries, in the directory.
+    fn register(&mut self, key: [i64; 2], t: u32) {
+        self.map.insert(key, t);
+        if let Some(i) = self.in_dir(key) {
+            self.dir[i] = t + 1;
+            return;
+        }
+        // Tile coordinates are within +-2^58, so these sums cannot overflow.
+        let (x0, x1, y0, y1) = if self.dw == 0 {
+            (key[0], key[0], key[1], key[1])
+        } else {
+            (
+                self.dx0.min(key[0]),
+                (self.dx0 + self.dw as i64 - 1).max(key[0]),
+                self.dy0.min(key[1]),
+                (self.dy0 + self.dh as i64 - 1).max(key[1]),
+            )
+        };
+        let mx = ((x1 - x0) / 4).max(2);
+        let my = ((y1 - y0) / 4).max(2);
+        let (x0, x1, y0, y1) = (x0 - mx, x1 + mx, y0 - my, y1 + my);
+        let (w, h) = ((x1 - x0 + 1) as u64, (y1 - y0 + 1) as u64);
+        if w.saturating_mul(h) > DIR_MAX {
+            return;
+        }
+        self.dx0 = x0;
+        self.dy0 = y0;
+        self.dw = w;
+        self.dh = h;
+        self.dir.clear();
+        self.dir.resize((w * h) as usize, 0);
+        for (&k, &t) in &self.map {
+            if let Some(i) = self.in_dir(k) {
+                self.dir[i] = t + 1;
+            }
+        }
+    }
+
     /// The kind byte on cell `p` ([`FREE`] when free).
     #[inline]
     pub fn kind(&self, p: [i64; 2]) -> u8 {
         let (key, off) = split(p);
-        match self.map.get(&key) {
-            Some(&t) => self.tiles[t as usize].kinds[off],
+        match self.slot(key) {
+            Some(t) => self.tiles[t as usize].kinds[off],
             None => FREE,
         }
     }
@@ -86,8 +157,8 @@ impl CellIndex {
     pub fn set(&mut self, p: [i64; 2], k: u8, id: u64) {
         debug_assert!(k != FREE);
         let (key, off) = split(p);
-        let t = match self.map.get(&key) {
-            Some(&t) => t,
+        let t = match self.slot(key) {
+            Some(t) => t,
             None => {
                 let t = match self.free.pop() {
                     Some(t) => t,
@@ -106,7 +177,7 @@ impl CellIndex {
                         (self.tiles.len() - 1) as u32
                     }
                 };
-                self.map.insert(key, t);
+                self.register(key, t);
                 t
             }
         };
@@ -120,7 +191,7 @@ impl CellIndex {
     /// Frees cell `p` (which must be occupied).
     pub fn clear(&mut self, p: [i64; 2]) {
         let (key, off) = split(p);
-        let Some(&t) = self.map.get(&key) else {
+        let Some(t) = self.slot(key) else {
             debug_assert!(false, "clearing a cell of a missing tile");
             return;
         };
@@ -130,6 +201,9 @@ impl CellIndex {
         tile.count -= 1;
         if tile.count == 0 {
             self.map.remove(&key);
+            if let Some(i) = self.in_dir(key) {
+                self.dir[i] = 0;
+            }
             self.free.push(t);
         }
     }
@@ -139,7 +213,7 @@ impl CellIndex {
         let (kf, of) = split(from);
         let (kt, ot) = split(to);
         if kf == kt {
-            if let Some(&t) = self.map.get(&kf) {
+            if let Some(t) = self.slot(kf) {
                 let tile = &mut self.tiles[t as usize];
                 tile.kinds[ot] = tile.kinds[of];
                 tile.ids[ot] = tile.ids[of];
@@ -156,9 +230,8 @@ impl CellIndex {
     /// Id of the animat on the occupied cell `p`.
     pub fn id(&self, p: [i64; 2]) -> u64 {
         let (key, off) = split(p);
-        self.map
-            .get(&key)
-            .map_or(0, |&t| self.tiles[t as usize].ids[off])
+        self.slot(key)
+            .map_or(0, |t| self.tiles[t as usize].ids[off])
     }
 
     /// A window of half-side `k <= WINDOW_MAX` around `p`, or `None` when `p` is too close to
@@ -176,8 +249,8 @@ impl CellIndex {
         let tx1 = (p[0] + k) >> SHIFT;
         let ty1 = (p[1] + k) >> SHIFT;
         let fetch = |tx: i64, ty: i64| -> (&[u8; CELLS], &[u64; CELLS]) {
-            match self.map.get(&[tx, ty]) {
-                Some(&t) => {
+            match self.slot([tx, ty]) {
+                Some(t) => {
                     let t = &self.tiles[t as usize];
                     (&t.kinds, &t.ids)
                 }
