@@ -318,6 +318,37 @@ impl Window<'_> {
         self.kinds[t][off]
     }
 
+    /// The kind bytes of the 8 cells `x0 .. x0 + 8` of rows `y0 .. y0 + N`, one `u64` per
+    /// row (byte `i` is cell `x0 + i`). These cells must lie within the window's square.
+    #[inline]
+    pub fn rows<const N: usize>(&self, x0: i64, y0: i64) -> [u64; N] {
+        // Kind bytes are stored in 8 x 8 blocks, each block row 8 consecutive bytes: the 8
+        // cells are the tail of one block row and the head of the next.
+        let a = x0 & !7;
+        let s = ((x0 - a) * 8) as u32;
+        let mut out = [0u64; N];
+        for (i, o) in out.iter_mut().enumerate() {
+            let y = y0 + i as i64;
+            let lo = self.row8(a, y);
+            *o = if s == 0 {
+                lo
+            } else {
+                (lo >> s) | (self.row8(a + 8, y) << (64 - s))
+            };
+        }
+        out
+    }
+
+    /// The 8 kind bytes of the block row starting at cell `(ax, y)`, `ax` a multiple of 8.
+    #[inline(always)]
+    fn row8(&self, ax: i64, y: i64) -> u64 {
+        let (t, off) = self.locate(ax, y);
+        let bytes: [u8; 8] = self.kinds[t][off..off + 8]
+            .try_into()
+            .expect("a block row is 8 bytes");
+        u64::from_le_bytes(bytes)
+    }
+
     /// The id of the animat on the occupied cell `(x, y)` (within the window's square).
     #[inline(always)]
     pub fn id(&self, x: i64, y: i64) -> u64 {

@@ -1,7 +1,7 @@
 //! The animat world: animats on the unbounded plane, their rules, and one step of the model
 //! (MODELS.md section 3; seed 000, section II.B).
 
-use crate::cells::{CellIndex, FREE, WINDOW_MAX, kind_byte};
+use crate::cells::{CellIndex, FREE, WINDOW_MAX, Window, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
@@ -158,6 +158,9 @@ pub struct World {
     order: Vec<u32>,
     /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
     crowd_offsets: Vec<[i64; 2]>,
+    /// The same offsets as bit 0 of byte `dx + 3` of row `dy + 3` (see [`Near::rows`]), when
+    /// `crowd_radius <= 3`.
+    crowd_masks: [u64; NEAR_ROWS],
     /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
     /// by id. During a step the records of the animats alive at its start are stale: their
     /// current state is in `hot`, and is copied back at the end of the step.
@@ -189,6 +192,53 @@ fn sign_towards(a: i64, b: i64) -> i64 {
         std::cmp::Ordering::Less => -1,
         std::cmp::Ordering::Equal => 0,
     }
+}
+
+/// The unit step from `from` towards `to` (the sign of each coordinate difference).
+fn towards(from: Pos, to: Pos) -> [i64; 2] {
+    [sign_towards(from[0], to[0]), sign_towards(from[1], to[1])]
+}
+
+/// Query and work counters of one decision (added to the world's afterwards).
+#[derive(Debug, Default)]
+struct Tally {
+    adjacent: u64,
+    nearest: u64,
+    count: u64,
+    evals: u64,
+}
+
+/// Half-side of the square of cells [`Near::rows`] holds.
+const NEAR_HALF: i64 = 3;
+/// Rows of [`Near::rows`].
+const NEAR_ROWS: usize = 2 * NEAR_HALF as usize + 1;
+// Rows are read through a window of half-side RING_MAX, which must reach 2 cells beyond them.
+const _: () = assert!(RING_MAX >= NEAR_HALF + 2);
+
+/// The cells around the acting animat (the cell-index fast path), located once per turn.
+struct Near<'a> {
+    /// Window of half-side [`RING_MAX`] around the animat; `None` when the fast path is off.
+    w: Option<Window<'a>>,
+    /// The kind bytes of the `NEAR_ROWS` rows around the animat, read on first use.
+    rows: Option<[u64; NEAR_ROWS]>,
+}
+
+impl Near<'_> {
+    /// Kind bytes of rows `y - 3 ..= y + 3` around `p = [x, y]`, each holding cells
+    /// `x - 3 ..= x + 4` as bytes 0..8 (byte `dx + 3` is cell `x + dx`). The window must be
+    /// present.
+    #[inline]
+    fn rows(&mut self, p: Pos) -> &[u64; NEAR_ROWS] {
+        let w = self.w.as_ref().expect("rows need the window");
+        self.rows
+            .get_or_insert_with(|| w.rows::<NEAR_ROWS>(p[0] - NEAR_HALF, p[1] - NEAR_HALF))
+    }
+}
+
+/// The kind byte of cell `(x + dx, y + dy)` from [`Near::rows`] (`|dx|, |dy| <= 3`).
+#[inline(always)]
+fn row_cell(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
+    (rows[(dy + NEAR_HALF) as usize] >> (8 * (dx + NEAR_HALF))) as u8
 }
 
 /// `p + d`, or `None` on overflow.
@@ -227,6 +277,18 @@ impl World {
                     .collect()
             } else {
                 Vec::new()
+            },
+            crowd_masks: {
+                let r = params.crowd_radius.min(NEAR_HALF);
+                let mut m = [0u64; NEAR_ROWS];
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        if (dx, dy) != (0, 0) && (dx * dx + dy * dy) as u64 <= c * c {
+                            m[(dy + NEAR_HALF) as usize] |= 1 << (8 * (dx + NEAR_HALF));
+                        }
+                    }
+                }
+                m
             },
             recs: Vec::new(),
             flags: Vec::new(),
@@ -525,22 +587,48 @@ impl World {
         }
     }
 
-    /// Chooses the action of animat `i`: the first rule whose condition holds. Asks only the
+    /// Chooses the action of animat `a`: the first rule whose condition holds. Asks only the
     /// queries each condition needs, in priority order.
     fn decide(&mut self, a: &Animat) -> Action {
+        let mut t = Tally::default();
+        let act = {
+            let mut near = self.near(a);
+            self.decide_in(a, &mut near, &mut t)
+        };
+        self.queries.adjacent += t.adjacent;
+        self.queries.nearest += t.nearest;
+        self.queries.count += t.count;
+        self.cell_evals += t.evals;
+        act
+    }
+
+    /// The cells around `a` for the cell-index fast path (no window when the fast path is
+    /// off or `a` is too near the `i64` limits).
+    fn near(&self, a: &Animat) -> Near<'_> {
+        Near {
+            w: if self.cell_search {
+                self.cells.window(a.pos, RING_MAX)
+            } else {
+                None
+            },
+            rows: None,
+        }
+    }
+
+    fn decide_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> Action {
         match a.species {
             Species::Fox => {
                 let hungry = a.hunger >= self.params.hungry_at;
-                for k in 0..self.fox_rules.len() {
-                    if let Some(act) = self.fox_rule(self.fox_rules[k], a, hungry) {
+                for &rule in &self.fox_rules {
+                    if let Some(act) = self.fox_rule(rule, a, hungry, near, t) {
                         return act;
                     }
                 }
                 Action::Stay
             }
             Species::Rabbit => {
-                for k in 0..self.rabbit_rules.len() {
-                    if let Some(act) = self.rabbit_rule(self.rabbit_rules[k], a) {
+                for &rule in &self.rabbit_rules {
+                    if let Some(act) = self.rabbit_rule(rule, a, near, t) {
                         return act;
                     }
                 }
@@ -549,186 +637,212 @@ impl World {
         }
     }
 
-    fn fox_rule(&mut self, rule: FoxRule, a: &Animat, hungry: bool) -> Option<Action> {
+    fn fox_rule(
+        &self,
+        rule: FoxRule,
+        a: &Animat,
+        hungry: bool,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Action> {
         match rule {
             FoxRule::Eat => {
                 if !hungry {
                     return None;
                 }
-                self.nearest_adjacent(a, Species::Rabbit)
+                self.nearest_adjacent(a, Species::Rabbit, near, t)
                     .map(Action::Eat)
             }
             FoxRule::Breed => (!hungry
-                && self.adjacent(a, Species::Fox)
-                && !self.overcrowded(a)
-                && self.enough_prey(a))
+                && self.adjacent(a, Species::Fox, near, t)
+                && !self.overcrowded_in(a, near, t)
+                && self.enough_prey_in(a, near, t))
             .then_some(Action::Breed),
             FoxRule::Hunt => {
                 if !hungry {
                     return None;
                 }
-                self.nearest_seen(a, Species::Rabbit)
-                    .map(|t| Action::Step(self.towards(a.pos, t)))
+                self.nearest_seen(a, Species::Rabbit, near, t)
+                    .map(|p| Action::Step(towards(a.pos, p)))
             }
             FoxRule::SeekMate => {
                 if hungry {
                     return None;
                 }
-                self.nearest_seen(a, Species::Fox)
-                    .map(|t| Action::Step(self.towards(a.pos, t)))
+                self.nearest_seen(a, Species::Fox, near, t)
+                    .map(|p| Action::Step(towards(a.pos, p)))
             }
             FoxRule::Wander => Some(Action::Wander),
         }
     }
 
-    fn rabbit_rule(&mut self, rule: RabbitRule, a: &Animat) -> Option<Action> {
+    fn rabbit_rule(
+        &self,
+        rule: RabbitRule,
+        a: &Animat,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Action> {
         match rule {
-            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox).map(|f| {
-                let t = self.towards(a.pos, f);
-                Action::Step([-t[0], -t[1]])
+            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox, near, t).map(|f| {
+                let d = towards(a.pos, f);
+                Action::Step([-d[0], -d[1]])
             }),
-            RabbitRule::Breed => {
-                (self.adjacent(a, Species::Rabbit) && !self.overcrowded(a)).then_some(Action::Breed)
-            }
+            RabbitRule::Breed => (self.adjacent(a, Species::Rabbit, near, t)
+                && !self.overcrowded_in(a, near, t))
+            .then_some(Action::Breed),
             RabbitRule::Herd => self
-                .nearest_seen(a, Species::Rabbit)
-                .map(|t| Action::Step(self.towards(a.pos, t))),
+                .nearest_seen(a, Species::Rabbit, near, t)
+                .map(|p| Action::Step(towards(a.pos, p))),
             RabbitRule::Wander => Some(Action::Wander),
         }
     }
 
-    fn towards(&self, from: Pos, to: Pos) -> [i64; 2] {
-        [sign_towards(from[0], to[0]), sign_towards(from[1], to[1])]
-    }
-
     /// The position of the nearest adjacent animat of `kind` (ties: lower id).
-    fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
-        self.queries.adjacent += 1;
-        if self.cell_search {
-            if let Some(w) = self.cells.window(a.pos, 1) {
-                let kb = kind_byte(kind == Species::Rabbit);
-                let [x, y] = a.pos;
-                let mut evals = 0;
-                // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
-                // Ids are read only to break a tie (they live in a larger array that is
-                // rarely in cache).
-                for group in [&ORTHOGONAL, &DIAGONAL] {
-                    let mut best: Option<Pos> = None;
-                    let mut best_id: Option<u64> = None;
-                    for d in group {
+    fn nearest_adjacent(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        t.adjacent += 1;
+        if let Some(w) = near.w {
+            let rows = near.rows(a.pos);
+            let kb = kind_byte(kind == Species::Rabbit);
+            let [x, y] = a.pos;
+            // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
+            // Ids are read only to break a tie (they live in a larger array that is rarely in
+            // cache).
+            for group in [&ORTHOGONAL, &DIAGONAL] {
+                let mut best: Option<Pos> = None;
+                let mut best_id: Option<u64> = None;
+                for d in group {
+                    if row_cell(rows, d[0], d[1]) == kb {
+                        t.evals += 1;
                         let c = [x + d[0], y + d[1]];
-                        if w.at(c[0], c[1]) == kb {
-                            evals += 1;
-                            if let Some(b) = best {
-                                let bi = *best_id.get_or_insert_with(|| w.id(b[0], b[1]));
-                                let id = w.id(c[0], c[1]);
-                                if id < bi {
-                                    best = Some(c);
-                                    best_id = Some(id);
-                                }
-                            } else {
+                        if let Some(b) = best {
+                            let bi = *best_id.get_or_insert_with(|| w.id(b[0], b[1]));
+                            let id = w.id(c[0], c[1]);
+                            if id < bi {
                                 best = Some(c);
+                                best_id = Some(id);
                             }
+                        } else {
+                            best = Some(c);
                         }
                     }
-                    if best.is_some() {
-                        self.cell_evals += evals;
-                        return best;
-                    }
                 }
-                self.cell_evals += evals;
-                return None;
+                if best.is_some() {
+                    return best;
+                }
             }
+            return None;
         }
         let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
 
-    fn adjacent(&mut self, a: &Animat, kind: Species) -> bool {
-        self.queries.adjacent += 1;
-        if self.cell_search {
-            if let Some(w) = self.cells.window(a.pos, 1) {
-                let kb = kind_byte(kind == Species::Rabbit);
-                let [x, y] = a.pos;
-                for d in DIRECTIONS {
-                    if w.at(x + d[0], y + d[1]) == kb {
-                        self.cell_evals += 1;
-                        return true;
-                    }
-                }
-                return false;
-            }
+    fn adjacent(&self, a: &Animat, kind: Species, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.adjacent += 1;
+        if near.w.is_some() {
+            let rows = near.rows(a.pos);
+            let kb = kind_byte(kind == Species::Rabbit);
+            let found = DIRECTIONS.iter().any(|d| row_cell(rows, d[0], d[1]) == kb);
+            t.evals += u64::from(found);
+            return found;
         }
         self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
     }
 
     /// Position of the nearest animat of `kind` within vision (ties: lower id).
-    fn nearest_seen(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
-        self.queries.nearest += 1;
-        if self.cell_search {
+    fn nearest_seen(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        t.nearest += 1;
+        if let Some(w) = near.w {
             let k_max = RING_MAX.min(self.params.vision);
-            if let Some(w) = self.cells.window(a.pos, k_max) {
-                let kb = kind_byte(kind == Species::Rabbit);
-                let [x, y] = a.pos;
-                let v2 = self.vision2;
-                let mut evals = 0;
-                // Best as (d2, position, id once read): ids are read only to break a tie of
-                // distances (they live in a larger array that is rarely in cache).
-                type Best = Option<(u64, Pos, Option<u64>)>;
-                let mut best: Best = None;
-                let mut look = |dx: i64, dy: i64, best: &mut Best| {
-                    if w.at(x + dx, y + dy) == kb {
-                        evals += 1;
-                        let d2 = (dx * dx + dy * dy) as u64;
-                        let c = [x + dx, y + dy];
-                        match best {
-                            _ if d2 > v2 => {}
-                            None => *best = Some((d2, c, None)),
-                            Some((bd, bp, bid)) => {
-                                if d2 < *bd {
-                                    *best = Some((d2, c, None));
-                                } else if d2 == *bd {
-                                    let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
-                                    let id = w.id(c[0], c[1]);
-                                    if id < bi {
-                                        *best = Some((d2, c, Some(id)));
-                                    }
+            let kb = kind_byte(kind == Species::Rabbit);
+            let [x, y] = a.pos;
+            let v2 = self.vision2;
+            let mut evals = 0;
+            // Best as (d2, position, id once read): ids are read only to break a tie of
+            // distances (they live in a larger array that is rarely in cache).
+            type Best = Option<(u64, Pos, Option<u64>)>;
+            let mut best: Best = None;
+            let mut look = |dx: i64, dy: i64, best: &mut Best| {
+                if w.at(x + dx, y + dy) == kb {
+                    evals += 1;
+                    let d2 = (dx * dx + dy * dy) as u64;
+                    let c = [x + dx, y + dy];
+                    match best {
+                        _ if d2 > v2 => {}
+                        None => *best = Some((d2, c, None)),
+                        Some((bd, bp, bid)) => {
+                            if d2 < *bd {
+                                *best = Some((d2, c, None));
+                            } else if d2 == *bd {
+                                let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
+                                let id = w.id(c[0], c[1]);
+                                if id < bi {
+                                    *best = Some((d2, c, Some(id)));
                                 }
                             }
                         }
                     }
-                };
-                for k in 1..=k_max {
-                    for dx in -k..=k {
-                        look(dx, -k, &mut best);
-                        look(dx, k, &mut best);
-                    }
-                    for dy in (-k + 1)..k {
-                        look(-k, dy, &mut best);
-                        look(k, dy, &mut best);
-                    }
-                    // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
-                    // than that is final (an equally near one could still win on id).
-                    let next = ((k + 1) * (k + 1)) as u64;
-                    if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
-                        self.cell_evals += evals;
-                        return best.map(|(_, p, _)| p);
-                    }
                 }
-                self.cell_evals += evals;
+            };
+            for k in 1..=k_max {
+                for dx in -k..=k {
+                    look(dx, -k, &mut best);
+                    look(dx, k, &mut best);
+                }
+                for dy in (-k + 1)..k {
+                    look(-k, dy, &mut best);
+                    look(k, dy, &mut best);
+                }
+                // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
+                // than that is final (an equally near one could still win on id).
+                let next = ((k + 1) * (k + 1)) as u64;
+                if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
+                    t.evals += evals;
+                    return best.map(|(_, p, _)| p);
+                }
             }
+            t.evals += evals;
         }
         let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
 
     /// More than `crowd_max` animats (either species, `a` excluded) within `crowd_radius`.
-    fn overcrowded(&mut self, a: &Animat) -> bool {
-        self.queries.count += 1;
+    #[cfg(test)]
+    fn overcrowded(&self, a: &Animat) -> bool {
+        self.overcrowded_in(a, &mut self.near(a), &mut Tally::default())
+    }
+
+    fn overcrowded_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.count += 1;
         let n = self.params.crowd_max as usize + 1;
         let r = self.params.crowd_radius;
-        if self.cell_search && r <= RING_MAX {
-            if let Some(w) = self.cells.window(a.pos, r) {
+        if let Some(w) = near.w {
+            if r <= NEAR_HALF {
+                // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
+                // the masks keep the cells within the radius.
+                let rows = near.rows(a.pos);
+                let count: usize = rows
+                    .iter()
+                    .zip(&self.crowd_masks)
+                    .map(|(&row, &m)| ((row | row >> 1) & m).count_ones() as usize)
+                    .sum();
+                t.evals += count.min(n) as u64;
+                return count >= n;
+            }
+            if r <= RING_MAX {
                 let [x, y] = a.pos;
                 let mut count = 0;
                 for d in &self.crowd_offsets {
@@ -739,7 +853,7 @@ impl World {
                         }
                     }
                 }
-                self.cell_evals += count as u64;
+                t.evals += count as u64;
                 return count >= n;
             }
         }
@@ -747,42 +861,45 @@ impl World {
     }
 
     /// At least `prey_needed` rabbits within vision.
-    fn enough_prey(&mut self, a: &Animat) -> bool {
-        self.queries.count += 1;
+    #[cfg(test)]
+    fn enough_prey(&self, a: &Animat) -> bool {
+        self.enough_prey_in(a, &mut self.near(a), &mut Tally::default())
+    }
+
+    fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.count += 1;
         let n = self.params.prey_needed as usize;
-        if self.cell_search && n > 0 {
+        if let (Some(w), true) = (near.w, n > 0) {
             let k_max = RING_MAX.min(self.params.vision);
-            if let Some(w) = self.cells.window(a.pos, k_max) {
-                let [x, y] = a.pos;
-                let v2 = self.vision2;
-                let kb = kind_byte(true);
-                let mut count = 0usize;
-                let mut look = |dx: i64, dy: i64| -> bool {
-                    if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
-                        count += 1;
-                    }
-                    count >= n
-                };
-                let mut found = false;
-                'rings: for k in 1..=k_max {
-                    for dx in -k..=k {
-                        if look(dx, -k) || look(dx, k) {
-                            found = true;
-                            break 'rings;
-                        }
-                    }
-                    for dy in (-k + 1)..k {
-                        if look(-k, dy) || look(k, dy) {
-                            found = true;
-                            break 'rings;
-                        }
+            let [x, y] = a.pos;
+            let v2 = self.vision2;
+            let kb = kind_byte(true);
+            let mut count = 0usize;
+            let mut look = |dx: i64, dy: i64| -> bool {
+                if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
+                    count += 1;
+                }
+                count >= n
+            };
+            let mut found = false;
+            'rings: for k in 1..=k_max {
+                for dx in -k..=k {
+                    if look(dx, -k) || look(dx, k) {
+                        found = true;
+                        break 'rings;
                     }
                 }
-                self.cell_evals += count as u64;
-                // Rings 1..=k_max cover the whole vision disc when k_max = vision.
-                if found || k_max == self.params.vision {
-                    return found;
+                for dy in (-k + 1)..k {
+                    if look(-k, dy) || look(k, dy) {
+                        found = true;
+                        break 'rings;
+                    }
                 }
+            }
+            t.evals += count as u64;
+            // Rings 1..=k_max cover the whole vision disc when k_max = vision.
+            if found || k_max == self.params.vision {
+                return found;
             }
         }
         self.grid
