@@ -323,30 +323,32 @@ impl Window<'_> {
     #[inline]
     pub fn rows<const N: usize>(&self, x0: i64, y0: i64) -> [u64; N] {
         // Kind bytes are stored in 8 x 8 blocks, each block row 8 consecutive bytes: the 8
-        // cells are the tail of one block row and the head of the next.
-        let a = x0 & !7;
-        let s = ((x0 - a) * 8) as u32;
+        // cells are the tail of one block row and the head of the next (in the same tile or
+        // the next one along x).
+        let rx = x0 - self.bx;
+        let ry0 = y0 - self.by;
+        let a = rx & !7;
+        let b = a + 8;
+        let s = ((rx - a) * 8) as u32;
+        let (ta, xa) = (usize::from(a >= TILE), (((a >> 3) & 7) << 6) as usize);
+        let (tb, xb) = (usize::from(b >= TILE), (((b >> 3) & 7) << 6) as usize);
+        let load = |t: usize, o: usize| -> u64 {
+            let o = o & (CELLS - 8);
+            let bytes: [u8; 8] = self.kinds[t][o..o + 8]
+                .try_into()
+                .expect("a block row is 8 bytes");
+            u64::from_le_bytes(bytes)
+        };
         let mut out = [0u64; N];
-        for (i, o) in out.iter_mut().enumerate() {
-            let y = y0 + i as i64;
-            let lo = self.row8(a, y);
-            *o = if s == 0 {
-                lo
-            } else {
-                (lo >> s) | (self.row8(a + 8, y) << (64 - s))
-            };
+        for (i, row) in out.iter_mut().enumerate() {
+            let ry = ry0 + i as i64;
+            let ty = usize::from(ry >= TILE) << 1;
+            let yo = ((((ry >> 3) & 7) << 9) | ((ry & 7) << 3)) as usize;
+            let lo = load(ta | ty, xa | yo);
+            let hi = load(tb | ty, xb | yo);
+            *row = ((u128::from(hi) << 64 | u128::from(lo)) >> s) as u64;
         }
         out
-    }
-
-    /// The 8 kind bytes of the block row starting at cell `(ax, y)`, `ax` a multiple of 8.
-    #[inline(always)]
-    fn row8(&self, ax: i64, y: i64) -> u64 {
-        let (t, off) = self.locate(ax, y);
-        let bytes: [u8; 8] = self.kinds[t][off..off + 8]
-            .try_into()
-            .expect("a block row is 8 bytes");
-        u64::from_le_bytes(bytes)
     }
 
     /// The id of the animat on the occupied cell `(x, y)` (within the window's square).

@@ -158,8 +158,8 @@ pub struct World {
     order: Vec<u32>,
     /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
     crowd_offsets: Vec<[i64; 2]>,
-    /// The same offsets as bit 0 of byte `dx + 3` of row `dy + 3` (see [`Near::rows`]), when
-    /// `crowd_radius <= 3`.
+    /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see [`Near::rows`]), when
+    /// `crowd_radius <= 2`.
     crowd_masks: [u64; NEAR_ROWS],
     /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
     /// by id. During a step the records of the animats alive at its start are stale: their
@@ -209,11 +209,12 @@ struct Tally {
 }
 
 /// Half-side of the square of cells [`Near::rows`] holds.
-const NEAR_HALF: i64 = 3;
+const NEAR_HALF: i64 = 2;
 /// Rows of [`Near::rows`].
 const NEAR_ROWS: usize = 2 * NEAR_HALF as usize + 1;
-// Rows are read through a window of half-side RING_MAX, which must reach 2 cells beyond them.
-const _: () = assert!(RING_MAX >= NEAR_HALF + 2);
+// Rows are read through a window of half-side RING_MAX, which must hold their cells
+// (x - NEAR_HALF ..= x - NEAR_HALF + 7).
+const _: () = assert!(RING_MAX >= NEAR_HALF && RING_MAX >= 7 - NEAR_HALF);
 
 /// The cells around the acting animat (the cell-index fast path), located once per turn.
 struct Near<'a> {
@@ -224,8 +225,8 @@ struct Near<'a> {
 }
 
 impl Near<'_> {
-    /// Kind bytes of rows `y - 3 ..= y + 3` around `p = [x, y]`, each holding cells
-    /// `x - 3 ..= x + 4` as bytes 0..8 (byte `dx + 3` is cell `x + dx`). The window must be
+    /// Kind bytes of rows `y - 2 ..= y + 2` around `p = [x, y]`, each holding cells
+    /// `x - 2 ..= x + 5` as bytes 0..8 (byte `dx + 2` is cell `x + dx`). The window must be
     /// present.
     #[inline]
     fn rows(&mut self, p: Pos) -> &[u64; NEAR_ROWS] {
@@ -235,7 +236,7 @@ impl Near<'_> {
     }
 }
 
-/// The kind byte of cell `(x + dx, y + dy)` from [`Near::rows`] (`|dx|, |dy| <= 3`).
+/// The kind byte of cell `(x + dx, y + dy)` from [`Near::rows`] (`|dx|, |dy| <= 2`).
 #[inline(always)]
 fn row_cell(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
     (rows[(dy + NEAR_HALF) as usize] >> (8 * (dx + NEAR_HALF))) as u8
@@ -522,9 +523,6 @@ impl World {
         // feed black_box).
         let mut touch = 0u64;
         for j in 0..n {
-            if let Some(h) = hot.get(j + LOOKAHEAD) {
-                touch ^= u64::from(self.cells.kind(h.pos));
-            }
             let k = order[j] as usize;
             let f = self.flags[k];
             if f & DEAD != 0 {
@@ -541,15 +539,15 @@ impl World {
                 age: r.age,
                 hunger: r.hunger,
             };
-            let action = if self.timing {
+            let (action, rows) = if self.timing {
                 let t = Instant::now();
-                let act = self.decide(&a);
+                let act = self.decide_near(&a);
                 self.search_seconds += t.elapsed().as_secs_f64();
                 act
             } else {
-                self.decide(&a)
+                self.decide_near(&a)
             };
-            self.apply(&mut a, action);
+            self.apply(&mut a, action, rows.as_ref());
             self.age_and_die(k, &mut a);
             hot[j] = Rec {
                 pos: a.pos,
@@ -589,11 +587,26 @@ impl World {
 
     /// Chooses the action of animat `a`: the first rule whose condition holds. Asks only the
     /// queries each condition needs, in priority order.
+    #[cfg(test)]
     fn decide(&mut self, a: &Animat) -> Action {
+        self.decide_near(a).0
+    }
+
+    /// [`World::decide`], with the kind bytes around `a` ([`Near::rows`]) when the action
+    /// moves or breeds and the cell-index fast path is on: applying it reads its free
+    /// neighbours from them.
+    fn decide_near(&mut self, a: &Animat) -> (Action, Option<[u64; NEAR_ROWS]>) {
         let mut t = Tally::default();
         let act = {
             let mut near = self.near(a);
-            self.decide_in(a, &mut near, &mut t)
+            let act = self.decide_in(a, &mut near, &mut t);
+            let rows = match act {
+                Action::Step(_) | Action::Wander | Action::Breed if near.w.is_some() => {
+                    Some(*near.rows(a.pos))
+                }
+                _ => None,
+            };
+            (act, rows)
         };
         self.queries.adjacent += t.adjacent;
         self.queries.nearest += t.nearest;
@@ -834,11 +847,13 @@ impl World {
                 // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
                 // the masks keep the cells within the radius.
                 let rows = near.rows(a.pos);
-                let count: usize = rows
+                // At most one bit per byte and NEAR_ROWS rows: the byte sums stay below 256,
+                // and the multiplication adds the bytes up into the top byte.
+                let bits = rows
                     .iter()
                     .zip(&self.crowd_masks)
-                    .map(|(&row, &m)| ((row | row >> 1) & m).count_ones() as usize)
-                    .sum();
+                    .fold(0u64, |acc, (&row, &m)| acc + ((row | row >> 1) & m));
+                let count = (bits.wrapping_mul(0x0101_0101_0101_0101) >> 56) as usize;
                 t.evals += count.min(n) as u64;
                 return count >= n;
             }
@@ -906,13 +921,22 @@ impl World {
             .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
     }
 
+    /// Whether the neighbour `c = a.pos + d` of `a` is free, from `rows` (the kind bytes
+    /// around `a`) when given.
+    fn is_free(&self, c: Pos, d: [i64; 2], rows: Option<&[u64; NEAR_ROWS]>) -> bool {
+        match rows {
+            Some(r) => row_cell(r, d[0], d[1]) == FREE,
+            None => !self.cells.occupied(c),
+        }
+    }
+
     /// Moves animat `a` one step by `d` unless the target cell is occupied.
-    fn try_step(&mut self, a: &mut Animat, d: [i64; 2]) {
+    fn try_step(&mut self, a: &mut Animat, d: [i64; 2], rows: Option<&[u64; NEAR_ROWS]>) {
         if d == [0, 0] {
             return;
         }
         let Some(to) = offset(a.pos, d) else { return };
-        if self.cells.occupied(to) {
+        if !self.is_free(to, d, rows) {
             return;
         }
         self.grid
@@ -922,13 +946,13 @@ impl World {
         a.pos = to;
     }
 
-    fn apply(&mut self, a: &mut Animat, action: Action) {
+    fn apply(&mut self, a: &mut Animat, action: Action, rows: Option<&[u64; NEAR_ROWS]>) {
         match action {
             Action::Stay => {}
-            Action::Step(d) => self.try_step(a, d),
+            Action::Step(d) => self.try_step(a, d, rows),
             Action::Wander => {
                 let d = DIRECTIONS[self.action_rng.random_range(0..8usize)];
-                self.try_step(a, d);
+                self.try_step(a, d, rows);
             }
             Action::Eat(pos) => {
                 // The rabbit's record is found (and dropped) at the end of the step; until
@@ -954,7 +978,7 @@ impl World {
                 let mut n = 0;
                 for d in DIRECTIONS {
                     if let Some(c) = offset(a.pos, d) {
-                        if !self.cells.occupied(c) {
+                        if self.is_free(c, d, rows) {
                             free[n] = c;
                             n += 1;
                         }
