@@ -35,14 +35,6 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
 const RING_MAX: i64 = 8;
 const _: () = assert!(RING_MAX <= WINDOW_MAX);
 
-/// How many turns ahead [`World::step`] reads the cells it will need.
-const LOOKAHEAD: usize = 8;
-
-/// The 4 orthogonal neighbours (squared distance 1).
-const ORTHOGONAL: [[i64; 2]; 4] = [[1, 0], [0, 1], [-1, 0], [0, -1]];
-/// The 4 diagonal neighbours (squared distance 2).
-const DIAGONAL: [[i64; 2]; 4] = [[1, 1], [-1, 1], [-1, -1], [1, -1]];
-
 /// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Animat {
@@ -240,6 +232,85 @@ impl Near<'_> {
 #[inline(always)]
 fn row_cell(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
     (rows[(dy + NEAR_HALF) as usize] >> (8 * (dx + NEAR_HALF))) as u8
+}
+
+/// The cells of [`Near::rows`] at squared distance exactly `d2` from the centre, as bit 0 of
+/// their bytes.
+const fn class_mask(d2: i64) -> [u64; NEAR_ROWS] {
+    let mut m = [0u64; NEAR_ROWS];
+    let mut dy = -NEAR_HALF;
+    while dy <= NEAR_HALF {
+        let mut dx = -NEAR_HALF;
+        while dx <= NEAR_HALF {
+            if dx * dx + dy * dy == d2 {
+                m[(dy + NEAR_HALF) as usize] |= 1 << (8 * (dx + NEAR_HALF));
+            }
+            dx += 1;
+        }
+        dy += 1;
+    }
+    m
+}
+
+/// The cells of rings 1 and 2 by squared distance, nearest first: ring 1 is `d2` 1 and 2,
+/// ring 2 is `d2` 4, 5 and 8.
+const RING_CLASSES: [[u64; NEAR_ROWS]; 5] = [
+    class_mask(1),
+    class_mask(2),
+    class_mask(4),
+    class_mask(5),
+    class_mask(8),
+];
+
+/// Bit 0 of each byte of [`Near::rows`] whose cell holds kind byte `kb` (1 fox: bit 0 of the
+/// byte; 2 rabbit: bit 1).
+#[inline(always)]
+fn kind_bits(rows: &[u64; NEAR_ROWS], kb: u8) -> [u64; NEAR_ROWS] {
+    let shift = u32::from(kb - 1);
+    rows.map(|r| (r >> shift) & 0x0101_0101_0101_0101)
+}
+
+/// How many cells of `bits` (from [`kind_bits`]) lie in `class` (at most one bit per byte and
+/// `NEAR_ROWS` rows: byte sums stay below 256, and the multiplication adds them up into the
+/// top byte).
+#[inline(always)]
+fn count_in(bits: &[u64; NEAR_ROWS], class: &[u64; NEAR_ROWS]) -> u64 {
+    let sum = bits
+        .iter()
+        .zip(class)
+        .fold(0u64, |acc, (&b, &m)| acc + (b & m));
+    sum.wrapping_mul(0x0101_0101_0101_0101) >> 56
+}
+
+/// The cell of `bits` in `class` with the lowest id (`n` of them, `n >= 1`), around `p`;
+/// ids are read only when `n > 1`.
+fn lowest_in(
+    bits: &[u64; NEAR_ROWS],
+    class: &[u64; NEAR_ROWS],
+    n: u64,
+    p: Pos,
+    w: &Window<'_>,
+) -> Pos {
+    let mut best: Option<(Pos, u64)> = None;
+    for (r, (&b, &m)) in bits.iter().zip(class).enumerate() {
+        let mut hits = b & m;
+        while hits != 0 {
+            let byte = i64::from(hits.trailing_zeros() / 8);
+            hits &= hits - 1;
+            let c = [
+                p[0] + byte - NEAR_HALF,
+                p[1] + r as i64 - NEAR_HALF,
+            ];
+            if n == 1 {
+                return c;
+            }
+            let id = w.id(c[0], c[1]);
+            if best.is_none_or(|(_, bi)| id < bi) {
+                best = Some((c, id));
+            }
+        }
+    }
+    best.map_or(p, |(c, _)| c)
 }
 
 /// `p + d`, or `None` on overflow.
@@ -518,10 +589,6 @@ impl World {
         let mut hot = std::mem::take(&mut self.hot);
         hot.clear();
         hot.extend(order.iter().map(|&k| self.recs[k as usize]));
-        // A turn's first read of the cells around its animat misses the caches too; reading
-        // them a few turns ahead starts that miss early. The reads change nothing (they only
-        // feed black_box).
-        let mut touch = 0u64;
         for j in 0..n {
             let k = order[j] as usize;
             let f = self.flags[k];
@@ -556,7 +623,6 @@ impl World {
                 hunger: a.hunger,
             };
         }
-        std::hint::black_box(touch);
         for (&k, r) in order.iter().zip(&hot) {
             self.recs[k as usize] = *r;
         }
@@ -723,31 +789,15 @@ impl World {
         if let Some(w) = near.w {
             let rows = near.rows(a.pos);
             let kb = kind_byte(kind == Species::Rabbit);
-            let [x, y] = a.pos;
             // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
             // Ids are read only to break a tie (they live in a larger array that is rarely in
             // cache).
-            for group in [&ORTHOGONAL, &DIAGONAL] {
-                let mut best: Option<Pos> = None;
-                let mut best_id: Option<u64> = None;
-                for d in group {
-                    if row_cell(rows, d[0], d[1]) == kb {
-                        t.evals += 1;
-                        let c = [x + d[0], y + d[1]];
-                        if let Some(b) = best {
-                            let bi = *best_id.get_or_insert_with(|| w.id(b[0], b[1]));
-                            let id = w.id(c[0], c[1]);
-                            if id < bi {
-                                best = Some(c);
-                                best_id = Some(id);
-                            }
-                        } else {
-                            best = Some(c);
-                        }
-                    }
-                }
-                if best.is_some() {
-                    return best;
+            let bits = kind_bits(rows, kb);
+            for class in &RING_CLASSES[..2] {
+                let n = count_in(&bits, class);
+                if n > 0 {
+                    t.evals += n;
+                    return Some(lowest_in(&bits, class, n, a.pos, &w));
                 }
             }
             return None;
@@ -783,6 +833,26 @@ impl World {
             let [x, y] = a.pos;
             let v2 = self.vision2;
             let mut evals = 0;
+            // Rings 1 and 2 from the row words when they lie within vision.
+            let mut k_first = 1;
+            if self.params.vision >= 3 {
+                let mut bits = kind_bits(near.rows(a.pos), kb);
+                // Not the animat itself.
+                bits[NEAR_HALF as usize] &= !(1 << (8 * NEAR_HALF));
+                for ring in [&RING_CLASSES[..2], &RING_CLASSES[2..]] {
+                    let counts = ring.iter().map(|c| count_in(&bits, c));
+                    let total: u64 = counts.clone().sum();
+                    if total > 0 {
+                        t.evals += total;
+                        for (class, n) in ring.iter().zip(counts) {
+                            if n > 0 {
+                                return Some(lowest_in(&bits, class, n, a.pos, &w));
+                            }
+                        }
+                    }
+                }
+                k_first = 3;
+            }
             // Best as (d2, position, id once read): ids are read only to break a tie of
             // distances (they live in a larger array that is rarely in cache).
             type Best = Option<(u64, Pos, Option<u64>)>;
@@ -809,7 +879,7 @@ impl World {
                     }
                 }
             };
-            for k in 1..=k_max {
+            for k in k_first..=k_max {
                 for dx in -k..=k {
                     look(dx, -k, &mut best);
                     look(dx, k, &mut best);
