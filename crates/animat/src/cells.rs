@@ -95,7 +95,7 @@ impl CellIndex {
     fn in_dir(&self, key: [i64; 2]) -> Option<usize> {
         let u = key[0].wrapping_sub(self.dx0) as u64;
         let v = key[1].wrapping_sub(self.dy0) as u64;
-        (u < self.dw && v < self.dh).then_some((v * self.dw + u) as usize)
+        (u < self.dw && v < self.dh).then(|| (v * self.dw + u) as usize)
     }
 
     /// Records a new tile `t` at `key` in the map and, growing the directory's rectangle
@@ -407,6 +407,32 @@ mod tests {
         assert!(c.is_empty());
         assert_eq!(c.len(), 0);
         assert!(c.window([i64::MAX, 0], 1).is_none());
+        // Tiles far apart: the directory covers some, the map the rest; all are found, and
+        // a tile that empties is gone from both.
+        let far = [
+            [3, 3],
+            [1 << 40, 0],
+            [-(1 << 40), 7],
+            [5000, -9000],
+            [i64::MAX - 5, i64::MIN + 3],
+            [i64::MIN, i64::MAX],
+        ];
+        for (i, &p) in far.iter().enumerate() {
+            c.set(p, kind_byte(i % 2 == 0), 100 + i as u64);
+        }
+        for (i, &p) in far.iter().enumerate() {
+            assert_eq!(c.kind(p), kind_byte(i % 2 == 0), "{p:?}");
+            assert_eq!(c.id(p), 100 + i as u64);
+        }
+        let w = c.window([5001, -9001], WINDOW_MAX).unwrap();
+        assert_eq!(w.at(5000, -9000), kind_byte(false));
+        assert_eq!(w.rows::<1>(4998, -9000)[0], u64::from(kind_byte(false)) << 16);
+        for &p in &far {
+            c.clear(p);
+            assert!(!c.occupied(p));
+        }
+        assert!(c.is_empty());
+        assert!(c.dir.iter().all(|&t| t == 0));
         assert_eq!(c.kind([i64::MAX, i64::MIN]), FREE);
     }
 }
