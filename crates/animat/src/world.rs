@@ -165,6 +165,8 @@ pub struct World {
     /// During a step: the records of the animats alive at its start, in visiting order
     /// (`hot[j]` is `recs[order[j]]`).
     hot: Vec<Rec>,
+    /// During a step: the flags of `hot` (`hot_flags[j]` is `flags[order[j]]` at the start).
+    hot_flags: Vec<u8>,
     next_id: u64,
     steps: u64,
     order_rng: SimRng,
@@ -366,6 +368,7 @@ impl World {
             flags: Vec::new(),
             eaten: FxHashSet::default(),
             hot: Vec::new(),
+            hot_flags: Vec::new(),
             next_id: 0,
             steps: 0,
             order_rng: stream(seed, stream_id(STREAM_ORDER, 0)),
@@ -589,13 +592,15 @@ impl World {
         let mut hot = std::mem::take(&mut self.hot);
         hot.clear();
         hot.extend(order.iter().map(|&k| self.recs[k as usize]));
+        let mut hot_flags = std::mem::take(&mut self.hot_flags);
+        hot_flags.clear();
+        hot_flags.extend(order.iter().map(|&k| self.flags[k as usize]));
         for j in 0..n {
-            let k = order[j] as usize;
-            let f = self.flags[k];
-            if f & DEAD != 0 {
-                continue;
-            }
+            let f = hot_flags[j];
             let r = hot[j];
+            // An animat dies in its own turn or is eaten (listed in `eaten`): the DEAD bit of
+            // one that has not acted yet is never set.
+            debug_assert_eq!(self.flags[order[j] as usize] & DEAD, 0);
             if f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&r.id) {
                 continue;
             }
@@ -615,7 +620,7 @@ impl World {
                 self.decide_near(&a)
             };
             self.apply(&mut a, action, rows.as_ref());
-            self.age_and_die(k, &mut a);
+            self.age_and_die(order[j] as usize, &mut a);
             hot[j] = Rec {
                 pos: a.pos,
                 id: a.id,
@@ -623,6 +628,7 @@ impl World {
                 hunger: a.hunger,
             };
         }
+        self.hot_flags = hot_flags;
         for (&k, r) in order.iter().zip(&hot) {
             self.recs[k as usize] = *r;
         }
