@@ -139,6 +139,8 @@ pub struct World {
     vision2: u64,
     crowd2: u64,
     grid: PlaneGrid<Species>,
+    /// Grid changes not yet applied (see [`GridOp`]); empty between steps.
+    pending: Vec<GridOp>,
     /// Which animat stands on each cell (always maintained; read by perception when
     /// `cell_search` is on).
     cells: CellIndex,
@@ -200,6 +202,17 @@ struct Tally {
     nearest: u64,
     count: u64,
     evals: u64,
+    /// A query needed the grid while it lagged behind the logged changes.
+    stale: bool,
+}
+
+/// A change of the grid, logged during a step and applied in order before the grid is next
+/// read (a loop of independent updates instead of one dependent cache miss per move).
+#[derive(Debug, Clone, Copy)]
+enum GridOp {
+    Insert(u64, Pos, Species),
+    Remove(u64),
+    Move(u64, Pos),
 }
 
 /// Half-side of the square of cells [`Near::rows`] holds.
@@ -340,6 +353,7 @@ impl World {
             crowd2: c * c,
             cell_search: grid.box_size() != spatial::plane::BoxSize::None,
             grid,
+            pending: Vec::new(),
             cells: CellIndex::default(),
             cell_evals: 0,
             order: Vec::new(),
@@ -436,11 +450,44 @@ impl World {
         age: u32,
         hunger: u32,
     ) -> Result<u64, WorldError> {
+        let id = self.add_deferred(species, pos, age, hunger)?;
+        self.flush_grid();
+        Ok(id)
+    }
+
+    /// Brings the grid up to date with the changes logged in `pending`, in order.
+    fn flush_grid(&mut self) {
+        for op in self.pending.drain(..) {
+            match op {
+                GridOp::Insert(id, pos, species) => self
+                    .grid
+                    .insert(id, pos, species)
+                    .expect("ids are never reused"),
+                GridOp::Remove(id) => {
+                    self.grid.remove(id).expect("a live animat is in the grid");
+                }
+                GridOp::Move(id, to) => {
+                    self.grid
+                        .move_to(id, to)
+                        .expect("a live animat is in the grid");
+                }
+            }
+        }
+    }
+
+    /// [`World::add`], with the grid's insertion logged in `pending`.
+    fn add_deferred(
+        &mut self,
+        species: Species,
+        pos: Pos,
+        age: u32,
+        hunger: u32,
+    ) -> Result<u64, WorldError> {
         if self.cells.occupied(pos) {
             return Err(WorldError::Occupied(pos));
         }
         let id = self.next_id;
-        self.grid.insert(id, pos, species)?;
+        self.pending.push(GridOp::Insert(id, pos, species));
         self.cells
             .set(pos, kind_byte(species == Species::Rabbit), id);
         self.next_id += 1;
@@ -649,6 +696,7 @@ impl World {
         self.flags.truncate(w);
         self.eaten.clear();
         self.steps += 1;
+        self.flush_grid();
         let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals;
         StepStats {
@@ -668,17 +716,23 @@ impl World {
     /// moves or breeds and the cell-index fast path is on: applying it reads its free
     /// neighbours from them.
     fn decide_near(&mut self, a: &Animat) -> (Action, Option<[u64; NEAR_ROWS]>) {
-        let mut t = Tally::default();
-        let act = {
+        let (act, t) = loop {
+            let mut t = Tally::default();
             let mut near = self.near(a);
             let act = self.decide_in(a, &mut near, &mut t);
+            if t.stale {
+                // A query needed the grid while changes were still logged: bring it up to
+                // date and decide again (the first attempt changed nothing).
+                self.flush_grid();
+                continue;
+            }
             let rows = match act {
                 Action::Step(_) | Action::Wander | Action::Breed if near.w.is_some() => {
                     Some(*near.rows(a.pos))
                 }
                 _ => None,
             };
-            (act, rows)
+            break ((act, rows), t);
         };
         self.queries.adjacent += t.adjacent;
         self.queries.nearest += t.nearest;
@@ -698,6 +752,14 @@ impl World {
             },
             rows: None,
         }
+    }
+
+    /// Whether the grid lags behind the logged changes; if so, notes in `t` that the
+    /// decision must be made again after [`World::flush_grid`].
+    #[inline]
+    fn stale(&self, t: &mut Tally) -> bool {
+        t.stale = !self.pending.is_empty();
+        t.stale
     }
 
     fn decide_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> Action {
@@ -808,6 +870,9 @@ impl World {
             }
             return None;
         }
+        if self.stale(t) {
+            return None;
+        }
         let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
@@ -820,6 +885,9 @@ impl World {
             let found = DIRECTIONS.iter().any(|d| row_cell(rows, d[0], d[1]) == kb);
             t.evals += u64::from(found);
             return found;
+        }
+        if self.stale(t) {
+            return false;
         }
         self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
     }
@@ -904,6 +972,9 @@ impl World {
             }
             t.evals += evals;
         }
+        if self.stale(t) {
+            return None;
+        }
         let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
@@ -947,6 +1018,9 @@ impl World {
                 t.evals += count as u64;
                 return count >= n;
             }
+        }
+        if self.stale(t) {
+            return false;
         }
         self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
     }
@@ -993,6 +1067,9 @@ impl World {
                 return found;
             }
         }
+        if self.stale(t) {
+            return false;
+        }
         self.grid
             .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
     }
@@ -1015,9 +1092,7 @@ impl World {
         if !self.is_free(to, d, rows) {
             return;
         }
-        self.grid
-            .move_to(a.id, to)
-            .expect("a live animat is in the grid");
+        self.pending.push(GridOp::Move(a.id, to));
         self.cells.relocate(a.pos, to);
         a.pos = to;
     }
@@ -1036,9 +1111,7 @@ impl World {
                 let rabbit = self.cells.id(pos);
                 self.eaten.insert(rabbit);
                 self.rabbits -= 1;
-                self.grid
-                    .remove(rabbit)
-                    .expect("a live animat is in the grid");
+                self.pending.push(GridOp::Remove(rabbit));
                 self.cells.clear(pos);
                 a.hunger = 0;
             }
@@ -1062,7 +1135,7 @@ impl World {
                 }
                 if n > 0 {
                     let c = free[self.action_rng.random_range(0..n)];
-                    self.add(a.species, c, 0, 0)
+                    self.add_deferred(a.species, c, 0, 0)
                         .expect("the birth cell was free");
                 }
             }
@@ -1080,7 +1153,7 @@ impl World {
             Species::Fox => self.foxes -= 1,
             Species::Rabbit => self.rabbits -= 1,
         }
-        self.grid.remove(id).expect("a live animat is in the grid");
+        self.pending.push(GridOp::Remove(id));
         self.cells.clear(pos);
     }
 
