@@ -29,6 +29,10 @@ const EDGE_GUARD: i64 = 4 * TILE;
 /// The kind byte of a free cell.
 pub const FREE: u8 = 0;
 
+/// The species bits of a cell byte: [`FREE`], 1 fox or 2 rabbit. The other six bits hold the
+/// occupant's id bucket (see [`CellIndex::bucket`]).
+pub const SPECIES: u8 = 3;
+
 /// Kind byte of an occupant: 1 fox, 2 rabbit (never [`FREE`]).
 #[inline]
 pub fn kind_byte(rabbit: bool) -> u8 {
@@ -57,6 +61,9 @@ pub struct CellIndex {
     dy0: i64,
     dw: u64,
     dh: u64,
+    /// Ids map to buckets `min(63, (id - bucket_base) >> bucket_shift)`.
+    bucket_base: u64,
+    bucket_shift: u32,
 }
 
 /// Largest number of entries of the dense tile directory (1 MiB); tiles beyond the rectangle
@@ -142,8 +149,48 @@ impl CellIndex {
     pub fn kind(&self, p: [i64; 2]) -> u8 {
         let (key, off) = split(p);
         match self.slot(key) {
-            Some(t) => self.tiles[t as usize].kinds[off],
+            Some(t) => self.tiles[t as usize].kinds[off] & SPECIES,
             None => FREE,
+        }
+    }
+
+    /// The bucket of an id, kept in the top six bits of its cell byte: non-decreasing in the
+    /// id, so between two animats the one with the lower bucket has the lower id, and only
+    /// equal buckets need the ids themselves.
+    #[inline]
+    pub fn bucket(&self, id: u64) -> u8 {
+        let d = id.saturating_sub(self.bucket_base) >> self.bucket_shift;
+        d.min(63) as u8
+    }
+
+    /// Whether the bucket of `id` would exceed 63 (and be capped).
+    pub fn bucket_capped(&self, id: u64) -> bool {
+        id.saturating_sub(self.bucket_base) >> self.bucket_shift > 63
+    }
+
+    /// The lowest id bucket 0 stands for, and the bucket width (log2).
+    pub fn bucket_range(&self) -> (u64, u32) {
+        (self.bucket_base, self.bucket_shift)
+    }
+
+    /// Maps ids to buckets afresh (`base`, `shift < 64`) and rewrites the bucket of every
+    /// animat, given as (cell, id).
+    pub fn rebucket(
+        &mut self,
+        base: u64,
+        shift: u32,
+        animats: impl Iterator<Item = ([i64; 2], u64)>,
+    ) {
+        debug_assert!(shift < 64);
+        self.bucket_base = base;
+        self.bucket_shift = shift;
+        for (p, id) in animats {
+            let b = self.bucket(id) << 2;
+            let (key, off) = split(p);
+            if let Some(t) = self.slot(key) {
+                let k = &mut self.tiles[t as usize].kinds[off];
+                *k = (*k & SPECIES) | b;
+            }
         }
     }
 
@@ -155,7 +202,8 @@ impl CellIndex {
 
     /// Puts animat `id` of kind byte `k != FREE` on the free cell `p`.
     pub fn set(&mut self, p: [i64; 2], k: u8, id: u64) {
-        debug_assert!(k != FREE);
+        debug_assert!(k != FREE && k & SPECIES == k);
+        let b = self.bucket(id) << 2;
         let (key, off) = split(p);
         let t = match self.slot(key) {
             Some(t) => t,
@@ -183,7 +231,7 @@ impl CellIndex {
         };
         let tile = &mut self.tiles[t as usize];
         debug_assert_eq!(tile.kinds[off], FREE, "cell {p:?} already occupied");
-        tile.kinds[off] = k;
+        tile.kinds[off] = k | b;
         tile.ids[off] = id;
         tile.count += 1;
     }
@@ -314,12 +362,19 @@ impl Window<'_> {
     /// The kind byte on cell `(x, y)`, which must lie within the window's square.
     #[inline(always)]
     pub fn at(&self, x: i64, y: i64) -> u8 {
+        self.byte(x, y) & SPECIES
+    }
+
+    /// The whole cell byte on `(x, y)`: kind and id bucket (within the window's square).
+    #[inline(always)]
+    pub fn byte(&self, x: i64, y: i64) -> u8 {
         let (t, off) = self.locate(x, y);
         self.kinds[t][off]
     }
 
-    /// The kind bytes of the 8 cells `x0 .. x0 + 8` of rows `y0 .. y0 + N`, one `u64` per
-    /// row (byte `i` is cell `x0 + i`). These cells must lie within the window's square.
+    /// The cell bytes (kind and id bucket) of the 8 cells `x0 .. x0 + 8` of rows
+    /// `y0 .. y0 + N`, one `u64` per row (byte `i` is cell `x0 + i`). These cells must lie
+    /// within the window's square.
     #[inline]
     pub fn rows<const N: usize>(&self, x0: i64, y0: i64) -> [u64; N] {
         // Kind bytes are stored in 8 x 8 blocks, each block row 8 consecutive bytes: the 8
@@ -426,7 +481,10 @@ mod tests {
         }
         let w = c.window([5001, -9001], WINDOW_MAX).unwrap();
         assert_eq!(w.at(5000, -9000), kind_byte(false));
-        assert_eq!(w.rows::<1>(4998, -9000)[0], u64::from(kind_byte(false)) << 16);
+        assert_eq!(
+            w.rows::<1>(4998, -9000)[0],
+            u64::from(kind_byte(false) | c.bucket(103) << 2) << 16
+        );
         for &p in &far {
             c.clear(p);
             assert!(!c.occupied(p));

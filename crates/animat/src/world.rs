@@ -1,7 +1,7 @@
 //! The animat world: animats on the unbounded plane, their rules, and one step of the model
 //! (MODELS.md section 3; seed 000, section II.B).
 
-use crate::cells::{CellIndex, FREE, WINDOW_MAX, Window, kind_byte};
+use crate::cells::{CellIndex, FREE, SPECIES, WINDOW_MAX, Window, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
@@ -246,6 +246,12 @@ impl Near<'_> {
 /// The kind byte of cell `(x + dx, y + dy)` from [`Near::rows`] (`|dx|, |dy| <= 2`).
 #[inline(always)]
 fn row_cell(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
+    row_byte(rows, dx, dy) & SPECIES
+}
+
+/// The whole cell byte (kind and id bucket) of cell `(x + dx, y + dy)` from [`Near::rows`].
+#[inline(always)]
+fn row_byte(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
     (rows[(dy + NEAR_HALF) as usize] >> (8 * (dx + NEAR_HALF))) as u8
 }
 
@@ -297,33 +303,47 @@ fn count_in(bits: &[u64; NEAR_ROWS], class: &[u64; NEAR_ROWS]) -> u64 {
     sum.wrapping_mul(0x0101_0101_0101_0101) >> 56
 }
 
-/// The cell of `bits` in `class` with the lowest id (`n` of them, `n >= 1`), around `p`;
-/// ids are read only when `n > 1`.
+/// The cell of `bits` in `class` with the lowest id (`n` of them, `n >= 1`), around `p`:
+/// the lowest id bucket of the cell bytes in `rows` decides, and ids are read only when
+/// several cells share it.
 fn lowest_in(
     bits: &[u64; NEAR_ROWS],
     class: &[u64; NEAR_ROWS],
     n: u64,
     p: Pos,
+    rows: &[u64; NEAR_ROWS],
     w: &Window<'_>,
 ) -> Pos {
-    let mut best: Option<(Pos, u64)> = None;
-    for (r, (&b, &m)) in bits.iter().zip(class).enumerate() {
-        let mut hits = b & m;
+    // (dx, dy, bucket) of each candidate; a class has at most 8 cells.
+    let mut cand = [(0i64, 0i64, 0u8); 8];
+    let mut m = 0;
+    for (r, (&b, &c)) in bits.iter().zip(class).enumerate() {
+        let mut hits = b & c;
         while hits != 0 {
-            let byte = i64::from(hits.trailing_zeros() / 8);
+            let dx = i64::from(hits.trailing_zeros() / 8) - NEAR_HALF;
+            let dy = r as i64 - NEAR_HALF;
             hits &= hits - 1;
-            let c = [
-                p[0] + byte - NEAR_HALF,
-                p[1] + r as i64 - NEAR_HALF,
-            ];
-            if n == 1 {
-                return c;
-            }
-            let id = w.id(c[0], c[1]);
-            if best.is_none_or(|(_, bi)| id < bi) {
-                best = Some((c, id));
-            }
+            cand[m] = (dx, dy, row_byte(rows, dx, dy) >> 2);
+            m += 1;
         }
+    }
+    debug_assert_eq!(m as u64, n);
+    let cand = &cand[..m];
+    let low = cand.iter().map(|c| c.2).min().unwrap_or(0);
+    let mut best: Option<(Pos, Option<u64>)> = None;
+    for &(dx, dy, b) in cand {
+        if b != low {
+            continue;
+        }
+        let c = [p[0] + dx, p[1] + dy];
+        best = match best {
+            None => Some((c, None)),
+            Some((bc, bid)) => {
+                let bi = bid.unwrap_or_else(|| w.id(bc[0], bc[1]));
+                let id = w.id(c[0], c[1]);
+                Some(if id < bi { (c, Some(id)) } else { (bc, Some(bi)) })
+            }
+        };
     }
     best.map_or(p, |(c, _)| c)
 }
@@ -628,6 +648,7 @@ impl World {
         self.total_distance_evals += evals_before;
         self.search_seconds = 0.0;
         let n = self.recs.len();
+        self.maybe_rebucket(n);
         let mut order = std::mem::take(&mut self.order);
         order.clear();
         order.extend(0..n as u32);
@@ -703,6 +724,32 @@ impl World {
             search_seconds: self.search_seconds,
             distance_evals: evals,
         }
+    }
+
+    /// Spreads the id buckets of the cell bytes ([`CellIndex::bucket`]) over the ids that can
+    /// be alive during the next step (the live ones, sorted in `recs`, and at most `n`
+    /// newborns) when the top bucket could overflow or the lower half of the buckets has
+    /// gone unused. Buckets only speed up tie-breaks; any non-decreasing map gives the same
+    /// answers.
+    fn maybe_rebucket(&mut self, n: usize) {
+        let Some(first) = self.recs.first() else {
+            return;
+        };
+        let lo = first.id;
+        let hi = self.next_id.saturating_add(n as u64);
+        let (base, shift) = self.cells.bucket_range();
+        let wasted = lo.saturating_sub(base) >> shift >= 32;
+        if !self.cells.bucket_capped(hi) && !wasted {
+            return;
+        }
+        // The smallest width that keeps `hi` within bucket 47 (room for later births).
+        let span = hi - lo;
+        let mut s = 0;
+        while span >> s > 47 {
+            s += 1;
+        }
+        self.cells
+            .rebucket(lo, s, self.recs.iter().map(|r| (r.pos, r.id)));
     }
 
     /// Chooses the action of animat `a`: the first rule whose condition holds. Asks only the
@@ -865,7 +912,7 @@ impl World {
                 let n = count_in(&bits, class);
                 if n > 0 {
                     t.evals += n;
-                    return Some(lowest_in(&bits, class, n, a.pos, &w));
+                    return Some(lowest_in(&bits, class, n, a.pos, rows, &w));
                 }
             }
             return None;
@@ -910,7 +957,8 @@ impl World {
             // Rings 1 and 2 from the row words when they lie within vision.
             let mut k_first = 1;
             if self.params.vision >= 3 {
-                let mut bits = kind_bits(near.rows(a.pos), kb);
+                let rows = near.rows(a.pos);
+                let mut bits = kind_bits(rows, kb);
                 // Not the animat itself.
                 bits[NEAR_HALF as usize] &= !(1 << (8 * NEAR_HALF));
                 for ring in [&RING_CLASSES[..2], &RING_CLASSES[2..]] {
@@ -920,33 +968,36 @@ impl World {
                         t.evals += total;
                         for (class, n) in ring.iter().zip(counts) {
                             if n > 0 {
-                                return Some(lowest_in(&bits, class, n, a.pos, &w));
+                                return Some(lowest_in(&bits, class, n, a.pos, rows, &w));
                             }
                         }
                     }
                 }
                 k_first = 3;
             }
-            // Best as (d2, position, id once read): ids are read only to break a tie of
-            // distances (they live in a larger array that is rarely in cache).
-            type Best = Option<(u64, Pos, Option<u64>)>;
+            // Best as (d2, position, id bucket, id once read): a tie of distances goes to
+            // the lower bucket, and ids (in a larger array that is rarely in cache) are read
+            // only when the buckets are equal too.
+            type Best = Option<(u64, Pos, u8, Option<u64>)>;
             let mut best: Best = None;
             let mut look = |dx: i64, dy: i64, best: &mut Best| {
-                if w.at(x + dx, y + dy) == kb {
+                let byte = w.byte(x + dx, y + dy);
+                if byte & SPECIES == kb {
                     evals += 1;
                     let d2 = (dx * dx + dy * dy) as u64;
                     let c = [x + dx, y + dy];
+                    let cb = byte >> 2;
                     match best {
                         _ if d2 > v2 => {}
-                        None => *best = Some((d2, c, None)),
-                        Some((bd, bp, bid)) => {
-                            if d2 < *bd {
-                                *best = Some((d2, c, None));
-                            } else if d2 == *bd {
+                        None => *best = Some((d2, c, cb, None)),
+                        Some((bd, bp, bb, bid)) => {
+                            if d2 < *bd || (d2 == *bd && cb < *bb) {
+                                *best = Some((d2, c, cb, None));
+                            } else if d2 == *bd && cb == *bb {
                                 let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
                                 let id = w.id(c[0], c[1]);
                                 if id < bi {
-                                    *best = Some((d2, c, Some(id)));
+                                    *best = Some((d2, c, cb, Some(id)));
                                 }
                             }
                         }
@@ -965,9 +1016,9 @@ impl World {
                 // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
                 // than that is final (an equally near one could still win on id).
                 let next = ((k + 1) * (k + 1)) as u64;
-                if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
+                if best.is_some_and(|(bd, _, _, _)| bd < next) || next > v2 {
                     t.evals += evals;
-                    return best.map(|(_, p, _)| p);
+                    return best.map(|(_, p, _, _)| p);
                 }
             }
             t.evals += evals;
