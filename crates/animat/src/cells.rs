@@ -2,17 +2,20 @@
 //! species) stands on each cell.
 //!
 //! The plane is cut into square tiles of [`TILE`] x [`TILE`] cells; each tile that holds an
-//! animat has a kind byte per cell (0 free, 1 fox, 2 rabbit) and, in a parallel array, the id
-//! of the animat on the cell. Kind bytes are stored in 8 x 8 blocks of 64 bytes, so a cell's
-//! whole 5 x 5 neighbourhood lies in at most four cache lines, and the kind bytes of a
-//! population of 1e5 at density 0.2 fit in L2. Tiles are kept in a vector, and a hash map (rustc-hash, already used by
-//! `spatial`) goes from tile coordinates to the tile's slot. A tile that empties returns to a
+//! animat has a cell byte per cell and, in a parallel array, the id of the animat on the cell.
+//! A cell byte holds the kind in its low two bits ([`SPECIES`]: 0 free, 1 fox, 2 rabbit) and
+//! the occupant's id bucket in the other six ([`CellIndex::bucket`]), which settles most id
+//! comparisons without the ids. Cell bytes are stored in 8 x 8 blocks of 64 bytes, so a
+//! cell's whole 5 x 5 neighbourhood lies in at most four cache lines. Tiles are kept in a
+//! vector; a dense directory over the rectangle of tile coordinates in use (grown with a
+//! margin, at most 2^18 entries) and, beyond it, a hash map (rustc-hash, already used
+//! by `spatial`) go from tile coordinates to the tile's slot. A tile that empties returns to a
 //! free list, so memory follows the occupied area, not the area the animats ever roamed.
 //!
-//! Small-radius perception (adjacency, overcrowding, and the first few cell rings of a nearest
-//! or counting query) reads cells through a [`Window`]: the at most 2 x 2 tiles covering a
-//! square of half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four
-//! hash lookups per query; every cell read after that is an array index.
+//! Perception reads cells through a [`Window`]: the at most 2 x 2 tiles covering a square of
+//! half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four directory
+//! lookups; every cell read after that is an array index, and [`Window::rows`] reads 8 cells
+//! of a row as one word.
 
 use rustc_hash::FxHashMap;
 

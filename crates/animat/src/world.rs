@@ -5,8 +5,8 @@ use crate::cells::{CellIndex, FREE, SPECIES, WINDOW_MAX, Window, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
-use spatial::plane::{PlaneError, PlaneGrid, Pos};
 use rustc_hash::FxHashSet;
+use spatial::plane::{PlaneError, PlaneGrid, Pos};
 use std::time::Instant;
 
 /// Random stream purposes of a run (each its own stream of the run seed).
@@ -341,7 +341,11 @@ fn lowest_in(
             Some((bc, bid)) => {
                 let bi = bid.unwrap_or_else(|| w.id(bc[0], bc[1]));
                 let id = w.id(c[0], c[1]);
-                Some(if id < bi { (c, Some(id)) } else { (bc, Some(bi)) })
+                Some(if id < bi {
+                    (c, Some(id))
+                } else {
+                    (bc, Some(bi))
+                })
             }
         };
     }
@@ -517,8 +521,11 @@ impl World {
             age,
             hunger: if species == Species::Fox { hunger } else { 0 },
         });
-        self.flags
-            .push(if species == Species::Rabbit { RABBIT } else { 0 });
+        self.flags.push(if species == Species::Rabbit {
+            RABBIT
+        } else {
+            0
+        });
         match species {
             Species::Fox => self.foxes += 1,
             Species::Rabbit => self.rabbits += 1,
