@@ -392,7 +392,7 @@ impl Window<'_> {
         let (tb, xb) = (usize::from(b >= TILE), (((b >> 3) & 7) << 6) as usize);
         let load = |t: usize, o: usize| -> u64 {
             let o = o & (CELLS - 8);
-            let bytes: [u8; 8] = self.kinds[t][o..o + 8]
+            let bytes: [u8; 8] = self.kinds[t & 3][o..o + 8]
                 .try_into()
                 .expect("a block row is 8 bytes");
             u64::from_le_bytes(bytes)

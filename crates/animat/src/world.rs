@@ -237,9 +237,17 @@ impl Near<'_> {
     /// present.
     #[inline]
     fn rows(&mut self, p: Pos) -> &[u64; NEAR_ROWS] {
-        let w = self.w.as_ref().expect("rows need the window");
-        self.rows
-            .get_or_insert_with(|| w.rows::<NEAR_ROWS>(p[0] - NEAR_HALF, p[1] - NEAR_HALF))
+        self.parts(p).expect("rows need the window").1
+    }
+
+    /// The window and the row words ([`Near::rows`]), if the window is present.
+    #[inline]
+    fn parts(&mut self, p: Pos) -> Option<(&Window<'_>, &[u64; NEAR_ROWS])> {
+        let w = self.w.as_ref()?;
+        let rows = self
+            .rows
+            .get_or_insert_with(|| w.rows::<NEAR_ROWS>(p[0] - NEAR_HALF, p[1] - NEAR_HALF));
+        Some((w, rows))
     }
 }
 
@@ -908,8 +916,7 @@ impl World {
         t: &mut Tally,
     ) -> Option<Pos> {
         t.adjacent += 1;
-        if let Some(w) = near.w {
-            let rows = near.rows(a.pos);
+        if let Some((w, rows)) = near.parts(a.pos) {
             let kb = kind_byte(kind == Species::Rabbit);
             // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
             // Ids are read only to break a tie (they live in a larger array that is rarely in
@@ -919,7 +926,7 @@ impl World {
                 let n = count_in(&bits, class);
                 if n > 0 {
                     t.evals += n;
-                    return Some(lowest_in(&bits, class, n, a.pos, rows, &w));
+                    return Some(lowest_in(&bits, class, n, a.pos, rows, w));
                 }
             }
             return None;
@@ -933,8 +940,7 @@ impl World {
 
     fn adjacent(&self, a: &Animat, kind: Species, near: &mut Near<'_>, t: &mut Tally) -> bool {
         t.adjacent += 1;
-        if near.w.is_some() {
-            let rows = near.rows(a.pos);
+        if let Some((_, rows)) = near.parts(a.pos) {
             let kb = kind_byte(kind == Species::Rabbit);
             let found = DIRECTIONS.iter().any(|d| row_cell(rows, d[0], d[1]) == kb);
             t.evals += u64::from(found);
@@ -955,7 +961,7 @@ impl World {
         t: &mut Tally,
     ) -> Option<Pos> {
         t.nearest += 1;
-        if let Some(w) = near.w {
+        if near.w.is_some() {
             let k_max = RING_MAX.min(self.params.vision);
             let kb = kind_byte(kind == Species::Rabbit);
             let [x, y] = a.pos;
@@ -964,7 +970,7 @@ impl World {
             // Rings 1 and 2 from the row words when they lie within vision.
             let mut k_first = 1;
             if self.params.vision >= 3 {
-                let rows = near.rows(a.pos);
+                let (w, rows) = near.parts(a.pos).expect("the window is present");
                 let mut bits = kind_bits(rows, kb);
                 // Not the animat itself.
                 bits[NEAR_HALF as usize] &= !(1 << (8 * NEAR_HALF));
@@ -975,13 +981,14 @@ impl World {
                         t.evals += total;
                         for (class, n) in ring.iter().zip(counts) {
                             if n > 0 {
-                                return Some(lowest_in(&bits, class, n, a.pos, rows, &w));
+                                return Some(lowest_in(&bits, class, n, a.pos, rows, w));
                             }
                         }
                     }
                 }
                 k_first = 3;
             }
+            let w = near.w.as_ref().expect("the window is present");
             // Best as (d2, position, id bucket, id once read): a tie of distances goes to
             // the lower bucket, and ids (in a larger array that is rarely in cache) are read
             // only when the buckets are equal too.
@@ -1047,7 +1054,7 @@ impl World {
         t.count += 1;
         let n = self.params.crowd_max as usize + 1;
         let r = self.params.crowd_radius;
-        if let Some(w) = near.w {
+        if near.w.is_some() {
             if r <= NEAR_HALF {
                 // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
                 // the masks keep the cells within the radius.
@@ -1063,6 +1070,7 @@ impl World {
                 return count >= n;
             }
             if r <= RING_MAX {
+                let w = near.w.as_ref().expect("the window is present");
                 let [x, y] = a.pos;
                 let mut count = 0;
                 for d in &self.crowd_offsets {
@@ -1092,7 +1100,7 @@ impl World {
     fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
         t.count += 1;
         let n = self.params.prey_needed as usize;
-        if let (Some(w), true) = (near.w, n > 0) {
+        if let (Some(w), true) = (near.w.as_ref(), n > 0) {
             let k_max = RING_MAX.min(self.params.vision);
             let [x, y] = a.pos;
             let v2 = self.vision2;
