@@ -2,17 +2,20 @@
 //! species) stands on each cell.
 //!
 //! The plane is cut into square tiles of [`TILE`] x [`TILE`] cells; each tile that holds an
-//! animat has a kind byte per cell (0 free, 1 fox, 2 rabbit) and, in a parallel array, the id
-//! of the animat on the cell. Kind bytes are stored in 8 x 8 blocks of 64 bytes, so a cell's
-//! whole 5 x 5 neighbourhood lies in at most four cache lines, and the kind bytes of a
-//! population of 1e5 at density 0.2 fit in L2. Tiles are kept in a vector, and a hash map (rustc-hash, already used by
-//! `spatial`) goes from tile coordinates to the tile's slot. A tile that empties returns to a
+//! animat has a cell byte per cell and, in a parallel array, the id of the animat on the cell.
+//! A cell byte holds the kind in its low two bits ([`SPECIES`]: 0 free, 1 fox, 2 rabbit) and
+//! the occupant's id bucket in the other six ([`CellIndex::bucket`]), which settles most id
+//! comparisons without the ids. Cell bytes are stored in 8 x 8 blocks of 64 bytes, so a
+//! cell's whole 5 x 5 neighbourhood lies in at most four cache lines. Tiles are kept in a
+//! vector; a dense directory over the rectangle of tile coordinates in use (grown with a
+//! margin, at most 2^18 entries) and, beyond it, a hash map (rustc-hash, already used
+//! by `spatial`) go from tile coordinates to the tile's slot. A tile that empties returns to a
 //! free list, so memory follows the occupied area, not the area the animats ever roamed.
 //!
-//! Small-radius perception (adjacency, overcrowding, and the first few cell rings of a nearest
-//! or counting query) reads cells through a [`Window`]: the at most 2 x 2 tiles covering a
-//! square of half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four
-//! hash lookups per query; every cell read after that is an array index.
+//! Perception reads cells through a [`Window`]: the at most 2 x 2 tiles covering a square of
+//! half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four directory
+//! lookups; every cell read after that is an array index, and [`Window::rows`] reads 8 cells
+//! of a row as one word.
 
 use rustc_hash::FxHashMap;
 
@@ -28,6 +31,10 @@ const EDGE_GUARD: i64 = 4 * TILE;
 
 /// The kind byte of a free cell.
 pub const FREE: u8 = 0;
+
+/// The species bits of a cell byte: [`FREE`], 1 fox or 2 rabbit. The other six bits hold the
+/// occupant's id bucket (see [`CellIndex::bucket`]).
+pub const SPECIES: u8 = 3;
 
 /// Kind byte of an occupant: 1 fox, 2 rabbit (never [`FREE`]).
 #[inline]
@@ -45,10 +52,26 @@ struct Tile {
 /// The cell index; see the module documentation.
 #[derive(Debug, Clone, Default)]
 pub struct CellIndex {
+    /// Every tile's slot by tile coordinates.
     map: FxHashMap<[i64; 2], u32>,
     tiles: Vec<Tile>,
     free: Vec<u32>,
+    /// Dense directory of the tiles in the rectangle of tile coordinates `[dx0, dx0 + dw) x
+    /// [dy0, dy0 + dh)`: slot + 1, or 0 for no tile. Complete for its rectangle (a lookup
+    /// there never needs the map).
+    dir: Vec<u32>,
+    dx0: i64,
+    dy0: i64,
+    dw: u64,
+    dh: u64,
+    /// Ids map to buckets `min(63, (id - bucket_base) >> bucket_shift)`.
+    bucket_base: u64,
+    bucket_shift: u32,
 }
+
+/// Largest number of entries of the dense tile directory (1 MiB); tiles beyond the rectangle
+/// it can cover are found through the hash map alone.
+const DIR_MAX: u64 = 1 << 18;
 
 const CELLS: usize = (TILE * TILE) as usize;
 
@@ -66,13 +89,111 @@ fn split(p: [i64; 2]) -> ([i64; 2], usize) {
 }
 
 impl CellIndex {
+    /// The slot of the tile with coordinates `key`, if there is one.
+    #[inline(always)]
+    fn slot(&self, key: [i64; 2]) -> Option<u32> {
+        let u = key[0].wrapping_sub(self.dx0) as u64;
+        let v = key[1].wrapping_sub(self.dy0) as u64;
+        if u < self.dw && v < self.dh {
+            self.dir[(v * self.dw + u) as usize].checked_sub(1)
+        } else {
+            self.map.get(&key).copied()
+        }
+    }
+
+    /// Whether tile coordinates `key` lie in the directory's rectangle.
+    fn in_dir(&self, key: [i64; 2]) -> Option<usize> {
+        let u = key[0].wrapping_sub(self.dx0) as u64;
+        let v = key[1].wrapping_sub(self.dy0) as u64;
+        (u < self.dw && v < self.dh).then(|| (v * self.dw + u) as usize)
+    }
+
+    /// Records a new tile `t` at `key` in the map and, growing the directory's rectangle
+    /// (with a margin) when it stays within [`DIR_MAX`] entries, in the directory.
+    fn register(&mut self, key: [i64; 2], t: u32) {
+        self.map.insert(key, t);
+        if let Some(i) = self.in_dir(key) {
+            self.dir[i] = t + 1;
+            return;
+        }
+        // Tile coordinates are within +-2^58, so these sums cannot overflow.
+        let (x0, x1, y0, y1) = if self.dw == 0 {
+            (key[0], key[0], key[1], key[1])
+        } else {
+            (
+                self.dx0.min(key[0]),
+                (self.dx0 + self.dw as i64 - 1).max(key[0]),
+                self.dy0.min(key[1]),
+                (self.dy0 + self.dh as i64 - 1).max(key[1]),
+            )
+        };
+        let mx = ((x1 - x0) / 4).max(2);
+        let my = ((y1 - y0) / 4).max(2);
+        let (x0, x1, y0, y1) = (x0 - mx, x1 + mx, y0 - my, y1 + my);
+        let (w, h) = ((x1 - x0 + 1) as u64, (y1 - y0 + 1) as u64);
+        if w.saturating_mul(h) > DIR_MAX {
+            return;
+        }
+        self.dx0 = x0;
+        self.dy0 = y0;
+        self.dw = w;
+        self.dh = h;
+        self.dir.clear();
+        self.dir.resize((w * h) as usize, 0);
+        for (&k, &t) in &self.map {
+            if let Some(i) = self.in_dir(k) {
+                self.dir[i] = t + 1;
+            }
+        }
+    }
+
     /// The kind byte on cell `p` ([`FREE`] when free).
     #[inline]
     pub fn kind(&self, p: [i64; 2]) -> u8 {
         let (key, off) = split(p);
-        match self.map.get(&key) {
-            Some(&t) => self.tiles[t as usize].kinds[off],
+        match self.slot(key) {
+            Some(t) => self.tiles[t as usize].kinds[off] & SPECIES,
             None => FREE,
+        }
+    }
+
+    /// The bucket of an id, kept in the top six bits of its cell byte: non-decreasing in the
+    /// id, so between two animats the one with the lower bucket has the lower id, and only
+    /// equal buckets need the ids themselves.
+    #[inline]
+    pub fn bucket(&self, id: u64) -> u8 {
+        let d = id.saturating_sub(self.bucket_base) >> self.bucket_shift;
+        d.min(63) as u8
+    }
+
+    /// Whether the bucket of `id` would exceed 63 (and be capped).
+    pub fn bucket_capped(&self, id: u64) -> bool {
+        id.saturating_sub(self.bucket_base) >> self.bucket_shift > 63
+    }
+
+    /// The lowest id bucket 0 stands for, and the bucket width (log2).
+    pub fn bucket_range(&self) -> (u64, u32) {
+        (self.bucket_base, self.bucket_shift)
+    }
+
+    /// Maps ids to buckets afresh (`base`, `shift < 64`) and rewrites the bucket of every
+    /// animat, given as (cell, id).
+    pub fn rebucket(
+        &mut self,
+        base: u64,
+        shift: u32,
+        animats: impl Iterator<Item = ([i64; 2], u64)>,
+    ) {
+        debug_assert!(shift < 64);
+        self.bucket_base = base;
+        self.bucket_shift = shift;
+        for (p, id) in animats {
+            let b = self.bucket(id) << 2;
+            let (key, off) = split(p);
+            if let Some(t) = self.slot(key) {
+                let k = &mut self.tiles[t as usize].kinds[off];
+                *k = (*k & SPECIES) | b;
+            }
         }
     }
 
@@ -84,10 +205,11 @@ impl CellIndex {
 
     /// Puts animat `id` of kind byte `k != FREE` on the free cell `p`.
     pub fn set(&mut self, p: [i64; 2], k: u8, id: u64) {
-        debug_assert!(k != FREE);
+        debug_assert!(k != FREE && k & SPECIES == k);
+        let b = self.bucket(id) << 2;
         let (key, off) = split(p);
-        let t = match self.map.get(&key) {
-            Some(&t) => t,
+        let t = match self.slot(key) {
+            Some(t) => t,
             None => {
                 let t = match self.free.pop() {
                     Some(t) => t,
@@ -106,13 +228,13 @@ impl CellIndex {
                         (self.tiles.len() - 1) as u32
                     }
                 };
-                self.map.insert(key, t);
+                self.register(key, t);
                 t
             }
         };
         let tile = &mut self.tiles[t as usize];
         debug_assert_eq!(tile.kinds[off], FREE, "cell {p:?} already occupied");
-        tile.kinds[off] = k;
+        tile.kinds[off] = k | b;
         tile.ids[off] = id;
         tile.count += 1;
     }
@@ -120,7 +242,7 @@ impl CellIndex {
     /// Frees cell `p` (which must be occupied).
     pub fn clear(&mut self, p: [i64; 2]) {
         let (key, off) = split(p);
-        let Some(&t) = self.map.get(&key) else {
+        let Some(t) = self.slot(key) else {
             debug_assert!(false, "clearing a cell of a missing tile");
             return;
         };
@@ -130,6 +252,9 @@ impl CellIndex {
         tile.count -= 1;
         if tile.count == 0 {
             self.map.remove(&key);
+            if let Some(i) = self.in_dir(key) {
+                self.dir[i] = 0;
+            }
             self.free.push(t);
         }
     }
@@ -139,7 +264,7 @@ impl CellIndex {
         let (kf, of) = split(from);
         let (kt, ot) = split(to);
         if kf == kt {
-            if let Some(&t) = self.map.get(&kf) {
+            if let Some(t) = self.slot(kf) {
                 let tile = &mut self.tiles[t as usize];
                 tile.kinds[ot] = tile.kinds[of];
                 tile.ids[ot] = tile.ids[of];
@@ -154,11 +279,10 @@ impl CellIndex {
     }
 
     /// Id of the animat on the occupied cell `p`.
-    fn id(&self, p: [i64; 2]) -> u64 {
+    pub fn id(&self, p: [i64; 2]) -> u64 {
         let (key, off) = split(p);
-        self.map
-            .get(&key)
-            .map_or(0, |&t| self.tiles[t as usize].ids[off])
+        self.slot(key)
+            .map_or(0, |t| self.tiles[t as usize].ids[off])
     }
 
     /// A window of half-side `k <= WINDOW_MAX` around `p`, or `None` when `p` is too close to
@@ -176,8 +300,8 @@ impl CellIndex {
         let tx1 = (p[0] + k) >> SHIFT;
         let ty1 = (p[1] + k) >> SHIFT;
         let fetch = |tx: i64, ty: i64| -> (&[u8; CELLS], &[u64; CELLS]) {
-            match self.map.get(&[tx, ty]) {
-                Some(&t) => {
+            match self.slot([tx, ty]) {
+                Some(t) => {
                     let t = &self.tiles[t as usize];
                     (&t.kinds, &t.ids)
                 }
@@ -241,8 +365,48 @@ impl Window<'_> {
     /// The kind byte on cell `(x, y)`, which must lie within the window's square.
     #[inline(always)]
     pub fn at(&self, x: i64, y: i64) -> u8 {
+        self.byte(x, y) & SPECIES
+    }
+
+    /// The whole cell byte on `(x, y)`: kind and id bucket (within the window's square).
+    #[inline(always)]
+    pub fn byte(&self, x: i64, y: i64) -> u8 {
         let (t, off) = self.locate(x, y);
         self.kinds[t][off]
+    }
+
+    /// The cell bytes (kind and id bucket) of the 8 cells `x0 .. x0 + 8` of rows
+    /// `y0 .. y0 + N`, one `u64` per row (byte `i` is cell `x0 + i`). These cells must lie
+    /// within the window's square.
+    #[inline]
+    pub fn rows<const N: usize>(&self, x0: i64, y0: i64) -> [u64; N] {
+        // Kind bytes are stored in 8 x 8 blocks, each block row 8 consecutive bytes: the 8
+        // cells are the tail of one block row and the head of the next (in the same tile or
+        // the next one along x).
+        let rx = x0 - self.bx;
+        let ry0 = y0 - self.by;
+        let a = rx & !7;
+        let b = a + 8;
+        let s = ((rx - a) * 8) as u32;
+        let (ta, xa) = (usize::from(a >= TILE), (((a >> 3) & 7) << 6) as usize);
+        let (tb, xb) = (usize::from(b >= TILE), (((b >> 3) & 7) << 6) as usize);
+        let load = |t: usize, o: usize| -> u64 {
+            let o = o & (CELLS - 8);
+            let bytes: [u8; 8] = self.kinds[t & 3][o..o + 8]
+                .try_into()
+                .expect("a block row is 8 bytes");
+            u64::from_le_bytes(bytes)
+        };
+        let mut out = [0u64; N];
+        for (i, row) in out.iter_mut().enumerate() {
+            let ry = ry0 + i as i64;
+            let ty = usize::from(ry >= TILE) << 1;
+            let yo = ((((ry >> 3) & 7) << 9) | ((ry & 7) << 3)) as usize;
+            let lo = load(ta | ty, xa | yo);
+            let hi = load(tb | ty, xb | yo);
+            *row = ((u128::from(hi) << 64 | u128::from(lo)) >> s) as u64;
+        }
+        out
     }
 
     /// The id of the animat on the occupied cell `(x, y)` (within the window's square).
@@ -301,6 +465,35 @@ mod tests {
         assert!(c.is_empty());
         assert_eq!(c.len(), 0);
         assert!(c.window([i64::MAX, 0], 1).is_none());
+        // Tiles far apart: the directory covers some, the map the rest; all are found, and
+        // a tile that empties is gone from both.
+        let far = [
+            [3, 3],
+            [1 << 40, 0],
+            [-(1 << 40), 7],
+            [5000, -9000],
+            [i64::MAX - 5, i64::MIN + 3],
+            [i64::MIN, i64::MAX],
+        ];
+        for (i, &p) in far.iter().enumerate() {
+            c.set(p, kind_byte(i % 2 == 0), 100 + i as u64);
+        }
+        for (i, &p) in far.iter().enumerate() {
+            assert_eq!(c.kind(p), kind_byte(i % 2 == 0), "{p:?}");
+            assert_eq!(c.id(p), 100 + i as u64);
+        }
+        let w = c.window([5001, -9001], WINDOW_MAX).unwrap();
+        assert_eq!(w.at(5000, -9000), kind_byte(false));
+        assert_eq!(
+            w.rows::<1>(4998, -9000)[0],
+            u64::from(kind_byte(false) | c.bucket(103) << 2) << 16
+        );
+        for &p in &far {
+            c.clear(p);
+            assert!(!c.occupied(p));
+        }
+        assert!(c.is_empty());
+        assert!(c.dir.iter().all(|&t| t == 0));
         assert_eq!(c.kind([i64::MAX, i64::MIN]), FREE);
     }
 }

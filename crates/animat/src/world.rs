@@ -1,10 +1,11 @@
 //! The animat world: animats on the unbounded plane, their rules, and one step of the model
 //! (MODELS.md section 3; seed 000, section II.B).
 
-use crate::cells::{CellIndex, FREE, WINDOW_MAX, kind_byte};
+use crate::cells::{CellIndex, FREE, SPECIES, WINDOW_MAX, Window, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, shuffle, stream, stream_id, uniform01};
+use rustc_hash::FxHashSet;
 use spatial::plane::{PlaneError, PlaneGrid, Pos};
 use std::time::Instant;
 
@@ -34,16 +35,7 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
 const RING_MAX: i64 = 8;
 const _: () = assert!(RING_MAX <= WINDOW_MAX);
 
-/// How many turns ahead [`World::step`] reads the cells it will need (the records twice as
-/// far ahead).
-const LOOKAHEAD: usize = 8;
-
-/// The 4 orthogonal neighbours (squared distance 1).
-const ORTHOGONAL: [[i64; 2]; 4] = [[1, 0], [0, 1], [-1, 0], [0, -1]];
-/// The 4 diagonal neighbours (squared distance 2).
-const DIAGONAL: [[i64; 2]; 4] = [[1, 1], [-1, 1], [-1, -1], [1, -1]];
-
-/// One animat.
+/// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Animat {
     /// Unique id; ids increase with creation and are never reused.
@@ -56,8 +48,29 @@ pub struct Animat {
     pub age: u32,
     /// Foxes: steps since the fox last ate. Always 0 for rabbits.
     pub hunger: u32,
-    /// False once dead (eaten, starved, too old) until removed at the end of the step.
-    alive: bool,
+}
+
+/// The stored state of an animat apart from its species and liveness (kept in
+/// [`World::flags`]): 32 bytes, half a cache line.
+#[derive(Debug, Clone, Copy)]
+struct Rec {
+    pos: Pos,
+    id: u64,
+    age: u32,
+    hunger: u32,
+}
+
+/// Flag bit: the animat is a rabbit (else a fox).
+const RABBIT: u8 = 1;
+/// Flag bit: the animat died in the current step (removed at its end).
+const DEAD: u8 = 2;
+
+fn species_of(flags: u8) -> Species {
+    if flags & RABBIT != 0 {
+        Species::Rabbit
+    } else {
+        Species::Fox
+    }
 }
 
 /// Perception queries asked, by kind (for the lazy-perception tests and diagnostics).
@@ -81,8 +94,8 @@ impl QueryCounts {
 /// What an animat decided to do.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Action {
-    /// Eat this rabbit.
-    Eat(u64),
+    /// Eat the rabbit on this cell.
+    Eat(Pos),
     /// Breed (the probability is drawn when applied).
     Breed,
     /// Step by this unit vector (blocked steps stay put).
@@ -126,6 +139,8 @@ pub struct World {
     vision2: u64,
     crowd2: u64,
     grid: PlaneGrid<Species>,
+    /// Grid changes not yet applied (see [`GridOp`]); empty between steps.
+    pending: Vec<GridOp>,
     /// Which animat stands on each cell (always maintained; read by perception when
     /// `cell_search` is on).
     cells: CellIndex,
@@ -137,8 +152,23 @@ pub struct World {
     order: Vec<u32>,
     /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
     crowd_offsets: Vec<[i64; 2]>,
-    /// Live animats (and, during a step, the ones that died in it), sorted by id.
-    animats: Vec<Animat>,
+    /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see [`Near::rows`]), when
+    /// `crowd_radius <= 2`.
+    crowd_masks: [u64; NEAR_ROWS],
+    /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
+    /// by id. During a step the records of the animats alive at its start are stale: their
+    /// current state is in `hot`, and is copied back at the end of the step.
+    recs: Vec<Rec>,
+    /// [`RABBIT`] and [`DEAD`] bits of each record of `recs` (same index).
+    flags: Vec<u8>,
+    /// Ids of the rabbits eaten in the current step (their records are dead, though their
+    /// [`DEAD`] bits are not set: finding a record by id would cost a search).
+    eaten: FxHashSet<u64>,
+    /// During a step: the records of the animats alive at its start, in visiting order
+    /// (`hot[j]` is `recs[order[j]]`).
+    hot: Vec<Rec>,
+    /// During a step: the flags of `hot` (`hot_flags[j]` is `flags[order[j]]` at the start).
+    hot_flags: Vec<u8>,
     next_id: u64,
     steps: u64,
     order_rng: SimRng,
@@ -158,6 +188,176 @@ fn sign_towards(a: i64, b: i64) -> i64 {
         std::cmp::Ordering::Less => -1,
         std::cmp::Ordering::Equal => 0,
     }
+}
+
+/// The unit step from `from` towards `to` (the sign of each coordinate difference).
+fn towards(from: Pos, to: Pos) -> [i64; 2] {
+    [sign_towards(from[0], to[0]), sign_towards(from[1], to[1])]
+}
+
+/// Query and work counters of one decision (added to the world's afterwards).
+#[derive(Debug, Default)]
+struct Tally {
+    adjacent: u64,
+    nearest: u64,
+    count: u64,
+    evals: u64,
+    /// A query needed the grid while it lagged behind the logged changes.
+    stale: bool,
+}
+
+/// A change of the grid, logged during a step and applied in order before the grid is next
+/// read (a loop of independent updates instead of one dependent cache miss per move).
+#[derive(Debug, Clone, Copy)]
+enum GridOp {
+    Insert(u64, Pos, Species),
+    Remove(u64),
+    Move(u64, Pos),
+}
+
+/// Half-side of the square of cells [`Near::rows`] holds.
+const NEAR_HALF: i64 = 2;
+/// Rows of [`Near::rows`].
+const NEAR_ROWS: usize = 2 * NEAR_HALF as usize + 1;
+// Rows are read through a window of half-side RING_MAX, which must hold their cells
+// (x - NEAR_HALF ..= x - NEAR_HALF + 7).
+const _: () = assert!(RING_MAX >= NEAR_HALF && RING_MAX >= 7 - NEAR_HALF);
+
+/// The cells around the acting animat (the cell-index fast path), located once per turn.
+struct Near<'a> {
+    /// Window of half-side [`RING_MAX`] around the animat; `None` when the fast path is off.
+    w: Option<Window<'a>>,
+    /// The kind bytes of the `NEAR_ROWS` rows around the animat, read on first use.
+    rows: Option<[u64; NEAR_ROWS]>,
+}
+
+impl Near<'_> {
+    /// Kind bytes of rows `y - 2 ..= y + 2` around `p = [x, y]`, each holding cells
+    /// `x - 2 ..= x + 5` as bytes 0..8 (byte `dx + 2` is cell `x + dx`). The window must be
+    /// present.
+    #[inline]
+    fn rows(&mut self, p: Pos) -> &[u64; NEAR_ROWS] {
+        self.parts(p).expect("rows need the window").1
+    }
+
+    /// The window and the row words ([`Near::rows`]), if the window is present.
+    #[inline]
+    fn parts(&mut self, p: Pos) -> Option<(&Window<'_>, &[u64; NEAR_ROWS])> {
+        let w = self.w.as_ref()?;
+        let rows = self
+            .rows
+            .get_or_insert_with(|| w.rows::<NEAR_ROWS>(p[0] - NEAR_HALF, p[1] - NEAR_HALF));
+        Some((w, rows))
+    }
+}
+
+/// The kind byte of cell `(x + dx, y + dy)` from [`Near::rows`] (`|dx|, |dy| <= 2`).
+#[inline(always)]
+fn row_cell(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
+    row_byte(rows, dx, dy) & SPECIES
+}
+
+/// The whole cell byte (kind and id bucket) of cell `(x + dx, y + dy)` from [`Near::rows`].
+#[inline(always)]
+fn row_byte(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
+    (rows[(dy + NEAR_HALF) as usize] >> (8 * (dx + NEAR_HALF))) as u8
+}
+
+/// The cells of [`Near::rows`] at squared distance exactly `d2` from the centre, as bit 0 of
+/// their bytes.
+const fn class_mask(d2: i64) -> [u64; NEAR_ROWS] {
+    let mut m = [0u64; NEAR_ROWS];
+    let mut dy = -NEAR_HALF;
+    while dy <= NEAR_HALF {
+        let mut dx = -NEAR_HALF;
+        while dx <= NEAR_HALF {
+            if dx * dx + dy * dy == d2 {
+                m[(dy + NEAR_HALF) as usize] |= 1 << (8 * (dx + NEAR_HALF));
+            }
+            dx += 1;
+        }
+        dy += 1;
+    }
+    m
+}
+
+/// The cells of rings 1 and 2 by squared distance, nearest first: ring 1 is `d2` 1 and 2,
+/// ring 2 is `d2` 4, 5 and 8.
+const RING_CLASSES: [[u64; NEAR_ROWS]; 5] = [
+    class_mask(1),
+    class_mask(2),
+    class_mask(4),
+    class_mask(5),
+    class_mask(8),
+];
+
+/// Bit 0 of each byte of [`Near::rows`] whose cell holds kind byte `kb` (1 fox: bit 0 of the
+/// byte; 2 rabbit: bit 1).
+#[inline(always)]
+fn kind_bits(rows: &[u64; NEAR_ROWS], kb: u8) -> [u64; NEAR_ROWS] {
+    let shift = u32::from(kb - 1);
+    rows.map(|r| (r >> shift) & 0x0101_0101_0101_0101)
+}
+
+/// How many cells of `bits` (from [`kind_bits`]) lie in `class` (at most one bit per byte and
+/// `NEAR_ROWS` rows: byte sums stay below 256, and the multiplication adds them up into the
+/// top byte).
+#[inline(always)]
+fn count_in(bits: &[u64; NEAR_ROWS], class: &[u64; NEAR_ROWS]) -> u64 {
+    let sum = bits
+        .iter()
+        .zip(class)
+        .fold(0u64, |acc, (&b, &m)| acc + (b & m));
+    sum.wrapping_mul(0x0101_0101_0101_0101) >> 56
+}
+
+/// The cell of `bits` in `class` with the lowest id (`n` of them, `n >= 1`), around `p`:
+/// the lowest id bucket of the cell bytes in `rows` decides, and ids are read only when
+/// several cells share it.
+fn lowest_in(
+    bits: &[u64; NEAR_ROWS],
+    class: &[u64; NEAR_ROWS],
+    n: u64,
+    p: Pos,
+    rows: &[u64; NEAR_ROWS],
+    w: &Window<'_>,
+) -> Pos {
+    // (dx, dy, bucket) of each candidate; a class has at most 8 cells.
+    let mut cand = [(0i64, 0i64, 0u8); 8];
+    let mut m = 0;
+    for (r, (&b, &c)) in bits.iter().zip(class).enumerate() {
+        let mut hits = b & c;
+        while hits != 0 {
+            let dx = i64::from(hits.trailing_zeros() / 8) - NEAR_HALF;
+            let dy = r as i64 - NEAR_HALF;
+            hits &= hits - 1;
+            cand[m] = (dx, dy, row_byte(rows, dx, dy) >> 2);
+            m += 1;
+        }
+    }
+    debug_assert_eq!(m as u64, n);
+    let cand = &cand[..m];
+    let low = cand.iter().map(|c| c.2).min().unwrap_or(0);
+    let mut best: Option<(Pos, Option<u64>)> = None;
+    for &(dx, dy, b) in cand {
+        if b != low {
+            continue;
+        }
+        let c = [p[0] + dx, p[1] + dy];
+        best = match best {
+            None => Some((c, None)),
+            Some((bc, bid)) => {
+                let bi = bid.unwrap_or_else(|| w.id(bc[0], bc[1]));
+                let id = w.id(c[0], c[1]);
+                Some(if id < bi {
+                    (c, Some(id))
+                } else {
+                    (bc, Some(bi))
+                })
+            }
+        };
+    }
+    best.map_or(p, |(c, _)| c)
 }
 
 /// `p + d`, or `None` on overflow.
@@ -185,6 +385,7 @@ impl World {
             crowd2: c * c,
             cell_search: grid.box_size() != spatial::plane::BoxSize::None,
             grid,
+            pending: Vec::new(),
             cells: CellIndex::default(),
             cell_evals: 0,
             order: Vec::new(),
@@ -197,7 +398,23 @@ impl World {
             } else {
                 Vec::new()
             },
-            animats: Vec::new(),
+            crowd_masks: {
+                let r = params.crowd_radius.min(NEAR_HALF);
+                let mut m = [0u64; NEAR_ROWS];
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        if (dx, dy) != (0, 0) && (dx * dx + dy * dy) as u64 <= c * c {
+                            m[(dy + NEAR_HALF) as usize] |= 1 << (8 * (dx + NEAR_HALF));
+                        }
+                    }
+                }
+                m
+            },
+            recs: Vec::new(),
+            flags: Vec::new(),
+            eaten: FxHashSet::default(),
+            hot: Vec::new(),
+            hot_flags: Vec::new(),
             next_id: 0,
             steps: 0,
             order_rng: stream(seed, stream_id(STREAM_ORDER, 0)),
@@ -265,21 +482,57 @@ impl World {
         age: u32,
         hunger: u32,
     ) -> Result<u64, WorldError> {
+        let id = self.add_deferred(species, pos, age, hunger)?;
+        self.flush_grid();
+        Ok(id)
+    }
+
+    /// Brings the grid up to date with the changes logged in `pending`, in order.
+    fn flush_grid(&mut self) {
+        for op in self.pending.drain(..) {
+            match op {
+                GridOp::Insert(id, pos, species) => self
+                    .grid
+                    .insert(id, pos, species)
+                    .expect("ids are never reused"),
+                GridOp::Remove(id) => {
+                    self.grid.remove(id).expect("a live animat is in the grid");
+                }
+                GridOp::Move(id, to) => {
+                    self.grid
+                        .move_to(id, to)
+                        .expect("a live animat is in the grid");
+                }
+            }
+        }
+    }
+
+    /// [`World::add`], with the grid's insertion logged in `pending`.
+    fn add_deferred(
+        &mut self,
+        species: Species,
+        pos: Pos,
+        age: u32,
+        hunger: u32,
+    ) -> Result<u64, WorldError> {
         if self.cells.occupied(pos) {
             return Err(WorldError::Occupied(pos));
         }
         let id = self.next_id;
-        self.grid.insert(id, pos, species)?;
+        self.pending.push(GridOp::Insert(id, pos, species));
         self.cells
             .set(pos, kind_byte(species == Species::Rabbit), id);
         self.next_id += 1;
-        self.animats.push(Animat {
-            id,
-            species,
+        self.recs.push(Rec {
             pos,
+            id,
             age,
             hunger: if species == Species::Fox { hunger } else { 0 },
-            alive: true,
+        });
+        self.flags.push(if species == Species::Rabbit {
+            RABBIT
+        } else {
+            0
         });
         match species {
             Species::Fox => self.foxes += 1,
@@ -309,15 +562,26 @@ impl World {
     }
 
     /// Live animats, sorted by id (between steps).
-    pub fn animats(&self) -> impl Iterator<Item = &Animat> + '_ {
-        self.animats.iter().filter(|a| a.alive)
+    pub fn animats(&self) -> impl Iterator<Item = Animat> + '_ {
+        (0..self.recs.len()).filter_map(|i| self.animat_at(i))
     }
 
     /// A live animat by id.
-    pub fn get(&self, id: u64) -> Option<&Animat> {
-        self.index_of(id)
-            .map(|i| &self.animats[i])
-            .filter(|a| a.alive)
+    pub fn get(&self, id: u64) -> Option<Animat> {
+        self.index_of(id).and_then(|i| self.animat_at(i))
+    }
+
+    /// The animat of record `i`, if alive (between steps).
+    fn animat_at(&self, i: usize) -> Option<Animat> {
+        let f = self.flags[i];
+        let r = self.recs[i];
+        (f & DEAD == 0).then_some(Animat {
+            id: r.id,
+            species: species_of(f),
+            pos: r.pos,
+            age: r.age,
+            hunger: r.hunger,
+        })
     }
 
     /// Perception queries asked so far.
@@ -375,13 +639,13 @@ impl World {
     }
 
     fn index_of(&self, id: u64) -> Option<usize> {
-        self.animats.binary_search_by_key(&id, |a| a.id).ok()
+        self.recs.binary_search_by_key(&id, |a| a.id).ok()
     }
 
     /// Runs `n` steps (stopping early if every animat has died).
     pub fn run(&mut self, n: u64) {
         for _ in 0..n {
-            if self.animats.is_empty() {
+            if self.recs.is_empty() {
                 break;
             }
             self.step();
@@ -398,42 +662,77 @@ impl World {
         let evals_before = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals_before;
         self.search_seconds = 0.0;
-        let n = self.animats.len();
+        let n = self.recs.len();
+        self.maybe_rebucket(n);
         let mut order = std::mem::take(&mut self.order);
         order.clear();
         order.extend(0..n as u32);
         shuffle(&mut self.order_rng, &mut order);
-        // The visiting order is random, so a turn's first reads of its animat's record and of
-        // the cells around it miss the caches. Reading them a few turns ahead starts those
-        // misses early, overlapped with the turns in between; the reads change nothing (they
-        // only feed black_box).
-        let mut touch = 0u64;
-        for (j, &i) in order.iter().enumerate() {
-            if let Some(&k) = order.get(j + 2 * LOOKAHEAD) {
-                touch ^= self.animats[k as usize].pos[0] as u64;
-            }
-            if let Some(&k) = order.get(j + LOOKAHEAD) {
-                touch ^= u64::from(self.cells.kind(self.animats[k as usize].pos));
-            }
-            let i = i as usize;
-            if !self.animats[i].alive {
+        // The visiting order is random, so reading each turn's record where it is stored (id
+        // order) would start every turn with a cache miss that nothing overlaps. Copying the
+        // records into visiting order first is a loop of independent loads that the CPU
+        // overlaps; the turns then read their records in sequence.
+        let mut hot = std::mem::take(&mut self.hot);
+        hot.clear();
+        hot.extend(order.iter().map(|&k| self.recs[k as usize]));
+        let mut hot_flags = std::mem::take(&mut self.hot_flags);
+        hot_flags.clear();
+        hot_flags.extend(order.iter().map(|&k| self.flags[k as usize]));
+        for j in 0..n {
+            let f = hot_flags[j];
+            let r = hot[j];
+            // An animat dies in its own turn or is eaten (listed in `eaten`): the DEAD bit of
+            // one that has not acted yet is never set.
+            debug_assert_eq!(self.flags[order[j] as usize] & DEAD, 0);
+            if f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&r.id) {
                 continue;
             }
-            let action = if self.timing {
-                let t = Instant::now();
-                let a = self.decide(i);
-                self.search_seconds += t.elapsed().as_secs_f64();
-                a
-            } else {
-                self.decide(i)
+            let mut a = Animat {
+                id: r.id,
+                species: species_of(f),
+                pos: r.pos,
+                age: r.age,
+                hunger: r.hunger,
             };
-            self.apply(i, action);
-            self.age_and_die(i);
+            let (action, rows) = if self.timing {
+                let t = Instant::now();
+                let act = self.decide_near(&a);
+                self.search_seconds += t.elapsed().as_secs_f64();
+                act
+            } else {
+                self.decide_near(&a)
+            };
+            self.apply(&mut a, action, rows.as_ref());
+            self.age_and_die(order[j] as usize, &mut a);
+            hot[j] = Rec {
+                pos: a.pos,
+                id: a.id,
+                age: a.age,
+                hunger: a.hunger,
+            };
         }
-        std::hint::black_box(touch);
+        self.hot_flags = hot_flags;
+        for (&k, r) in order.iter().zip(&hot) {
+            self.recs[k as usize] = *r;
+        }
         self.order = order;
-        self.animats.retain(|a| a.alive);
+        self.hot = hot;
+        let mut w = 0;
+        for i in 0..self.recs.len() {
+            let f = self.flags[i];
+            let eaten =
+                f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&self.recs[i].id);
+            if f & DEAD == 0 && !eaten {
+                self.recs[w] = self.recs[i];
+                self.flags[w] = f;
+                w += 1;
+            }
+        }
+        self.recs.truncate(w);
+        self.flags.truncate(w);
+        self.eaten.clear();
         self.steps += 1;
+        self.flush_grid();
         let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals;
         StepStats {
@@ -442,23 +741,103 @@ impl World {
         }
     }
 
-    /// Chooses the action of animat `i`: the first rule whose condition holds. Asks only the
+    /// Spreads the id buckets of the cell bytes ([`CellIndex::bucket`]) over the ids that can
+    /// be alive during the next step (the live ones, sorted in `recs`, and at most `n`
+    /// newborns) when the top bucket could overflow or the lower half of the buckets has
+    /// gone unused. Buckets only speed up tie-breaks; any non-decreasing map gives the same
+    /// answers.
+    fn maybe_rebucket(&mut self, n: usize) {
+        let Some(first) = self.recs.first() else {
+            return;
+        };
+        let lo = first.id;
+        let hi = self.next_id.saturating_add(n as u64);
+        let (base, shift) = self.cells.bucket_range();
+        let wasted = lo.saturating_sub(base) >> shift >= 32;
+        if !self.cells.bucket_capped(hi) && !wasted {
+            return;
+        }
+        // The smallest width that keeps `hi` within bucket 47 (room for later births).
+        let span = hi - lo;
+        let mut s = 0;
+        while span >> s > 47 {
+            s += 1;
+        }
+        self.cells
+            .rebucket(lo, s, self.recs.iter().map(|r| (r.pos, r.id)));
+    }
+
+    /// Chooses the action of animat `a`: the first rule whose condition holds. Asks only the
     /// queries each condition needs, in priority order.
-    fn decide(&mut self, i: usize) -> Action {
-        let a = self.animats[i];
+    #[cfg(test)]
+    fn decide(&mut self, a: &Animat) -> Action {
+        self.decide_near(a).0
+    }
+
+    /// [`World::decide`], with the kind bytes around `a` ([`Near::rows`]) when the action
+    /// moves or breeds and the cell-index fast path is on: applying it reads its free
+    /// neighbours from them.
+    fn decide_near(&mut self, a: &Animat) -> (Action, Option<[u64; NEAR_ROWS]>) {
+        let (act, t) = loop {
+            let mut t = Tally::default();
+            let mut near = self.near(a);
+            let act = self.decide_in(a, &mut near, &mut t);
+            if t.stale {
+                // A query needed the grid while changes were still logged: bring it up to
+                // date and decide again (the first attempt changed nothing).
+                self.flush_grid();
+                continue;
+            }
+            let rows = match act {
+                Action::Step(_) | Action::Wander | Action::Breed if near.w.is_some() => {
+                    Some(*near.rows(a.pos))
+                }
+                _ => None,
+            };
+            break ((act, rows), t);
+        };
+        self.queries.adjacent += t.adjacent;
+        self.queries.nearest += t.nearest;
+        self.queries.count += t.count;
+        self.cell_evals += t.evals;
+        act
+    }
+
+    /// The cells around `a` for the cell-index fast path (no window when the fast path is
+    /// off or `a` is too near the `i64` limits).
+    fn near(&self, a: &Animat) -> Near<'_> {
+        Near {
+            w: if self.cell_search {
+                self.cells.window(a.pos, RING_MAX)
+            } else {
+                None
+            },
+            rows: None,
+        }
+    }
+
+    /// Whether the grid lags behind the logged changes; if so, notes in `t` that the
+    /// decision must be made again after [`World::flush_grid`].
+    #[inline]
+    fn stale(&self, t: &mut Tally) -> bool {
+        t.stale = !self.pending.is_empty();
+        t.stale
+    }
+
+    fn decide_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> Action {
         match a.species {
             Species::Fox => {
                 let hungry = a.hunger >= self.params.hungry_at;
-                for k in 0..self.fox_rules.len() {
-                    if let Some(act) = self.fox_rule(self.fox_rules[k], &a, hungry) {
+                for &rule in &self.fox_rules {
+                    if let Some(act) = self.fox_rule(rule, a, hungry, near, t) {
                         return act;
                     }
                 }
                 Action::Stay
             }
             Species::Rabbit => {
-                for k in 0..self.rabbit_rules.len() {
-                    if let Some(act) = self.rabbit_rule(self.rabbit_rules[k], &a) {
+                for &rule in &self.rabbit_rules {
+                    if let Some(act) = self.rabbit_rule(rule, a, near, t) {
                         return act;
                     }
                 }
@@ -467,165 +846,231 @@ impl World {
         }
     }
 
-    fn fox_rule(&mut self, rule: FoxRule, a: &Animat, hungry: bool) -> Option<Action> {
+    fn fox_rule(
+        &self,
+        rule: FoxRule,
+        a: &Animat,
+        hungry: bool,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Action> {
         match rule {
             FoxRule::Eat => {
                 if !hungry {
                     return None;
                 }
-                self.nearest_adjacent(a, Species::Rabbit)
-                    .map(|(id, _)| Action::Eat(id))
+                self.nearest_adjacent(a, Species::Rabbit, near, t)
+                    .map(Action::Eat)
             }
             FoxRule::Breed => (!hungry
-                && self.adjacent(a, Species::Fox)
-                && !self.overcrowded(a)
-                && self.enough_prey(a))
+                && self.adjacent(a, Species::Fox, near, t)
+                && !self.overcrowded_in(a, near, t)
+                && self.enough_prey_in(a, near, t))
             .then_some(Action::Breed),
             FoxRule::Hunt => {
                 if !hungry {
                     return None;
                 }
-                self.nearest_seen(a, Species::Rabbit)
-                    .map(|t| Action::Step(self.towards(a.pos, t)))
+                self.nearest_seen(a, Species::Rabbit, near, t)
+                    .map(|p| Action::Step(towards(a.pos, p)))
             }
             FoxRule::SeekMate => {
                 if hungry {
                     return None;
                 }
-                self.nearest_seen(a, Species::Fox)
-                    .map(|t| Action::Step(self.towards(a.pos, t)))
+                self.nearest_seen(a, Species::Fox, near, t)
+                    .map(|p| Action::Step(towards(a.pos, p)))
             }
             FoxRule::Wander => Some(Action::Wander),
         }
     }
 
-    fn rabbit_rule(&mut self, rule: RabbitRule, a: &Animat) -> Option<Action> {
+    fn rabbit_rule(
+        &self,
+        rule: RabbitRule,
+        a: &Animat,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Action> {
         match rule {
-            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox).map(|(_, f)| {
-                let t = self.towards(a.pos, f);
-                Action::Step([-t[0], -t[1]])
+            RabbitRule::Flee => self.nearest_adjacent(a, Species::Fox, near, t).map(|f| {
+                let d = towards(a.pos, f);
+                Action::Step([-d[0], -d[1]])
             }),
-            RabbitRule::Breed => {
-                (self.adjacent(a, Species::Rabbit) && !self.overcrowded(a)).then_some(Action::Breed)
-            }
+            RabbitRule::Breed => (self.adjacent(a, Species::Rabbit, near, t)
+                && !self.overcrowded_in(a, near, t))
+            .then_some(Action::Breed),
             RabbitRule::Herd => self
-                .nearest_seen(a, Species::Rabbit)
-                .map(|t| Action::Step(self.towards(a.pos, t))),
+                .nearest_seen(a, Species::Rabbit, near, t)
+                .map(|p| Action::Step(towards(a.pos, p))),
             RabbitRule::Wander => Some(Action::Wander),
         }
     }
 
-    fn towards(&self, from: Pos, to: Pos) -> [i64; 2] {
-        [sign_towards(from[0], to[0]), sign_towards(from[1], to[1])]
-    }
-
-    /// The nearest adjacent animat of `kind` (ties: lower id) and its position.
-    fn nearest_adjacent(&mut self, a: &Animat, kind: Species) -> Option<(u64, Pos)> {
-        self.queries.adjacent += 1;
-        if self.cell_search {
-            if let Some(w) = self.cells.window(a.pos, 1) {
-                let kb = kind_byte(kind == Species::Rabbit);
-                let [x, y] = a.pos;
-                let mut evals = 0;
-                // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
-                for group in [&ORTHOGONAL, &DIAGONAL] {
-                    let mut best: Option<(u64, Pos)> = None;
-                    for d in group {
-                        if w.at(x + d[0], y + d[1]) == kb {
-                            evals += 1;
-                            let id = w.id(x + d[0], y + d[1]);
-                            if best.is_none_or(|(b, _)| id < b) {
-                                best = Some((id, [x + d[0], y + d[1]]));
-                            }
-                        }
-                    }
-                    if best.is_some() {
-                        self.cell_evals += evals;
-                        return best;
-                    }
+    /// The position of the nearest adjacent animat of `kind` (ties: lower id).
+    fn nearest_adjacent(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        t.adjacent += 1;
+        if let Some((w, rows)) = near.parts(a.pos) {
+            let kb = kind_byte(kind == Species::Rabbit);
+            // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
+            // Ids are read only to break a tie (they live in a larger array that is rarely in
+            // cache).
+            let bits = kind_bits(rows, kb);
+            for class in &RING_CLASSES[..2] {
+                let n = count_in(&bits, class);
+                if n > 0 {
+                    t.evals += n;
+                    return Some(lowest_in(&bits, class, n, a.pos, rows, w));
                 }
-                self.cell_evals += evals;
-                return None;
             }
+            return None;
+        }
+        if self.stale(t) {
+            return None;
         }
         let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
-        self.grid.get(id).map(|(p, _)| (id, p))
+        self.grid.get(id).map(|(p, _)| p)
     }
 
-    fn adjacent(&mut self, a: &Animat, kind: Species) -> bool {
-        self.queries.adjacent += 1;
-        if self.cell_search {
-            if let Some(w) = self.cells.window(a.pos, 1) {
-                let kb = kind_byte(kind == Species::Rabbit);
-                let [x, y] = a.pos;
-                for d in DIRECTIONS {
-                    if w.at(x + d[0], y + d[1]) == kb {
-                        self.cell_evals += 1;
-                        return true;
-                    }
-                }
-                return false;
-            }
+    fn adjacent(&self, a: &Animat, kind: Species, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.adjacent += 1;
+        if let Some((_, rows)) = near.parts(a.pos) {
+            let kb = kind_byte(kind == Species::Rabbit);
+            let found = DIRECTIONS.iter().any(|d| row_cell(rows, d[0], d[1]) == kb);
+            t.evals += u64::from(found);
+            return found;
+        }
+        if self.stale(t) {
+            return false;
         }
         self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
     }
 
     /// Position of the nearest animat of `kind` within vision (ties: lower id).
-    fn nearest_seen(&mut self, a: &Animat, kind: Species) -> Option<Pos> {
-        self.queries.nearest += 1;
-        if self.cell_search {
+    fn nearest_seen(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        t.nearest += 1;
+        if near.w.is_some() {
             let k_max = RING_MAX.min(self.params.vision);
-            if let Some(w) = self.cells.window(a.pos, k_max) {
-                let kb = kind_byte(kind == Species::Rabbit);
-                let [x, y] = a.pos;
-                let v2 = self.vision2;
-                let mut evals = 0;
-                // Best as (d2, id, position).
-                let mut best: Option<(u64, u64, Pos)> = None;
-                let mut look = |dx: i64, dy: i64, best: &mut Option<(u64, u64, Pos)>| {
-                    if w.at(x + dx, y + dy) == kb {
-                        evals += 1;
-                        let d2 = (dx * dx + dy * dy) as u64;
-                        if d2 > v2 || best.is_some_and(|(bd, _, _)| d2 > bd) {
-                            return;
+            let kb = kind_byte(kind == Species::Rabbit);
+            let [x, y] = a.pos;
+            let v2 = self.vision2;
+            let mut evals = 0;
+            // Rings 1 and 2 from the row words when they lie within vision.
+            let mut k_first = 1;
+            if self.params.vision >= 3 {
+                let (w, rows) = near.parts(a.pos).expect("the window is present");
+                let mut bits = kind_bits(rows, kb);
+                // Not the animat itself.
+                bits[NEAR_HALF as usize] &= !(1 << (8 * NEAR_HALF));
+                for ring in [&RING_CLASSES[..2], &RING_CLASSES[2..]] {
+                    let counts = ring.iter().map(|c| count_in(&bits, c));
+                    let total: u64 = counts.clone().sum();
+                    if total > 0 {
+                        t.evals += total;
+                        for (class, n) in ring.iter().zip(counts) {
+                            if n > 0 {
+                                return Some(lowest_in(&bits, class, n, a.pos, rows, w));
+                            }
                         }
-                        let id = w.id(x + dx, y + dy);
-                        if best.is_none_or(|(bd, bi, _)| (d2, id) < (bd, bi)) {
-                            *best = Some((d2, id, [x + dx, y + dy]));
-                        }
-                    }
-                };
-                for k in 1..=k_max {
-                    for dx in -k..=k {
-                        look(dx, -k, &mut best);
-                        look(dx, k, &mut best);
-                    }
-                    for dy in (-k + 1)..k {
-                        look(-k, dy, &mut best);
-                        look(k, dy, &mut best);
-                    }
-                    // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
-                    // than that is final (an equally near one could still win on id).
-                    let next = ((k + 1) * (k + 1)) as u64;
-                    if best.is_some_and(|(bd, _, _)| bd < next) || next > v2 {
-                        self.cell_evals += evals;
-                        return best.map(|(_, _, p)| p);
                     }
                 }
-                self.cell_evals += evals;
+                k_first = 3;
             }
+            let w = near.w.as_ref().expect("the window is present");
+            // Best as (d2, position, id bucket, id once read): a tie of distances goes to
+            // the lower bucket, and ids (in a larger array that is rarely in cache) are read
+            // only when the buckets are equal too.
+            type Best = Option<(u64, Pos, u8, Option<u64>)>;
+            let mut best: Best = None;
+            let mut look = |dx: i64, dy: i64, best: &mut Best| {
+                let byte = w.byte(x + dx, y + dy);
+                if byte & SPECIES == kb {
+                    evals += 1;
+                    let d2 = (dx * dx + dy * dy) as u64;
+                    let c = [x + dx, y + dy];
+                    let cb = byte >> 2;
+                    match best {
+                        _ if d2 > v2 => {}
+                        None => *best = Some((d2, c, cb, None)),
+                        Some((bd, bp, bb, bid)) => {
+                            if d2 < *bd || (d2 == *bd && cb < *bb) {
+                                *best = Some((d2, c, cb, None));
+                            } else if d2 == *bd && cb == *bb {
+                                let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
+                                let id = w.id(c[0], c[1]);
+                                if id < bi {
+                                    *best = Some((d2, c, cb, Some(id)));
+                                }
+                            }
+                        }
+                    }
+                }
+            };
+            for k in k_first..=k_max {
+                for dx in -k..=k {
+                    look(dx, -k, &mut best);
+                    look(dx, k, &mut best);
+                }
+                for dy in (-k + 1)..k {
+                    look(-k, dy, &mut best);
+                    look(k, dy, &mut best);
+                }
+                // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
+                // than that is final (an equally near one could still win on id).
+                let next = ((k + 1) * (k + 1)) as u64;
+                if best.is_some_and(|(bd, _, _, _)| bd < next) || next > v2 {
+                    t.evals += evals;
+                    return best.map(|(_, p, _, _)| p);
+                }
+            }
+            t.evals += evals;
+        }
+        if self.stale(t) {
+            return None;
         }
         let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
         self.grid.get(id).map(|(p, _)| p)
     }
 
     /// More than `crowd_max` animats (either species, `a` excluded) within `crowd_radius`.
-    fn overcrowded(&mut self, a: &Animat) -> bool {
-        self.queries.count += 1;
+    #[cfg(test)]
+    fn overcrowded(&self, a: &Animat) -> bool {
+        self.overcrowded_in(a, &mut self.near(a), &mut Tally::default())
+    }
+
+    fn overcrowded_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.count += 1;
         let n = self.params.crowd_max as usize + 1;
         let r = self.params.crowd_radius;
-        if self.cell_search && r <= RING_MAX {
-            if let Some(w) = self.cells.window(a.pos, r) {
+        if near.w.is_some() {
+            if r <= NEAR_HALF {
+                // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
+                // the masks keep the cells within the radius.
+                let rows = near.rows(a.pos);
+                // At most one bit per byte and NEAR_ROWS rows: the byte sums stay below 256,
+                // and the multiplication adds the bytes up into the top byte.
+                let bits = rows
+                    .iter()
+                    .zip(&self.crowd_masks)
+                    .fold(0u64, |acc, (&row, &m)| acc + ((row | row >> 1) & m));
+                let count = (bits.wrapping_mul(0x0101_0101_0101_0101) >> 56) as usize;
+                t.evals += count.min(n) as u64;
+                return count >= n;
+            }
+            if r <= RING_MAX {
+                let w = near.w.as_ref().expect("the window is present");
                 let [x, y] = a.pos;
                 let mut count = 0;
                 for d in &self.crowd_offsets {
@@ -636,87 +1081,107 @@ impl World {
                         }
                     }
                 }
-                self.cell_evals += count as u64;
+                t.evals += count as u64;
                 return count >= n;
             }
+        }
+        if self.stale(t) {
+            return false;
         }
         self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
     }
 
     /// At least `prey_needed` rabbits within vision.
-    fn enough_prey(&mut self, a: &Animat) -> bool {
-        self.queries.count += 1;
+    #[cfg(test)]
+    fn enough_prey(&self, a: &Animat) -> bool {
+        self.enough_prey_in(a, &mut self.near(a), &mut Tally::default())
+    }
+
+    fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.count += 1;
         let n = self.params.prey_needed as usize;
-        if self.cell_search && n > 0 {
+        if let (Some(w), true) = (near.w.as_ref(), n > 0) {
             let k_max = RING_MAX.min(self.params.vision);
-            if let Some(w) = self.cells.window(a.pos, k_max) {
-                let [x, y] = a.pos;
-                let v2 = self.vision2;
-                let kb = kind_byte(true);
-                let mut count = 0usize;
-                let mut look = |dx: i64, dy: i64| -> bool {
-                    if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
-                        count += 1;
-                    }
-                    count >= n
-                };
-                let mut found = false;
-                'rings: for k in 1..=k_max {
-                    for dx in -k..=k {
-                        if look(dx, -k) || look(dx, k) {
-                            found = true;
-                            break 'rings;
-                        }
-                    }
-                    for dy in (-k + 1)..k {
-                        if look(-k, dy) || look(k, dy) {
-                            found = true;
-                            break 'rings;
-                        }
+            let [x, y] = a.pos;
+            let v2 = self.vision2;
+            let kb = kind_byte(true);
+            let mut count = 0usize;
+            let mut look = |dx: i64, dy: i64| -> bool {
+                if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
+                    count += 1;
+                }
+                count >= n
+            };
+            let mut found = false;
+            'rings: for k in 1..=k_max {
+                for dx in -k..=k {
+                    if look(dx, -k) || look(dx, k) {
+                        found = true;
+                        break 'rings;
                     }
                 }
-                self.cell_evals += count as u64;
-                // Rings 1..=k_max cover the whole vision disc when k_max = vision.
-                if found || k_max == self.params.vision {
-                    return found;
+                for dy in (-k + 1)..k {
+                    if look(-k, dy) || look(k, dy) {
+                        found = true;
+                        break 'rings;
+                    }
                 }
             }
+            t.evals += count as u64;
+            // Rings 1..=k_max cover the whole vision disc when k_max = vision.
+            if found || k_max == self.params.vision {
+                return found;
+            }
+        }
+        if self.stale(t) {
+            return false;
         }
         self.grid
             .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
     }
 
-    /// Moves animat `i` one step by `d` unless the target cell is occupied.
-    fn try_step(&mut self, i: usize, d: [i64; 2]) {
+    /// Whether the neighbour `c = a.pos + d` of `a` is free, from `rows` (the kind bytes
+    /// around `a`) when given.
+    fn is_free(&self, c: Pos, d: [i64; 2], rows: Option<&[u64; NEAR_ROWS]>) -> bool {
+        match rows {
+            Some(r) => row_cell(r, d[0], d[1]) == FREE,
+            None => !self.cells.occupied(c),
+        }
+    }
+
+    /// Moves animat `a` one step by `d` unless the target cell is occupied.
+    fn try_step(&mut self, a: &mut Animat, d: [i64; 2], rows: Option<&[u64; NEAR_ROWS]>) {
         if d == [0, 0] {
             return;
         }
-        let a = self.animats[i];
         let Some(to) = offset(a.pos, d) else { return };
-        if self.cells.occupied(to) {
+        if !self.is_free(to, d, rows) {
             return;
         }
-        self.grid
-            .move_to(a.id, to)
-            .expect("a live animat is in the grid");
+        self.pending.push(GridOp::Move(a.id, to));
         self.cells.relocate(a.pos, to);
-        self.animats[i].pos = to;
+        a.pos = to;
     }
 
-    fn apply(&mut self, i: usize, action: Action) {
+    fn apply(&mut self, a: &mut Animat, action: Action, rows: Option<&[u64; NEAR_ROWS]>) {
         match action {
             Action::Stay => {}
-            Action::Step(d) => self.try_step(i, d),
+            Action::Step(d) => self.try_step(a, d, rows),
             Action::Wander => {
                 let d = DIRECTIONS[self.action_rng.random_range(0..8usize)];
-                self.try_step(i, d);
+                self.try_step(a, d, rows);
             }
-            Action::Eat(rabbit) => {
-                self.kill_id(rabbit);
-                self.animats[i].hunger = 0;
+            Action::Eat(pos) => {
+                // The rabbit's record is found (and dropped) at the end of the step; until
+                // then the set of eaten ids marks it dead.
+                let rabbit = self.cells.id(pos);
+                self.eaten.insert(rabbit);
+                self.rabbits -= 1;
+                self.pending.push(GridOp::Remove(rabbit));
+                self.cells.clear(pos);
+                a.hunger = 0;
             }
             Action::Breed => {
-                let a = self.animats[i];
                 let p = match a.species {
                     Species::Fox => self.params.fox_breed_p,
                     Species::Rabbit => self.params.rabbit_breed_p,
@@ -728,7 +1193,7 @@ impl World {
                 let mut n = 0;
                 for d in DIRECTIONS {
                     if let Some(c) = offset(a.pos, d) {
-                        if !self.cells.occupied(c) {
+                        if self.is_free(c, d, rows) {
                             free[n] = c;
                             n += 1;
                         }
@@ -736,36 +1201,30 @@ impl World {
                 }
                 if n > 0 {
                     let c = free[self.action_rng.random_range(0..n)];
-                    self.add(a.species, c, 0, 0)
+                    self.add_deferred(a.species, c, 0, 0)
                         .expect("the birth cell was free");
                 }
             }
         }
     }
 
-    fn kill_id(&mut self, id: u64) {
-        if let Some(j) = self.index_of(id) {
-            self.kill(j);
-        }
-    }
-
-    fn kill(&mut self, j: usize) {
-        let a = &mut self.animats[j];
-        if !a.alive {
+    /// Marks record `k` (animat `id` on cell `pos`) dead and takes it off the plane.
+    fn kill(&mut self, k: usize, id: u64, pos: Pos) {
+        let f = self.flags[k];
+        if f & DEAD != 0 {
             return;
         }
-        a.alive = false;
-        match a.species {
+        self.flags[k] = f | DEAD;
+        match species_of(f) {
             Species::Fox => self.foxes -= 1,
             Species::Rabbit => self.rabbits -= 1,
         }
-        let (id, pos) = (a.id, a.pos);
-        self.grid.remove(id).expect("a live animat is in the grid");
+        self.pending.push(GridOp::Remove(id));
         self.cells.clear(pos);
     }
 
-    fn age_and_die(&mut self, i: usize) {
-        let a = &mut self.animats[i];
+    /// Ages the animat `a` of record `k` and kills it if it is too old or has starved.
+    fn age_and_die(&mut self, k: usize, a: &mut Animat) {
         a.age = a.age.saturating_add(1);
         let dies = match a.species {
             Species::Fox => {
@@ -775,7 +1234,7 @@ impl World {
             Species::Rabbit => a.age > self.params.rabbit_max_age,
         };
         if dies {
-            self.kill(i);
+            self.kill(k, a.id, a.pos);
         }
     }
 }
@@ -934,7 +1393,7 @@ mod tests {
         w.add(Rabbit, [1, 1], 0, 0).unwrap();
         w.add(Rabbit, [2, 1], 0, 0).unwrap();
         w.add(Rabbit, [0, -2], 0, 0).unwrap();
-        let a = *w.get(me).unwrap();
+        let a = w.get(me).unwrap();
         assert!(!w.overcrowded(&a));
         w.add(Fox, [-1, 0], 0, 0).unwrap();
         assert!(w.overcrowded(&a));
@@ -943,7 +1402,7 @@ mod tests {
         let f = w.add(Fox, [0, 0], 0, 0).unwrap();
         w.add(Rabbit, [60, 0], 0, 0).unwrap();
         w.add(Rabbit, [43, 43], 0, 0).unwrap(); // d2 = 3698 > 3600: unseen
-        let a = *w.get(f).unwrap();
+        let a = w.get(f).unwrap();
         assert!(!w.enough_prey(&a));
         w.add(Rabbit, [0, -60], 0, 0).unwrap();
         assert!(w.enough_prey(&a));
@@ -1084,8 +1543,8 @@ mod tests {
         w.add(Fox, [0, 0], 0, 9).unwrap();
         w.add(Rabbit, [1, 0], 0, 0).unwrap();
         let q0 = w.queries();
-        let a = w.animats[0];
-        assert_eq!(w.decide(0), Action::Eat(1));
+        let a = w.get(0).unwrap();
+        assert_eq!(w.decide(&a), Action::Eat([1, 0]));
         let q = w.queries();
         assert_eq!(q.total() - q0.total(), 1);
         assert_eq!(q.adjacent, 1);
@@ -1099,7 +1558,7 @@ mod tests {
         for x in 0..5 {
             w.add(Rabbit, [20 + x, 0], 0, 0).unwrap();
         }
-        assert_eq!(w.decide(0), Action::Step([0, 1]));
+        assert_eq!(w.decide(&w.get(0).unwrap()), Action::Step([0, 1]));
         assert_eq!(
             w.queries(),
             QueryCounts {
@@ -1114,7 +1573,7 @@ mod tests {
         w.add(Rabbit, [0, 0], 0, 0).unwrap();
         w.add(Fox, [1, 0], 0, 0).unwrap();
         w.add(Rabbit, [-1, 0], 0, 0).unwrap();
-        assert_eq!(w.decide(0), Action::Step([-1, 0]));
+        assert_eq!(w.decide(&w.get(0).unwrap()), Action::Step([-1, 0]));
         assert_eq!(w.queries().total(), 1);
 
         // Over a whole step of a real run, fewer queries than the eager "ask everything"
