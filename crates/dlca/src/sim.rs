@@ -151,7 +151,51 @@ pub struct Simulation {
     order: Vec<ItemId>,
 }
 
+/// The state [`Simulation::new`] and [`Simulation::restore`] build differently; everything
+/// else starts out the same ([`Simulation::assemble`]).
+struct Assembly {
+    params: Params,
+    seed: u64,
+    lattice: Lattice,
+    sets: SiteSets,
+    records: Records,
+    strategy_reason: String,
+    rng: SimRng,
+    directions: DirectionSampler,
+    particles: u64,
+    sweep: u64,
+    largest: u64,
+}
+
 impl Simulation {
+    /// A simulation from `a`, with the all-pairs engine (the caller installs the chosen
+    /// search) and empty scratch buffers.
+    fn assemble(a: Assembly) -> Self {
+        let sorted_size = vec![0; a.sets.id_bound()];
+        Simulation {
+            records: a.records,
+            params: a.params,
+            seed: a.seed,
+            lattice: a.lattice,
+            sets: a.sets,
+            materialized: OnceLock::new(),
+            engine: Engine::AllPairs(AllPairs::new()),
+            strategy_reason: a.strategy_reason,
+            bbox: Vec::new(),
+            rng: a.rng,
+            directions: a.directions,
+            particles: a.particles,
+            sweep: a.sweep,
+            largest: a.largest,
+            events: Vec::new(),
+            check_invariants: false,
+            sorted_size,
+            old: Vec::new(),
+            contacts: Vec::new(),
+            order: Vec::new(),
+        }
+    }
+
     /// Validate `params`, place the particles, form the initial clusters (face-adjacent
     /// particles belong to one cluster from the start) and set up the search.
     pub fn new(params: Params, seed: u64) -> Result<Self, ParamError> {
@@ -176,29 +220,19 @@ impl Simulation {
             .max()
             .unwrap_or(0);
         let (kind, reason) = choose_strategy(&params, &lattice, n);
-        let mut sim = Simulation {
+        let mut sim = Simulation::assemble(Assembly {
             records: Records::new(&params),
             params,
             seed,
             lattice,
             sets,
-            materialized: OnceLock::new(),
-            engine: Engine::AllPairs(AllPairs::new()),
             strategy_reason: reason,
-            bbox: Vec::new(),
             rng: stream(seed, stream_id(STREAM_DYNAMICS, 0)),
             directions,
             particles: n,
             sweep: 0,
             largest,
-            events: Vec::new(),
-            check_invariants: false,
-            sorted_size: Vec::new(),
-            old: Vec::new(),
-            contacts: Vec::new(),
-            order: Vec::new(),
-        };
-        sim.sorted_size = vec![0; sim.sets.id_bound()];
+        });
         sim.install(kind)?;
         sim.records.record_sweep(0, sim.clusters(), largest, None);
         Ok(sim)
@@ -255,29 +289,19 @@ impl Simulation {
         for id in dead {
             sets.remove(id);
         }
-        let mut sim = Simulation {
+        let mut sim = Simulation::assemble(Assembly {
             records: s.records,
             params: s.params,
             seed: s.seed,
             lattice,
             sets,
-            materialized: OnceLock::new(),
-            engine: Engine::AllPairs(AllPairs::new()),
             strategy_reason: s.strategy_reason,
-            bbox: Vec::new(),
             rng: s.rng,
             directions,
             particles: s.particles,
             sweep: s.sweep,
             largest: s.largest,
-            events: Vec::new(),
-            check_invariants: false,
-            sorted_size: Vec::new(),
-            old: Vec::new(),
-            contacts: Vec::new(),
-            order: Vec::new(),
-        };
-        sim.sorted_size = vec![0; sim.sets.id_bound()];
+        });
         // The grid resumes with the box side it had (the parameters stay as given).
         let grid_box = sim.params.grid_box;
         if s.strategy == Search::Grid {
