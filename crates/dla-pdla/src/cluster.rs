@@ -96,16 +96,15 @@ impl<const D: usize> Cluster<D> {
         Ok(())
     }
 
-    /// Grows the maps to cover `|x_i| < r + cap + cell`, before they are shared; `false` if
-    /// they are already shared (nothing done).
-    pub fn reserve_maps(&mut self, r: f64) -> Result<bool, SimError> {
-        let Some(maps) = Arc::get_mut(&mut self.maps) else {
-            return Ok(false);
-        };
-        for map in maps {
-            map.reserve(r + map.cap() + map.cell_side())?;
+    /// Grows the maps to cover `|x_i| < r + cap + cell`, before they are shared (once shared
+    /// they cannot grow, and this does nothing).
+    pub fn reserve_maps(&mut self, r: f64) -> Result<(), SimError> {
+        if let Some(maps) = Arc::get_mut(&mut self.maps) {
+            for map in maps {
+                map.reserve(r + map.cap() + map.cell_side())?;
+            }
         }
-        Ok(true)
+        Ok(())
     }
 
     /// The orthtree.
