@@ -173,7 +173,7 @@ impl<const D: usize> Walker<D> {
     /// nodes covering that ball ([`Orthtree::vpdist_bounded`]) rather than from the root.
     pub(crate) fn advance<R: Rng + ?Sized>(
         &mut self,
-        state: &mut WalkState,
+        state: &mut WalkState<D>,
         cluster: &Cluster<D>,
         r_ext: f64,
         params: &Params,
@@ -185,7 +185,7 @@ impl<const D: usize> Walker<D> {
         // may round to slightly above r_b) in the near field, which is valid everywhere;
         // without it a walker at r_b (1 + 1e-16) would be "returned" to itself forever.
         if r > r_b * FAR_FIELD_MARGIN {
-            state.upper = f64::INFINITY;
+            state.reset();
             match params.far_field {
                 FarField::Return => self.p = return_to_sphere(&self.p, r_b, rng),
                 FarField::Jump => {
@@ -211,9 +211,10 @@ impl<const D: usize> Walker<D> {
         }
         // Then the tree: a lower bound on the distance to the nearest centre.
         let tree = cluster.tree();
-        let est = tree
-            .vpdist_bounded(&self.p, params.precision, state.upper)
+        let (est, nearest) = tree
+            .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
             .expect("the cluster is never empty");
+        state.anchor = nearest;
         let delta = est.distance;
         // The exact distance is at most delta + 2 r (the gap of a far node's bound), with a
         // relative margin for the rounding of that bound.
@@ -326,23 +327,46 @@ fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut 
 }
 
 /// What a walker remembers between moves: an upper bound of its exact distance to the
-/// nearest centre (`+inf` when unknown). It stays valid while particles are only added, so
-/// PDLA threads keep it when other threads store particles.
+/// nearest centre (`+inf` when unknown), and the stored particle found nearest at the last
+/// exact tree query (`anchor`). Both stay valid while particles are only added, so PDLA
+/// threads keep them when other threads store particles.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct WalkState {
+pub(crate) struct WalkState<const D: usize> {
     upper: f64,
+    anchor: Option<[f64; D]>,
 }
 
-impl WalkState {
+impl<const D: usize> WalkState<D> {
     pub(crate) fn new() -> Self {
         WalkState {
             upper: f64::INFINITY,
+            anchor: None,
         }
     }
 
     /// A new walker: nothing known.
     pub(crate) fn reset(&mut self) {
         self.upper = f64::INFINITY;
+        self.anchor = None;
+    }
+
+    /// An upper bound of the nearest distance from `p`: the smaller of `upper` (the last
+    /// answer plus every distance moved since) and the distance to the anchor particle (the
+    /// walker jumped in a random direction, so the anchor is typically about `sqrt 2` times
+    /// the last answer away rather than twice), with a relative margin for rounding.
+    #[inline]
+    fn upper(&self, p: &[f64; D]) -> f64 {
+        match self.anchor {
+            Some(a) => {
+                let mut d2 = 0.0;
+                for i in 0..D {
+                    let e = p[i] - a[i];
+                    d2 += e * e;
+                }
+                self.upper.min(d2.sqrt() * (1.0 + 1e-9) + 1e-9)
+            }
+            None => self.upper,
+        }
     }
 }
 
@@ -600,7 +624,7 @@ pub struct Simulation<const D: usize> {
     growth: Growth<D>,
     rng: SimRng,
     discarded: u64,
-    walk: WalkState,
+    walk: WalkState<D>,
     parallel_seconds: f64,
     lock_wait_seconds: f64,
 }

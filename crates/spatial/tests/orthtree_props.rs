@@ -135,7 +135,8 @@ fn check<const D: usize>(
                 0.0,
                 f64::INFINITY,
             ] {
-                let b = tree.vpdist_bounded(q, kappa, upper).unwrap();
+                // `vpdist_bounded` is this walk without the point.
+                let (b, near) = tree.vpdist_bounded_nearest(q, kappa, upper).unwrap();
                 prop_assert!(
                     b.distance <= d
                         && (!kappa.is_finite()
@@ -156,6 +157,22 @@ fn check<const D: usize>(
                             && b.distance + r > 2.0 * kappa * r * (1.0 - TOL)
                             && d - b.distance <= 2.0 * r * (1.0 + TOL) + TOL * d
                     ),
+                }
+                // When exact, a stored point at exactly that distance.
+                match (b.half_diagonal, near) {
+                    (None, Some(x)) => {
+                        if upper == d {
+                            // One exact nearest query per point is enough to show it is stored.
+                            prop_assert_eq!(tree.nearest(&x).unwrap().point, x, "not stored");
+                        }
+                        let mut e2 = 0.0;
+                        for i in 0..q.len() {
+                            e2 += (q[i] - x[i]) * (q[i] - x[i]);
+                        }
+                        prop_assert_eq!(e2.sqrt(), d);
+                    }
+                    (Some(_), None) => {}
+                    other => prop_assert!(false, "exact answer without point or back: {:?}", other),
                 }
             }
             if kappa.is_finite() {

@@ -188,18 +188,45 @@ impl<const D: usize> Orthtree<D> {
         if !(0.0..f64::INFINITY).contains(&upper) {
             return self.vpdist_detailed(p, kappa);
         }
-        let s = if kappa == f64::INFINITY || kappa.is_nan() {
+        self.vpdist_bounded_nearest(p, kappa, upper).map(|(e, _)| e)
+    }
+
+    /// [`vpdist_bounded`](Self::vpdist_bounded), and when its answer is exact (`half_diagonal`
+    /// is `None`) the stored position of a nearest point, at that distance (ties: the first
+    /// found). A walker keeps that point: its distance from wherever the walker moves next is
+    /// an upper bound of the nearest distance there, usually much tighter than the last answer
+    /// plus the distance moved. Same walk and same answer as `vpdist_bounded`.
+    pub fn vpdist_bounded_nearest(
+        &self,
+        p: &[f64; D],
+        kappa: f64,
+        upper: f64,
+    ) -> Option<(VpEstimate, Option<[f64; D]>)> {
+        if self.root == EMPTY {
+            return None;
+        }
+        let s = if !(0.0..f64::INFINITY).contains(&upper) {
+            None
+        } else if kappa == f64::INFINITY || kappa.is_nan() {
             self.walk_bounded::<false>(p, f64::INFINITY, upper)
         } else {
             self.walk_bounded::<true>(p, far_factor::<D>(kappa), upper)
         };
-        match s {
-            Some(s) => Some(VpEstimate {
+        let s = match s {
+            Some(s) => s,
+            None if kappa == f64::INFINITY || kappa.is_nan() => {
+                self.walk::<false, true>(p, f64::INFINITY)?
+            }
+            None => self.walk::<true, true>(p, far_factor::<D>(kappa))?,
+        };
+        let exact = s.source == 0.0;
+        Some((
+            VpEstimate {
                 distance: s.best,
-                half_diagonal: (s.source > 0.0).then_some(s.source),
-            }),
-            None => self.vpdist_detailed(p, kappa),
-        }
+                half_diagonal: (!exact).then_some(s.source),
+            },
+            exact.then_some(s.point),
+        ))
     }
 
     /// The walk of [`vpdist_bounded`](Self::vpdist_bounded); `None` if nothing nearer than
@@ -223,9 +250,9 @@ impl<const D: usize> Orthtree<D> {
                 return;
             }
             if level == 0 {
-                tree.visit_leaf::<APPROX, false>(&mut s, node, c, half);
+                tree.visit_leaf::<APPROX, true>(&mut s, node, c, half);
             } else {
-                tree.visit::<APPROX, false>(&mut s, node, level, c, half);
+                tree.visit::<APPROX, true>(&mut s, node, level, c, half);
             }
         });
         (s.best < upper).then_some(s)
@@ -445,20 +472,7 @@ impl<const D: usize> Orthtree<D> {
         }
         let origin = c.map(|x| x - half);
         let pts = self.pool.points(self.leaves[leaf as usize]);
-        let step = self.step;
-        let mut best_sq = s.best_sq;
-        let mut best_j = usize::MAX;
-        for (j, code) in pts.iter().enumerate() {
-            let mut d2 = 0.0;
-            for i in 0..D {
-                let e = s.p[i] - decode(origin[i], code[i], step);
-                d2 += e * e;
-            }
-            if d2 < best_sq {
-                best_sq = d2;
-                best_j = j;
-            }
-        }
+        let (best_sq, best_j) = nearest_in_leaf(&s.p, &origin, self.step, pts, s.best_sq);
         if best_j != usize::MAX {
             s.best_sq = best_sq;
             s.best = best_sq.sqrt();
@@ -466,7 +480,7 @@ impl<const D: usize> Orthtree<D> {
             if TRACK {
                 let code = pts[best_j];
                 for i in 0..D {
-                    s.point[i] = decode(origin[i], code[i], step);
+                    s.point[i] = decode(origin[i], code[i], self.step);
                 }
             }
         }
@@ -537,6 +551,65 @@ impl<const D: usize> Orthtree<D> {
             }
         }
     }
+}
+
+/// Lanes of the leaf scan: independent running minima, so consecutive points do not wait for
+/// each other's comparison (the scan was bound by that dependency chain) and the compiler can
+/// keep each lane in a vector register.
+const LANES: usize = 4;
+
+/// The smallest squared distance below `best_sq` from `p` to a point of a leaf (origin
+/// `origin`), and the index of the first point reaching it (`usize::MAX` if none is below
+/// `best_sq`). Each point's squared distance is computed exactly as the scalar loop
+/// `sum_i (p_i - decode(origin_i, code_i, step))^2` would, so the result is bit for bit the same
+/// as scanning the points one by one; ties go to the lowest index, as in that scan.
+#[inline(always)]
+fn nearest_in_leaf<const D: usize>(
+    p: &[f64; D],
+    origin: &[f64; D],
+    step: f64,
+    pts: &[[u32; D]],
+    best_sq: f64,
+) -> (f64, usize) {
+    let mut m = [best_sq; LANES];
+    let mut at = [usize::MAX; LANES];
+    let chunks = pts.chunks_exact(LANES);
+    let tail = chunks.remainder();
+    for (c, chunk) in chunks.enumerate() {
+        let mut d2 = [0.0f64; LANES];
+        for i in 0..D {
+            for k in 0..LANES {
+                let e = p[i] - decode(origin[i], chunk[k][i], step);
+                d2[k] += e * e;
+            }
+        }
+        for k in 0..LANES {
+            if d2[k] < m[k] {
+                m[k] = d2[k];
+                at[k] = c * LANES + k;
+            }
+        }
+    }
+    let base = pts.len() - tail.len();
+    for (k, code) in tail.iter().enumerate() {
+        let mut d2 = 0.0;
+        for i in 0..D {
+            let e = p[i] - decode(origin[i], code[i], step);
+            d2 += e * e;
+        }
+        if d2 < m[k] {
+            m[k] = d2;
+            at[k] = base + k;
+        }
+    }
+    // Combine the lanes: smallest value, then lowest index among equal values.
+    let mut best = (best_sq, usize::MAX);
+    for k in 0..LANES {
+        if m[k] < best.0 || (m[k] == best.0 && at[k] < best.1) {
+            best = (m[k], at[k]);
+        }
+    }
+    best
 }
 
 /// `kappa^2 D` for the far test `|p - c|^2 > kappa^2 D a^2` (a node of side `a` has diagonal
