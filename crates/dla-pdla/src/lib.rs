@@ -18,6 +18,7 @@
 
 pub mod cluster;
 pub mod farfield;
+mod near;
 pub mod output;
 pub mod params;
 pub mod sim;

@@ -72,6 +72,14 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Toggle::On)]
     distance_map: Toggle,
 
+    /// Each walker copies the particles within 5 diameters out of the tree and answers its
+    /// moves close to the cluster from that short list. Exact: the same answers as the tree,
+    /// so the same trajectory and state hash on or off; speed only. Used when the tree is
+    /// exact at those distances anyway ((precision - 1/2) leaf diagonals >= 5, as by
+    /// default).
+    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    near_cache: Toggle,
+
     /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -137,6 +145,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             || cli.checkpoint_every.is_some(),
         leaf_side: cli.leaf_side,
         distance_map: cli.distance_map == Toggle::On,
+        near_cache: cli.near_cache == Toggle::On,
     };
     p.validate().map_err(|e| e.to_string())?;
     if let Some(n) = cli.checkpoint_every {

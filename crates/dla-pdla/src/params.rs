@@ -60,6 +60,17 @@ pub struct Params {
     /// distance to the cluster), but it changes the random trajectory: see `docs/dla.md`.
     #[serde(default = "default_distance_map")]
     pub distance_map: bool,
+    /// Give each walker a near cache: the particles within 5 diameters, copied out of the
+    /// tree, which answer its moves close to the cluster (`--near-cache`, default on). Exact:
+    /// the same answers as the tree, so the same trajectory and state hash with it on or off;
+    /// only speed changes (`docs/dla.md`). Used only where the tree's answers are exact
+    /// anyway (`(precision - 1/2)` leaf diagonals of at least 5 diameters, as by default).
+    #[serde(default = "default_near_cache")]
+    pub near_cache: bool,
+}
+
+fn default_near_cache() -> bool {
+    true
 }
 
 fn default_distance_map() -> bool {
@@ -90,6 +101,7 @@ impl Default for Params {
             keep_positions: false,
             leaf_side: DEFAULT_LEAF_SIDE,
             distance_map: true,
+            near_cache: true,
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::cluster::Cluster;
 use crate::farfield::{norm, return_to_sphere};
+use crate::near::{NEAR_RADIUS, NearCache, REBUILD_UPPER};
 use crate::params::{FarField, Params, ParamsError};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{Rng, SimRng, stream, stream_id, uniform01, unit_vector};
@@ -10,7 +11,7 @@ use core_lattice::{Gyration, LogLogFit};
 use parking_lot::Mutex;
 use serde::{Deserialize, Serialize};
 use spatial::distmap::DistanceMapError;
-use spatial::orthtree::{Orthtree, OrthtreeError};
+use spatial::orthtree::{Orthtree, OrthtreeError, VpEstimate};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -165,7 +166,7 @@ impl<const D: usize> Walker<D> {
         params: &Params,
         rng: &mut R,
     ) -> Option<[f64; D]> {
-        self.advance(&mut WalkState::new(), cluster, r_ext, params, rng)
+        self.advance(&mut WalkState::new(params), cluster, r_ext, params, rng)
     }
 
     /// [`step`](Self::step) with the walker's memory `state` (reset it for each new walker):
@@ -210,10 +211,20 @@ impl<const D: usize> Walker<D> {
             }
         }
         // Then the tree: a lower bound on the distance to the nearest centre.
+        // Near the cluster the walker's near cache gives the same exact answer as the tree.
         let tree = cluster.tree();
-        let (est, nearest) = tree
-            .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
-            .expect("the cluster is never empty");
+        let (est, nearest) = match state.near_query(&self.p, tree) {
+            Some((distance, x)) => (
+                VpEstimate {
+                    distance,
+                    half_diagonal: None,
+                },
+                Some(x),
+            ),
+            None => tree
+                .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
+                .expect("the cluster is never empty"),
+        };
         state.anchor = nearest;
         let delta = est.distance;
         // The exact distance is at most delta + 2 r (the gap of a far node's bound), with a
@@ -226,7 +237,17 @@ impl<const D: usize> Walker<D> {
         }
         state.upper += params.step_min * (1.0 + 1e-9);
         let u = direction::<D, _>(rng);
-        let t = first_contact(tree, &self.p, &u, params.step_min);
+        let r = params.step_min + 1.0;
+        let t = if state.near_on && state.near.covers(&self.p, r) {
+            // The same particles as the tree's range query (see `near`), so the same contact.
+            let mut best = f64::INFINITY;
+            state
+                .near
+                .for_each_within(&self.p, r, |q| contact(&self.p, &u, &q, &mut best));
+            (best <= params.step_min).then_some(best)
+        } else {
+            first_contact(tree, &self.p, &u, params.step_min)
+        };
         if let Some(t) = t {
             let mut q = self.p;
             for i in 0..D {
@@ -330,17 +351,29 @@ fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut 
 /// nearest centre (`+inf` when unknown), and the stored particle found nearest at the last
 /// exact tree query (`anchor`). Both stay valid while particles are only added, so PDLA
 /// threads keep them when other threads store particles.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub(crate) struct WalkState<const D: usize> {
     upper: f64,
     anchor: Option<[f64; D]>,
+    /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
+    /// wherever the cache answers (`(kappa - 1/2)` leaf diagonals cover [`NEAR_RADIUS`]).
+    near_on: bool,
+    near: NearCache<D>,
 }
 
 impl<const D: usize> WalkState<D> {
-    pub(crate) fn new() -> Self {
+    pub(crate) fn new(params: &Params) -> Self {
+        let kappa = params.precision;
+        let exact_within = if kappa.is_nan() {
+            f64::INFINITY
+        } else {
+            (kappa - 0.5) * params.leaf_side * (D as f64).sqrt()
+        };
         WalkState {
             upper: f64::INFINITY,
             anchor: None,
+            near_on: params.near_cache && exact_within >= NEAR_RADIUS,
+            near: NearCache::new(),
         }
     }
 
@@ -348,6 +381,25 @@ impl<const D: usize> WalkState<D> {
     pub(crate) fn reset(&mut self) {
         self.upper = f64::INFINITY;
         self.anchor = None;
+        self.near.reset();
+    }
+
+    /// The exact nearest distance and a particle at it from the near cache, rebuilding the
+    /// cache around `p` when it cannot answer and `p` is known to be close to the cluster;
+    /// `None` when the tree must answer.
+    #[inline]
+    fn near_query(&mut self, p: &[f64; D], tree: &Orthtree<D>) -> Option<(f64, [f64; D])> {
+        if !self.near_on {
+            return None;
+        }
+        if let Some(hit) = self.near.nearest(p) {
+            return Some(hit);
+        }
+        if self.upper(p) <= REBUILD_UPPER {
+            self.near.rebuild(tree, p);
+            return self.near.nearest(p);
+        }
+        None
     }
 
     /// An upper bound of the nearest distance from `p`: the smaller of `upper` (the last
@@ -425,6 +477,8 @@ struct Replica<const D: usize> {
     /// Taken from the log but not yet inserted (filled under the lock, inserted after it).
     pending: Vec<[f64; D]>,
     index: usize,
+    /// The memory of the thread's current walker.
+    walk: WalkState<D>,
 }
 
 /// References shared by the PDLA threads.
@@ -472,6 +526,7 @@ impl<const D: usize> Ctx<'_, D> {
                 self.fail(&mut self.lock(), e);
                 return false;
             }
+            rep.walk.near.added(&q);
             rep.r_ext = rep.r_ext.max(norm(&q));
         }
         true
@@ -507,15 +562,14 @@ impl<const D: usize> Ctx<'_, D> {
         rng: &mut R,
         progress: &(dyn Fn(u64) + Sync),
     ) {
-        let state = &mut WalkState::new();
         loop {
             if !self.sync(rep) {
                 return;
             }
             let mut w = Walker::born(rep.r_ext + params.birth_gap, rng);
-            state.reset();
+            rep.walk.reset();
             let stick = loop {
-                if let Some(p) = w.advance(state, &rep.cluster, rep.r_ext, params, rng) {
+                if let Some(p) = w.advance(&mut rep.walk, &rep.cluster, rep.r_ext, params, rng) {
                     break p;
                 }
                 if !self.sync(rep) {
@@ -644,12 +698,12 @@ impl<const D: usize> Simulation<D> {
         growth.add(&mut cluster, [0.0; D], params.particles)?;
         Ok(Simulation {
             rng: stream(seed, stream_id(PURPOSE_WALK, 0)),
+            walk: WalkState::new(&params),
             params,
             seed,
             cluster,
             growth,
             discarded: 0,
-            walk: WalkState::new(),
             parallel_seconds: 0.0,
             lock_wait_seconds: 0.0,
         })
@@ -764,13 +818,13 @@ impl<const D: usize> Simulation<D> {
             growth.started = t;
         }
         Ok(Simulation {
+            walk: WalkState::new(&params),
             params,
             seed: snap.seed,
             cluster,
             growth,
             rng: snap.rng,
             discarded: 0,
-            walk: WalkState::new(),
             parallel_seconds: 0.0,
             lock_wait_seconds: 0.0,
         })
@@ -858,6 +912,7 @@ impl<const D: usize> Simulation<D> {
                             applied: start,
                             pending: Vec::new(),
                             index: t,
+                            walk: WalkState::new(params),
                         };
                         let mut rng = stream(seed, stream_id(PURPOSE_PDLA, t as u32));
                         ctx.walk(&mut rep, params, &mut rng, progress);

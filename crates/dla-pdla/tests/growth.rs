@@ -101,6 +101,46 @@ fn contacts_3d_two_threads() {
     contacts::<3>(2);
 }
 
+/// The walker's near cache answers exactly as the tree does, so it changes nothing but speed:
+/// the same positions with it on and off, for the default walk, the tree-only walk (where the
+/// cache answers most moves), the exact search, and a precision too coarse for the cache to
+/// be used.
+fn near_cache_is_invisible<const D: usize>(n: u64) {
+    for (precision, distance_map) in [
+        (2.0, true),
+        (2.0, false),
+        (f64::INFINITY, true),
+        (1.0, true),
+    ] {
+        let run = |near_cache| {
+            grow_with::<D>(
+                Params {
+                    dim: D,
+                    particles: n,
+                    precision,
+                    distance_map,
+                    near_cache,
+                    ..Params::default()
+                },
+                3,
+            )
+        };
+        let (on, off) = (run(true), run(false));
+        assert_eq!(
+            on.positions(),
+            off.positions(),
+            "{D}D, precision {precision}, distance map {distance_map}"
+        );
+        assert_eq!(on.state_hash(), off.state_hash());
+    }
+}
+
+#[test]
+fn near_cache_changes_nothing_but_speed() {
+    near_cache_is_invisible::<2>(4000);
+    near_cache_is_invisible::<3>(3000);
+}
+
 #[test]
 fn same_seed_same_hash_different_seed_different_hash() {
     let a = grow::<2>(3000, 5, 1);
