@@ -25,7 +25,7 @@
 //!   in PDLA the particles another thread stored are added to the cache as they are applied
 //!   to the replica ([`NearCache::added`]), so the cache never misses one its tree has.
 
-use spatial::orthtree::Orthtree;
+use spatial::orthtree::{Orthtree, dist_sq};
 
 /// Radius of the ball a cache holds, in diameters. Tuned by instruction counts (cachegrind;
 /// 3D 3e4 particles, 2D 1e5; the tree alone: 4.64e9 and 3.99e9): radius 5 with rebuilds from
@@ -192,7 +192,8 @@ impl<const D: usize> NearCache<D> {
     }
 }
 
-/// Squared distances from `p` to the particles of a block, each summed axis by axis from 0.
+/// Squared distances from `p` to the particles of a block, each summed axis by axis from 0,
+/// as [`dist_sq`] (the tree's formula) sums them.
 #[inline(always)]
 fn block_dist_sq<const D: usize>(p: &[f64; D], block: &[[f64; LANES]; D]) -> [f64; LANES] {
     let mut d2 = [0.0f64; LANES];
@@ -201,17 +202,6 @@ fn block_dist_sq<const D: usize>(p: &[f64; D], block: &[[f64; LANES]; D]) -> [f6
             let e = p[i] - block[i][k];
             d2[k] += e * e;
         }
-    }
-    d2
-}
-
-/// Squared distance summed axis by axis from 0 (the order the tree's scans use).
-#[inline(always)]
-fn dist_sq<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
-    let mut d2 = 0.0;
-    for i in 0..D {
-        let e = a[i] - b[i];
-        d2 += e * e;
     }
     d2
 }

@@ -11,7 +11,7 @@ use core_lattice::{Gyration, LogLogFit};
 use parking_lot::Mutex;
 use serde::{Deserialize, Serialize};
 use spatial::distmap::DistanceMapError;
-use spatial::orthtree::{Orthtree, OrthtreeError, VpEstimate};
+use spatial::orthtree::{Orthtree, OrthtreeError, VpEstimate, dist_sq};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -409,14 +409,7 @@ impl<const D: usize> WalkState<D> {
     #[inline]
     fn upper(&self, p: &[f64; D]) -> f64 {
         match self.anchor {
-            Some(a) => {
-                let mut d2 = 0.0;
-                for i in 0..D {
-                    let e = p[i] - a[i];
-                    d2 += e * e;
-                }
-                self.upper.min(d2.sqrt() * (1.0 + 1e-9) + 1e-9)
-            }
+            Some(a) => self.upper.min(dist_sq(p, &a).sqrt() * (1.0 + 1e-9) + 1e-9),
             None => self.upper,
         }
     }
@@ -596,14 +589,7 @@ impl<const D: usize> Ctx<'_, D> {
             // Re-check under the lock (seed 002, section 3.4) against the particles other
             // threads stored since the walker's last move (now in `pending`, a handful at most).
             let r_sq = OVERLAP_DISTANCE * OVERLAP_DISTANCE;
-            overlap |= rep.pending.iter().any(|x| {
-                let mut d2 = 0.0;
-                for i in 0..D {
-                    let e = stick[i] - x[i];
-                    d2 += e * e;
-                }
-                d2 <= r_sq
-            });
+            overlap |= rep.pending.iter().any(|x| dist_sq(&stick, x) <= r_sq);
             if let Err(e) = guard.guard.record(overlap) {
                 return self.fail(&mut guard, e);
             }

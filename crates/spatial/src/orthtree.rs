@@ -141,7 +141,7 @@ mod tests;
 use std::fmt;
 
 use pool::LeafPool;
-pub use query::{Neighbour, VpEstimate};
+pub use query::{Neighbour, VpEstimate, dist_sq};
 
 /// Default leaf side (seed 002, section 3.3: the leaf cell holding a chunk of particles), in
 /// particle diameters: a few to a dozen DLA particles per leaf. See the module docs for the

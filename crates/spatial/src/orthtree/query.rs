@@ -631,9 +631,11 @@ fn floor(x: f64) -> f64 {
     if t > x { t - 1.0 } else { t }
 }
 
-/// Squared distance summed axis by axis from 0 (the order a brute-force loop uses).
+/// Squared distance summed axis by axis from 0 (the order a brute-force loop uses): the formula
+/// every query here compares, so a caller that keeps stored positions (as returned by the
+/// queries) and measures with this function gets the queries' values bit for bit.
 #[inline(always)]
-fn dist_sq<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
+pub fn dist_sq<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
     let mut d2 = 0.0;
     for i in 0..D {
         let e = a[i] - b[i];
