@@ -128,6 +128,23 @@ pub struct Measurement {
     pub bytes_per_item: Option<f64>,
     /// The run's state hash (equal for equal code and seeds).
     pub state_hash: Option<String>,
+    /// With `--repeat R > 1`: the wall seconds of every repeat, in run order; the other fields
+    /// are those of the fastest repeat (other jobs on a shared machine only ever slow a run
+    /// down, so the fastest is the least disturbed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub wall_seconds_runs: Vec<f64>,
+}
+
+/// The fastest of a workload's repeats, with every repeat's wall seconds attached.
+pub fn fastest(runs: Vec<Measurement>) -> Option<Measurement> {
+    let walls: Vec<f64> = runs.iter().map(|m| m.wall_seconds).collect();
+    let mut best = runs
+        .into_iter()
+        .min_by(|a, b| a.wall_seconds.total_cmp(&b.wall_seconds))?;
+    if walls.len() > 1 {
+        best.wall_seconds_runs = walls;
+    }
+    Some(best)
 }
 
 /// A whole `cargo xtask bench` report.
@@ -264,6 +281,7 @@ pub fn measure(w: &Workload, bin_dir: &Path) -> Result<Measurement> {
             .get("state_hash")
             .and_then(|v| v.as_str())
             .map(String::from),
+        wall_seconds_runs: Vec::new(),
     };
     eprintln!(
         "    {:.2} s wall, {:.3e} {}, peak RSS {} MB",
@@ -293,15 +311,20 @@ pub fn compare(now: &[Measurement], base: &[Measurement]) -> Vec<Ratio> {
         .collect()
 }
 
-/// `cargo xtask bench`: build, run the workloads whose name contains `only` (all if `None`),
-/// print JSON, optionally save it and compare with a baseline.
+/// `cargo xtask bench`: build, run the workloads whose name contains `only` (all if `None`)
+/// `repeat` times each, in rounds (every workload once, then again), keep each workload's
+/// fastest run, print JSON, optionally save it and compare with a baseline.
 pub fn run(
     root: &Path,
     cargo: &str,
     only: Option<&str>,
+    repeat: usize,
     save: Option<&Path>,
     against: Option<&Path>,
 ) -> Result<BenchReport> {
+    if repeat == 0 {
+        bail!("--repeat 0 is outside the accepted range: 1 or more");
+    }
     let baseline: Option<BenchReport> = match against {
         Some(p) => Some(
             serde_json::from_slice(
@@ -328,9 +351,35 @@ pub fn run(
     }
     build(root, cargo)?;
     let bin_dir = target_dir(root).join("release");
-    let mut workloads = Vec::new();
-    for w in chosen {
-        workloads.push(measure(w, &bin_dir)?);
+    // Rounds rather than back-to-back repeats, so a drift of the machine's speed touches
+    // every workload alike.
+    let mut runs: Vec<Vec<Measurement>> = vec![Vec::new(); chosen.len()];
+    for round in 0..repeat {
+        if repeat > 1 {
+            eprintln!("==> round {} of {repeat}", round + 1);
+        }
+        for (w, r) in chosen.iter().zip(runs.iter_mut()) {
+            r.push(measure(w, &bin_dir)?);
+        }
+    }
+    let workloads: Vec<Measurement> = runs
+        .into_iter()
+        .map(|r| fastest(r).expect("repeat >= 1"))
+        .collect();
+    if repeat > 1 {
+        eprintln!("==> fastest of {repeat} per workload");
+        for m in &workloads {
+            eprintln!(
+                "    {:<28} {:.2} s (runs: {})",
+                m.name,
+                m.wall_seconds,
+                m.wall_seconds_runs
+                    .iter()
+                    .map(|t| format!("{t:.2}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
     }
     let mut report = BenchReport {
         date: utc_now(),
@@ -386,7 +435,31 @@ mod tests {
             unit: "x".into(),
             bytes_per_item: None,
             state_hash: Some(hash.into()),
+            wall_seconds_runs: Vec::new(),
         }
+    }
+
+    #[test]
+    fn fastest_repeat_is_kept_with_every_time() {
+        let runs = vec![
+            m("a", 3.0, 10, "h1"),
+            m("a", 2.0, 11, "h2"),
+            m("a", 2.5, 12, "h3"),
+        ];
+        let f = fastest(runs).unwrap();
+        assert_eq!(f.wall_seconds, 2.0);
+        assert_eq!(f.peak_rss_bytes, Some(11));
+        assert_eq!(f.state_hash.as_deref(), Some("h2"));
+        assert_eq!(f.wall_seconds_runs, vec![3.0, 2.0, 2.5]);
+        // One run: no list, so reports without --repeat look as before.
+        let one = fastest(vec![m("b", 1.0, 1, "h")]).unwrap();
+        assert!(one.wall_seconds_runs.is_empty());
+        assert!(fastest(Vec::new()).is_none());
+        // Old reports (no runs field) still parse.
+        let json = serde_json::to_string(&one).unwrap();
+        assert!(!json.contains("wall_seconds_runs"));
+        let back: Measurement = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, one);
     }
 
     #[test]

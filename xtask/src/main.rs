@@ -4,7 +4,7 @@
 //!   warnings denied, and the test suite (the README's test command).
 //! - `cargo xtask scaling [--quick] [--only ...] [--out DIR]`: regenerate the papers' tables
 //!   and figures from our own runs (see `docs/results/README.md`).
-//! - `cargo xtask bench [--save FILE] [--against FILE]`: the headline speed and memory figures
+//! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and memory figures
 //!   as JSON, and their ratios to a saved baseline.
 
 use anyhow::{Context, Result, bail};
@@ -66,6 +66,10 @@ enum Cmd {
         /// Only workloads whose name contains this text.
         #[arg(long)]
         only: Option<String>,
+        /// Run every workload this many times, in rounds, and keep each one's fastest run
+        /// (for shared or noisy machines; every repeat's time is in the JSON).
+        #[arg(long, default_value_t = 1)]
+        repeat: usize,
     },
 }
 
@@ -181,10 +185,12 @@ fn main() -> Result<()> {
             save,
             against,
             only,
+            repeat,
         } => xtask::bench::run(
             &workspace_root(),
             &cargo(),
             only.as_deref(),
+            repeat,
             save.as_deref(),
             against.as_deref(),
         )
