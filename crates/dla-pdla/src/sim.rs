@@ -238,7 +238,9 @@ impl<const D: usize> Walker<D> {
         state.upper += params.step_min * (1.0 + 1e-9);
         let u = direction::<D, _>(rng);
         let r = params.step_min + 1.0;
-        let t = if state.near_on && state.near.covers(&self.p, r) {
+        // `covers` is false unless the cache was built, which only `near_query` does, and only
+        // when the cache is on.
+        let t = if state.near.covers(&self.p, r) {
             // The same particles as the tree's range query (see `near`), so the same contact.
             let mut best = f64::INFINITY;
             state
@@ -1009,5 +1011,53 @@ impl<const D: usize> Simulation<D> {
             .map(|s| (s.radius_of_gyration, s.n as f64))
             .unzip();
         LogLogFit::fit(&rg, &n)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Walkers on a grown cluster: the number of moves answered by a built near cache.
+    fn cache_builds<const D: usize>(precision: f64) -> usize {
+        let params = Params {
+            dim: D,
+            particles: 1500,
+            precision,
+            ..Params::default()
+        };
+        let mut sim = Simulation::<D>::new(params.clone(), 4).unwrap();
+        sim.run().unwrap();
+        let mut state = WalkState::<D>::new(&params);
+        let mut rng = stream(9, 0);
+        let mut live = 0;
+        for _ in 0..20 {
+            let mut w = Walker::born(sim.growth.r_ext + params.birth_gap, &mut rng);
+            state.reset();
+            while w
+                .advance(
+                    &mut state,
+                    &sim.cluster,
+                    sim.growth.r_ext,
+                    &params,
+                    &mut rng,
+                )
+                .is_none()
+            {
+                live += usize::from(state.near.covers(&w.p, 0.0));
+            }
+        }
+        live
+    }
+
+    #[test]
+    fn near_cache_is_used_only_where_the_tree_is_exact() {
+        // Default precision: (2 - 1/2) leaf diagonals cover the cache's radius.
+        assert!(cache_builds::<2>(2.0) > 0);
+        assert!(cache_builds::<3>(2.0) > 0);
+        // kappa 0.8: exact only within 0.3 leaf diagonals (3.4 in 2D, 4.2 in 3D), less than
+        // the radius: the cache must stay off.
+        assert_eq!(cache_builds::<2>(0.8), 0);
+        assert_eq!(cache_builds::<3>(0.8), 0);
     }
 }
