@@ -40,6 +40,7 @@
 //! - Memory: one byte per cell, `(2 H / c)^D` bytes for a map of half side `H`; for a 2D DLA
 //!   cluster of 1e6 particles (radius about 3 000 diameters, `c = 8`) about 0.7 MB.
 
+use crate::round::{ceil, floor};
 use std::fmt;
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -406,20 +407,6 @@ fn finite_max_norm<const D: usize>(q: &[f64; D]) -> Result<f64, DistanceMapError
     Ok(m)
 }
 
-/// `x.floor()` without a library call on targets without SSE4.1 (`x` finite and well inside
-/// the `i64` range, which the map's size limit guarantees for cell coordinates).
-#[inline(always)]
-fn floor(x: f64) -> f64 {
-    let t = x as i64 as f64;
-    if t > x { t - 1.0 } else { t }
-}
-
-/// `x.ceil()`, likewise.
-#[inline(always)]
-fn ceil(x: f64) -> f64 {
-    -floor(-x)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -543,25 +530,6 @@ mod tests {
         let (lb, _) = shared.lower_bound(&p).unwrap();
         assert!(lb <= brute(&all, &p));
         assert!(shared.insert_shared(&[f64::NAN, 0.0]).is_err());
-    }
-
-    #[test]
-    fn floor_and_ceil_match_std() {
-        for x in [
-            -3.5,
-            -3.0,
-            -0.2,
-            -0.0,
-            0.0,
-            0.7,
-            2.0,
-            2.5,
-            1e12 + 0.5,
-            -1e12 - 0.5,
-        ] {
-            assert_eq!(floor(x), x.floor(), "{x}");
-            assert_eq!(ceil(x), x.ceil(), "{x}");
-        }
     }
 
     #[test]

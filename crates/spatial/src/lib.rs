@@ -16,4 +16,5 @@ pub mod distmap;
 pub mod lattice;
 pub mod orthtree;
 pub mod plane;
+mod round;
 pub mod testdata;

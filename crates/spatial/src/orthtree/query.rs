@@ -8,6 +8,7 @@
 //! possible, avoiding ... unnecessary calls to the standard function sqrt()").
 
 use super::{EMPTY, Orthtree, decode};
+use crate::round::{ceil, floor};
 
 /// Relative shrink applied to far-node lower bounds `|p - c| - r`, so that rounding in the
 /// distance to the centre can never push the bound above a point's computed distance. `2^-44`
@@ -282,7 +283,7 @@ impl<const D: usize> Orthtree<D> {
         let level = if side_leaves <= 1.0 {
             0
         } else if side_leaves.is_finite() && side_leaves < (1u64 << 62) as f64 {
-            64 - ((side_leaves.ceil() as u64) - 1).leading_zeros()
+            64 - ((ceil(side_leaves) as u64) - 1).leading_zeros()
         } else {
             u32::MAX
         };
@@ -621,14 +622,6 @@ fn far_factor<const D: usize>(kappa: f64) -> f64 {
     } else {
         0.0
     }
-}
-
-/// `x.floor()` without a library call on targets without SSE4.1 (`x` finite; values beyond
-/// `i64` saturate, which the callers clamp anyway).
-#[inline(always)]
-fn floor(x: f64) -> f64 {
-    let t = x as i64 as f64;
-    if t > x { t - 1.0 } else { t }
 }
 
 /// Squared distance summed axis by axis from 0 (the order a brute-force loop uses): the formula
