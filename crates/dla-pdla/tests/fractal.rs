@@ -15,6 +15,24 @@ fn dims<const D: usize>(n: u64, seeds: std::ops::Range<u64>, precision: f64) -> 
     dims_with::<D>(n, seeds, precision, true)
 }
 
+/// Asserts that two ensembles' mean D agree within three combined standard errors.
+fn assert_agree(a_name: &str, a: &Welford, b_name: &str, b: &Welford) {
+    let se = (a.std_error().powi(2) + b.std_error().powi(2)).sqrt();
+    eprintln!(
+        "{a_name} {} +- {}, {b_name} {} +- {}",
+        a.mean(),
+        a.std_error(),
+        b.mean(),
+        b.std_error()
+    );
+    assert!(
+        (a.mean() - b.mean()).abs() <= 3.0 * se,
+        "{a_name} {} {b_name} {} (se {se})",
+        a.mean(),
+        b.mean()
+    );
+}
+
 fn dims_with<const D: usize>(
     n: u64,
     seeds: std::ops::Range<u64>,
@@ -66,20 +84,7 @@ fn fractal_dimension_3d_is_2_50() {
 fn exact_and_vpdist_agree() {
     let vp = dims::<2>(20_000, 100..108, 2.0);
     let ex = dims::<2>(20_000, 200..208, f64::INFINITY);
-    let se = (vp.std_error().powi(2) + ex.std_error().powi(2)).sqrt();
-    eprintln!(
-        "vpdist {} +- {}, exact {} +- {}",
-        vp.mean(),
-        vp.std_error(),
-        ex.mean(),
-        ex.std_error()
-    );
-    assert!(
-        (vp.mean() - ex.mean()).abs() <= 3.0 * se,
-        "vpdist {} exact {} (se {se})",
-        vp.mean(),
-        ex.mean()
-    );
+    assert_agree("2D vpdist", &vp, "exact", &ex);
     assert!((ex.mean() - 1.71).abs() <= 0.05);
 }
 
@@ -90,27 +95,8 @@ fn exact_and_vpdist_agree() {
 fn distance_map_on_and_off_agree() {
     let on = dims_with::<2>(20_000, 300..308, 2.0, true);
     let off = dims_with::<2>(20_000, 400..408, 2.0, false);
-    let se = (on.std_error().powi(2) + off.std_error().powi(2)).sqrt();
-    eprintln!(
-        "map on {} +- {}, off {} +- {}",
-        on.mean(),
-        on.std_error(),
-        off.mean(),
-        off.std_error()
-    );
-    assert!(
-        (on.mean() - off.mean()).abs() <= 3.0 * se,
-        "map on {} off {} (se {se})",
-        on.mean(),
-        off.mean()
-    );
+    assert_agree("2D map on", &on, "off", &off);
     let on3 = dims_with::<3>(5_000, 300..308, 2.0, true);
     let off3 = dims_with::<3>(5_000, 400..408, 2.0, false);
-    let se3 = (on3.std_error().powi(2) + off3.std_error().powi(2)).sqrt();
-    assert!(
-        (on3.mean() - off3.mean()).abs() <= 3.0 * se3,
-        "3D map on {} off {} (se {se3})",
-        on3.mean(),
-        off3.mean()
-    );
+    assert_agree("3D map on", &on3, "off", &off3);
 }

@@ -165,11 +165,7 @@ fn check<const D: usize>(
                             // One exact nearest query per point is enough to show it is stored.
                             prop_assert_eq!(tree.nearest(&x).unwrap().point, x, "not stored");
                         }
-                        let mut e2 = 0.0;
-                        for i in 0..q.len() {
-                            e2 += (q[i] - x[i]) * (q[i] - x[i]);
-                        }
-                        prop_assert_eq!(e2.sqrt(), d);
+                        prop_assert_eq!(d2(q, &x).sqrt(), d);
                     }
                     (Some(_), None) => {}
                     other => prop_assert!(false, "exact answer without point or back: {:?}", other),
