@@ -324,6 +324,22 @@ impl CellIndex {
         })
     }
 
+    /// Asks the CPU to start loading the cell bytes [`Window::rows`] reads first around `p`
+    /// (cells `x - 2 ..= x + 5` of rows `y - 2 ..= y + 2`), without waiting for them. Only the
+    /// lines in `p`'s own tile are asked for ([`near_corners`]); the rest are rare and load on
+    /// use.
+    #[inline]
+    pub fn prefetch_near(&self, p: [i64; 2]) {
+        let (key, _) = split(p);
+        if let Some(t) = self.slot(key) {
+            let kinds = &self.tiles[t as usize].kinds;
+            // One line per 8 x 8 block of cells; a repeated line costs only an issue slot.
+            for [x, y] in near_corners(p) {
+                crate::hint::prefetch(&kinds[offset(x, y)]);
+            }
+        }
+    }
+
     /// Occupied cells (for consistency checks).
     #[cfg(test)]
     pub fn len(&self) -> usize {
@@ -338,6 +354,27 @@ impl CellIndex {
     pub fn is_empty(&self) -> bool {
         self.map.is_empty()
     }
+}
+
+/// The corners of the part of `x - 2 ..= x + 5`, `y - 2 ..= y + 2` around `p = [x, y]` that
+/// lies in `p`'s tile. That part spans at most 2 x 2 blocks of 8 x 8 cells (it is 8 x 5 cells),
+/// so its corners touch every block, hence every cache line of kind bytes, that it covers.
+fn near_corners(p: [i64; 2]) -> [[i64; 2]; 4] {
+    // The tile's cells are `k << SHIFT ..= (k << SHIFT) + TILE - 1` on each axis, with
+    // `k = v >> SHIFT` (no overflow: `k << SHIFT <= v`).
+    let clamp = |c: i64, v: i64| {
+        let lo = (v >> SHIFT) << SHIFT;
+        c.clamp(lo, lo + (TILE - 1))
+    };
+    let (x0, x1) = (
+        clamp(p[0].saturating_sub(2), p[0]),
+        clamp(p[0].saturating_add(5), p[0]),
+    );
+    let (y0, y1) = (
+        clamp(p[1].saturating_sub(2), p[1]),
+        clamp(p[1].saturating_add(2), p[1]),
+    );
+    [[x0, y0], [x1, y0], [x0, y1], [x1, y1]]
 }
 
 static EMPTY_KINDS: [u8; CELLS] = [FREE; CELLS];
@@ -420,6 +457,47 @@ impl Window<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn prefetched_lines_are_exactly_the_rows_lines_in_the_tile() {
+        // Every 8-byte row word `Window::rows` reads around p, where it lies in p's tile, is
+        // in one of the lines of the four corners, and no corner lies outside the rows or
+        // the tile; also at the limits of i64, where the rows cannot be formed.
+        let line = |c: [i64; 2]| ((c[0] >> SHIFT, c[1] >> SHIFT), offset(c[0], c[1]) / 64);
+        let mut pts = vec![
+            [i64::MIN, i64::MIN],
+            [i64::MAX, i64::MAX],
+            [i64::MIN, i64::MAX],
+        ];
+        for x in -70..70 {
+            for y in [
+                -66, -65, -64, -63, -9, -8, -7, -1, 0, 1, 6, 7, 8, 62, 63, 64, 65,
+            ] {
+                pts.push([x, y]);
+            }
+        }
+        for p in pts {
+            let corners = near_corners(p);
+            let lines: Vec<_> = corners.iter().map(|&c| line(c)).collect();
+            for c in corners {
+                assert_eq!(c[0] >> SHIFT, p[0] >> SHIFT, "{p:?} {c:?}");
+                assert_eq!(c[1] >> SHIFT, p[1] >> SHIFT, "{p:?} {c:?}");
+                assert!(c[0] >= p[0].saturating_sub(2) && c[0] <= p[0].saturating_add(5));
+                assert!(c[1] >= p[1].saturating_sub(2) && c[1] <= p[1].saturating_add(2));
+            }
+            if p[0].checked_sub(2).is_none() || p[0].checked_add(5).is_none() {
+                continue;
+            }
+            for dy in -2..=2 {
+                for dx in -2..=5 {
+                    let c = [p[0] + dx, p[1] + dy];
+                    if c[0] >> SHIFT == p[0] >> SHIFT && c[1] >> SHIFT == p[1] >> SHIFT {
+                        assert!(lines.contains(&line(c)), "{p:?}: cell {c:?} not prefetched");
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn set_get_clear_relocate_and_windows_across_tiles() {

@@ -19,6 +19,7 @@
 pub mod bench;
 mod cells;
 pub mod config;
+mod hint;
 pub mod output;
 pub mod params;
 pub mod world;

@@ -220,6 +220,8 @@ enum GridOp {
 
 /// Half-side of the square of cells [`Near::rows`] holds.
 const NEAR_HALF: i64 = 2;
+/// How many turns ahead a turn's cells are prefetched.
+const PREFETCH_TURNS: usize = 8;
 /// Rows of [`Near::rows`].
 const NEAR_ROWS: usize = 2 * NEAR_HALF as usize + 1;
 // Rows are read through a window of half-side RING_MAX, which must hold their cells
@@ -698,13 +700,26 @@ impl World {
                 age: r.age,
                 hunger: r.hunger,
             };
+            // The turns' positions are known ahead (an animat moves only in its own turn), so
+            // the cells a later turn reads first are asked for now: their misses overlap this
+            // turn's work instead of stalling that one's. Part of the search, so timed with it.
+            let ahead = hot
+                .get(j + PREFETCH_TURNS)
+                .filter(|_| self.cell_search)
+                .map(|r| r.pos);
             let (action, rows) = if self.timing {
                 let flushed = self.flush_seconds;
                 let t = Instant::now();
+                if let Some(p) = ahead {
+                    self.cells.prefetch_near(p);
+                }
                 let act = self.decide_near(&a);
                 self.search_seconds += t.elapsed().as_secs_f64() - (self.flush_seconds - flushed);
                 act
             } else {
+                if let Some(p) = ahead {
+                    self.cells.prefetch_near(p);
+                }
                 self.decide_near(&a)
             };
             self.apply(&mut a, action, rows.as_ref());
