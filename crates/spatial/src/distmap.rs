@@ -32,7 +32,10 @@
 //! - [`lower_bound`](DistanceMap::lower_bound): one byte read and one square root, O(1).
 //! - [`insert`](DistanceMap::insert): O((cap / c)^D): every cell whose centre lies within `cap`
 //!   of the point is lowered (about 200 cells in 2D for the defaults of `dla`, `cap = 64`,
-//!   `c = 8`; the rows are contiguous in memory).
+//!   `c = 8`; the rows are contiguous in memory). A row's range comes from a table of
+//!   widths indexed by its distance from the point in whole cells, integer arithmetic with no
+//!   square root per row; it visits a few cells more than the exact range, which the
+//!   per-cell test rejects.
 //! - Growth: when a point comes within `cap + c` of the map's edge (max-norm), the map grows by a
 //!   quarter (at least to cover the point) and the old cells are copied; no cell of the new rim
 //!   can be within `cap` of a point inserted before, so the copy is exact. Amortised O(1) per
@@ -95,7 +98,16 @@ pub struct DistanceMap<const D: usize> {
     /// `below[v]`: a squared distance below which a cell holding `v` may be lowered,
     /// `(v u)^2` widened by a relative `2^-40` (so rounding never skips a lowering).
     below: Box<[f64; 256]>,
+    /// `widths[j]`: for a row of cells whose centres lie at a squared distance of at least
+    /// `j` squared cell sides from the inserted point along the other axes, half the length,
+    /// in cells, of the part of the row within `cap` of it, widened a little (so a row never
+    /// misses a cell); empty when
+    /// `(cap / cell)^2` exceeds [`WIDTHS_MAX`] (rows then solve for their range exactly).
+    widths: Box<[f64]>,
 }
+
+/// Largest `(cap / cell)^2` for which [`DistanceMap`] tabulates its row widths.
+const WIDTHS_MAX: f64 = 4096.0;
 
 impl<const D: usize> Clone for DistanceMap<D> {
     fn clone(&self) -> Self {
@@ -114,6 +126,7 @@ impl<const D: usize> Clone for DistanceMap<D> {
                 .collect(),
             points: self.points,
             below: self.below.clone(),
+            widths: self.widths.clone(),
         }
     }
 }
@@ -145,8 +158,17 @@ impl<const D: usize> DistanceMap<D> {
             let d = v as f64 * quantum;
             *b = d * d * (1.0 + SHRINK);
         }
+        let r2 = (cap / cell) * (cap / cell);
+        let widths = if r2 <= WIDTHS_MAX {
+            (0..=r2 as usize)
+                .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
+                .collect()
+        } else {
+            Box::default()
+        };
         Ok(DistanceMap {
             below,
+            widths,
             cell,
             inv_cell: 1.0 / cell,
             cap,
@@ -299,20 +321,49 @@ impl<const D: usize> DistanceMap<D> {
         // Odometer over axes 1..D; axis 0 is a contiguous row whose range is solved for.
         let mut k = lo;
         let cap2 = self.cap * self.cap;
+        // q in units of cells, with the cells' centres at whole numbers, and the lower of the
+        // two centre indices around it on each axis: the centres of a row `j_i` whole cells
+        // beyond that pair on axis i are at least `j_i` cells from q along that axis.
+        let t0 = q[0] * self.inv_cell - 0.5;
+        let kq: [i64; D] = std::array::from_fn(|i| floor(q[i] * self.inv_cell - 0.5) as i64);
         loop {
             let mut s = 0.0;
+            let mut j2 = 0usize;
             let mut base = 0usize;
             let mut stride = self.side;
             for i in 1..D {
                 let e = q[i] - (k[i] as f64 + 0.5) * self.cell;
                 s += e * e;
+                let j = if k[i] <= kq[i] {
+                    kq[i] - k[i]
+                } else {
+                    k[i] - kq[i] - 1
+                };
+                j2 += (j * j) as usize;
                 base += (k[i] + self.half) as usize * stride;
                 stride *= self.side;
             }
-            if s < cap2 {
-                let w = (cap2 - s).sqrt();
-                let a = (ceil((q[0] - w) * self.inv_cell - 0.5) as i64).max(lo[0]);
-                let b = (floor((q[0] + w) * self.inv_cell - 0.5) as i64).min(hi[0]);
+            // The row's range along axis 0: from the table of widths (no square root per
+            // row; a few cells more than the exact range, which the per-cell test rejects),
+            // or solved exactly when there is no table.
+            let range = if self.widths.is_empty() {
+                (s < cap2).then(|| {
+                    let w = (cap2 - s).sqrt();
+                    (
+                        ceil((q[0] - w) * self.inv_cell - 0.5),
+                        floor((q[0] + w) * self.inv_cell - 0.5),
+                    )
+                })
+            } else {
+                // `j2` is at most the row's squared distance from q in cells, so its width in
+                // the table is at least the exact one. It is integer arithmetic: the row's
+                // range does not wait for the floating-point distance (which only the
+                // per-cell test below uses), and the rows' set-up overlaps.
+                self.widths.get(j2).map(|&h| (ceil(t0 - h), floor(t0 + h)))
+            };
+            if let Some((a, b)) = range {
+                let a = (a as i64).max(lo[0]);
+                let b = (b as i64).min(hi[0]);
                 if a <= b {
                     let row = &self.values
                         [base + (a + self.half) as usize..=base + (b + self.half) as usize];
@@ -530,6 +581,54 @@ mod tests {
         let (lb, _) = shared.lower_bound(&p).unwrap();
         assert!(lb <= brute(&all, &p));
         assert!(shared.insert_shared(&[f64::NAN, 0.0]).is_err());
+    }
+
+    /// The rows' ranges from the table of widths cover every cell the exactly solved ranges
+    /// cover, and the extra cells they visit are never lowered: the same bytes either way,
+    /// in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
+    /// centres among random ones.
+    #[test]
+    fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
+        fn same<const D: usize>(cell: f64, cap: f64, seed: u64) {
+            let mut rng = seed;
+            let mut next = || {
+                rng ^= rng << 13;
+                rng ^= rng >> 7;
+                rng ^= rng << 17;
+                (rng >> 11) as f64 / (1u64 << 53) as f64
+            };
+            let span = 6.0 * cap;
+            let mut pts: Vec<[f64; D]> = (0..600)
+                .map(|_| std::array::from_fn(|_| (next() - 0.5) * span))
+                .collect();
+            // Corners and centres of cells: the rounding edge cases of the ranges.
+            for k in -3..3 {
+                pts.push(std::array::from_fn(|i| (k + i as i64) as f64 * cell));
+                pts.push(std::array::from_fn(|i| (k as f64 + 0.5 + i as f64) * cell));
+            }
+            let mut table = DistanceMap::<D>::new(cell, cap).unwrap();
+            assert!(!table.widths.is_empty());
+            let mut exact = table.clone();
+            exact.widths = Box::default();
+            for q in &pts {
+                table.insert(q).unwrap();
+                exact.insert(q).unwrap();
+            }
+            assert_eq!(table.side, exact.side);
+            let bytes = |m: &DistanceMap<D>| -> Vec<u8> {
+                m.values.iter().map(|v| v.load(Ordering::Relaxed)).collect()
+            };
+            let lowered = bytes(&table).iter().filter(|&&v| v < CAPPED).count();
+            assert!(lowered > 100, "{lowered} cells lowered");
+            assert!(bytes(&table) == bytes(&exact), "cell {cell}, cap {cap}");
+        }
+        same::<2>(8.0, 64.0, 1);
+        same::<2>(64.0, 512.0, 2);
+        same::<2>(3.0, 10.5, 3);
+        same::<2>(1.0, 64.0, 4);
+        same::<3>(8.0, 32.0, 5);
+        same::<3>(32.0, 128.0, 6);
+        same::<3>(2.5, 11.0, 7);
     }
 
     #[test]
