@@ -459,7 +459,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn prefetched_lines_are_exactly_the_rows_lines_in_the_tile() {
+    fn prefetched_lines_cover_the_rows_lines_in_the_tile() {
         // Every 8-byte row word `Window::rows` reads around p, where it lies in p's tile, is
         // in one of the lines of the four corners, and no corner lies outside the rows or
         // the tile; also at the limits of i64, where the rows cannot be formed.

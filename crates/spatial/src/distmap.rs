@@ -101,8 +101,8 @@ pub struct DistanceMap<const D: usize> {
     /// `widths[j]`: for a row of cells whose centres lie at a squared distance of at least
     /// `j` squared cell sides from the inserted point along the other axes, half the length,
     /// in cells, of the part of the row within `cap` of it, widened a little (so a row never
-    /// misses a cell); empty when
-    /// `(cap / cell)^2` exceeds [`WIDTHS_MAX`] (rows then solve for their range exactly).
+    /// misses a cell). Empty when `(cap / cell)^2` exceeds [`WIDTHS_MAX`]; rows then solve
+    /// for their range exactly.
     widths: Box<[f64]>,
 }
 
