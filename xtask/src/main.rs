@@ -4,8 +4,8 @@
 //!   warnings denied, and the test suite (the README's test command).
 //! - `cargo xtask scaling [--quick] [--only ...] [--out DIR]`: regenerate the papers' tables
 //!   and figures from our own runs (see `docs/results/README.md`).
-//! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and memory figures
-//!   as JSON, and their ratios to a saved baseline.
+//! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and
+//!   memory figures as JSON, and their ratios to a saved baseline.
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};

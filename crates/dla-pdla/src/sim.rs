@@ -1019,7 +1019,7 @@ mod tests {
     use super::*;
 
     /// Walkers on a grown cluster: the number of moves answered by a built near cache.
-    fn cache_builds<const D: usize>(precision: f64) -> usize {
+    fn cached_moves<const D: usize>(precision: f64) -> usize {
         let params = Params {
             dim: D,
             particles: 1500,
@@ -1053,11 +1053,11 @@ mod tests {
     #[test]
     fn near_cache_is_used_only_where_the_tree_is_exact() {
         // Default precision: (2 - 1/2) leaf diagonals cover the cache's radius.
-        assert!(cache_builds::<2>(2.0) > 0);
-        assert!(cache_builds::<3>(2.0) > 0);
+        assert!(cached_moves::<2>(2.0) > 0);
+        assert!(cached_moves::<3>(2.0) > 0);
         // kappa 0.8: exact only within 0.3 leaf diagonals (3.4 in 2D, 4.2 in 3D), less than
         // the radius: the cache must stay off.
-        assert_eq!(cache_builds::<2>(0.8), 0);
-        assert_eq!(cache_builds::<3>(0.8), 0);
+        assert_eq!(cached_moves::<2>(0.8), 0);
+        assert_eq!(cached_moves::<3>(0.8), 0);
     }
 }

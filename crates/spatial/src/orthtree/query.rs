@@ -593,11 +593,10 @@ fn nearest_in_leaf<const D: usize>(
     }
     let base = pts.len() - tail.len();
     for (k, code) in tail.iter().enumerate() {
-        let mut d2 = 0.0;
-        for i in 0..D {
-            let e = p[i] - decode(origin[i], code[i], step);
-            d2 += e * e;
-        }
+        let d2 = dist_sq(
+            p,
+            &std::array::from_fn(|i| decode(origin[i], code[i], step)),
+        );
         if d2 < m[k] {
             m[k] = d2;
             at[k] = base + k;
