@@ -137,6 +137,7 @@ fn check<const D: usize>(
             ] {
                 // `vpdist_bounded` is this walk without the point.
                 let (b, near) = tree.vpdist_bounded_nearest(q, kappa, upper).unwrap();
+                prop_assert_eq!(tree.vpdist_bounded(q, kappa, upper), Some(b));
                 prop_assert!(
                     b.distance <= d
                         && (!kappa.is_finite()
