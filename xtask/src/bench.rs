@@ -23,7 +23,7 @@ pub struct Workload {
     pub unit: &'static str,
 }
 
-/// The workloads of issue 7, in the order they run.
+/// The headline workloads, in the order they run.
 pub const WORKLOADS: &[Workload] = &[
     Workload {
         name: "dla-2d-1e6-1thread",
@@ -220,23 +220,37 @@ fn items(w: &Workload, m: &RunManifest, dir: &Path) -> Result<(f64, Option<f64>)
             num("particles"),
         ),
         _ => {
-            // Animat-steps: the population at each step, summed, from populations.csv.
-            let text = std::fs::read_to_string(dir.join("populations.csv"))
-                .context("reading populations.csv")?;
-            let mut total = 0.0;
-            let mut peak: f64 = 0.0;
-            for line in text.lines().skip(1) {
-                let f: Vec<&str> = line.split(',').collect();
-                if f.len() >= 3 {
-                    let pop =
-                        f[1].parse::<f64>().unwrap_or(0.0) + f[2].parse::<f64>().unwrap_or(0.0);
-                    total += pop;
-                    peak = peak.max(pop);
-                }
-            }
+            let (total, peak) = animat_steps(&dir.join("populations.csv"))?;
             (total, Some(peak))
         }
     })
+}
+
+/// One row of an animat run's `populations.csv` (the columns the rate needs; others ignored).
+#[derive(Debug, Deserialize)]
+struct PopulationRow {
+    foxes: u64,
+    rabbits: u64,
+}
+
+/// Animat-steps of a run (the population at each step, summed) and its peak population, from
+/// `populations.csv`. A missing column, an unparsable cell or an empty file is an error naming
+/// the file, never a silent zero.
+fn animat_steps(path: &Path) -> Result<(f64, f64)> {
+    let mut reader =
+        csv::Reader::from_path(path).with_context(|| format!("reading {}", path.display()))?;
+    let (mut total, mut peak, mut rows) = (0u64, 0u64, 0usize);
+    for row in reader.deserialize::<PopulationRow>() {
+        let row = row.with_context(|| format!("parsing {}", path.display()))?;
+        let pop = row.foxes + row.rabbits;
+        total += pop;
+        peak = peak.max(pop);
+        rows += 1;
+    }
+    if rows == 0 {
+        bail!("{} has no rows", path.display());
+    }
+    Ok((total as f64, peak as f64))
 }
 
 /// Run one workload in a temporary directory.
@@ -437,6 +451,29 @@ mod tests {
             state_hash: Some(hash.into()),
             wall_seconds_runs: Vec::new(),
         }
+    }
+
+    #[test]
+    fn animat_steps_sum_populations_and_refuse_bad_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("populations.csv");
+        std::fs::write(
+            &p,
+            "step,foxes,rabbits,search_seconds\n0,2,3,0.1\n1,4,5,0.2\n",
+        )
+        .unwrap();
+        assert_eq!(animat_steps(&p).unwrap(), (14.0, 9.0));
+        // A missing column, a bad cell and an empty table are errors, not zeros.
+        for bad in [
+            "step,foxes\n0,2\n",
+            "step,foxes,rabbits\n0,2,x\n",
+            "step,foxes,rabbits\n",
+        ] {
+            std::fs::write(&p, bad).unwrap();
+            let e = animat_steps(&p).unwrap_err();
+            assert!(format!("{e:#}").contains("populations.csv"), "{e:#}");
+        }
+        assert!(animat_steps(&dir.path().join("missing.csv")).is_err());
     }
 
     #[test]

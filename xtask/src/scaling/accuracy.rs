@@ -3,13 +3,14 @@
 //! the R_g prefactor (both against the most exact setting), the Pareto front, and the
 //! distribution of `vpdist` errors against the exact nearest distance.
 
+use super::Ctx;
 use super::dla::{Grown, fit_from, grow};
-use super::{Ctx, par_map};
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;
 use core_lattice::rng::{stream, uniform01};
 use dla_pdla::{FarField, Params, Simulation};
+use rayon::prelude::*;
 
 /// One point of the sweep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -141,19 +142,22 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         "{} settings x {e} runs of N = {n}",
         settings.len()
     ));
-    let runs = par_map(&jobs, |&(i, s)| {
-        let st = settings[i];
-        let p = Params {
-            particles: n,
-            precision: st.precision,
-            step_min: st.step_min,
-            far_field: st.far_field,
-            distance_map: st.distance_map,
-            fit_from: from,
-            ..Params::default()
-        };
-        grow(&p, ctx.seed + s)
-    });
+    let runs: Vec<_> = jobs
+        .par_iter()
+        .map(|&(i, s)| {
+            let st = settings[i];
+            let p = Params {
+                particles: n,
+                precision: st.precision,
+                step_min: st.step_min,
+                far_field: st.far_field,
+                distance_map: st.distance_map,
+                fit_from: from,
+                ..Params::default()
+            };
+            grow(&p, ctx.seed + s)
+        })
+        .collect();
     let mut per: Vec<Vec<Grown>> = vec![Vec::new(); settings.len()];
     for ((i, _), r) in jobs.iter().zip(runs) {
         per[*i].push(r?);

@@ -2,12 +2,13 @@
 //! `vpdist` (Fig. 3), fractal dimensions in Table 2's layout, and the PDLA speed-up with the
 //! parallel fraction from Amdahl's law.
 
-use super::{Ctx, par_map};
+use super::Ctx;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig, std_dev};
 use anyhow::Result;
 use core_lattice::LinearFit;
 use dla_pdla::{Params, Sample, Simulation};
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// What one DLA/PDLA run gives the experiments.
@@ -194,7 +195,7 @@ fn table2(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
             let seeds: Vec<u64> = (0..e).map(|i| ctx.seed + i).collect();
             // Single-threaded runs fill both cores; two-thread runs go one at a time.
             let runs: Vec<Result<Grown>> = if threads == 1 {
-                par_map(&seeds, |&s| grow(&p, s))
+                seeds.par_iter().map(|&s| grow(&p, s)).collect()
             } else {
                 seeds.iter().map(|&s| grow(&p, s)).collect()
             };

@@ -3,13 +3,14 @@
 //! clusters examined per move (Figs. 4, 7, 8), and the log-log gradient of the sweep cost
 //! against N for each strategy.
 
-use super::{Ctx, log_spaced, par_map};
+use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, mean_stderr, pm, sig};
 use anyhow::{Result, bail};
 use core_lattice::{Boundary, LogLogFit};
 use dlca::record::SweepRecord;
 use dlca::{Init, Params, Search, Simulation};
+use rayon::prelude::*;
 
 const FILLS: [f64; 2] = [0.01, 0.05];
 
@@ -71,11 +72,14 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     let mut series = Vec::new();
     for fill in FILLS {
         let jobs: Vec<u64> = (0..seeds).map(|i| ctx.seed + i).collect();
-        let runs = par_map(&jobs, |&seed| -> Result<(u64, Vec<SweepRecord>)> {
-            let mut sim = Simulation::new(params(size, fill, Search::Lattice), seed)?;
-            sim.run();
-            Ok((sim.particles(), sim.records().sweeps().to_vec()))
-        });
+        let runs: Vec<_> = jobs
+            .par_iter()
+            .map(|&seed| -> Result<(u64, Vec<SweepRecord>)> {
+                let mut sim = Simulation::new(params(size, fill, Search::Lattice), seed)?;
+                sim.run();
+                Ok((sim.particles(), sim.records().sweeps().to_vec()))
+            })
+            .collect();
         let mut to_target = Vec::new();
         let mut exponents = Vec::new();
         let mut particles = 0;

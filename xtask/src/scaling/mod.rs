@@ -234,39 +234,6 @@ fn previous_row(index: &str, e: Experiment) -> Option<Vec<String>> {
     (cells.len() == 5).then_some(cells)
 }
 
-/// Apply `f` to every item on all cores (work-stealing by index); results keep the items'
-/// order. Used for ensembles whose wall time is not itself a result.
-pub fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    use std::sync::Mutex;
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    let workers = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .min(items.len().max(1));
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<R>>> = Mutex::new((0..items.len()).map(|_| None).collect());
-    std::thread::scope(|s| {
-        for _ in 0..workers {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    if i >= items.len() {
-                        break;
-                    }
-                    let r = f(&items[i]);
-                    results.lock().expect("no worker panicked")[i] = Some(r);
-                }
-            });
-        }
-    });
-    results
-        .into_inner()
-        .expect("no worker panicked")
-        .into_iter()
-        .map(|r| r.expect("every item was processed"))
-        .collect()
-}
-
 /// About `n` log-spaced integers from `lo` to `hi` inclusive, deduplicated.
 pub fn log_spaced(lo: u64, hi: u64, n: usize) -> Vec<u64> {
     let (a, b) = ((lo.max(1) as f64).ln(), (hi.max(1) as f64).ln());
@@ -284,15 +251,6 @@ pub fn log_spaced(lo: u64, hi: u64, n: usize) -> Vec<u64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn par_map_keeps_order() {
-        let v: Vec<u64> = (0..100).collect();
-        assert_eq!(
-            par_map(&v, |x| x * 2),
-            (0..100).map(|x| x * 2).collect::<Vec<_>>()
-        );
-    }
 
     #[test]
     fn index_keeps_rows_of_experiments_not_rerun() {
@@ -326,8 +284,19 @@ mod tests {
     }
 
     #[test]
-    fn log_spacing() {
-        let v = log_spaced(1, 1000, 4);
-        assert_eq!(v, vec![1, 10, 100, 1000]);
+    fn log_spaced_has_constant_ratio_and_ends_included() {
+        assert_eq!(log_spaced(1, 1000, 4), vec![1, 10, 100, 1000]);
+        // Consecutive ratios are equal (up to rounding to integers) and both ends are included.
+        let v = log_spaced(10, 1_000_000, 11);
+        assert_eq!((v[0], *v.last().unwrap()), (10, 1_000_000));
+        let ratio = (1e5f64).powf(0.1);
+        for w in v.windows(2) {
+            let r = w[1] as f64 / w[0] as f64;
+            assert!((r / ratio - 1.0).abs() < 0.05, "{v:?}");
+        }
+        // Rounding collisions at the low end are removed, not repeated.
+        let d = log_spaced(1, 4, 10);
+        assert!(d.windows(2).all(|w| w[0] < w[1]), "{d:?}");
+        assert_eq!((d[0], *d.last().unwrap()), (1, 4));
     }
 }
