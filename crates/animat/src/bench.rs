@@ -1,6 +1,7 @@
-//! Measurement entry points for the scaling study of seed 000, section IV.B (Fig. 9, Table I)
-//! and the whole-step throughput target (REFERENCE.md): library functions so that `xtask`,
-//! examples and benches all measure the same thing the same way.
+//! Measurement entry points for the scaling study of Hawick, James & Scogings (2006),
+//! "Grid-Boxing for Spatial Simulation Performance Optimisation", section IV.B (Fig. 9,
+//! Table I), and for the whole-step throughput (`docs/benchmarks.md`): library functions so
+//! that `xtask`, examples and benches all measure the same thing the same way.
 //!
 //! - [`search_scaling_point`]: neighbour-search time and distance evaluations per step for one
 //!   population at a fixed start density and one grid setting (one point of Fig. 9);
@@ -10,7 +11,8 @@
 //!   the species in the default ratio and the start radius set by the density).
 //!
 //! None of these assert anything about time; they measure and report. Wall-clock figures depend
-//! on the machine and its load.
+//! on the machine and its load. Invariants: the world is built before any clock starts, and
+//! measuring never changes the trajectory (the reported state hashes are the untimed run's).
 //!
 //! ```
 //! use animat::GridBox;
@@ -48,7 +50,7 @@ pub fn scaling_params(population: u64, density: f64, grid: GridBox) -> Params {
     }
 }
 
-/// Cost of the neighbour search for one population (one point of seed 000, Fig. 9).
+/// Cost of the neighbour search for one population (one point of the paper's Fig. 9).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SearchCost {
     /// Animats at the start.
@@ -101,7 +103,7 @@ pub fn search_scaling_point(
 }
 
 /// [`search_scaling_point`] with the cell-index search on or off
-/// ([`World::set_cell_search`]): off measures seed 000's structure, the grid boxes alone
+/// ([`World::set_cell_search`]): off measures the paper's structure, the grid boxes alone
 /// (`none` is always the exhaustive scan).
 ///
 /// # Errors
@@ -148,8 +150,8 @@ pub fn search_scaling_point_with(
     })
 }
 
-/// Whole-step throughput (REFERENCE.md target: at least 5 million animat-steps per second at
-/// 1e5 animats on one core).
+/// Whole-step throughput: animat-steps per second (the target and the figures are in
+/// `docs/benchmarks.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Throughput {
     /// Animats at the start.

@@ -47,7 +47,11 @@ pub struct PopulationRow {
 ///
 /// # Errors
 /// [`OutputError`] if a file cannot be written.
-pub fn write_populations(dir: &Path, rows: &[PopulationRow], timing: bool) -> Result<(), OutputError> {
+pub fn write_populations(
+    dir: &Path,
+    rows: &[PopulationRow],
+    timing: bool,
+) -> Result<(), OutputError> {
     let mut header = vec!["step", "foxes", "rabbits"];
     if timing {
         header.extend(["search_seconds", "distance_evaluations"]);

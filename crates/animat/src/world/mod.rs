@@ -451,7 +451,8 @@ impl World {
     /// adjacency and overcrowding tests read the cells around the animat directly, and nearest
     /// and counting queries scan cell rings outward up to radius 8 before falling back to the
     /// grid boxes; both give the exact answers, so the trajectory does not change. Turning it
-    /// off measures the grid boxes alone (seed 000's structure).
+    /// off measures the grid boxes alone (the paper's structure: Hawick, James & Scogings 2006,
+    /// section III).
     pub fn set_cell_search(&mut self, on: bool) {
         self.cell_search = on && self.grid.box_size() != spatial::plane::BoxSize::None;
     }

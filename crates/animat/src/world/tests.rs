@@ -74,19 +74,34 @@ fn eat_removes_the_rabbit_and_resets_hunger() {
 
 #[test]
 fn an_eaten_rabbit_does_not_act() {
-    // Whatever the order, the rabbit acts only if it moves before the fox; with flee it
-    // would step away. Run several seeds: when the fox goes first, the rabbit is gone and
-    // has not moved; the world never holds a dead rabbit.
+    // The rabbit acts only if its turn comes before the fox's: with flee it steps away to
+    // [2, 0] and the fox, its prey gone, stays. When the fox goes first the rabbit is eaten
+    // and must not take its turn: had it fled, [2, 0] would be occupied. Over several seeds
+    // both orders occur.
+    let (mut fled, mut eaten) = (0, 0);
     for seed in 0..20 {
         let mut w = World::empty(only(&["eat"], &["flee"]), seed).unwrap();
-        w.add(Fox, [0, 0], 0, 7).unwrap();
+        let f = w.add(Fox, [0, 0], 0, 7).unwrap();
         let r = w.add(Rabbit, [1, 0], 0, 0).unwrap();
         w.step();
+        assert_eq!(w.get(f).unwrap().pos, [0, 0]);
         match w.get(r) {
-            Some(a) => assert_eq!(a.pos, [2, 0]),
-            None => assert_eq!(w.rabbits(), 0),
+            Some(a) => {
+                assert_eq!(a.pos, [2, 0]);
+                fled += 1;
+            }
+            None => {
+                assert_eq!(w.rabbits(), 0);
+                assert_eq!(w.animats().count(), 1);
+                for c in [[1, 0], [2, 0]] {
+                    assert!(!w.grid().is_occupied(c), "seed {seed}: {c:?} occupied");
+                }
+                eaten += 1;
+            }
         }
+        w.grid().validate().unwrap();
     }
+    assert!(fled > 0 && eaten > 0, "fled {fled}, eaten {eaten}");
 }
 
 #[test]
@@ -176,6 +191,8 @@ fn newborns_act_next_step_and_ids_increase() {
     w.add(Rabbit, [1, 0], 0, 0).unwrap();
     w.step();
     let ages: Vec<(u64, u32)> = w.animats().map(|a| (a.id, a.age)).collect();
+    assert!(ages.len() > 2, "no rabbit was born");
+    assert!(ages.windows(2).all(|p| p[0].0 < p[1].0), "{ages:?}");
     assert_eq!(&ages[..2], &[(0, 1), (1, 1)]);
     for &(id, age) in &ages[2..] {
         assert!(id >= 2);
@@ -224,24 +241,53 @@ fn ties_go_to_the_lower_id() {
 
 #[test]
 fn seek_mate_and_herd_step_towards_the_nearest() {
+    // Each fox steps one cell towards its nearest other fox, each rabbit towards its nearest
+    // other rabbit (whatever the order: the targets move along the same line and no step is
+    // blocked).
     let mut w = world(only(&["seek_mate"], &["herd"]));
     let f = w.add(Fox, [0, 0], 0, 0).unwrap();
-    w.add(Fox, [0, 20], 0, 0).unwrap();
+    let mate = w.add(Fox, [0, 20], 0, 0).unwrap();
+    let far_fox = w.add(Fox, [0, -30], 0, 0).unwrap();
     let r = w.add(Rabbit, [40, 0], 0, 0).unwrap();
-    w.add(Rabbit, [40, -10], 0, 0).unwrap();
+    let herd = w.add(Rabbit, [40, -10], 0, 0).unwrap();
+    let far_rabbit = w.add(Rabbit, [40, 25], 0, 0).unwrap();
     w.step();
-    let fp = w.get(f).unwrap().pos;
-    assert!(fp == [0, 1] || fp == [0, 0], "{fp:?}");
-    let rp = w.get(r).unwrap().pos;
-    assert_eq!(rp, [40, -1]);
-    // Hungry foxes do not seek mates; out of vision nothing is seen.
-    let mut w = world(only(&["seek_mate"], &["herd"]));
+    let pos = |id| w.get(id).unwrap().pos;
+    // [0, 0] seeks its mate at distance 20, not the fox at distance 30; the mate and the far
+    // fox seek [0, 0], their nearest.
+    assert_eq!(pos(f), [0, 1]);
+    assert_eq!(pos(mate), [0, 19]);
+    assert_eq!(pos(far_fox), [0, -29]);
+    // [40, 0] herds towards [40, -10] (10 away), not [40, 25] (25 away).
+    assert_eq!(pos(r), [40, -1]);
+    assert_eq!(pos(herd), [40, -9]);
+    assert_eq!(pos(far_rabbit), [40, 24]);
+    // Hungry foxes do not seek mates; another fox seeks a hungry one all the same.
+    let mut w = world(only(&["seek_mate"], &[]));
     let f = w.add(Fox, [0, 0], 0, 9).unwrap();
-    w.add(Fox, [0, 20], 0, 0).unwrap();
-    let r = w.add(Rabbit, [1000, 0], 0, 0).unwrap();
+    let mate = w.add(Fox, [0, 20], 0, 0).unwrap();
     w.step();
     assert_eq!(w.get(f).unwrap().pos, [0, 0]);
-    assert_eq!(w.get(r).unwrap().pos, [1000, 0]);
+    assert_eq!(w.get(mate).unwrap().pos, [0, 19]);
+    // Vision (60) is inclusive: a pair 60 apart herd together, a pair 61 apart (and foxes
+    // 61 apart) see nothing and stay.
+    let mut w = world(only(&["seek_mate"], &["herd"]));
+    let seen = [
+        w.add(Rabbit, [1000, 0], 0, 0).unwrap(),
+        w.add(Rabbit, [1000, 60], 0, 0).unwrap(),
+    ];
+    let unseen = [
+        w.add(Rabbit, [2000, 0], 0, 0).unwrap(),
+        w.add(Rabbit, [2061, 0], 0, 0).unwrap(),
+        w.add(Fox, [3000, 0], 0, 0).unwrap(),
+        w.add(Fox, [3000, -61], 0, 0).unwrap(),
+    ];
+    let before: Vec<Pos> = unseen.iter().map(|&id| w.get(id).unwrap().pos).collect();
+    w.step();
+    assert_eq!(w.get(seen[0]).unwrap().pos, [1000, 1]);
+    assert_eq!(w.get(seen[1]).unwrap().pos, [1000, 59]);
+    let after: Vec<Pos> = unseen.iter().map(|&id| w.get(id).unwrap().pos).collect();
+    assert_eq!(after, before);
 }
 
 #[test]
