@@ -14,7 +14,7 @@
 //! - `tests`: hand-built scenes.
 //!
 //! Invariants between steps: `recs` holds exactly the live animats, sorted by id, with
-//! `flags` parallel to it and no [`DEAD`] bit set; every live animat stands alone on its cell
+//! `flags` parallel to it and no `DEAD` bit set; every live animat stands alone on its cell
 //! in `cells` and is in `grid` at that cell (`pending` is empty); `foxes` and `rabbits` count
 //! the live animats; every id is below `next_id` and none is reused. During a step `grid` may
 //! lag behind `cells` by the changes logged in `pending` (see `step`).
