@@ -59,7 +59,7 @@ impl World {
         self.decide_near(a).0
     }
 
-    /// [`World::decide`], with the kind bytes around `a` ([`Near::rows`]) when the action
+    /// `World::decide`, with the kind bytes around `a` ([`Near::rows`]) when the action
     /// moves or breeds and the cell-index fast path is on: applying it reads its free
     /// neighbours from them.
     pub(super) fn decide_near(&mut self, a: &Animat) -> (Action, Option<[u64; NEAR_ROWS]>) {
