@@ -24,7 +24,7 @@
 //! ```
 
 use crate::params::{GridBox, Params};
-use crate::world::{World, WorldError};
+use crate::world::{StepStats, World, WorldError};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -119,19 +119,12 @@ pub fn search_scaling_point_with(
     let mut w = World::new(scaling_params(population, density, grid), seed)?;
     w.set_timing(true);
     w.set_cell_search(cell_search);
-    let (mut search, mut evals, mut turns, mut done) = (0.0, 0u64, 0u64, 0u64);
+    let (mut search, mut evals) = (0.0, 0u64);
     let t = Instant::now();
-    for _ in 0..steps {
-        let n = w.foxes() + w.rabbits();
-        if n == 0 {
-            break;
-        }
-        turns += n;
-        let s = w.step();
+    let (turns, done) = measured_steps(&mut w, steps, |s| {
         search += s.search_seconds;
         evals += s.distance_evals;
-        done += 1;
-    }
+    });
     let wall = t.elapsed().as_secs_f64();
     let per = |x: f64| if done > 0 { x / done as f64 } else { 0.0 };
     Ok(SearchCost {
@@ -146,7 +139,7 @@ pub fn search_scaling_point_with(
         step_seconds: per(wall),
         final_foxes: w.foxes(),
         final_rabbits: w.rabbits(),
-        state_hash: u64::from_str_radix(&w.state_hash(), 16).unwrap_or(0),
+        state_hash: state_hash_u64(&w),
     })
 }
 
@@ -187,19 +180,9 @@ pub fn step_throughput(
 ) -> Result<Throughput, WorldError> {
     let mut w = World::new(scaling_params(population, density, grid), seed)?;
     w.run(warmup);
-    let mut turns = 0u64;
-    let mut done = 0u64;
     let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
-    for _ in 0..steps {
-        let n = w.foxes() + w.rabbits();
-        if n == 0 {
-            break;
-        }
-        turns += n;
-        w.step();
-        done += 1;
-    }
+    let (turns, done) = measured_steps(&mut w, steps, |_| {});
     let seconds = t.elapsed().as_secs_f64();
     let cpu_seconds = thread_cpu_seconds().zip(cpu0).map(|(b, a)| b - a);
     Ok(Throughput {
@@ -213,8 +196,30 @@ pub fn step_throughput(
         } else {
             0.0
         },
-        state_hash: u64::from_str_radix(&w.state_hash(), 16).unwrap_or(0),
+        state_hash: state_hash_u64(&w),
     })
+}
+
+/// Runs up to `steps` steps of `w`, stopping early when every animat has died, and hands each
+/// step's counters to `each`. Returns the animat turns taken (the population at the start of
+/// each step, summed) and the steps done.
+fn measured_steps(w: &mut World, steps: u64, mut each: impl FnMut(StepStats)) -> (u64, u64) {
+    let (mut turns, mut done) = (0u64, 0u64);
+    for _ in 0..steps {
+        let n = w.foxes() + w.rabbits();
+        if n == 0 {
+            break;
+        }
+        turns += n;
+        each(w.step());
+        done += 1;
+    }
+    (turns, done)
+}
+
+/// [`World::state_hash`] as a number.
+fn state_hash_u64(w: &World) -> u64 {
+    u64::from_str_radix(&w.state_hash(), 16).expect("a state hash is 16 hex digits")
 }
 
 /// CPU time of the calling thread in seconds (Linux `/proc/thread-self/schedstat`, whose

@@ -30,7 +30,7 @@ use crate::cells::{CellIndex, WINDOW_MAX, kind_byte};
 use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
-use near::{NEAR_HALF, NEAR_ROWS};
+use near::{NEAR_ROWS, disc_mask};
 use rustc_hash::FxHashSet;
 use spatial::plane::{PlaneError, PlaneGrid, Pos};
 
@@ -236,18 +236,8 @@ impl World {
             } else {
                 Vec::new()
             },
-            crowd_masks: {
-                let r = params.crowd_radius.min(NEAR_HALF);
-                let mut m = [0u64; NEAR_ROWS];
-                for dy in -r..=r {
-                    for dx in -r..=r {
-                        if (dx, dy) != (0, 0) && (dx * dx + dy * dy) as u64 <= c * c {
-                            m[(dy + NEAR_HALF) as usize] |= 1 << (8 * (dx + NEAR_HALF));
-                        }
-                    }
-                }
-                m
-            },
+            // `c <= MAX_RADIUS = 2^30`: `c * c` fits in i64.
+            crowd_masks: disc_mask(1, (c * c) as i64),
             recs: Vec::new(),
             flags: Vec::new(),
             eaten: FxHashSet::default(),

@@ -59,15 +59,16 @@ pub(super) fn row_byte(rows: &[u64; NEAR_ROWS], dx: i64, dy: i64) -> u8 {
     (rows[(dy + NEAR_HALF) as usize] >> (8 * (dx + NEAR_HALF))) as u8
 }
 
-/// The cells of [`Near::rows`] at squared distance exactly `d2` from the centre, as bit 0 of
-/// their bytes.
-pub(super) const fn class_mask(d2: i64) -> [u64; NEAR_ROWS] {
+/// The cells of [`Near::rows`] at squared distance `lo ..= hi` from the centre (the
+/// `NEAR_ROWS` x `NEAR_ROWS` square around it), as bit 0 of their bytes.
+pub(super) const fn disc_mask(lo: i64, hi: i64) -> [u64; NEAR_ROWS] {
     let mut m = [0u64; NEAR_ROWS];
     let mut dy = -NEAR_HALF;
     while dy <= NEAR_HALF {
         let mut dx = -NEAR_HALF;
         while dx <= NEAR_HALF {
-            if dx * dx + dy * dy == d2 {
+            let d2 = dx * dx + dy * dy;
+            if lo <= d2 && d2 <= hi {
                 m[(dy + NEAR_HALF) as usize] |= 1 << (8 * (dx + NEAR_HALF));
             }
             dx += 1;
@@ -80,11 +81,11 @@ pub(super) const fn class_mask(d2: i64) -> [u64; NEAR_ROWS] {
 /// The cells of rings 1 and 2 by squared distance, nearest first: ring 1 is `d2` 1 and 2,
 /// ring 2 is `d2` 4, 5 and 8.
 pub(super) const RING_CLASSES: [[u64; NEAR_ROWS]; 5] = [
-    class_mask(1),
-    class_mask(2),
-    class_mask(4),
-    class_mask(5),
-    class_mask(8),
+    disc_mask(1, 1),
+    disc_mask(2, 2),
+    disc_mask(4, 4),
+    disc_mask(5, 5),
+    disc_mask(8, 8),
 ];
 
 /// Bit 0 of each byte of [`Near::rows`] whose cell holds kind byte `kb` (1 fox: bit 0 of the
@@ -96,15 +97,22 @@ pub(super) fn kind_bits(rows: &[u64; NEAR_ROWS], kb: u8) -> [u64; NEAR_ROWS] {
 }
 
 /// How many cells of `bits` (from [`kind_bits`]) lie in `class` (at most one bit per byte and
-/// `NEAR_ROWS` rows: byte sums stay below 256, and the multiplication adds them up into the
-/// top byte).
+/// `NEAR_ROWS` rows: see [`byte_sum`]).
 #[inline(always)]
 pub(super) fn count_in(bits: &[u64; NEAR_ROWS], class: &[u64; NEAR_ROWS]) -> u64 {
     let sum = bits
         .iter()
         .zip(class)
         .fold(0u64, |acc, (&b, &m)| acc + (b & m));
-    sum.wrapping_mul(0x0101_0101_0101_0101) >> 56
+    byte_sum(sum)
+}
+
+/// The sum of the 8 bytes of `x`, when it is below 256 (true of a sum of at most `NEAR_ROWS`
+/// row words with at most one bit per byte): the multiplication adds every byte into the top
+/// byte.
+#[inline(always)]
+pub(super) fn byte_sum(x: u64) -> u64 {
+    x.wrapping_mul(0x0101_0101_0101_0101) >> 56
 }
 
 /// The cell of `bits` in `class` with the lowest id (`n` of them, `n >= 1`), around `p`:

@@ -8,7 +8,9 @@
 //! changes are still logged does not read it but marks the decision stale ([`Tally::stale`]),
 //! and the decision is made again once the grid is up to date.
 
-use super::near::{NEAR_HALF, Near, RING_CLASSES, count_in, kind_bits, lowest_in, row_cell};
+use super::near::{
+    NEAR_HALF, Near, RING_CLASSES, byte_sum, count_in, kind_bits, lowest_in, row_cell,
+};
 use super::{ADJACENT_R2, Animat, DIRECTIONS, RING_MAX, World};
 use crate::cells::{FREE, SPECIES, kind_byte};
 use crate::params::Species;
@@ -23,6 +25,24 @@ pub(super) struct Tally {
     pub(super) evals: u64,
     /// A query needed the grid while it lagged behind the logged changes.
     pub(super) stale: bool,
+}
+
+/// Visits the cells of ring `k >= 1` (Chebyshev distance `k`) as offsets `(dx, dy)` in a fixed
+/// order (the bottom and top rows pairwise by `dx`, then the left and right columns pairwise by
+/// `dy`) until `visit` returns `true`; returns whether it did.
+#[inline(always)]
+fn ring_until(k: i64, mut visit: impl FnMut(i64, i64) -> bool) -> bool {
+    for dx in -k..=k {
+        if visit(dx, -k) || visit(dx, k) {
+            return true;
+        }
+    }
+    for dy in (-k + 1)..k {
+        if visit(-k, dy) || visit(k, dy) {
+            return true;
+        }
+    }
+    false
 }
 
 impl World {
@@ -165,14 +185,10 @@ impl World {
                 }
             };
             for k in k_first..=k_max {
-                for dx in -k..=k {
-                    look(dx, -k, &mut best);
-                    look(dx, k, &mut best);
-                }
-                for dy in (-k + 1)..k {
-                    look(-k, dy, &mut best);
-                    look(k, dy, &mut best);
-                }
+                ring_until(k, |dx, dy| {
+                    look(dx, dy, &mut best);
+                    false
+                });
                 // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
                 // than that is final (an equally near one could still win on id).
                 let next = ((k + 1) * (k + 1)) as u64;
@@ -205,13 +221,12 @@ impl World {
                 // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
                 // the masks keep the cells within the radius.
                 let rows = near.rows(a.pos);
-                // At most one bit per byte and NEAR_ROWS rows: the byte sums stay below 256,
-                // and the multiplication adds the bytes up into the top byte.
+                // At most one bit per byte and NEAR_ROWS rows: [`byte_sum`] applies.
                 let bits = rows
                     .iter()
                     .zip(&self.crowd_masks)
                     .fold(0u64, |acc, (&row, &m)| acc + ((row | row >> 1) & m));
-                let count = (bits.wrapping_mul(0x0101_0101_0101_0101) >> 56) as usize;
+                let count = byte_sum(bits) as usize;
                 t.evals += count.min(n) as u64;
                 return count >= n;
             }
@@ -259,18 +274,10 @@ impl World {
                 count >= n
             };
             let mut found = false;
-            'rings: for k in 1..=k_max {
-                for dx in -k..=k {
-                    if look(dx, -k) || look(dx, k) {
-                        found = true;
-                        break 'rings;
-                    }
-                }
-                for dy in (-k + 1)..k {
-                    if look(-k, dy) || look(k, dy) {
-                        found = true;
-                        break 'rings;
-                    }
+            for k in 1..=k_max {
+                if ring_until(k, &mut look) {
+                    found = true;
+                    break;
                 }
             }
             t.evals += count as u64;
