@@ -1,4 +1,5 @@
-//! Neighbour-search time per step against population at fixed density (seed 000, Fig. 9 and
+//! Neighbour-search time per step against population at fixed density (Hawick, James &
+//! Scogings 2006, "Grid-Boxing for Spatial Simulation Performance Optimisation", Fig. 9 and
 //! Table I) for grid 60, 120, 240 and none, with log-log gradients; prints markdown tables.
 //!
 //! `cargo run --release -p animat --example search_scaling -- [MAX_N] [NONE_MAX_N] [BOXES_MAX_N] [REPEATS]`
@@ -6,7 +7,7 @@
 //! - Populations 1e3, 3e3, 1e4, ... up to `MAX_N` (default 1e6), start density 0.2 (the
 //!   default start's), default parameters otherwise, seed 1.
 //! - Two search set-ups: the default (cell index first, grid boxes behind it) and the grid boxes
-//!   alone (seed 000's structure; `World::set_cell_search(false)`); `none` is the exhaustive
+//!   alone (the paper's structure; `World::set_cell_search(false)`); `none` is the exhaustive
 //!   scan, run up to `NONE_MAX_N` (default 3e4). Grid boxes alone are run up to `BOXES_MAX_N`
 //!   (default 1e6) for side 60, a third of it for 120 and a tenth for 240 (their big boxes
 //!   make large populations slow).

@@ -1,6 +1,7 @@
-//! Measurement entry points for the scaling study of seed 000, section IV.B (Fig. 9, Table I)
-//! and the whole-step throughput target (REFERENCE.md): library functions so that `xtask`,
-//! examples and benches all measure the same thing the same way.
+//! Measurement entry points for the scaling study of Hawick, James & Scogings (2006),
+//! "Grid-Boxing for Spatial Simulation Performance Optimisation", section IV.B (Fig. 9,
+//! Table I), and for the whole-step throughput (`docs/benchmarks.md`): library functions so
+//! that `xtask`, examples and benches all measure the same thing the same way.
 //!
 //! - [`search_scaling_point`]: neighbour-search time and distance evaluations per step for one
 //!   population at a fixed start density and one grid setting (one point of Fig. 9);
@@ -10,7 +11,8 @@
 //!   the species in the default ratio and the start radius set by the density).
 //!
 //! None of these assert anything about time; they measure and report. Wall-clock figures depend
-//! on the machine and its load.
+//! on the machine and its load. Invariants: the world is built before any clock starts, and
+//! measuring never changes the trajectory (the reported state hashes are the untimed run's).
 //!
 //! ```
 //! use animat::GridBox;
@@ -22,7 +24,7 @@
 //! ```
 
 use crate::params::{GridBox, Params};
-use crate::world::{World, WorldError};
+use crate::world::{StepStats, World, WorldError};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -48,7 +50,7 @@ pub fn scaling_params(population: u64, density: f64, grid: GridBox) -> Params {
     }
 }
 
-/// Cost of the neighbour search for one population (one point of seed 000, Fig. 9).
+/// Cost of the neighbour search for one population (one point of the paper's Fig. 9).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SearchCost {
     /// Animats at the start.
@@ -101,7 +103,7 @@ pub fn search_scaling_point(
 }
 
 /// [`search_scaling_point`] with the cell-index search on or off
-/// ([`World::set_cell_search`]): off measures seed 000's structure, the grid boxes alone
+/// ([`World::set_cell_search`]): off measures the paper's structure, the grid boxes alone
 /// (`none` is always the exhaustive scan).
 ///
 /// # Errors
@@ -117,19 +119,12 @@ pub fn search_scaling_point_with(
     let mut w = World::new(scaling_params(population, density, grid), seed)?;
     w.set_timing(true);
     w.set_cell_search(cell_search);
-    let (mut search, mut evals, mut turns, mut done) = (0.0, 0u64, 0u64, 0u64);
+    let (mut search, mut evals) = (0.0, 0u64);
     let t = Instant::now();
-    for _ in 0..steps {
-        let n = w.foxes() + w.rabbits();
-        if n == 0 {
-            break;
-        }
-        turns += n;
-        let s = w.step();
+    let (turns, done) = measured_steps(&mut w, steps, |s| {
         search += s.search_seconds;
         evals += s.distance_evals;
-        done += 1;
-    }
+    });
     let wall = t.elapsed().as_secs_f64();
     let per = |x: f64| if done > 0 { x / done as f64 } else { 0.0 };
     Ok(SearchCost {
@@ -144,12 +139,12 @@ pub fn search_scaling_point_with(
         step_seconds: per(wall),
         final_foxes: w.foxes(),
         final_rabbits: w.rabbits(),
-        state_hash: u64::from_str_radix(&w.state_hash(), 16).unwrap_or(0),
+        state_hash: state_hash_u64(&w),
     })
 }
 
-/// Whole-step throughput (REFERENCE.md target: at least 5 million animat-steps per second at
-/// 1e5 animats on one core).
+/// Whole-step throughput: animat-steps per second (the target and the figures are in
+/// `docs/benchmarks.md`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Throughput {
     /// Animats at the start.
@@ -185,19 +180,9 @@ pub fn step_throughput(
 ) -> Result<Throughput, WorldError> {
     let mut w = World::new(scaling_params(population, density, grid), seed)?;
     w.run(warmup);
-    let mut turns = 0u64;
-    let mut done = 0u64;
     let cpu0 = thread_cpu_seconds();
     let t = Instant::now();
-    for _ in 0..steps {
-        let n = w.foxes() + w.rabbits();
-        if n == 0 {
-            break;
-        }
-        turns += n;
-        w.step();
-        done += 1;
-    }
+    let (turns, done) = measured_steps(&mut w, steps, |_| {});
     let seconds = t.elapsed().as_secs_f64();
     let cpu_seconds = thread_cpu_seconds().zip(cpu0).map(|(b, a)| b - a);
     Ok(Throughput {
@@ -211,8 +196,30 @@ pub fn step_throughput(
         } else {
             0.0
         },
-        state_hash: u64::from_str_radix(&w.state_hash(), 16).unwrap_or(0),
+        state_hash: state_hash_u64(&w),
     })
+}
+
+/// Runs up to `steps` steps of `w`, stopping early when every animat has died, and hands each
+/// step's counters to `each`. Returns the animat turns taken (the population at the start of
+/// each step, summed) and the steps done.
+fn measured_steps(w: &mut World, steps: u64, mut each: impl FnMut(StepStats)) -> (u64, u64) {
+    let (mut turns, mut done) = (0u64, 0u64);
+    for _ in 0..steps {
+        let n = w.foxes() + w.rabbits();
+        if n == 0 {
+            break;
+        }
+        turns += n;
+        each(w.step());
+        done += 1;
+    }
+    (turns, done)
+}
+
+/// [`World::state_hash`] as a number.
+fn state_hash_u64(w: &World) -> u64 {
+    u64::from_str_radix(&w.state_hash(), 16).expect("a state hash is 16 hex digits")
 }
 
 /// CPU time of the calling thread in seconds (Linux `/proc/thread-self/schedstat`, whose

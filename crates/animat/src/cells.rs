@@ -16,6 +16,12 @@
 //! half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four directory
 //! lookups; every cell read after that is an array index, and [`Window::rows`] reads 8 cells
 //! of a row as one word.
+//!
+//! Invariants: a cell byte is [`FREE`] exactly when no animat stands on the cell, and then its
+//! id slot is unused; an occupied cell's byte holds its occupant's kind and the bucket of its
+//! id under the current bucket map, which is non-decreasing in the id; a tile is in use
+//! exactly while it holds an animat (`count` is its number of occupied cells); the dense
+//! directory agrees with the map for every tile coordinate in its rectangle.
 
 use rustc_hash::FxHashMap;
 

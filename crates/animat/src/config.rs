@@ -1,4 +1,10 @@
-//! Reading parameters from a TOML config file (`--config FILE.toml`).
+//! Reading parameters from a TOML config file (`--config FILE.toml`, `data/animat-default.toml`).
+//! Library functionality rather than part of the binary, so every front end reads the same
+//! format with the same errors.
+//!
+//! Invariants: keys not given keep their defaults ([`Params::default`]); unknown keys and
+//! values of the wrong type are errors naming the line; nothing here validates ranges (that is
+//! [`Params::validate`]).
 
 use crate::params::Params;
 use std::path::Path;

@@ -1,7 +1,8 @@
 //! # animat: predator-prey artificial life with rule priorities and grid boxes
 //!
-//! The foxes-and-rabbits animat model of Hawick, James & Scogings (seed 000, sections II.B and
-//! IV.B), defined precisely in MODELS.md section 3: animats on the unbounded integer plane, one
+//! The foxes-and-rabbits animat model of Hawick, James & Scogings (2006), "Grid-Boxing for
+//! Spatial Simulation Performance Optimisation" (section II.B; the scaling study of section
+//! IV.B), stated precisely in `docs/animat.md`: animats on the unbounded integer plane, one
 //! per cell, each running its species' rule list in priority order and executing the first
 //! rule whose condition holds. Perception is lazy: a rule asks only the neighbour queries its
 //! condition needs. Neighbour searches go through [`spatial::plane::PlaneGrid`]; every grid-box

@@ -1,6 +1,7 @@
-//! `animat`: the predator-prey animat model of seed 000, section II.B (MODELS.md section 3). A
-//! thin layer over the `animat` library: parse flags and the config file, validate, run, write
-//! outputs.
+//! `animat`: the predator-prey animat model of Hawick, James & Scogings (2006), "Grid-Boxing
+//! for Spatial Simulation Performance Optimisation", section II.B (see `docs/animat.md`). A thin
+//! layer over the `animat` library: parse flags and the config file, validate, run, write
+//! outputs. Built with the `cli` feature (on by default).
 
 use animat::output::{self, PopulationRow};
 use animat::{GridBox, Params, World};
@@ -138,7 +139,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     );
     let snapshot = |w: &World| -> anyhow::Result<()> {
         let path = cli.out.join(format!("snapshot_{:06}.png", w.steps()));
-        output::write_snapshot(&path, w)
+        output::write_snapshot(&path, w)?;
+        Ok(())
     };
     let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
         let bar = indicatif::ProgressBar::new(cli.steps);

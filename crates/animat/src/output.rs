@@ -1,5 +1,5 @@
-//! Recording a run and writing it into its output directory (DESIGN.md, "Outputs"). Every
-//! file is written atomically.
+//! Recording a run and writing it into its output directory (`docs/animat.md`, "Outputs").
+//! Every file is written atomically: a failed write leaves no partial file behind.
 //!
 //! | file | content |
 //! |---|---|
@@ -10,8 +10,23 @@
 
 use crate::params::Species;
 use crate::world::World;
+use core_lattice::io::image::ImageError;
 use core_lattice::io::{CsvWriter, RunClock, RunManifest, write_png_rgb};
 use std::path::Path;
+
+/// Errors writing an output file; each displays as the underlying error does.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// Creating, writing or renaming a file.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// Encoding a PNG snapshot.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    /// Serialising the manifest.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
 
 /// One row of `populations.csv`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,8 +46,12 @@ pub struct PopulationRow {
 /// Writes `populations.csv`; `timing` adds the search columns.
 ///
 /// # Errors
-/// I/O errors.
-pub fn write_populations(dir: &Path, rows: &[PopulationRow], timing: bool) -> anyhow::Result<()> {
+/// [`OutputError`] if a file cannot be written.
+pub fn write_populations(
+    dir: &Path,
+    rows: &[PopulationRow],
+    timing: bool,
+) -> Result<(), OutputError> {
     let mut header = vec!["step", "foxes", "rabbits"];
     if timing {
         header.extend(["search_seconds", "distance_evaluations"]);
@@ -58,8 +77,8 @@ pub fn write_populations(dir: &Path, rows: &[PopulationRow], timing: bool) -> an
 /// Writes `positions.csv`: every live animat at the end, in id order.
 ///
 /// # Errors
-/// I/O errors.
-pub fn write_positions(dir: &Path, world: &World) -> anyhow::Result<()> {
+/// [`OutputError`] if a file cannot be written.
+pub fn write_positions(dir: &Path, world: &World) -> Result<(), OutputError> {
     let mut w = CsvWriter::create(
         dir.join("positions.csv"),
         &["id", "species", "x", "y", "age", "hunger"],
@@ -86,8 +105,8 @@ pub const SNAPSHOT_MAX_SIDE: i64 = 1024;
 /// when it would exceed [`SNAPSHOT_MAX_SIDE`]; y points up.
 ///
 /// # Errors
-/// I/O errors.
-pub fn write_snapshot(path: &Path, world: &World) -> anyhow::Result<()> {
+/// [`OutputError`] if the PNG cannot be encoded or written.
+pub fn write_snapshot(path: &Path, world: &World) -> Result<(), OutputError> {
     let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
     for a in world.animats() {
         x0 = x0.min(a.pos[0]);
@@ -124,13 +143,13 @@ pub fn write_snapshot(path: &Path, world: &World) -> anyhow::Result<()> {
 /// Writes `run.json` with the headline results and returns it.
 ///
 /// # Errors
-/// I/O or serialisation errors.
+/// [`OutputError`] if the manifest cannot be serialised or written.
 pub fn write_manifest(
     dir: &Path,
     world: &World,
     seed: u64,
     clock: &RunClock,
-) -> anyhow::Result<RunManifest> {
+) -> Result<RunManifest, OutputError> {
     let mut m = clock.finish("animat", env!("CARGO_PKG_VERSION"), seed, 1, world.params())?;
     let q = world.queries();
     m.set_result("steps", world.steps())

@@ -1,4 +1,5 @@
-//! Parameters of an animat run (MODELS.md section 3), validated before anything runs.
+//! Parameters of an animat run (`docs/animat.md`, "Parameters and defaults"), validated
+//! before anything runs.
 //!
 //! Every field has a default ([`Params::default`]) chosen by the experiment documented in
 //! `docs/animat.md`; `data/animat-default.toml` spells the same values out. A config file may
@@ -8,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use spatial::plane::BoxSize;
 use std::fmt;
 
-/// The two species of seed 000, section II.B.
+/// The two species of the model (Hawick, James & Scogings 2006, section II.B).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Species {
@@ -36,7 +37,7 @@ impl Species {
     }
 }
 
-/// A fox rule (MODELS.md section 3, "Fox"). Priority is the position in [`Params::fox_rules`].
+/// A fox rule (`docs/animat.md`, "Rules"). Priority is the position in [`Params::fox_rules`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum FoxRule {
     /// Hungry and a rabbit adjacent: eat it, hunger = 0.
@@ -74,7 +75,7 @@ impl FoxRule {
     }
 }
 
-/// A rabbit rule (MODELS.md section 3, "Rabbit"). Priority is the position in
+/// A rabbit rule (`docs/animat.md`, "Rules"). Priority is the position in
 /// [`Params::rabbit_rules`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum RabbitRule {
@@ -108,14 +109,15 @@ impl RabbitRule {
     }
 }
 
-/// The grid-box setting (`--grid-box`, MODELS.md section 3, "Search"): in config files an
+/// The grid-box setting (`--grid-box`; `docs/animat.md`, "Search"): in config files an
 /// integer side, `"none"` or `"vision"`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum GridBox {
     /// Boxes of side equal to the vision radius (the paper's choice; the default).
     #[default]
     Vision,
-    /// No boxes: the exhaustive "no grid" search of seed 000, Fig. 9.
+    /// No boxes: the exhaustive "no grid" search (Hawick, James & Scogings 2006, section IV.B,
+    /// Fig. 9).
     None,
     /// Boxes of this side (must be positive).
     Side(i64),
@@ -247,7 +249,8 @@ pub enum ParamsError {
 /// far inside `u64` and coordinates far inside `i64`.
 pub const MAX_RADIUS: i64 = 1 << 30;
 
-/// Every parameter of the model (MODELS.md section 3). Build one (or start from
+/// Every parameter of the model (`docs/animat.md`, "Parameters and defaults"). Build one (or
+/// start from
 /// [`Params::default`]), call [`Params::validate`] (the [`World`](crate::World) does), run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

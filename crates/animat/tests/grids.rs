@@ -1,4 +1,5 @@
-//! Every grid-box setting gives a bit-identical trajectory (MODELS.md section 3, "Search").
+//! Every grid-box setting gives a bit-identical trajectory (`docs/animat.md`, "Search, and why
+//! every grid size gives the same trajectory").
 
 use animat::{GridBox, Params, World};
 

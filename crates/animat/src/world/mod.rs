@@ -1,0 +1,484 @@
+//! The animat world: the animats on the unbounded plane, their stored records, the structures
+//! that index them by cell, and the public face of the model ([`World`]): construction (the
+//! default start and hand-built scenes), accessors and the state hash.
+//!
+//! The model is the foxes-and-rabbits animat model of Hawick, James & Scogings (2006),
+//! "Grid-Boxing for Spatial Simulation Performance Optimisation", section II.B, as
+//! `docs/animat.md` states it. The rest of the world lives in child modules, each using only
+//! this module and the ones listed after it:
+//!
+//! - `step`: one step (visiting order, turns, ageing and deaths, end-of-step compaction);
+//! - `rules`: the fox and rabbit rule lists, the action each chooses and how actions apply;
+//! - `perception`: the neighbour queries the rules ask, from the cell index or the grid boxes;
+//! - `near`: the per-turn cache of the cells around the acting animat and its bit tricks;
+//! - `tests`: hand-built scenes.
+//!
+//! Invariants between steps: `recs` holds exactly the live animats, sorted by id, with
+//! `flags` parallel to it and no `DEAD` bit set; every live animat stands alone on its cell
+//! in `cells` and is in `grid` at that cell (`pending` is empty); `foxes` and `rabbits` count
+//! the live animats; every id is below `next_id` and none is reused. During a step `grid` may
+//! lag behind `cells` by the changes logged in `pending` (see `step`).
+
+mod near;
+mod perception;
+mod rules;
+mod step;
+#[cfg(test)]
+mod tests;
+
+use crate::cells::{CellIndex, WINDOW_MAX, kind_byte};
+use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
+use core_lattice::io::StateHasher;
+use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
+use near::{NEAR_ROWS, disc_mask};
+use rustc_hash::FxHashSet;
+use spatial::plane::{PlaneError, PlaneGrid, Pos};
+
+/// Random stream purposes of a run (each its own stream of the run seed).
+const STREAM_PLACEMENT: u32 = 1;
+/// The visiting order of each step.
+const STREAM_ORDER: u32 = 2;
+/// Breeding draws, birth cells and wander directions.
+const STREAM_ACTION: u32 = 3;
+
+/// Squared radius of "adjacent": Chebyshev distance 1 is squared Euclidean distance <= 2.
+pub const ADJACENT_R2: u64 = 2;
+
+/// The 8 unit steps, in a fixed order (wander directions, birth cells).
+pub const DIRECTIONS: [[i64; 2]; 8] = [
+    [1, 0],
+    [1, 1],
+    [0, 1],
+    [-1, 1],
+    [-1, 0],
+    [-1, -1],
+    [0, -1],
+    [1, -1],
+];
+
+/// Largest cell-ring radius the cell-index searches scan before handing a query to the grid.
+const RING_MAX: i64 = 8;
+const _: () = assert!(RING_MAX <= WINDOW_MAX);
+
+/// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Animat {
+    /// Unique id; ids increase with creation and are never reused.
+    pub id: u64,
+    /// Fox or rabbit.
+    pub species: Species,
+    /// Cell.
+    pub pos: Pos,
+    /// Steps lived.
+    pub age: u32,
+    /// Foxes: steps since the fox last ate. Always 0 for rabbits.
+    pub hunger: u32,
+}
+
+/// The stored state of an animat apart from its species and liveness (kept in
+/// [`World::flags`]): 32 bytes, half a cache line.
+#[derive(Debug, Clone, Copy)]
+struct Rec {
+    pos: Pos,
+    id: u64,
+    age: u32,
+    hunger: u32,
+}
+
+/// Flag bit: the animat is a rabbit (else a fox).
+const RABBIT: u8 = 1;
+/// Flag bit: the animat died in the current step (removed at its end).
+const DEAD: u8 = 2;
+
+fn species_of(flags: u8) -> Species {
+    if flags & RABBIT != 0 {
+        Species::Rabbit
+    } else {
+        Species::Fox
+    }
+}
+
+/// Perception queries asked, by kind (for the lazy-perception tests and diagnostics).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QueryCounts {
+    /// "Is an animat of a kind adjacent" (including "which adjacent one is nearest").
+    pub adjacent: u64,
+    /// "Nearest animat of a kind within vision".
+    pub nearest: u64,
+    /// Counting queries (overcrowding, enough prey).
+    pub count: u64,
+}
+
+impl QueryCounts {
+    /// All queries.
+    pub fn total(&self) -> u64 {
+        self.adjacent + self.nearest + self.count
+    }
+}
+
+/// Errors building a hand-made scene.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum WorldError {
+    /// Bad parameters.
+    #[error(transparent)]
+    Params(#[from] ParamsError),
+    /// The cell is already occupied (at most one animat per cell).
+    #[error("cell [{}, {}] is already occupied", .0[0], .0[1])]
+    Occupied(Pos),
+    /// An error of the search structure.
+    #[error(transparent)]
+    Plane(#[from] PlaneError),
+}
+
+/// Counters of one step.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepStats {
+    /// Seconds spent in perception queries (only with [`World::set_timing`]; else 0).
+    pub search_seconds: f64,
+    /// Distance evaluations of the search structure during the step.
+    pub distance_evals: u64,
+}
+
+/// The simulation: a pure function of `(Params, seed)`; every grid-box setting gives the same
+/// trajectory.
+#[derive(Debug, Clone)]
+pub struct World {
+    params: Params,
+    fox_rules: Vec<FoxRule>,
+    rabbit_rules: Vec<RabbitRule>,
+    vision2: u64,
+    crowd2: u64,
+    grid: PlaneGrid<Species>,
+    /// Grid changes not yet applied (see [`GridOp`]); empty between steps.
+    pending: Vec<GridOp>,
+    /// Which animat stands on each cell (always maintained; read by perception when
+    /// `cell_search` is on).
+    cells: CellIndex,
+    /// Answer small-radius perception from the cell index before the grid boxes.
+    cell_search: bool,
+    /// Distance evaluations made by cell-index searches since the last step boundary.
+    cell_evals: u64,
+    /// Reused visiting-order buffer.
+    order: Vec<u32>,
+    /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
+    crowd_offsets: Vec<[i64; 2]>,
+    /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see [`Near::rows`](near::Near::rows)), when
+    /// `crowd_radius <= 2`.
+    crowd_masks: [u64; NEAR_ROWS],
+    /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
+    /// by id. During a step the records of the animats alive at its start are stale: their
+    /// current state is in `hot`, and is copied back at the end of the step.
+    recs: Vec<Rec>,
+    /// [`RABBIT`] and [`DEAD`] bits of each record of `recs` (same index).
+    flags: Vec<u8>,
+    /// Ids of the rabbits eaten in the current step (their records are dead, though their
+    /// [`DEAD`] bits are not set: finding a record by id would cost a search).
+    eaten: FxHashSet<u64>,
+    /// During a step: the records of the animats alive at its start, in visiting order
+    /// (`hot[j]` is `recs[order[j]]`).
+    hot: Vec<Rec>,
+    /// During a step: the flags of `hot` (`hot_flags[j]` is `flags[order[j]]` at the start).
+    hot_flags: Vec<u8>,
+    next_id: u64,
+    steps: u64,
+    order_rng: SimRng,
+    action_rng: SimRng,
+    queries: QueryCounts,
+    timing: bool,
+    search_seconds: f64,
+    /// Seconds spent applying logged grid changes inside decisions (timing on), left out of
+    /// `search_seconds`.
+    flush_seconds: f64,
+    total_distance_evals: u64,
+    foxes: u64,
+    rabbits: u64,
+}
+
+/// A change of the grid, logged during a step and applied in order before the grid is next
+/// read (a loop of independent updates instead of one dependent cache miss per move).
+#[derive(Debug, Clone, Copy)]
+enum GridOp {
+    Insert(u64, Pos, Species),
+    Remove(u64),
+    Move(u64, Pos),
+}
+
+impl World {
+    /// An empty world (no animats) with validated parameters: for hand-built scenes.
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] if the parameters are invalid.
+    pub fn empty(params: Params, seed: u64) -> Result<Self, WorldError> {
+        params.validate()?;
+        let fox_rules = params.fox_rule_list()?;
+        let rabbit_rules = params.rabbit_rule_list()?;
+        // The cell index answers "is this cell free", so the grid need not count cells.
+        let grid = PlaneGrid::without_cell_counts(params.grid_box.box_size(params.vision))?;
+        let v = params.vision as u64;
+        let c = params.crowd_radius as u64;
+        Ok(World {
+            fox_rules,
+            rabbit_rules,
+            vision2: v * v,
+            crowd2: c * c,
+            cell_search: grid.box_size() != spatial::plane::BoxSize::None,
+            grid,
+            pending: Vec::new(),
+            cells: CellIndex::default(),
+            cell_evals: 0,
+            order: Vec::new(),
+            crowd_offsets: if params.crowd_radius <= RING_MAX {
+                let r = params.crowd_radius;
+                (-r..=r)
+                    .flat_map(|dy| (-r..=r).map(move |dx| [dx, dy]))
+                    .filter(|&[dx, dy]| (dx, dy) != (0, 0) && (dx * dx + dy * dy) as u64 <= c * c)
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            // `c <= MAX_RADIUS = 2^30`: `c * c` fits in i64.
+            crowd_masks: disc_mask(1, (c * c) as i64),
+            recs: Vec::new(),
+            flags: Vec::new(),
+            eaten: FxHashSet::default(),
+            hot: Vec::new(),
+            hot_flags: Vec::new(),
+            next_id: 0,
+            steps: 0,
+            order_rng: stream(seed, stream_id(STREAM_ORDER, 0)),
+            action_rng: stream(seed, stream_id(STREAM_ACTION, 0)),
+            queries: QueryCounts::default(),
+            timing: false,
+            search_seconds: 0.0,
+            flush_seconds: 0.0,
+            total_distance_evals: 0,
+            foxes: 0,
+            rabbits: 0,
+            params,
+        })
+    }
+
+    /// The default start: `foxes + rabbits` animats on distinct cells drawn uniformly in the
+    /// disc of radius `start_radius` around the origin (foxes first, so foxes have the lower
+    /// ids), with ages uniform in `[0, max_age / 2]` and fox hunger uniform in
+    /// `[0, hungry_at]`, all from the placement stream of `seed`.
+    ///
+    /// # Errors
+    /// [`WorldError::Params`] if the parameters are invalid.
+    pub fn new(params: Params, seed: u64) -> Result<Self, WorldError> {
+        let mut w = World::empty(params, seed)?;
+        let mut rng = stream(seed, stream_id(STREAM_PLACEMENT, 0));
+        let r = w.params.start_radius;
+        let r2 = (r as i128) * (r as i128);
+        let counts = [
+            (Species::Fox, w.params.foxes),
+            (Species::Rabbit, w.params.rabbits),
+        ];
+        for (species, n) in counts {
+            let max_age = match species {
+                Species::Fox => w.params.fox_max_age,
+                Species::Rabbit => w.params.rabbit_max_age,
+            };
+            let mut placed = 0;
+            while placed < n {
+                let x = rng.random_range(-r..=r);
+                let y = rng.random_range(-r..=r);
+                if (x as i128) * (x as i128) + (y as i128) * (y as i128) > r2
+                    || w.cells.occupied([x, y])
+                {
+                    continue;
+                }
+                let age = rng.random_range(0..=max_age / 2);
+                let hunger = match species {
+                    Species::Fox => rng.random_range(0..=w.params.hungry_at),
+                    Species::Rabbit => 0,
+                };
+                w.add(species, [x, y], age, hunger)?;
+                placed += 1;
+            }
+        }
+        Ok(w)
+    }
+
+    /// Adds an animat (a newborn, or part of a hand-built scene) and returns its id.
+    ///
+    /// # Errors
+    /// [`WorldError::Occupied`] if the cell holds an animat.
+    pub fn add(
+        &mut self,
+        species: Species,
+        pos: Pos,
+        age: u32,
+        hunger: u32,
+    ) -> Result<u64, WorldError> {
+        let id = self.add_deferred(species, pos, age, hunger)?;
+        self.flush_grid();
+        Ok(id)
+    }
+
+    /// Brings the grid up to date with the changes logged in `pending`, in order.
+    fn flush_grid(&mut self) {
+        for op in self.pending.drain(..) {
+            match op {
+                GridOp::Insert(id, pos, species) => self
+                    .grid
+                    .insert(id, pos, species)
+                    .expect("ids are never reused"),
+                GridOp::Remove(id) => {
+                    self.grid.remove(id).expect("a live animat is in the grid");
+                }
+                GridOp::Move(id, to) => {
+                    self.grid
+                        .move_to(id, to)
+                        .expect("a live animat is in the grid");
+                }
+            }
+        }
+    }
+
+    /// [`World::add`], with the grid's insertion logged in `pending`.
+    fn add_deferred(
+        &mut self,
+        species: Species,
+        pos: Pos,
+        age: u32,
+        hunger: u32,
+    ) -> Result<u64, WorldError> {
+        if self.cells.occupied(pos) {
+            return Err(WorldError::Occupied(pos));
+        }
+        let id = self.next_id;
+        self.pending.push(GridOp::Insert(id, pos, species));
+        self.cells
+            .set(pos, kind_byte(species == Species::Rabbit), id);
+        self.next_id += 1;
+        self.recs.push(Rec {
+            pos,
+            id,
+            age,
+            hunger: if species == Species::Fox { hunger } else { 0 },
+        });
+        self.flags.push(if species == Species::Rabbit {
+            RABBIT
+        } else {
+            0
+        });
+        match species {
+            Species::Fox => self.foxes += 1,
+            Species::Rabbit => self.rabbits += 1,
+        }
+        Ok(id)
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Steps done.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Live foxes.
+    pub fn foxes(&self) -> u64 {
+        self.foxes
+    }
+
+    /// Live rabbits.
+    pub fn rabbits(&self) -> u64 {
+        self.rabbits
+    }
+
+    /// Live animats, sorted by id (between steps).
+    pub fn animats(&self) -> impl Iterator<Item = Animat> + '_ {
+        (0..self.recs.len()).filter_map(|i| self.animat_at(i))
+    }
+
+    /// A live animat by id.
+    pub fn get(&self, id: u64) -> Option<Animat> {
+        self.index_of(id).and_then(|i| self.animat_at(i))
+    }
+
+    /// The animat of record `i`, if alive (between steps).
+    fn animat_at(&self, i: usize) -> Option<Animat> {
+        let f = self.flags[i];
+        let r = self.recs[i];
+        (f & DEAD == 0).then_some(Animat {
+            id: r.id,
+            species: species_of(f),
+            pos: r.pos,
+            age: r.age,
+            hunger: r.hunger,
+        })
+    }
+
+    /// Perception queries asked so far.
+    pub fn queries(&self) -> QueryCounts {
+        self.queries
+    }
+
+    /// The search structure (for work counters and diagnostics). It is built with
+    /// [`PlaneGrid::without_cell_counts`] (the world's own cell index answers "is this cell
+    /// free"), so its `is_occupied` scans a box rather than doing one lookup.
+    pub fn grid(&self) -> &PlaneGrid<Species> {
+        &self.grid
+    }
+
+    /// Distance evaluations of the search structure since the start.
+    pub fn distance_evals(&self) -> u64 {
+        self.total_distance_evals + self.grid.distance_evals() + self.cell_evals
+    }
+
+    /// Whether small-radius perception reads the cell index first (see
+    /// [`World::set_cell_search`]).
+    pub fn cell_search(&self) -> bool {
+        self.cell_search
+    }
+
+    /// Turns the cell-index search on or off. On by default with grid boxes, off (and ignored)
+    /// in the exhaustive `none` mode, which stays the paper's "no grid" baseline. With it on,
+    /// adjacency and overcrowding tests read the cells around the animat directly, and nearest
+    /// and counting queries scan cell rings outward up to radius 8 before falling back to the
+    /// grid boxes; both give the exact answers, so the trajectory does not change. Turning it
+    /// off measures the grid boxes alone (the paper's structure: Hawick, James & Scogings 2006,
+    /// section III).
+    pub fn set_cell_search(&mut self, on: bool) {
+        self.cell_search = on && self.grid.box_size() != spatial::plane::BoxSize::None;
+    }
+
+    /// Measure the wall time of perception queries (`--timing`); off by default because the
+    /// clock reads cost time themselves. Does not change the trajectory.
+    pub fn set_timing(&mut self, on: bool) {
+        self.timing = on;
+    }
+
+    /// Hash of every live animat's id, species, position, age and hunger, in id order, as 16
+    /// hex digits.
+    pub fn state_hash(&self) -> String {
+        let mut h = StateHasher::new();
+        for a in self.animats() {
+            h.u64(a.id)
+                .u64(a.species.code())
+                .i64(a.pos[0])
+                .i64(a.pos[1])
+                .u64(a.age.into())
+                .u64(a.hunger.into());
+        }
+        h.finish_hex()
+    }
+
+    fn index_of(&self, id: u64) -> Option<usize> {
+        self.recs.binary_search_by_key(&id, |a| a.id).ok()
+    }
+
+    /// Runs `n` steps (stopping early if every animat has died).
+    pub fn run(&mut self, n: u64) {
+        for _ in 0..n {
+            if self.recs.is_empty() {
+                break;
+            }
+            self.step();
+        }
+    }
+}

@@ -1,0 +1,295 @@
+//! Perception: the neighbour queries the rules ask ("a fox adjacent?", "the nearest rabbit
+//! within vision", "overcrowded?", "enough prey?"). Each is answered from the cell index first
+//! (the cells around the animat, then rings of cells up to `RING_MAX`) and handed to the grid
+//! boxes ([`spatial::plane::PlaneGrid`]) when the cell index cannot settle it.
+//!
+//! Invariants: both paths give the exact answer, ties going to the lower id, so the trajectory
+//! does not depend on the path or on the grid-box size; a query that needs the grid while
+//! changes are still logged does not read it but marks the decision stale ([`Tally::stale`]),
+//! and the decision is made again once the grid is up to date.
+
+use super::near::{
+    NEAR_HALF, Near, RING_CLASSES, byte_sum, count_in, kind_bits, lowest_in, row_cell,
+};
+use super::{ADJACENT_R2, Animat, DIRECTIONS, RING_MAX, World};
+use crate::cells::{FREE, SPECIES, kind_byte};
+use crate::params::Species;
+use spatial::plane::Pos;
+
+/// Query and work counters of one decision (added to the world's afterwards).
+#[derive(Debug, Default)]
+pub(super) struct Tally {
+    pub(super) adjacent: u64,
+    pub(super) nearest: u64,
+    pub(super) count: u64,
+    pub(super) evals: u64,
+    /// A query needed the grid while it lagged behind the logged changes.
+    pub(super) stale: bool,
+}
+
+/// Visits the cells of ring `k >= 1` (Chebyshev distance `k`) as offsets `(dx, dy)` in a fixed
+/// order (the bottom and top rows pairwise by `dx`, then the left and right columns pairwise by
+/// `dy`) until `visit` returns `true`; returns whether it did.
+#[inline(always)]
+fn ring_until(k: i64, mut visit: impl FnMut(i64, i64) -> bool) -> bool {
+    for dx in -k..=k {
+        if visit(dx, -k) || visit(dx, k) {
+            return true;
+        }
+    }
+    for dy in (-k + 1)..k {
+        if visit(-k, dy) || visit(k, dy) {
+            return true;
+        }
+    }
+    false
+}
+
+impl World {
+    /// The cells around `a` for the cell-index fast path (no window when the fast path is
+    /// off or `a` is too near the `i64` limits).
+    pub(super) fn near(&self, a: &Animat) -> Near<'_> {
+        Near {
+            w: if self.cell_search {
+                self.cells.window(a.pos, RING_MAX)
+            } else {
+                None
+            },
+            rows: None,
+        }
+    }
+
+    /// Whether the grid lags behind the logged changes; if so, notes in `t` that the
+    /// decision must be made again after [`World::flush_grid`].
+    #[inline]
+    pub(super) fn stale(&self, t: &mut Tally) -> bool {
+        t.stale = !self.pending.is_empty();
+        t.stale
+    }
+
+    /// The position of the nearest adjacent animat of `kind` (ties: lower id).
+    pub(super) fn nearest_adjacent(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        t.adjacent += 1;
+        if let Some((w, rows)) = near.parts(a.pos) {
+            let kb = kind_byte(kind == Species::Rabbit);
+            // Orthogonal cells (d2 = 1) before diagonal ones (d2 = 2); lower id wins ties.
+            // Ids are read only to break a tie (they live in a larger array that is rarely in
+            // cache).
+            let bits = kind_bits(rows, kb);
+            for class in &RING_CLASSES[..2] {
+                let n = count_in(&bits, class);
+                if n > 0 {
+                    t.evals += n;
+                    return Some(lowest_in(&bits, class, n, a.pos, rows, w));
+                }
+            }
+            return None;
+        }
+        if self.stale(t) {
+            return None;
+        }
+        let (id, _) = self.grid.nearest(a.pos, kind, ADJACENT_R2, Some(a.id))?;
+        self.grid.get(id).map(|(p, _)| p)
+    }
+
+    pub(super) fn adjacent(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> bool {
+        t.adjacent += 1;
+        if let Some((_, rows)) = near.parts(a.pos) {
+            let kb = kind_byte(kind == Species::Rabbit);
+            let found = DIRECTIONS.iter().any(|d| row_cell(rows, d[0], d[1]) == kb);
+            t.evals += u64::from(found);
+            return found;
+        }
+        if self.stale(t) {
+            return false;
+        }
+        self.grid.any_within(a.pos, kind, ADJACENT_R2, Some(a.id))
+    }
+
+    /// Position of the nearest animat of `kind` within vision (ties: lower id).
+    pub(super) fn nearest_seen(
+        &self,
+        a: &Animat,
+        kind: Species,
+        near: &mut Near<'_>,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        t.nearest += 1;
+        if near.w.is_some() {
+            let k_max = RING_MAX.min(self.params.vision);
+            let kb = kind_byte(kind == Species::Rabbit);
+            let [x, y] = a.pos;
+            let v2 = self.vision2;
+            let mut evals = 0;
+            // Rings 1 and 2 from the row words when they lie within vision.
+            let mut k_first = 1;
+            if self.params.vision >= 3 {
+                let (w, rows) = near.parts(a.pos).expect("the window is present");
+                let mut bits = kind_bits(rows, kb);
+                // Not the animat itself.
+                bits[NEAR_HALF as usize] &= !(1 << (8 * NEAR_HALF));
+                for ring in [&RING_CLASSES[..2], &RING_CLASSES[2..]] {
+                    let counts = ring.iter().map(|c| count_in(&bits, c));
+                    let total: u64 = counts.clone().sum();
+                    if total > 0 {
+                        t.evals += total;
+                        for (class, n) in ring.iter().zip(counts) {
+                            if n > 0 {
+                                return Some(lowest_in(&bits, class, n, a.pos, rows, w));
+                            }
+                        }
+                    }
+                }
+                k_first = 3;
+            }
+            let w = near.w.as_ref().expect("the window is present");
+            // Best as (d2, position, id bucket, id once read): a tie of distances goes to
+            // the lower bucket, and ids (in a larger array that is rarely in cache) are read
+            // only when the buckets are equal too.
+            type Best = Option<(u64, Pos, u8, Option<u64>)>;
+            let mut best: Best = None;
+            let mut look = |dx: i64, dy: i64, best: &mut Best| {
+                let byte = w.byte(x + dx, y + dy);
+                if byte & SPECIES == kb {
+                    evals += 1;
+                    let d2 = (dx * dx + dy * dy) as u64;
+                    let c = [x + dx, y + dy];
+                    let cb = byte >> 2;
+                    match best {
+                        _ if d2 > v2 => {}
+                        None => *best = Some((d2, c, cb, None)),
+                        Some((bd, bp, bb, bid)) => {
+                            if d2 < *bd || (d2 == *bd && cb < *bb) {
+                                *best = Some((d2, c, cb, None));
+                            } else if d2 == *bd && cb == *bb {
+                                let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
+                                let id = w.id(c[0], c[1]);
+                                if id < bi {
+                                    *best = Some((d2, c, cb, Some(id)));
+                                }
+                            }
+                        }
+                    }
+                }
+            };
+            for k in k_first..=k_max {
+                ring_until(k, |dx, dy| {
+                    look(dx, dy, &mut best);
+                    false
+                });
+                // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
+                // than that is final (an equally near one could still win on id).
+                let next = ((k + 1) * (k + 1)) as u64;
+                if best.is_some_and(|(bd, _, _, _)| bd < next) || next > v2 {
+                    t.evals += evals;
+                    return best.map(|(_, p, _, _)| p);
+                }
+            }
+            t.evals += evals;
+        }
+        if self.stale(t) {
+            return None;
+        }
+        let (id, _) = self.grid.nearest(a.pos, kind, self.vision2, Some(a.id))?;
+        self.grid.get(id).map(|(p, _)| p)
+    }
+
+    /// More than `crowd_max` animats (either species, `a` excluded) within `crowd_radius`.
+    #[cfg(test)]
+    pub(super) fn overcrowded(&self, a: &Animat) -> bool {
+        self.overcrowded_in(a, &mut self.near(a), &mut Tally::default())
+    }
+
+    pub(super) fn overcrowded_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.count += 1;
+        let n = self.params.crowd_max as usize + 1;
+        let r = self.params.crowd_radius;
+        if near.w.is_some() {
+            if r <= NEAR_HALF {
+                // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
+                // the masks keep the cells within the radius.
+                let rows = near.rows(a.pos);
+                // At most one bit per byte and NEAR_ROWS rows: [`byte_sum`] applies.
+                let bits = rows
+                    .iter()
+                    .zip(&self.crowd_masks)
+                    .fold(0u64, |acc, (&row, &m)| acc + ((row | row >> 1) & m));
+                let count = byte_sum(bits) as usize;
+                t.evals += count.min(n) as u64;
+                return count >= n;
+            }
+            if r <= RING_MAX {
+                let w = near.w.as_ref().expect("the window is present");
+                let [x, y] = a.pos;
+                let mut count = 0;
+                for d in &self.crowd_offsets {
+                    if w.at(x + d[0], y + d[1]) != FREE {
+                        count += 1;
+                        if count >= n {
+                            break;
+                        }
+                    }
+                }
+                t.evals += count as u64;
+                return count >= n;
+            }
+        }
+        if self.stale(t) {
+            return false;
+        }
+        self.grid.at_least(a.pos, None, self.crowd2, Some(a.id), n)
+    }
+
+    /// At least `prey_needed` rabbits within vision.
+    #[cfg(test)]
+    pub(super) fn enough_prey(&self, a: &Animat) -> bool {
+        self.enough_prey_in(a, &mut self.near(a), &mut Tally::default())
+    }
+
+    pub(super) fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
+        t.count += 1;
+        let n = self.params.prey_needed as usize;
+        if let (Some(w), true) = (near.w.as_ref(), n > 0) {
+            let k_max = RING_MAX.min(self.params.vision);
+            let [x, y] = a.pos;
+            let v2 = self.vision2;
+            let kb = kind_byte(true);
+            let mut count = 0usize;
+            let mut look = |dx: i64, dy: i64| -> bool {
+                if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
+                    count += 1;
+                }
+                count >= n
+            };
+            let mut found = false;
+            for k in 1..=k_max {
+                if ring_until(k, &mut look) {
+                    found = true;
+                    break;
+                }
+            }
+            t.evals += count as u64;
+            // Rings 1..=k_max cover the whole vision disc when k_max = vision.
+            if found || k_max == self.params.vision {
+                return found;
+            }
+        }
+        if self.stale(t) {
+            return false;
+        }
+        self.grid
+            .at_least(a.pos, Some(Species::Rabbit), self.vision2, Some(a.id), n)
+    }
+}
