@@ -1,9 +1,8 @@
 //! The stored particles as the walkers see them: the orthtree (the variable-precision
 //! distance `vpdist` and exact first contact of Sosa-Herrera & Rodriguez-Romo, "Variable
 //! precision distance search for random fractal cluster simulations") and, in front of it, the
-//! coarse distance maps of [`spatial::distmap`] (levels from
-//! [`Space::MAP_LEVELS`](crate::space::Space::MAP_LEVELS)) that let a walker a few diameters
-//! or more from the cluster jump without a tree query.
+//! coarse distance maps of [`spatial::distmap`] (levels from [`Space::MAP_LEVELS`]) that let a
+//! walker a few diameters or more from the cluster jump without a tree query.
 //!
 //! Invariants: in serial growth every stored particle has lowered every map, so a map's bound
 //! never exceeds the exact distance to the nearest stored particle (in PDLA a particle another

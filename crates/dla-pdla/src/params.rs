@@ -2,7 +2,7 @@
 //!
 //! Invariant: a [`Params`] that passed [`Params::validate`] has every field in its accepted
 //! range, which every other module assumes (in particular `dim` is one of
-//! [`DIMENSIONS`](crate::space::DIMENSIONS)).
+//! [`DIMENSIONS`]).
 
 use crate::space::DIMENSIONS;
 use serde::{Deserialize, Serialize};

@@ -4,9 +4,9 @@
 //! cluster (distance maps, then the orthtree's `vpdist` or the walker's near cache) and taking
 //! `step_min` steps near it, until a step ends in exact contact.
 //!
-//! Invariants: a move never brings the walker's centre closer than 1 to a stored particle
-//! (jumps stay within a lower bound of the distance minus 1, steps stop at the first contact);
-//! the walker's memory ([`WalkState`]) holds only bounds that stay valid while particles are
+//! Invariants: a move never brings the walker's centre closer than 1 to a particle stored
+//! when the move starts (jumps stay within a lower bound of the distance minus 1, steps stop at
+//! the first contact); the walker's memory (`WalkState`) holds only bounds that stay valid while particles are
 //! added, and is reset for every new walker. The walk is a pure function of the random stream
 //! and the stored particles: the near cache and the tree give the same answers bit for bit.
 

@@ -53,6 +53,17 @@ fn critical(n: usize) -> f64 {
     1.95 / (n as f64).sqrt()
 }
 
+/// Asserts that `samples` (drawn for the distance ratio `x`) pass the KS test against `table`.
+fn assert_ks_below_critical(samples: Vec<f64>, table: &[(f64, f64)], x: f64) {
+    let n = samples.len();
+    let d = ks(samples, table);
+    assert!(
+        d < critical(n),
+        "x = {x}: KS distance {d} >= {}",
+        critical(n)
+    );
+}
+
 #[test]
 fn ks_2d_return_angle_matches_harmonic_density() {
     let n = 20_000;
@@ -77,12 +88,7 @@ fn ks_2d_return_angle_matches_harmonic_density() {
                 phi
             })
             .collect();
-        let d = ks(samples, &table);
-        assert!(
-            d < critical(n),
-            "x = {x}: KS distance {d} >= {}",
-            critical(n)
-        );
+        assert_ks_below_critical(samples, &table, x);
     }
 }
 
@@ -118,12 +124,7 @@ fn ks_3d_return_matches_harmonic_measure() {
                 (q[0] * e[0] + q[1] * e[1] + q[2] * e[2]) / qn
             })
             .collect();
-        let d = ks(samples, &table);
-        assert!(
-            d < critical(n),
-            "x = {x}: KS distance {d} >= {}",
-            critical(n)
-        );
+        assert_ks_below_critical(samples, &table, x);
     }
 }
 

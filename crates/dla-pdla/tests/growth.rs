@@ -284,55 +284,52 @@ fn pdla_tree_holds_exactly_the_recorded_positions() {
     assert_eq!(a, b);
 }
 
+/// Checkpoints a 3000-particle run after `stop` walkers, resumes it and grows it to the end:
+/// the same state hash, positions and `R_g` as the uninterrupted run; `run_checkpointed` also
+/// ends with that hash and leaves a final checkpoint that resumes to it. Returns the directory
+/// holding that final checkpoint.
+fn checkpoint_and_resume<const D: usize>(stop: u64) -> tempfile::TempDir
+where
+    Dim<D>: Space<D>,
+{
+    let params = Params {
+        dim: D,
+        particles: 3000,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("checkpoint.bin");
+    let mut a = Simulation::<D>::new(params.clone(), 21).unwrap();
+    a.run().unwrap();
+    let mut b = Simulation::<D>::new(params.clone(), 21).unwrap();
+    for _ in 0..stop {
+        b.add_one().unwrap();
+    }
+    b.write_checkpoint(&path).unwrap();
+    drop(b);
+    let mut c = Simulation::<D>::resume(&path).unwrap();
+    assert_eq!(c.particles(), stop + 1);
+    c.run().unwrap();
+    assert_eq!(c.state_hash(), a.state_hash());
+    assert_eq!(c.positions(), a.positions());
+    assert_eq!(c.radius_of_gyration(), a.radius_of_gyration());
+    let mut d = Simulation::<D>::new(params, 21).unwrap();
+    d.run_checkpointed(1000, &path, &|_| {}).unwrap();
+    assert_eq!(d.state_hash(), a.state_hash());
+    assert_eq!(
+        Simulation::<D>::resume(&path).unwrap().state_hash(),
+        a.state_hash()
+    );
+    dir
+}
+
 #[test]
 fn checkpoint_and_resume_give_the_uninterrupted_state_hash() {
-    for dim in [2usize, 3] {
-        let params = Params {
-            dim,
-            particles: 3000,
-            keep_positions: true,
-            ..Params::default()
-        };
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("checkpoint.bin");
-        if dim == 2 {
-            let mut a = Simulation::<2>::new(params.clone(), 21).unwrap();
-            a.run().unwrap();
-            let mut b = Simulation::<2>::new(params.clone(), 21).unwrap();
-            for _ in 0..1234 {
-                b.add_one().unwrap();
-            }
-            b.write_checkpoint(&path).unwrap();
-            drop(b);
-            let mut c = Simulation::<2>::resume(&path).unwrap();
-            assert_eq!(c.particles(), 1235);
-            c.run().unwrap();
-            assert_eq!(c.state_hash(), a.state_hash());
-            assert_eq!(c.positions(), a.positions());
-            assert_eq!(c.radius_of_gyration(), a.radius_of_gyration());
-            // run_checkpointed ends with the same hash and leaves a final checkpoint.
-            let mut d = Simulation::<2>::new(params.clone(), 21).unwrap();
-            d.run_checkpointed(1000, &path, &|_| {}).unwrap();
-            assert_eq!(d.state_hash(), a.state_hash());
-            assert_eq!(
-                Simulation::<2>::resume(&path).unwrap().state_hash(),
-                a.state_hash()
-            );
-        } else {
-            let mut a = Simulation::<3>::new(params.clone(), 21).unwrap();
-            a.run().unwrap();
-            let mut b = Simulation::<3>::new(params.clone(), 21).unwrap();
-            for _ in 0..999 {
-                b.add_one().unwrap();
-            }
-            b.write_checkpoint(&path).unwrap();
-            let mut c = Simulation::<3>::resume(&path).unwrap();
-            c.run().unwrap();
-            assert_eq!(c.state_hash(), a.state_hash());
-            // A checkpoint of the wrong dimension is refused.
-            assert!(Simulation::<2>::resume(&path).is_err());
-        }
-    }
+    checkpoint_and_resume::<2>(1234);
+    let dir = checkpoint_and_resume::<3>(999);
+    // A checkpoint of the wrong dimension is refused.
+    assert!(Simulation::<2>::resume(&dir.path().join("checkpoint.bin")).is_err());
 }
 
 #[test]

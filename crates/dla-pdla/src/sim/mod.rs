@@ -5,10 +5,10 @@
 //!
 //! | module | owns |
 //! |---|---|
-//! | [`growth`] | what a stored particle changes: count, `R_ext`, `R_g`, hash, samples |
-//! | [`serial`] | serial DLA: one walker at a time on one stream |
-//! | [`pdla`] | PDLA: threads, replicas, the shared log, the re-check |
-//! | [`checkpoint`] | the checkpoint format, writing and rebuilding a run from it |
+//! | `growth` | what a stored particle changes: count, `R_ext`, `R_g`, hash, samples |
+//! | `serial` | serial DLA: one walker at a time on one stream |
+//! | `pdla` | PDLA: threads, replicas, the shared log, the re-check |
+//! | `checkpoint` | the checkpoint format, writing and rebuilding a run from it |
 //!
 //! Invariant: `growth.n` particles are stored in `cluster`, in the order `growth` accounted
 //! for them.

@@ -40,19 +40,19 @@ pub(crate) struct PdlaStats {
 }
 
 /// Grows `cluster` (holding `growth.n` particles) to `params.particles` with
-/// `params.threads` walkers at once, adding to `stats`. Each thread walks on its own replica of the
-/// orthtree, so walking takes no lock and touches no shared cache line but one atomic
-/// counter; stuck particles go through a shared log (a mutex held only to copy the new
-/// entries, re-check against them, append and account for one particle; inserting into the
-/// replica happens after the mutex is released). Before every move a thread applies the
-/// particles other threads appended since its last move, so it walks on the cluster as it
-/// was at most one move ago, as in the paper's shared tree. At sticking it re-checks, under
-/// the log's lock, that none of the particles stored since its last move lies within
-/// [`OVERLAP_DISTANCE`] (section 3.4), and against its replica before taking the
-/// lock (a move can end inside a particle stored during it); if one does the walker is
-/// discarded and counted. The replicas receive the same points in the same order, so they
-/// are identical;
-/// thread 0's becomes the simulation's tree.
+/// `params.threads` walkers at once, adding to `stats`.
+///
+/// Each thread walks on its own replica of the orthtree, so walking takes no lock and touches
+/// no shared cache line but one atomic counter; stuck particles go through a shared log (a
+/// mutex held only to copy the new entries, re-check against them, append and account for one
+/// particle; inserting into the replica happens after the mutex is released). Before every
+/// move a thread applies the particles other threads appended since its last move, so it walks
+/// on the cluster as it was at most one move ago, as in the paper's shared tree. At sticking it
+/// re-checks, under the log's lock, that none of the particles stored since its last move lies
+/// within [`OVERLAP_DISTANCE`] (section 3.4), and against its replica before taking the lock
+/// (a move can end inside a particle stored during it); if one does the walker is discarded
+/// and counted. The replicas receive the same points in the same order, so they are
+/// identical; thread 0's becomes the simulation's tree.
 pub(crate) fn grow_parallel<const D: usize>(
     params: &Params,
     seed: u64,
