@@ -1,41 +1,21 @@
-//! The stored particles as the walkers see them: the orthtree (seed 002: `vpdist`, exact
-//! first contact) and, in front of it, the coarse distance map of [`spatial::distmap`] that
-//! lets a walker a few diameters or more from the cluster jump without a tree query.
+//! The stored particles as the walkers see them: the orthtree (the variable-precision
+//! distance `vpdist` and exact first contact of Sosa-Herrera & Rodriguez-Romo, "Variable
+//! precision distance search for random fractal cluster simulations") and, in front of it, the
+//! coarse distance maps of [`spatial::distmap`] (levels from [`Space::MAP_LEVELS`]) that let a
+//! walker a few diameters or more from the cluster jump without a tree query.
+//!
+//! Invariants: in serial growth every stored particle has lowered every map, so a map's bound
+//! never exceeds the exact distance to the nearest stored particle (in PDLA a particle another
+//! thread has just stored may not have lowered the shared maps yet; the re-check at sticking
+//! catches a move made on such a stale bound). The maps are shared between clones and grow
+//! only while unshared.
 
+use crate::error::SimError;
 use crate::params::Params;
-use crate::sim::SimError;
+use crate::space::{Dim, Space};
 use spatial::distmap::DistanceMap;
 use spatial::orthtree::Orthtree;
 use std::sync::Arc;
-
-/// The distance maps, finest first, as `(cell side, cap distance)` in diameters, in `dim`
-/// dimensions: a fine map for walkers up to the cap from the cluster and a coarse one beyond
-/// it (a walker in a capped fine cell asks the coarse map). An insert lowers every cell whose
-/// centre lies within the cap, `(pi / 4) (2 cap / cell)^2` cells in 2D and `(pi / 6) (2 cap /
-/// cell)^3` in 3D: about 200 per map in 2D and 270 per map in 3D with these values. Chosen
-/// by measurement (`docs/benchmarks.md`): in 2D a fine map with 4-diameter cells costs more
-/// memory than it saves time, a coarse cap of 1024 costs more per insert, and coarse cells of
-/// 32 or 64 diameters are within noise of each other (64 is smaller and cheaper to update).
-pub fn map_levels(dim: usize) -> &'static [(f64, f64)] {
-    if dim <= 2 {
-        &[(8.0, 64.0), (64.0, 512.0)]
-    } else {
-        &[(8.0, 32.0), (32.0, 128.0)]
-    }
-}
-
-/// A generous estimate of `R_ext` for a cluster of `n` particles in `dim` dimensions, for
-/// sizing PDLA's shared distance maps up front: 1.3 times `0.85 n^(1/1.71)` in 2D and
-/// `1.15 n^(1/2.5)` in 3D (fitted to our runs: `R_ext` was 2 640-2 770 at 1e6 in 2D and 178
-/// at 3e5 in 3D). A cluster that outgrows it only loses the maps' help at its rim.
-pub fn expected_r_ext(dim: usize, n: u64) -> f64 {
-    let n = n as f64;
-    1.3 * if dim <= 2 {
-        0.85 * n.powf(1.0 / 1.71)
-    } else {
-        1.15 * n.powf(1.0 / 2.5)
-    }
-}
 
 /// The cluster: its orthtree and, when `params.distance_map` is on, the distance maps.
 ///
@@ -51,11 +31,14 @@ pub struct Cluster<const D: usize> {
 
 impl<const D: usize> Cluster<D> {
     /// An empty cluster for `params` (leaf side, distance map on or off).
-    pub fn new(params: &Params) -> Result<Self, SimError> {
+    pub fn new(params: &Params) -> Result<Self, SimError>
+    where
+        Dim<D>: Space<D>,
+    {
         Ok(Cluster {
             tree: Orthtree::with_leaf_side(params.leaf_side)?,
             maps: if params.distance_map {
-                map_levels(D)
+                Dim::<D>::MAP_LEVELS
                     .iter()
                     .map(|&(cell, cap)| DistanceMap::new(cell, cap))
                     .collect::<Result<_, _>>()?
@@ -158,60 +141,6 @@ impl<const D: usize> Cluster<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::Simulation;
-
-    /// The walker's bound from the maps never exceeds the exact distance to the nearest
-    /// particle (brute force), after serial growth and after PDLA (shared maps lowered by
-    /// both threads).
-    fn bound_is_below_exact<const D: usize>(n: u64, threads: usize) {
-        let params = Params {
-            dim: D,
-            particles: n,
-            threads,
-            keep_positions: true,
-            ..Params::default()
-        };
-        let mut sim = Simulation::<D>::new(params, 5).unwrap();
-        sim.run().unwrap();
-        let cluster = sim.cluster();
-        assert_eq!(cluster.maps().len(), 2);
-        if threads == 1 {
-            assert!(cluster.maps().iter().all(|m| m.len() == n));
-        }
-        let pos = sim.positions().unwrap();
-        let r = sim.r_ext() + 80.0;
-        let mut rng = core_lattice::rng::stream(9, 0);
-        let mut used = 0;
-        for _ in 0..4000 {
-            let mut p = [0.0; D];
-            for x in &mut p {
-                *x = (2.0 * core_lattice::rng::uniform01(&mut rng) - 1.0) * r;
-            }
-            let exact = pos
-                .iter()
-                .map(|q| (0..D).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt())
-                .fold(f64::INFINITY, f64::min);
-            if let Some(lb) = cluster.map_bound(&p) {
-                assert!(
-                    lb <= exact,
-                    "{D}D: map bound {lb} above exact {exact} at {p:?}"
-                );
-                used += 1;
-            }
-        }
-        assert!(
-            used > 3000,
-            "the maps cover the birth region ({used} of 4000)"
-        );
-    }
-
-    #[test]
-    fn map_bound_is_below_the_exact_distance() {
-        bound_is_below_exact::<2>(3000, 1);
-        bound_is_below_exact::<3>(1500, 1);
-        bound_is_below_exact::<2>(3000, 2);
-        bound_is_below_exact::<3>(1500, 2);
-    }
 
     #[test]
     fn map_off_has_no_maps() {

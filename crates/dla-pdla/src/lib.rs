@@ -1,11 +1,29 @@
-//! Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D and 3D
-//! (MODELS.md section 2; Sosa-Herrera & Rodriguez-Romo, seed 002, sections 3.2 to 3.4).
+//! Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D and 3D, after
+//! Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for random fractal
+//! cluster simulations" (sections 3.2 to 3.4).
 //!
 //! A seed particle sits at the origin; walkers are born on the sphere of radius
 //! `R_b = R_ext + birth_gap`, move by `vpdist` jumps far from the cluster and `step_min` steps
 //! near it, and stick at exact contact (centre distance 1). Outside the birth sphere they are
 //! returned to it exactly (harmonic measure) or, as in the paper, jump and die beyond the
 //! death radius. The cluster lives in a [`spatial::orthtree::Orthtree`]. See `docs/dla.md`.
+//!
+//! | module | owns |
+//! |---|---|
+//! | [`farfield`] | the exact far-field return samplers |
+//! | [`space`] | everything dimension-specific ([`Dim`], [`Space`]) |
+//! | [`params`] | the run's parameters and their validation |
+//! | [`error`] | [`SimError`] |
+//! | [`cluster`] | the stored particles: orthtree and distance maps |
+//! | `near` | a walker's near cache (private) |
+//! | [`walker`] | one walker's moves |
+//! | [`sim`] | the simulation: serial DLA, PDLA, checkpoints, observables |
+//! | [`output`] | the output files of a finished run |
+//!
+//! Each module uses only modules above it in this list (no import cycles).
+//!
+//! With the default feature `cli` the parameter enums derive `clap::ValueEnum` and the `dla`
+//! binary is built; without it the library does not depend on clap.
 //!
 //! ```
 //! use dla_pdla::{Params, Simulation};
@@ -17,12 +35,18 @@
 //! ```
 
 pub mod cluster;
+pub mod error;
 pub mod farfield;
 mod near;
 pub mod output;
 pub mod params;
 pub mod sim;
+pub mod space;
+pub mod walker;
 
 pub use cluster::Cluster;
+pub use error::SimError;
 pub use params::{FarField, Params, ParamsError};
-pub use sim::{Sample, SimError, Simulation, Walker};
+pub use sim::{Sample, Simulation};
+pub use space::{Dim, Space};
+pub use walker::Walker;

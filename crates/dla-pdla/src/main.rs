@@ -1,12 +1,13 @@
 //! `dla`: off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D and 3D
-//! (MODELS.md section 2; Sosa-Herrera & Rodriguez-Romo, seed 002). A thin layer over the
-//! `dla_pdla` library: parse flags, validate, run, write outputs.
+//! (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for random fractal
+//! cluster simulations"). A thin layer over the `dla_pdla` library: parse flags, validate,
+//! turn `--dim` into a type (the one run-time dimension dispatch), run, write outputs.
 
 use anyhow::Context;
 use clap::Parser;
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, write_outputs};
-use dla_pdla::{FarField, Params, Simulation};
+use dla_pdla::{Dim, FarField, Params, ParamsError, Simulation, Space};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -41,8 +42,8 @@ struct Cli {
     birth_gap: f64,
 
     /// Far field (|p| > R_b): `return` puts the walker exactly where Brownian motion would first
-    /// hit the birth sphere; `jump` is the paper's jump of |p| - R_ext - 1 with relaunch beyond
-    /// the death radius.
+    /// hit the birth sphere (harmonic measure; see docs/dla.md); `jump` is the paper's jump of
+    /// |p| - R_ext - 1 with relaunch beyond the death radius.
     #[arg(long, value_enum, default_value_t = FarField::Return)]
     far_field: FarField,
 
@@ -62,7 +63,7 @@ struct Cli {
 
     /// Side of the orthtree's leaf cells in diameters (power of two, 1 to 64): speed and
     /// memory only, not the physics.
-    #[arg(long, default_value_t = dla_pdla::params::DEFAULT_LEAF_SIDE)]
+    #[arg(long, default_value_t = dla_pdla::params::DLA_LEAF_SIDE)]
     leaf_side: f64,
 
     /// The coarse distance maps in front of the orthtree (one byte per cell of side 8
@@ -164,14 +165,20 @@ fn main() -> ExitCode {
         "dla",
         |c: &Cli| (c.quiet, c.verbose),
         params,
+        // The one run-time dimension dispatch: adding a dimension is one arm here (and its
+        // `Space` implementation).
         |cli, params: Params| match params.dim {
             2 => run::<2>(cli, params),
-            _ => run::<3>(cli, params),
+            3 => run::<3>(cli, params),
+            d => Err(ParamsError::Dim(d).into()),
         },
     )
 }
 
-fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()> {
+fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()>
+where
+    Dim<D>: Space<D>,
+{
     let clock = RunClock::start();
     std::fs::create_dir_all(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
@@ -219,6 +226,9 @@ fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()> {
         bar.finish_and_clear();
     }
     let m = write_outputs(&sim, &clock, &cli.out, cli.positions, cli.png)?;
+    if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
+        tracing::warn!("no fractal dimension: {e}");
+    }
     tracing::info!(discarded = sim.discarded_walkers(), "done");
     if !cli.quiet {
         let d = m

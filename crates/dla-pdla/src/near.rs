@@ -3,10 +3,9 @@
 //! list instead of the tree.
 //!
 //! A walker inside the cluster's envelope makes most of its moves within a few diameters of
-//! one branch (in 3D about 25 tree queries per particle, 90 % of them answered within
-//! 6 diameters). Each such query descends the tree and scans about three leaves of some 20
-//! particles; the cache answers it from the handful of particles around the walker, in a
-//! flat array scanned with vector instructions, with the same exact value:
+//! one branch. Each such query descends the tree and scans a few leaves; the cache answers it
+//! from the handful of particles around the walker, in a flat array scanned with vector
+//! instructions, with the same exact value:
 //!
 //! - **Exact, and the tree's value bit for bit.** The cache holds every stored particle whose
 //!   squared distance from the centre `c`, computed as the range query computes it, is at most
@@ -27,12 +26,9 @@
 
 use spatial::orthtree::{Orthtree, dist_sq};
 
-/// Radius of the ball a cache holds, in diameters. Tuned by instruction counts (cachegrind;
-/// 3D 3e4 particles, 2D 1e5; the tree alone: 4.64e9 and 3.99e9): radius 5 with rebuilds from
-/// distance 3 gives 3.77e9 and 3.27e9 (-19 %, -18 %); radius 4 3.81e9, 6 3.82e9, 7 3.94e9,
-/// 8 4.18e9 in 3D, and 10 costs more than the tree alone (4.81e9: larger caches are rebuilt
-/// as often and scanned at every move). In 3D at 1e5, a cache serves about 90 % of the
-/// moves that would ask the tree.
+/// Radius of the ball a cache holds, in diameters, tuned by instruction counts
+/// (`docs/benchmarks.md`): a smaller ball is rebuilt too often, a larger one costs more to
+/// build and to scan at every move than the tree queries it saves.
 pub const NEAR_RADIUS: f64 = 5.0;
 
 /// A cache is (re)built at the walker's position when its nearest distance is known to be

@@ -1,5 +1,5 @@
-//! Writing a finished run into its output directory (DESIGN.md, "Outputs"); every file is
-//! written atomically.
+//! Writing a finished run into its output directory (see `docs/dla.md`, "Outputs"); every file
+//! is written atomically, so a file is either complete or absent.
 //!
 //! | file | content |
 //! |---|---|
@@ -11,13 +11,30 @@
 //! | `dla.png` | `--png`: the cluster shaded by arrival order (3D: projection on x, y) |
 
 use crate::sim::Simulation;
+use crate::space::{Dim, Space};
+use core_lattice::io::image::ImageError;
 use core_lattice::io::{AtomicFile, CsvField, CsvWriter, RunClock, RunManifest, write_png_gray};
 use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 
+/// Why an output could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// Creating, writing or renaming a file.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// Encoding the picture.
+    #[error(transparent)]
+    Image(#[from] ImageError),
+    /// Serialising the parameters into the manifest.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
 /// Format of the optional positions file.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum PositionsFormat {
     /// No positions file (positions are not kept in memory).
@@ -30,14 +47,18 @@ pub enum PositionsFormat {
     Xyz,
 }
 
-/// Write every output of `sim` into `dir` (which must exist) and return the manifest.
+/// Write every output of `sim` into `dir` (which must exist) and return the manifest. When the
+/// fractal dimension cannot be fitted, its results are null and `fit_error` says why.
 pub fn write_outputs<const D: usize>(
     sim: &Simulation<D>,
     clock: &RunClock,
     dir: &Path,
     positions: PositionsFormat,
     png: bool,
-) -> anyhow::Result<RunManifest> {
+) -> Result<RunManifest, OutputError>
+where
+    Dim<D>: Space<D>,
+{
     let mut w = CsvWriter::create(
         dir.join("growth.csv"),
         &["n", "radius_of_gyration", "r_ext", "seconds"],
@@ -51,8 +72,7 @@ pub fn write_outputs<const D: usize>(
         match positions {
             PositionsFormat::None => {}
             PositionsFormat::Csv => {
-                let header = ["x", "y", "z"];
-                let mut w = CsvWriter::create(dir.join("positions.csv"), &header[..D])?;
+                let mut w = CsvWriter::create(dir.join("positions.csv"), &Dim::<D>::AXES)?;
                 for p in pos {
                     let f: Vec<&dyn CsvField> = p.iter().map(|x| x as &dyn CsvField).collect();
                     w.row(&f)?;
@@ -67,7 +87,8 @@ pub fn write_outputs<const D: usize>(
                     writeln!(b, "{}", pos.len())?;
                     writeln!(b, "DLA cluster, seed {}, arrival order", sim.seed())?;
                     for p in pos {
-                        let z = if D == 3 { p[2] } else { 0.0 };
+                        // XYZ holds three coordinates: z = 0 in the plane.
+                        let z = p.get(2).copied().unwrap_or(0.0);
                         writeln!(b, "C {} {} {}", p[0], p[1], z)?;
                     }
                     b.flush()?;
@@ -114,7 +135,6 @@ pub fn write_outputs<const D: usize>(
                 .set_result("fit_points", f.n as u64);
         }
         Err(e) => {
-            tracing::warn!("no fractal dimension: {e}");
             m.set_result("fractal_dimension", serde_json::Value::Null)
                 .set_result("fractal_dimension_stderr", serde_json::Value::Null)
                 .set_result("fit_error", e.to_string());
@@ -126,7 +146,10 @@ pub fn write_outputs<const D: usize>(
 
 /// `positions.bin`: little-endian; the 8 bytes `DLAPOS01`, `u32` dimension `D`, `u64` count
 /// `N`, then `N * D` `f64` coordinates, particle by particle in arrival order.
-pub fn write_positions_bin<const D: usize>(path: &Path, pos: &[[f64; D]]) -> anyhow::Result<()> {
+pub fn write_positions_bin<const D: usize>(
+    path: &Path,
+    pos: &[[f64; D]],
+) -> Result<(), OutputError> {
     let mut f = AtomicFile::create(path)?;
     {
         let mut b = std::io::BufWriter::new(&mut f);
@@ -146,7 +169,7 @@ pub fn write_positions_bin<const D: usize>(path: &Path, pos: &[[f64; D]]) -> any
 
 /// The cluster as a grayscale picture on black, projected on (x, y), each particle a disc of
 /// diameter 1 (at least one pixel) shaded from dark (first) to white (last) by arrival order.
-fn write_picture<const D: usize>(pos: &[[f64; D]], path: &Path) -> anyhow::Result<()> {
+fn write_picture<const D: usize>(pos: &[[f64; D]], path: &Path) -> Result<(), OutputError> {
     let extent = pos
         .iter()
         .map(|p| p[0].abs().max(p[1].abs()))

@@ -1,15 +1,21 @@
-//! Parameters of a DLA/PDLA run (MODELS.md section 2), validated before anything runs.
+//! Parameters of a DLA/PDLA run, with their defaults, validated before anything runs.
+//!
+//! Invariant: a [`Params`] that passed [`Params::validate`] has every field in its accepted
+//! range, which every other module assumes (in particular `dim` is one of
+//! [`DIMENSIONS`]).
 
+use crate::space::DIMENSIONS;
 use serde::{Deserialize, Serialize};
 
 /// What happens to a walker outside the birth sphere (`|p| > R_b`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum FarField {
     /// Exact return to the birth circle/sphere at the harmonic-measure hit point
-    /// (REFERENCE.md, "Exact far-field return"); no walker is ever killed.
+    /// ([`crate::farfield`], `docs/dla.md`); no walker is ever killed.
     Return,
-    /// Seed 002, section 3.2: jump `|p| - R_ext - 1` in a random direction (the distance to the
+    /// Sosa-Herrera & Rodriguez-Romo, section 3.2: jump `|p| - R_ext - 1` in a random direction (the distance to the
     /// cluster's bounding sphere less the contact distance), relaunch beyond the death radius.
     Jump,
 }
@@ -24,10 +30,10 @@ impl FarField {
     }
 }
 
-/// Every parameter of MODELS.md section 2, with its default.
+/// Every parameter of a run, with its default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Params {
-    /// Space dimension, 2 or 3 (`--dim`, default 2).
+    /// Space dimension, one of [`DIMENSIONS`] (`--dim`, default 2).
     pub dim: usize,
     /// Number of particles of the final cluster, seed included (`--particles`).
     pub particles: u64,
@@ -51,7 +57,7 @@ pub struct Params {
     /// `8 D` bytes per particle; off by default.
     pub keep_positions: bool,
     /// Side of the orthtree's leaf cells in diameters, a power of two in [1, 64]
-    /// (`--leaf-side`, default [`DEFAULT_LEAF_SIDE`]). Changes speed and memory, not the
+    /// (`--leaf-side`, default [`DLA_LEAF_SIDE`]). Changes speed and memory, not the
     /// physics: see `docs/dla.md`.
     #[serde(default = "default_leaf_side")]
     pub leaf_side: f64,
@@ -77,12 +83,14 @@ fn default_distance_map() -> bool {
     true
 }
 
-/// Default leaf side of the orthtree for DLA: 8 diameters (measured faster than 4 in 2D and 3D,
-/// and smaller: about 10 instead of 12 bytes per particle in 2D; `docs/benchmarks.md`).
-pub const DEFAULT_LEAF_SIDE: f64 = 8.0;
+/// Default leaf side of the orthtree for DLA, in diameters: 8, twice the orthtree's own
+/// default (`spatial::orthtree::DEFAULT_LEAF_SIDE`). In DLA the distance maps answer the far
+/// queries, so the tree serves walkers close to the cluster, where larger leaves mean fewer
+/// nodes to descend and less memory per particle (`docs/benchmarks.md`).
+pub const DLA_LEAF_SIDE: f64 = 8.0;
 
 fn default_leaf_side() -> f64 {
-    DEFAULT_LEAF_SIDE
+    DLA_LEAF_SIDE
 }
 
 impl Default for Params {
@@ -99,11 +107,17 @@ impl Default for Params {
             serial_until: 0,
             fit_from: 1000,
             keep_positions: false,
-            leaf_side: DEFAULT_LEAF_SIDE,
+            leaf_side: DLA_LEAF_SIDE,
             distance_map: true,
             near_cache: true,
         }
     }
+}
+
+/// The accepted dimensions as `2, 3`.
+fn dimension_list() -> String {
+    let dims: Vec<String> = DIMENSIONS.iter().map(usize::to_string).collect();
+    dims.join(", ")
 }
 
 /// Largest accepted particle count (the orthtree stores at most `u32::MAX` points).
@@ -112,8 +126,8 @@ pub const MAX_PARTICLES: u64 = u32::MAX as u64 - 1;
 /// A parameter outside its accepted range; the message names the value and the range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamsError {
-    /// `dim` not 2 or 3.
-    #[error("--dim {0} is outside the accepted range {{2, 3}}")]
+    /// `dim` not one of [`DIMENSIONS`].
+    #[error("--dim {0} is outside the accepted range {{{dims}}}", dims = dimension_list())]
     Dim(usize),
     /// `particles` is 0 or too large.
     #[error("--particles {0} is outside the accepted range 1..={MAX_PARTICLES}")]
@@ -143,7 +157,7 @@ pub enum ParamsError {
 impl Params {
     /// Check every field against its accepted range.
     pub fn validate(&self) -> Result<(), ParamsError> {
-        if !(2..=3).contains(&self.dim) {
+        if !DIMENSIONS.contains(&self.dim) {
             return Err(ParamsError::Dim(self.dim));
         }
         if self.particles == 0 || self.particles > MAX_PARTICLES {
@@ -179,60 +193,97 @@ mod tests {
     #[test]
     fn defaults_are_valid_and_bad_values_are_named() {
         assert!(Params::default().validate().is_ok());
+        let d = Params::default;
         let bad = [
-            Params {
-                dim: 4,
-                ..Params::default()
-            },
-            Params {
-                particles: 0,
-                ..Params::default()
-            },
-            Params {
-                precision: 0.0,
-                ..Params::default()
-            },
-            Params {
-                precision: f64::NAN,
-                ..Params::default()
-            },
-            Params {
-                step_min: 0.0,
-                ..Params::default()
-            },
-            Params {
-                step_min: -1.0,
-                ..Params::default()
-            },
-            Params {
-                threads: 0,
-                ..Params::default()
-            },
-            Params {
-                birth_gap: 0.5,
-                ..Params::default()
-            },
-            Params {
-                death_ratio: 1.0,
-                ..Params::default()
-            },
-            Params {
-                leaf_side: 3.0,
-                ..Params::default()
-            },
-            Params {
-                leaf_side: 128.0,
-                ..Params::default()
-            },
+            (Params { dim: 4, ..d() }, "--dim 4 ", "{2, 3}"),
+            (Params { dim: 1, ..d() }, "--dim 1 ", "{2, 3}"),
+            (
+                Params {
+                    particles: 0,
+                    ..d()
+                },
+                "--particles 0 ",
+                "1..=",
+            ),
+            (
+                Params {
+                    precision: 0.0,
+                    ..d()
+                },
+                "--precision 0 ",
+                "(0.5, inf]",
+            ),
+            (
+                Params {
+                    precision: f64::NAN,
+                    ..d()
+                },
+                "--precision NaN ",
+                "(0.5, inf]",
+            ),
+            (
+                Params {
+                    step_min: 0.0,
+                    ..d()
+                },
+                "--step-min 0 ",
+                "(0, 1e3]",
+            ),
+            (
+                Params {
+                    step_min: -1.0,
+                    ..d()
+                },
+                "--step-min -1 ",
+                "(0, 1e3]",
+            ),
+            (Params { threads: 0, ..d() }, "--threads 0 ", "1..=1024"),
+            (
+                Params {
+                    birth_gap: 0.5,
+                    ..d()
+                },
+                "--birth-gap 0.5 ",
+                "[1, 1e9]",
+            ),
+            (
+                Params {
+                    death_ratio: 1.0,
+                    ..d()
+                },
+                "--death-ratio 1 ",
+                "(1, 1e300]",
+            ),
+            (
+                Params {
+                    leaf_side: 3.0,
+                    ..d()
+                },
+                "--leaf-side 3 ",
+                "{1, 2, 4",
+            ),
+            (
+                Params {
+                    leaf_side: 128.0,
+                    ..d()
+                },
+                "--leaf-side 128 ",
+                "{1, 2, 4",
+            ),
         ];
-        for p in bad {
+        for (p, flag, range) in bad {
             let e = p.validate().unwrap_err().to_string();
-            assert!(e.contains("accepted range"), "{e}");
+            // The message names the flag, the bad value and the accepted range.
+            assert!(e.starts_with(flag), "{e}");
+            assert!(e.contains(&format!("accepted range {range}")), "{e}");
         }
         let inf = Params {
             precision: f64::INFINITY,
             ..Params::default()
         };
         assert!(inf.validate().is_ok());
+        for &dim in DIMENSIONS {
+            assert!(Params { dim, ..d() }.validate().is_ok());
+        }
     }
 }

@@ -1,10 +1,10 @@
 //! Kolmogorov-Smirnov tests of the exact far-field return samplers against the harmonic
-//! densities of REFERENCE.md, integrated numerically (so the test does not reuse the sampler's
+//! densities (Poisson kernels of the circle and the sphere), integrated numerically (so the test does not reuse the sampler's
 //! closed-form inversion). The hit point is measured from the returned position, relative to
 //! the walker's direction, so a sampler that hits the wrong side fails.
 
 use core_lattice::rng::stream;
-use dla_pdla::farfield::return_to_sphere;
+use dla_pdla::{Dim, Space};
 use std::f64::consts::PI;
 
 /// Numerical CDF on a fine grid of `density` over `[a, b]` (trapezoid rule), normalised.
@@ -53,6 +53,17 @@ fn critical(n: usize) -> f64 {
     1.95 / (n as f64).sqrt()
 }
 
+/// Asserts that `samples` (drawn for the distance ratio `x`) pass the KS test against `table`.
+fn assert_ks_below_critical(samples: Vec<f64>, table: &[(f64, f64)], x: f64) {
+    let n = samples.len();
+    let d = ks(samples, table);
+    assert!(
+        d < critical(n),
+        "x = {x}: KS distance {d} >= {}",
+        critical(n)
+    );
+}
+
 #[test]
 fn ks_2d_return_angle_matches_harmonic_density() {
     let n = 20_000;
@@ -65,7 +76,7 @@ fn ks_2d_return_angle_matches_harmonic_density() {
             .map(|i| {
                 let a = 0.37 * i as f64;
                 let p = [x * big_r * a.cos(), x * big_r * a.sin()];
-                let q = return_to_sphere(&p, big_r, &mut rng);
+                let q = Dim::<2>::return_to_sphere(&p, big_r, &mut rng);
                 assert!(((q[0].hypot(q[1])) - big_r).abs() < 1e-9);
                 let mut phi = q[1].atan2(q[0]) - a;
                 while phi > PI {
@@ -77,12 +88,7 @@ fn ks_2d_return_angle_matches_harmonic_density() {
                 phi
             })
             .collect();
-        let d = ks(samples, &table);
-        assert!(
-            d < critical(n),
-            "x = {x}: KS distance {d} >= {}",
-            critical(n)
-        );
+        assert_ks_below_critical(samples, &table, x);
     }
 }
 
@@ -112,18 +118,13 @@ fn ks_3d_return_matches_harmonic_measure() {
                 let (th, ph) = (0.3 + (i % 7) as f64 * 0.4, i as f64 * 0.77);
                 let e = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
                 let p = [r * e[0], r * e[1], r * e[2]];
-                let q = return_to_sphere(&p, big_r, &mut rng);
+                let q = Dim::<3>::return_to_sphere(&p, big_r, &mut rng);
                 let qn = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
                 assert!((qn - big_r).abs() < 1e-9);
                 (q[0] * e[0] + q[1] * e[1] + q[2] * e[2]) / qn
             })
             .collect();
-        let d = ks(samples, &table);
-        assert!(
-            d < critical(n),
-            "x = {x}: KS distance {d} >= {}",
-            critical(n)
-        );
+        assert_ks_below_critical(samples, &table, x);
     }
 }
 

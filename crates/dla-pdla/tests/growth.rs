@@ -1,8 +1,12 @@
-//! Contact, determinism and far-field-jump tests of whole runs (MODELS.md section 2).
+//! Contact, determinism, growth-sample, PDLA, checkpoint and far-field-jump tests of whole
+//! runs.
 
-use dla_pdla::{FarField, Params, Simulation};
+use dla_pdla::{Dim, FarField, Params, Simulation, Space};
 
-fn grow<const D: usize>(n: u64, seed: u64, threads: usize) -> Simulation<D> {
+fn grow<const D: usize>(n: u64, seed: u64, threads: usize) -> Simulation<D>
+where
+    Dim<D>: Space<D>,
+{
     grow_with(
         Params {
             dim: D,
@@ -14,7 +18,10 @@ fn grow<const D: usize>(n: u64, seed: u64, threads: usize) -> Simulation<D> {
     )
 }
 
-fn grow_with<const D: usize>(params: Params, seed: u64) -> Simulation<D> {
+fn grow_with<const D: usize>(params: Params, seed: u64) -> Simulation<D>
+where
+    Dim<D>: Space<D>,
+{
     let params = Params {
         keep_positions: true,
         ..params
@@ -42,11 +49,17 @@ fn check_contacts<const D: usize>(pos: &[[f64; D]]) -> (f64, f64) {
     (min_pair, max_contact)
 }
 
-fn contacts<const D: usize>(threads: usize) {
+fn contacts<const D: usize>(threads: usize)
+where
+    Dim<D>: Space<D>,
+{
     contacts_with::<D>(threads, true);
 }
 
-fn contacts_with<const D: usize>(threads: usize, distance_map: bool) {
+fn contacts_with<const D: usize>(threads: usize, distance_map: bool)
+where
+    Dim<D>: Space<D>,
+{
     let n = 20_000;
     let sim = grow_with::<D>(
         Params {
@@ -106,7 +119,10 @@ fn contacts_3d_two_threads() {
 /// cache answers most moves), the exact search, and a precision too coarse for the cache to
 /// be used (kappa 0.8: the tree is exact only within 0.3 leaf diagonals, under the cache's
 /// 5 diameters in 2D and 3D).
-fn near_cache_is_invisible<const D: usize>(n: u64) {
+fn near_cache_is_invisible<const D: usize>(n: u64)
+where
+    Dim<D>: Space<D>,
+{
     for (precision, distance_map) in [
         (2.0, true),
         (2.0, false),
@@ -163,42 +179,67 @@ fn same_seed_same_hash_different_seed_different_hash() {
     assert_eq!(d.state_hash(), a.state_hash());
 }
 
-#[test]
-fn far_field_jump_with_huge_death_radius_finishes_finite() {
-    for (dim, n) in [(2usize, 1500u64), (3, 1500)] {
-        let params = Params {
-            dim,
-            particles: n,
+/// A far-field-jump run with a death radius so large that walkers wander far before dying:
+/// every coordinate finite and every contact exact.
+fn jump_with_huge_death_radius<const D: usize>()
+where
+    Dim<D>: Space<D>,
+{
+    let sim = grow_with::<D>(
+        Params {
+            dim: D,
+            particles: 1500,
             far_field: FarField::Jump,
             death_ratio: 1e20,
-            keep_positions: true,
             ..Params::default()
-        };
-        if dim == 2 {
-            let mut sim = Simulation::<2>::new(params, 3).unwrap();
-            sim.run().unwrap();
-            let pos = sim.positions().unwrap();
-            assert!(pos.iter().flatten().all(|x| x.is_finite()));
-            let (mn, mx) = check_contacts(pos);
-            assert!(mn >= 1.0 - 1e-6 && mx <= 1.0 + 1e-6, "{mn} {mx}");
-        } else {
-            let mut sim = Simulation::<3>::new(params, 3).unwrap();
-            sim.run().unwrap();
-            let pos = sim.positions().unwrap();
-            assert!(pos.iter().flatten().all(|x| x.is_finite()));
-            let (mn, mx) = check_contacts(pos);
-            assert!(mn >= 1.0 - 1e-6 && mx <= 1.0 + 1e-6, "{mn} {mx}");
-        }
-    }
+        },
+        3,
+    );
+    let pos = sim.positions().unwrap();
+    assert!(pos.iter().flatten().all(|x| x.is_finite()));
+    let (mn, mx) = check_contacts(pos);
+    assert!(mn >= 1.0 - 1e-6 && mx <= 1.0 + 1e-6, "{D}D: {mn} {mx}");
+}
+
+#[test]
+fn far_field_jump_with_huge_death_radius_finishes_finite() {
+    jump_with_huge_death_radius::<2>();
+    jump_with_huge_death_radius::<3>();
 }
 
 #[test]
 fn growth_samples_are_log_spaced_and_end_at_n() {
-    let sim = grow::<2>(20_000, 1, 1);
+    let n = 20_000;
+    let sim = grow::<2>(n, 1, 1);
     let s = sim.samples();
     assert!(s.len() > 500 && s.len() <= 1001, "{}", s.len());
-    assert_eq!(s.last().unwrap().n, 20_000);
-    assert!(s.windows(2).all(|w| w[1].n > w[0].n));
+    assert_eq!(s[0].n, 1);
+    assert_eq!(s.last().unwrap().n, n);
+    // Each sample is taken at the next log-spaced size, `ceil(N ratio)` (at least one more
+    // particle), with `ratio^GROWTH_SAMPLES = n`; the last one at `n` itself.
+    let ratio = (n as f64).powf(1.0 / dla_pdla::sim::GROWTH_SAMPLES);
+    for w in s.windows(2) {
+        let next = (w[0].n + 1).max((w[0].n as f64 * ratio).ceil() as u64);
+        assert!(
+            w[1].n == next || (w[1].n == n && n < next),
+            "sample at {} after {}, expected {next}",
+            w[1].n,
+            w[0].n
+        );
+        assert!(w[1].r_ext >= w[0].r_ext && w[1].seconds >= w[0].seconds);
+    }
+    // Log-spaced: past the sizes where the one-particle minimum rules, successive sizes
+    // differ by the ratio (up to the rounding up to whole particles).
+    for w in s
+        .windows(2)
+        .filter(|w| w[1].n < n && w[0].n as f64 * (ratio - 1.0) > 1.0)
+    {
+        let r = w[1].n as f64 / w[0].n as f64;
+        assert!(
+            r >= ratio && r <= ratio + 1.0 / w[0].n as f64,
+            "{r} vs {ratio}"
+        );
+    }
 }
 
 #[test]
@@ -222,7 +263,7 @@ fn discard_guard_fails_loudly_instead_of_spinning() {
 }
 
 #[test]
-fn pdla_counts_every_walker_and_keeps_the_tree_complete() {
+fn pdla_tree_holds_exactly_the_recorded_positions() {
     let params = Params {
         particles: 5000,
         threads: 2,
@@ -243,55 +284,52 @@ fn pdla_counts_every_walker_and_keeps_the_tree_complete() {
     assert_eq!(a, b);
 }
 
+/// Checkpoints a 3000-particle run after `stop` walkers, resumes it and grows it to the end:
+/// the same state hash, positions and `R_g` as the uninterrupted run; `run_checkpointed` also
+/// ends with that hash and leaves a final checkpoint that resumes to it. Returns the directory
+/// holding that final checkpoint.
+fn checkpoint_and_resume<const D: usize>(stop: u64) -> tempfile::TempDir
+where
+    Dim<D>: Space<D>,
+{
+    let params = Params {
+        dim: D,
+        particles: 3000,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("checkpoint.bin");
+    let mut a = Simulation::<D>::new(params.clone(), 21).unwrap();
+    a.run().unwrap();
+    let mut b = Simulation::<D>::new(params.clone(), 21).unwrap();
+    for _ in 0..stop {
+        b.add_one().unwrap();
+    }
+    b.write_checkpoint(&path).unwrap();
+    drop(b);
+    let mut c = Simulation::<D>::resume(&path).unwrap();
+    assert_eq!(c.particles(), stop + 1);
+    c.run().unwrap();
+    assert_eq!(c.state_hash(), a.state_hash());
+    assert_eq!(c.positions(), a.positions());
+    assert_eq!(c.radius_of_gyration(), a.radius_of_gyration());
+    let mut d = Simulation::<D>::new(params, 21).unwrap();
+    d.run_checkpointed(1000, &path, &|_| {}).unwrap();
+    assert_eq!(d.state_hash(), a.state_hash());
+    assert_eq!(
+        Simulation::<D>::resume(&path).unwrap().state_hash(),
+        a.state_hash()
+    );
+    dir
+}
+
 #[test]
 fn checkpoint_and_resume_give_the_uninterrupted_state_hash() {
-    for dim in [2usize, 3] {
-        let params = Params {
-            dim,
-            particles: 3000,
-            keep_positions: true,
-            ..Params::default()
-        };
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("checkpoint.bin");
-        if dim == 2 {
-            let mut a = Simulation::<2>::new(params.clone(), 21).unwrap();
-            a.run().unwrap();
-            let mut b = Simulation::<2>::new(params.clone(), 21).unwrap();
-            for _ in 0..1234 {
-                b.add_one().unwrap();
-            }
-            b.write_checkpoint(&path).unwrap();
-            drop(b);
-            let mut c = Simulation::<2>::resume(&path).unwrap();
-            assert_eq!(c.particles(), 1235);
-            c.run().unwrap();
-            assert_eq!(c.state_hash(), a.state_hash());
-            assert_eq!(c.positions(), a.positions());
-            assert_eq!(c.radius_of_gyration(), a.radius_of_gyration());
-            // run_checkpointed ends with the same hash and leaves a final checkpoint.
-            let mut d = Simulation::<2>::new(params.clone(), 21).unwrap();
-            d.run_checkpointed(1000, &path, &|_| {}).unwrap();
-            assert_eq!(d.state_hash(), a.state_hash());
-            assert_eq!(
-                Simulation::<2>::resume(&path).unwrap().state_hash(),
-                a.state_hash()
-            );
-        } else {
-            let mut a = Simulation::<3>::new(params.clone(), 21).unwrap();
-            a.run().unwrap();
-            let mut b = Simulation::<3>::new(params.clone(), 21).unwrap();
-            for _ in 0..999 {
-                b.add_one().unwrap();
-            }
-            b.write_checkpoint(&path).unwrap();
-            let mut c = Simulation::<3>::resume(&path).unwrap();
-            c.run().unwrap();
-            assert_eq!(c.state_hash(), a.state_hash());
-            // A checkpoint of the wrong dimension is refused.
-            assert!(Simulation::<2>::resume(&path).is_err());
-        }
-    }
+    checkpoint_and_resume::<2>(1234);
+    let dir = checkpoint_and_resume::<3>(999);
+    // A checkpoint of the wrong dimension is refused.
+    assert!(Simulation::<2>::resume(&dir.path().join("checkpoint.bin")).is_err());
 }
 
 #[test]

@@ -7,7 +7,7 @@ use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig, std_dev};
 use anyhow::Result;
 use core_lattice::LinearFit;
-use dla_pdla::{Params, Sample, Simulation};
+use dla_pdla::{Dim, Params, Sample, Simulation, Space};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -26,7 +26,10 @@ pub struct Grown {
     pub discarded: u64,
 }
 
-fn grow_d<const D: usize>(params: &Params, seed: u64) -> Result<Grown> {
+fn grow_d<const D: usize>(params: &Params, seed: u64) -> Result<Grown>
+where
+    Dim<D>: Space<D>,
+{
     let mut sim = Simulation::<D>::new(params.clone(), seed)?;
     let start = Instant::now();
     sim.run()?;

@@ -1,0 +1,61 @@
+//! Serial DLA: one walker at a time, each released on the birth sphere and walked until it
+//! sticks, on one random stream (`stream_id(PURPOSE_WALK, 0)`).
+//!
+//! Invariant: a serial run is a pure function of `(Params, seed)`: the walker's moves depend
+//! only on the stream and the stored particles, and nothing else draws from the stream.
+
+use super::growth::Growth;
+use crate::cluster::Cluster;
+use crate::error::SimError;
+use crate::params::Params;
+use crate::space::{Dim, Space};
+use crate::walker::{WalkState, Walker};
+use core_lattice::rng::{SimRng, stream, stream_id};
+
+/// Stream purpose of the serial walker (`stream_id(PURPOSE_WALK, 0)`).
+pub const PURPOSE_WALK: u32 = 1;
+
+/// The serial walker's random stream and memory.
+#[derive(Debug)]
+pub(crate) struct Serial<const D: usize> {
+    /// The walk's random stream (saved in checkpoints).
+    pub(crate) rng: SimRng,
+    /// The current walker's memory (reset for each walker).
+    pub(crate) walk: WalkState<D>,
+}
+
+impl<const D: usize> Serial<D> {
+    /// The serial walk of run `seed`, from its first walker.
+    pub(crate) fn new(params: &Params, seed: u64) -> Self {
+        Serial::with_rng(params, stream(seed, stream_id(PURPOSE_WALK, 0)))
+    }
+
+    /// The serial walk continuing on `rng` (a resumed checkpoint).
+    pub(crate) fn with_rng(params: &Params, rng: SimRng) -> Self {
+        Serial {
+            rng,
+            walk: WalkState::new(params),
+        }
+    }
+
+    /// Releases one walker and grows `cluster` by the particle it becomes; returns its stored
+    /// position.
+    pub(crate) fn add_one(
+        &mut self,
+        params: &Params,
+        cluster: &mut Cluster<D>,
+        growth: &mut Growth<D>,
+    ) -> Result<[f64; D], SimError>
+    where
+        Dim<D>: Space<D>,
+    {
+        let mut w = Walker::born(growth.r_ext + params.birth_gap, &mut self.rng);
+        self.walk.reset();
+        loop {
+            if let Some(p) = w.advance(&mut self.walk, cluster, growth.r_ext, params, &mut self.rng)
+            {
+                return growth.add(cluster, p, params.particles);
+            }
+        }
+    }
+}

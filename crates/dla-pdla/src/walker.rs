@@ -1,0 +1,288 @@
+//! One walker's moves (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for
+//! random fractal cluster simulations", section 3.2): born on the birth sphere, returned to it
+//! (or jumping and dying) in the far field, jumping by a lower bound of its distance to the
+//! cluster (distance maps, then the orthtree's `vpdist` or the walker's near cache) and taking
+//! `step_min` steps near it, until a step ends in exact contact.
+//!
+//! Invariants: a move never brings the walker's centre closer than 1 to a particle stored
+//! when the move starts (jumps stay within a lower bound of the distance minus 1, steps stop at
+//! the first contact); the walker's memory (`WalkState`) holds only bounds that stay valid while particles are
+//! added, and is reset for every new walker. The walk is a pure function of the random stream
+//! and the stored particles: the near cache and the tree give the same answers bit for bit.
+
+use crate::cluster::Cluster;
+use crate::farfield::norm;
+use crate::near::{NEAR_RADIUS, NearCache, REBUILD_UPPER};
+use crate::params::{FarField, Params};
+use crate::space::{Dim, Space};
+use core_lattice::rng::Rng;
+use spatial::orthtree::{Orthtree, VpEstimate, dist_sq};
+
+/// A walker jumps by the distance map's bound `lb` when `lb - 1` exceeds this (diameters);
+/// closer to the cluster the tree's sharper bound pays for its cost.
+pub const MAP_JUMP_MIN: f64 = 2.0;
+/// The far field starts at `|p| > r_b * FAR_FIELD_MARGIN`.
+pub const FAR_FIELD_MARGIN: f64 = 1.0 + 1e-9;
+
+/// A random walker: the centre of a ball of diameter 1.
+#[derive(Debug, Clone, Copy)]
+pub struct Walker<const D: usize> {
+    /// Current centre.
+    pub p: [f64; D],
+}
+
+impl<const D: usize> Walker<D>
+where
+    Dim<D>: Space<D>,
+{
+    /// A walker born uniformly on the sphere of radius `r_b`.
+    pub fn born<R: Rng + ?Sized>(r_b: f64, rng: &mut R) -> Self {
+        let mut p = Dim::<D>::direction(rng);
+        p.iter_mut().for_each(|x| *x *= r_b);
+        Walker { p }
+    }
+
+    /// One move on a non-empty cluster whose particles all lie within `r_ext` of the origin.
+    /// Returns the sticking position (centre distance 1 to the particle first touched) when
+    /// the move ends in contact.
+    pub fn step<R: Rng + ?Sized>(
+        &mut self,
+        cluster: &Cluster<D>,
+        r_ext: f64,
+        params: &Params,
+        rng: &mut R,
+    ) -> Option<[f64; D]> {
+        self.advance(&mut WalkState::new(params), cluster, r_ext, params, rng)
+    }
+
+    /// [`step`](Self::step) with the walker's memory `state` (reset it for each new walker):
+    /// an upper bound of its distance to the cluster, so the tree query starts from the few
+    /// nodes covering that ball ([`Orthtree::vpdist_bounded`]) rather than from the root.
+    pub(crate) fn advance<R: Rng + ?Sized>(
+        &mut self,
+        state: &mut WalkState<D>,
+        cluster: &Cluster<D>,
+        r_ext: f64,
+        params: &Params,
+        rng: &mut R,
+    ) -> Option<[f64; D]> {
+        let r_b = r_ext + params.birth_gap;
+        let r = norm(&self.p);
+        // Far field. The margin keeps a walker just returned to the birth sphere (whose norm
+        // may round to slightly above r_b) in the near field, which is valid everywhere;
+        // without it a walker at r_b (1 + 1e-16) would be "returned" to itself forever.
+        if r > r_b * FAR_FIELD_MARGIN {
+            state.reset();
+            match params.far_field {
+                FarField::Return => self.p = Dim::<D>::return_to_sphere(&self.p, r_b, rng),
+                FarField::Jump => {
+                    if r > params.death_ratio * r_b {
+                        *self = Walker::born(r_b, rng);
+                    } else {
+                        // Every particle is within r_ext of the origin, so within distance
+                        // r - r_ext - 1 the walker cannot touch one.
+                        self.jump(r - r_ext - 1.0, rng);
+                    }
+                }
+            }
+            return None;
+        }
+        // Near field. First the distance map: one byte read bounds the distance to the
+        // cluster from below; a walker at least a few diameters out jumps by it.
+        if let Some(lb) = cluster.map_bound(&self.p) {
+            if lb - 1.0 > MAP_JUMP_MIN {
+                self.jump(lb - 1.0, rng);
+                state.upper += (lb - 1.0) * (1.0 + 1e-9);
+                return None;
+            }
+        }
+        // Then the tree: a lower bound on the distance to the nearest centre.
+        // Near the cluster the walker's near cache gives the same exact answer as the tree.
+        let tree = cluster.tree();
+        let (est, nearest) = match state.near_query(&self.p, tree) {
+            Some((distance, x)) => (
+                VpEstimate {
+                    distance,
+                    half_diagonal: None,
+                },
+                Some(x),
+            ),
+            None => tree
+                .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
+                .expect("the cluster is never empty"),
+        };
+        state.anchor = nearest;
+        let delta = est.distance;
+        // The exact distance is at most delta + 2 r (the gap of a far node's bound), with a
+        // relative margin for the rounding of that bound.
+        state.upper = (delta + 2.0 * est.half_diagonal.unwrap_or(0.0)) * (1.0 + 1e-9) + 1e-9;
+        if delta - 1.0 > params.step_min {
+            self.jump(delta - 1.0, rng);
+            state.upper += (delta - 1.0) * (1.0 + 1e-9);
+            return None;
+        }
+        state.upper += params.step_min * (1.0 + 1e-9);
+        let u = Dim::<D>::direction(rng);
+        let r = params.step_min + 1.0;
+        // `covers` is false unless the cache was built, which only `near_query` does, and only
+        // when the cache is on.
+        let t = if state.near.covers(&self.p, r) {
+            // The same particles as the tree's range query (see `near`), so the same contact.
+            let mut best = f64::INFINITY;
+            state
+                .near
+                .for_each_within(&self.p, r, |q| contact(&self.p, &u, &q, &mut best));
+            (best <= params.step_min).then_some(best)
+        } else {
+            first_contact(tree, &self.p, &u, params.step_min)
+        };
+        if let Some(t) = t {
+            let mut q = self.p;
+            for i in 0..D {
+                q[i] += t * u[i];
+            }
+            return Some(q);
+        }
+        for i in 0..D {
+            self.p[i] += params.step_min * u[i];
+        }
+        None
+    }
+
+    fn jump<R: Rng + ?Sized>(&mut self, len: f64, rng: &mut R) {
+        let u = Dim::<D>::direction(rng);
+        for i in 0..D {
+            self.p[i] += len * u[i];
+        }
+    }
+}
+
+/// A uniformly random unit vector: [`Space::direction`] of [`Dim<D>`].
+#[inline]
+pub fn direction<const D: usize, R: Rng + ?Sized>(rng: &mut R) -> [f64; D]
+where
+    Dim<D>: Space<D>,
+{
+    Dim::<D>::direction(rng)
+}
+
+/// Smallest `t` in `[0, len]` with `|p + t u - q| = 1` over every stored centre `q` (`u` a unit
+/// vector): the first contact along the step (Sosa-Herrera & Rodriguez-Romo, section 3.2, Fig. 6). A centre already
+/// at distance <= 1 gives `t = 0`.
+pub fn first_contact<const D: usize>(
+    tree: &Orthtree<D>,
+    p: &[f64; D],
+    u: &[f64; D],
+    len: f64,
+) -> Option<f64> {
+    let mut best = f64::INFINITY;
+    tree.for_each_within(p, len + 1.0, |q| contact(p, u, &q, &mut best));
+    (best <= len).then_some(best)
+}
+
+/// Lowers `best` to the contact time with centre `q` along `p + t u`, if there is one.
+#[inline(always)]
+fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut f64) {
+    let mut b = 0.0;
+    let mut w2 = 0.0;
+    for i in 0..D {
+        let w = p[i] - q[i];
+        b += w * u[i];
+        w2 += w * w;
+    }
+    let c = w2 - 1.0;
+    let t = if c <= 0.0 {
+        0.0
+    } else {
+        let disc = b * b - c;
+        if disc < 0.0 || b >= 0.0 {
+            return;
+        }
+        // Stable form of -b - sqrt(disc) (b < 0): c / (-b + sqrt(disc)).
+        c / (-b + disc.sqrt())
+    };
+    if t < *best {
+        *best = t;
+    }
+}
+
+/// What a walker remembers between moves: an upper bound of its exact distance to the
+/// nearest centre (`+inf` when unknown), and the stored particle found nearest at the last
+/// exact tree query (`anchor`). Both stay valid while particles are only added, so PDLA
+/// threads keep them when other threads store particles.
+#[derive(Debug, Clone)]
+pub(crate) struct WalkState<const D: usize> {
+    upper: f64,
+    anchor: Option<[f64; D]>,
+    /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
+    /// wherever the cache answers (`(kappa - 1/2)` leaf diagonals cover [`NEAR_RADIUS`]).
+    near_on: bool,
+    near: NearCache<D>,
+}
+
+impl<const D: usize> WalkState<D> {
+    pub(crate) fn new(params: &Params) -> Self {
+        let kappa = params.precision;
+        let exact_within = if kappa.is_nan() {
+            f64::INFINITY
+        } else {
+            (kappa - 0.5) * params.leaf_side * (D as f64).sqrt()
+        };
+        WalkState {
+            upper: f64::INFINITY,
+            anchor: None,
+            near_on: params.near_cache && exact_within >= NEAR_RADIUS,
+            near: NearCache::new(),
+        }
+    }
+
+    /// A new walker: nothing known.
+    pub(crate) fn reset(&mut self) {
+        self.upper = f64::INFINITY;
+        self.anchor = None;
+        self.near.reset();
+    }
+
+    /// A particle another PDLA thread stored while this walker moves: the near cache keeps it
+    /// if it lies in the cache's ball (the bounds stay valid as they are).
+    #[inline]
+    pub(crate) fn particle_added(&mut self, q: &[f64; D]) {
+        self.near.added(q);
+    }
+
+    /// Whether the near cache is built and holds `p` (tests: how often the cache serves).
+    #[cfg(test)]
+    pub(crate) fn cache_holds(&self, p: &[f64; D]) -> bool {
+        self.near.covers(p, 0.0)
+    }
+
+    /// The exact nearest distance and a particle at it from the near cache, rebuilding the
+    /// cache around `p` when it cannot answer and `p` is known to be close to the cluster;
+    /// `None` when the tree must answer.
+    #[inline]
+    fn near_query(&mut self, p: &[f64; D], tree: &Orthtree<D>) -> Option<(f64, [f64; D])> {
+        if !self.near_on {
+            return None;
+        }
+        if let Some(hit) = self.near.nearest(p) {
+            return Some(hit);
+        }
+        if self.upper(p) <= REBUILD_UPPER {
+            self.near.rebuild(tree, p);
+            return self.near.nearest(p);
+        }
+        None
+    }
+
+    /// An upper bound of the nearest distance from `p`: the smaller of `upper` (the last
+    /// answer plus every distance moved since) and the distance to the anchor particle (the
+    /// walker jumped in a random direction, so the anchor is typically about `sqrt 2` times
+    /// the last answer away rather than twice), with a relative margin for rounding.
+    #[inline]
+    fn upper(&self, p: &[f64; D]) -> f64 {
+        match self.anchor {
+            Some(a) => self.upper.min(dist_sq(p, &a).sqrt() * (1.0 + 1e-9) + 1e-9),
+            None => self.upper,
+        }
+    }
+}
