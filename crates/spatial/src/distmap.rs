@@ -538,13 +538,8 @@ mod tests {
     /// the bytes of the sequential map; points beyond the map are clipped, never wrong.
     #[test]
     fn shared_inserts_from_two_threads_equal_sequential_inserts() {
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::SplitMix::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.uniform();
         let pts: Vec<[f64; 2]> = (0..4000)
             .map(|_| [next() * 400.0 - 200.0, next() * 400.0 - 200.0])
             .collect();
