@@ -1,6 +1,6 @@
 //! Deterministic random-number streams and the sampling helpers the models share.
 //!
-//! Every run is a pure function of `(Params, seed)` (DESIGN.md, "Same seed, same result"). A run
+//! Every run is a pure function of `(Params, seed)` (`docs/architecture.md`, "Conventions"). A run
 //! draws from several *streams*, one per purpose (initial placement, move order, each PDLA
 //! thread, ...), each a [`SimRng`] (`rand_pcg::Pcg64Mcg`, 128-bit state) derived from the run
 //! seed and a stream id by [`stream`]. Streams never share state, so adding a consumer of one
@@ -11,8 +11,12 @@
 //!
 //! Sampling helpers: [`unit_vector`] (uniform direction on the unit sphere in `D` dimensions,
 //! for off-lattice walkers, seed 002 section 3.3), [`DirectionSampler`] (a random unit lattice
-//! direction, optionally weighted, for DLCA moves with gravity, MODELS.md section 1), and
+//! direction, optionally weighted, for DLCA moves with gravity, `docs/dlca.md`), and
 //! [`shuffle`] (the fresh random visiting order of every sweep or step, seed 000).
+//!
+//! [`SplitMix64`] is the one small generator for fixed-seed synthetic data in tests, examples
+//! and benchmarks; its output function [`splitmix64`] is also the hash [`stream`] derives
+//! stream states with.
 
 use crate::lattice::{Direction, MAX_DIM};
 use rand::seq::SliceRandom;
@@ -111,6 +115,9 @@ pub fn uniform01<R: Rng + ?Sized>(rng: &mut R) -> f64 {
 pub fn unit_vector<const D: usize, R: Rng + ?Sized>(rng: &mut R) -> [f64; D] {
     use std::f64::consts::TAU;
     let mut v = [0.0; D];
+    // `D` is a constant, so each instantiation keeps one arm. The `_` arm is the general method
+    // (every D >= 4), not a fallback for an unsupported dimension; the low dimensions use
+    // cheaper exact formulas. Their draw sequences are part of every DLA run's state hash.
     match D {
         0 => {}
         1 => v[0] = if rng.random::<bool>() { 1.0 } else { -1.0 },
@@ -168,8 +175,8 @@ pub enum DirectionError {
 }
 
 /// Draws one of the `2d` unit lattice directions (numbered as in [`Direction`]), uniformly or
-/// with given weights. Used for DLCA cluster moves, with gravity biasing `-e_d` (MODELS.md
-/// section 1, step 2).
+/// with given weights. Used for DLCA cluster moves, with gravity biasing `-e_d` (`docs/dlca.md`,
+/// "The model", step 2).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DirectionSampler {
     count: usize,
@@ -217,7 +224,7 @@ impl DirectionSampler {
         })
     }
 
-    /// MODELS.md section 1 gravity: `-e_d` (down the last axis) has weight `1 + g`, `+e_d` has
+    /// DLCA gravity (`docs/dlca.md`): `-e_d` (down the last axis) has weight `1 + g`, `+e_d` has
     /// `1 - g`, every other direction 1. `g = 0` is exactly [`DirectionSampler::uniform`] (same
     /// draws from the stream).
     pub fn gravity(dim: usize, g: f64) -> Result<Self, DirectionError> {
@@ -320,7 +327,10 @@ mod tests {
         let mut b = a.clone();
         for step in 0..100u64 {
             let z = b.next_u64();
-            assert_eq!(z, splitmix64(0x5EED_u64.wrapping_add(step.wrapping_mul(GOLDEN_GAMMA))));
+            assert_eq!(
+                z,
+                splitmix64(0x5EED_u64.wrapping_add(step.wrapping_mul(GOLDEN_GAMMA)))
+            );
             match step % 2 {
                 0 => assert_eq!(a.uniform(), (z >> 11) as f64 / (1u64 << 53) as f64),
                 _ => assert_eq!(a.below(7), (z % 7) as usize),

@@ -49,13 +49,13 @@
 //! The leaf side `s` trades memory against query work: a larger `s` means fewer nodes and leaf
 //! records (less memory, a shallower tree) but more points scanned per visited leaf (and a
 //! larger exact region of `vpdist`, `(kappa - 1/2)` leaf diagonals); a smaller `s` means more
-//! nodes per point. For unit-diameter
-//! particles `s = 4` holds 4 to 5 DLA particles per leaf and keeps the structure near 12 bytes
-//! per point in 2D; `s = 8` (about 12 particles per leaf) needs less memory and is one level
-//! shallower, so it is worth benchmarking for large clusters; `s = 2` costs more memory than it
-//! saves work (`docs/spatial.md` has the measured trade-off). Accepted: powers of two from [`MIN_LEAF_SIDE`] to [`MAX_LEAF_SIDE`] (powers of two make
-//! every cell corner, centre and decoded position an exact binary fraction, so the geometry used
-//! by the queries is exact).
+//! nodes per point. For unit-diameter particles `s = 4` holds 4 to 5 DLA particles per leaf and
+//! keeps the structure near 12 bytes per point in 2D; `s = 8` (about 12 particles per leaf)
+//! needs less memory and is one level shallower, so it is worth benchmarking for large clusters;
+//! `s = 2` costs more memory than it saves work (`docs/spatial.md` has the measured trade-off).
+//! Accepted: powers of two from [`MIN_LEAF_SIDE`] to [`MAX_LEAF_SIDE`] (powers of two make every
+//! cell corner, centre and decoded position an exact binary fraction, so the geometry used by
+//! the queries is exact).
 //!
 //! # Queries and complexity
 //!
