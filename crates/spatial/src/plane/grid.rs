@@ -51,7 +51,7 @@ fn box_key(side: Option<i64>, p: Pos) -> [i64; 2] {
 ///
 /// Queries take an optional id to exclude (the querying animat itself) and an inclusive squared
 /// radius `r2`: an item at squared distance `d2` qualifies when `d2 <= r2`. See the
-/// [module documentation](self) for the layout, the cost of each operation and why every answer
+/// [module documentation](crate::plane) for the layout, the cost of each operation and why every answer
 /// equals the exhaustive scan's.
 #[derive(Debug)]
 pub struct PlaneGrid<K> {
@@ -88,15 +88,20 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// [`PlaneError::BadBoxSide`] if the side is zero or negative.
     pub fn new(size: BoxSize) -> Result<Self, PlaneError> {
         let size = size.validate()?;
-        Ok(PlaneGrid {
-            side: size.side(),
+        Ok(Self::empty(size.side()))
+    }
+
+    /// An empty grid with boxes of side `side` (already checked positive) or none.
+    fn empty(side: Option<i64>) -> Self {
+        PlaneGrid {
+            side,
             boxes: FxHashMap::default(),
             slots: FxHashMap::default(),
             cells: FxHashMap::default(),
             track_cells: true,
             spare: Vec::new(),
             stats: Counters::default(),
-        })
+        }
     }
 
     /// An empty grid that does not keep the per-cell counts behind
@@ -131,15 +136,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// An empty grid without boxes: every query scans all items, the "no grid" baseline of
     /// seed 000, Fig. 9 and Table I.
     pub fn exhaustive() -> Self {
-        PlaneGrid {
-            side: None,
-            boxes: FxHashMap::default(),
-            slots: FxHashMap::default(),
-            cells: FxHashMap::default(),
-            track_cells: true,
-            spare: Vec::new(),
-            stats: Counters::default(),
-        }
+        Self::empty(None)
     }
 
     /// The box size this grid uses.

@@ -21,7 +21,7 @@
 //!   vector (a back-index), so removal is a `swap_remove` plus one back-index fix.
 //! - **Cells**: `FxHashMap<[i64; 2], u32>` counting the items on each cell, so "is this cell
 //!   free" ([`PlaneGrid::is_occupied`]) is one hash lookup in every mode.
-//! - **Counters**: [`AtomicU64`]s of distance evaluations, items scanned and boxes probed
+//! - **Counters**: [`AtomicU64`](std::sync::atomic::AtomicU64)s of distance evaluations, items scanned and boxes probed
 //!   ([`SearchStats`]).
 //!
 //! # Complexity (N items, expected-time hashing)
@@ -75,7 +75,7 @@
 //! halo's items with them) and [`SearchStats::boxes_probed`]: together they are the work
 //! measure behind Fig. 9 and Table I.
 //!
-//! The counters are [`AtomicU64`]s updated with `Relaxed` ordering once per query (each query
+//! The counters are [`AtomicU64`](std::sync::atomic::AtomicU64)s updated with `Relaxed` ordering once per query (each query
 //! tallies into local variables first). Queries take `&self`; atomics keep [`PlaneGrid`]
 //! `Sync`, so read-only queries may run on several threads at once (a `Cell` would forbid
 //! that). `Relaxed` suffices because the counters synchronise nothing else, and three atomic

@@ -238,7 +238,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// Serves the "move towards the nearest rabbit / fox" rules (seed 000, section II.B) and
     /// is the query timed in Fig. 9 and Table I (section IV.B). With boxes, it searches box
     /// rings outward from `p`'s box and stops as soon as no closer item can exist; in
-    /// [`BoxSize::None`] mode it scans every item.
+    /// [`BoxSize::None`](super::BoxSize::None) mode it scans every item.
     pub fn nearest(&self, p: Pos, kind: K, r2: u64, exclude: Option<u64>) -> Option<(u64, u64)> {
         self.nearest_filtered(p, Some(kind), r2, exclude)
     }
