@@ -1,5 +1,5 @@
-//! Command-line plumbing shared by the model binaries (feature `cli`): DESIGN.md's "Errors, not
-//! panics" for binaries (bad input is one line naming the value, exit code 2, nothing written)
+//! Command-line plumbing shared by the model binaries (feature `cli`): the "errors, not panics"
+//! convention of `docs/architecture.md` for binaries (bad input is one line naming the value, exit code 2, nothing written)
 //! and its logging convention (`-v`, `RUST_LOG`, quiet by default).
 
 use std::process::ExitCode;

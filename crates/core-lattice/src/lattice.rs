@@ -207,7 +207,7 @@ impl Direction {
 }
 
 /// A translation was refused because it would cross a wall (seed 000 DLCA with closed
-/// boundaries; MODELS.md section 1 step 3).
+/// boundaries; `docs/dlca.md`, "The model", step 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("move blocked by a wall")]
 pub struct Blocked;
@@ -460,7 +460,7 @@ impl Lattice {
         (n != k).then_some(n)
     }
 
-    /// Translate site `k` by the unit vector `dir` (seed 000 DLCA moves, MODELS.md section 1).
+    /// Translate site `k` by the unit vector `dir` (seed 000 DLCA moves, `docs/dlca.md`).
     ///
     /// On a periodic axis the move wraps around; on a wall axis a move past `0` or `L - 1`
     /// returns [`Blocked`]. On a periodic axis of length 1 the site moves onto itself.

@@ -15,7 +15,7 @@
 //! - `cli` (feature `cli`): one-line argument errors with exit code 2, and logging set-up, for
 //!   the model binaries.
 //!
-//! Conventions (see `DESIGN.md`): a run is a pure function of its parameters and seed; bad input
+//! Conventions (see `docs/architecture.md`): a run is a pure function of its parameters and seed; bad input
 //! is a typed error, never a panic; every output file is written atomically.
 
 #[cfg(feature = "cli")]

@@ -1,6 +1,6 @@
 //! Deterministic random-number streams and the sampling helpers the models share.
 //!
-//! Every run is a pure function of `(Params, seed)` (DESIGN.md, "Same seed, same result"). A run
+//! Every run is a pure function of `(Params, seed)` (`docs/architecture.md`, "Conventions"). A run
 //! draws from several *streams*, one per purpose (initial placement, move order, each PDLA
 //! thread, ...), each a [`SimRng`] (`rand_pcg::Pcg64Mcg`, 128-bit state) derived from the run
 //! seed and a stream id by [`stream`]. Streams never share state, so adding a consumer of one
@@ -11,8 +11,12 @@
 //!
 //! Sampling helpers: [`unit_vector`] (uniform direction on the unit sphere in `D` dimensions,
 //! for off-lattice walkers, seed 002 section 3.3), [`DirectionSampler`] (a random unit lattice
-//! direction, optionally weighted, for DLCA moves with gravity, MODELS.md section 1), and
+//! direction, optionally weighted, for DLCA moves with gravity, `docs/dlca.md`), and
 //! [`shuffle`] (the fresh random visiting order of every sweep or step, seed 000).
+//!
+//! [`SplitMix64`] is the one small generator for fixed-seed synthetic data in tests, examples
+//! and benchmarks; its output function [`splitmix64`] is also the hash [`stream`] derives
+//! stream states with.
 
 use crate::lattice::{Direction, MAX_DIM};
 use rand::seq::SliceRandom;
@@ -22,13 +26,57 @@ pub use rand::{Rng, RngExt, SeedableRng};
 /// passes BigCrush, and its state serialises with serde for checkpoints.
 pub type SimRng = rand_pcg::Pcg64Mcg;
 
-/// SplitMix64 finaliser (Steele, Lea & Flood 2014): a bijective avalanche mix of 64 bits.
+/// The SplitMix64 increment, `2^64 / phi` rounded to odd (Steele, Lea & Flood 2014).
+const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// The SplitMix64 output function of state `z` (Steele, Lea & Flood 2014): adds the golden
+/// gamma, then a bijective avalanche mix of the 64 bits. [`stream`] hashes seeds with it, and
+/// [`SplitMix64::next_u64`] returns `splitmix64(state)` before advancing the state.
 #[inline]
-fn splitmix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+pub const fn splitmix64(mut z: u64) -> u64 {
+    z = z.wrapping_add(GOLDEN_GAMMA);
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^ (z >> 31)
+}
+
+/// The SplitMix64 generator (Steele, Lea & Flood 2014): a 64-bit state advanced by a constant
+/// and hashed by [`splitmix64`]. Small, fast and dependency-free, for synthetic test data and
+/// benchmark inputs with fixed seeds; the models draw from [`SimRng`] streams instead.
+///
+/// The sequence is part of the fixed-seed test data of the workspace: `next_u64` must keep
+/// returning `splitmix64(state)` and advancing `state` by the golden gamma.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SplitMix64 {
+    state: u64,
+}
+
+impl SplitMix64 {
+    /// A generator whose first output is `splitmix64(seed)`.
+    pub const fn new(seed: u64) -> Self {
+        SplitMix64 { state: seed }
+    }
+
+    /// Next 64 random bits.
+    #[inline]
+    pub fn next_u64(&mut self) -> u64 {
+        let out = splitmix64(self.state);
+        self.state = self.state.wrapping_add(GOLDEN_GAMMA);
+        out
+    }
+
+    /// Uniform in `[0, 1)`: the top 53 bits of [`next_u64`](Self::next_u64).
+    #[inline]
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// `next_u64() % n`: uniform in `0..n` up to a modulo bias below `n / 2^64` (negligible
+    /// for test data). `n` must be positive.
+    #[inline]
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next_u64() % n as u64) as usize
+    }
 }
 
 /// The random stream number `stream_id` of the run with seed `seed`.
@@ -38,6 +86,7 @@ fn splitmix64(mut z: u64) -> u64 {
 /// 2^63 draws each before a chance of overlapping. The derivation is part of the reproducibility
 /// contract: it is pinned by a test and changes only with a major version.
 pub fn stream(seed: u64, stream_id: u64) -> SimRng {
+    // Changing any constant or step here changes every model's state hash.
     let a = splitmix64(seed);
     let b = splitmix64(a ^ splitmix64(stream_id ^ 0xD1B5_4A32_D192_ED03));
     let hi = splitmix64(b);
@@ -66,6 +115,9 @@ pub fn uniform01<R: Rng + ?Sized>(rng: &mut R) -> f64 {
 pub fn unit_vector<const D: usize, R: Rng + ?Sized>(rng: &mut R) -> [f64; D] {
     use std::f64::consts::TAU;
     let mut v = [0.0; D];
+    // `D` is a constant, so each instantiation keeps one arm. The `_` arm is the general method
+    // (every D >= 4), not a fallback for an unsupported dimension; the low dimensions use
+    // cheaper exact formulas. Their draw sequences are part of every DLA run's state hash.
     match D {
         0 => {}
         1 => v[0] = if rng.random::<bool>() { 1.0 } else { -1.0 },
@@ -123,8 +175,8 @@ pub enum DirectionError {
 }
 
 /// Draws one of the `2d` unit lattice directions (numbered as in [`Direction`]), uniformly or
-/// with given weights. Used for DLCA cluster moves, with gravity biasing `-e_d` (MODELS.md
-/// section 1, step 2).
+/// with given weights. Used for DLCA cluster moves, with gravity biasing `-e_d` (`docs/dlca.md`,
+/// "The model", step 2).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DirectionSampler {
     count: usize,
@@ -172,7 +224,7 @@ impl DirectionSampler {
         })
     }
 
-    /// MODELS.md section 1 gravity: `-e_d` (down the last axis) has weight `1 + g`, `+e_d` has
+    /// DLCA gravity (`docs/dlca.md`): `-e_d` (down the last axis) has weight `1 + g`, `+e_d` has
     /// `1 - g`, every other direction 1. `g = 0` is exactly [`DirectionSampler::uniform`] (same
     /// draws from the stream).
     pub fn gravity(dim: usize, g: f64) -> Result<Self, DirectionError> {
@@ -261,6 +313,30 @@ mod tests {
         );
     }
     const PINNED_FIRST_DRAW: u64 = 7_342_025_481_583_771_932;
+
+    /// `SplitMix64` from seed 0 gives the reference outputs of Vigna's `splitmix64.c`, its
+    /// `uniform` and `below` are the top 53 bits and the remainder of the next output, and
+    /// `splitmix64` is the output function of the state before each step.
+    #[test]
+    fn splitmix64_matches_the_reference_sequence() {
+        let mut r = SplitMix64::new(0);
+        assert_eq!(r.next_u64(), 0xE220_A839_7B1D_CDAF);
+        assert_eq!(r.next_u64(), 0x6E78_9E6A_A1B9_65F4);
+        assert_eq!(r.next_u64(), 0x06C4_5D18_8009_454F);
+        let mut a = SplitMix64::new(0x5EED);
+        let mut b = a.clone();
+        for step in 0..100u64 {
+            let z = b.next_u64();
+            assert_eq!(
+                z,
+                splitmix64(0x5EED_u64.wrapping_add(step.wrapping_mul(GOLDEN_GAMMA)))
+            );
+            match step % 2 {
+                0 => assert_eq!(a.uniform(), (z >> 11) as f64 / (1u64 << 53) as f64),
+                _ => assert_eq!(a.below(7), (z % 7) as usize),
+            }
+        }
+    }
 
     #[test]
     fn state_survives_serde() {

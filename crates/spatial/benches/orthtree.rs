@@ -20,7 +20,7 @@ use spatial::testdata::{SplitMix as Rng, branching_cluster, uniform_disc};
 
 /// Walker-like query points around a cluster.
 fn walker_queries(pts: &[[f64; 2]], count: usize, seed: u64) -> Vec<[f64; 2]> {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let r_ext = pts.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max);
     let r_birth = r_ext + 5.0;
     (0..count)

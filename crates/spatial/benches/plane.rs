@@ -12,6 +12,7 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use spatial::plane::{BoxSize, PlaneGrid, Pos};
+use spatial::testdata::SplitMix;
 
 /// Animat species.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,29 +28,12 @@ const CELLS_PER_ANIMAT: u64 = 100;
 /// Queries per benchmark iteration.
 const BATCH: usize = 1000;
 
-/// splitmix64: deterministic data without a dependency.
-struct Mix(u64);
-
-impl Mix {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
-
 /// `n` animats, one per cell at most, uniformly over a square of `100 n` cells centred on the
 /// origin (so half the coordinates are negative); one in five is a fox.
 fn world(n: usize, seed: u64) -> Vec<(u64, Pos, Species)> {
-    let side = ((n as u64 * CELLS_PER_ANIMAT) as f64).sqrt().ceil() as u64;
+    let side = ((n as u64 * CELLS_PER_ANIMAT) as f64).sqrt().ceil() as usize;
     let half = (side / 2) as i64;
-    let mut rng = Mix(seed);
+    let mut rng = SplitMix::new(seed);
     let mut taken = std::collections::HashSet::with_capacity(n);
     let mut out = Vec::with_capacity(n);
     while out.len() < n {
@@ -76,10 +60,10 @@ fn build(size: BoxSize, items: &[(u64, Pos, Species)]) -> PlaneGrid<Species> {
 
 /// The querying animats of one batch: (id, position, kind to look for).
 fn batch(items: &[(u64, Pos, Species)], seed: u64) -> Vec<(u64, Pos, Species)> {
-    let mut rng = Mix(seed);
+    let mut rng = SplitMix::new(seed);
     (0..BATCH)
         .map(|i| {
-            let (id, p, _) = items[rng.below(items.len() as u64) as usize];
+            let (id, p, _) = items[rng.below(items.len())];
             let want = if i % 2 == 0 {
                 Species::Rabbit
             } else {
@@ -170,11 +154,11 @@ fn unit_step_moves(c: &mut Criterion) {
     let items = world(n, 44);
     for (name, size) in sizes_for(n) {
         let mut g = build(size, &items);
-        let mut rng = Mix(9);
+        let mut rng = SplitMix::new(9);
         group.bench_with_input(BenchmarkId::new(name, n), &n, |b, _| {
             b.iter(|| {
                 for _ in 0..BATCH {
-                    let id = rng.below(n as u64);
+                    let id = rng.below(n) as u64;
                     let (p, _) = g.get(id).expect("present");
                     let to = [
                         p[0] + rng.below(3) as i64 - 1,

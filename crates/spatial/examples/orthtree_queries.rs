@@ -47,7 +47,7 @@ fn main() {
         }
         let kd: ImmutableKdTree<f64, 2> = ImmutableKdTree::new_from_slice(&pts).unwrap();
         let r_b = pts.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) + 5.0;
-        let mut rng = Rng(3);
+        let mut rng = Rng::new(3);
         let mut make_query = |kind: usize| -> [f64; 2] {
             let a = rng.uniform() * std::f64::consts::TAU;
             let (c, r) = match kind {

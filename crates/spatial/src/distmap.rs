@@ -5,7 +5,7 @@
 //!
 //! This is the device of Ball & Brady (*J. Phys. A* 18, L809, 1985) and of the fast lattice DLA
 //! codes that followed (a "distance map" kept up to date as particles stick), applied here to
-//! off-lattice DLA (MODELS.md section 2) in front of the orthtree of [`crate::orthtree`]: a
+//! off-lattice DLA (seed 002, section 3.3) in front of the orthtree of [`crate::orthtree`]: a
 //! walker a few diameters or more from the cluster jumps by the map's bound; only near the
 //! cluster (or where the map knows nothing) does it pay for a tree query.
 //!
@@ -538,13 +538,8 @@ mod tests {
     /// the bytes of the sequential map; points beyond the map are clipped, never wrong.
     #[test]
     fn shared_inserts_from_two_threads_equal_sequential_inserts() {
-        let mut rng = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::testdata::SplitMix::new(0x9e37_79b9_7f4a_7c15);
+        let mut next = || rng.uniform();
         let pts: Vec<[f64; 2]> = (0..4000)
             .map(|_| [next() * 400.0 - 200.0, next() * 400.0 - 200.0])
             .collect();

@@ -1,8 +1,8 @@
 //! Atomic file writes: a temporary file in the same directory, `fsync`, then `rename`.
 //!
 //! Readers see either the old file or the complete new one, never a partial write, and a run
-//! that fails part-way leaves no half-written outputs (DESIGN.md, "Errors, not panics": no partial
-//! output files). If an [`AtomicFile`] is dropped without [`AtomicFile::commit`], its temporary
+//! that fails part-way leaves no half-written outputs (`docs/architecture.md`: every output file
+//! is written atomically). If an [`AtomicFile`] is dropped without [`AtomicFile::commit`], its temporary
 //! file is deleted.
 
 use std::fs::File;

@@ -1,4 +1,4 @@
-//! The checkpoint envelope (DESIGN.md, "Long runs": `--checkpoint-every`, `--resume`).
+//! The checkpoint envelope behind the models' `--checkpoint-every` and `--resume` flags.
 //!
 //! Layout, all integers little-endian:
 //!

@@ -1,5 +1,6 @@
-//! The run manifest `run.json` every model writes into its `--out` directory (DESIGN.md,
-//! "Outputs"), and the process measurements that go into it.
+//! The run manifest `run.json` every model writes into its `--out` directory
+//! (`docs/architecture.md`, "How data flows through a run"), and the process measurements that
+//! go into it.
 //!
 //! Its top-level keys are exactly: `model`, `version`, `seed`, `threads`, `params` (the full
 //! validated parameters), `wall_seconds`, `cpu_seconds`, `peak_rss_bytes` (read from the

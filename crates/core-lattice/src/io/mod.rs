@@ -1,4 +1,5 @@
-//! Output and checkpoint I/O shared by every model (DESIGN.md, "Outputs" and "Long runs").
+//! Output and checkpoint I/O shared by every model (`docs/architecture.md`, "How data flows
+//! through a run").
 //!
 //! - [`atomic`]: every file is written to a temporary file in its target directory, flushed to
 //!   disk and renamed into place, so a crashed or failed run never leaves a partial file.

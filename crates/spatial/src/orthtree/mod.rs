@@ -3,8 +3,8 @@
 //! Rodriguez-Romo, *Variable precision distance search for random fractal cluster simulations*
 //! (seed 002, section 3.1 and Listing 1; storage after section 3.3).
 //!
-//! Built for off-lattice DLA/PDLA (MODELS.md section 2): particle centres in units of particle
-//! diameters, inserted one at a time, queried millions of times by random walkers.
+//! Built for off-lattice DLA/PDLA (seed 002, sections 3.3 and 3.4): particle centres in units
+//! of particle diameters, inserted one at a time, queried millions of times by random walkers.
 //!
 //! # Structure
 //!
@@ -38,25 +38,24 @@
 //!   counted by [`Orthtree::memory_bytes`] stays near 12 %; this also bounds the latency of an
 //!   insert under a writer lock.
 //!
-//! Memory (2D, 8 bytes per point record): with the default leaf side, measured 12.0 to 12.4
-//! bytes per point on a DLA-like cluster and 10.6 to 11.1 on uniform points at unit density, at
-//! 1e6 and 1e7 points (`examples/orthtree_memory.rs`, `docs/spatial.md`). Positions are restored
-//! to within `s / 2^33` per coordinate (4.7e-10 for the default), far inside the 1e-6 that DLA
-//! contact needs, plus the rounding of `f64` at the coordinate's magnitude.
+//! Memory (2D): 8 bytes per point record plus the node and leaf records and the capped slack,
+//! about 12 bytes per point with the default leaf side (`examples/orthtree_memory.rs` measures
+//! it; `docs/spatial.md` has the table). Positions are restored to within `s / 2^33` per
+//! coordinate (4.7e-10 for the default), far inside the 1e-6 that DLA contact needs, plus the
+//! rounding of `f64` at the coordinate's magnitude.
 //!
 //! # Choosing the leaf side
 //!
 //! The leaf side `s` trades memory against query work: a larger `s` means fewer nodes and leaf
 //! records (less memory, a shallower tree) but more points scanned per visited leaf (and a
 //! larger exact region of `vpdist`, `(kappa - 1/2)` leaf diagonals); a smaller `s` means more
-//! nodes per point. For unit-diameter
-//! particles `s = 4` holds 4 to 5 DLA particles per leaf and keeps the structure near 12 bytes
-//! per point in 2D; `s = 8` (12 particles per leaf) takes about 10 bytes per point and, being
-//! shallower, touched less memory per query in our measurements at 1e6 points, so it is worth
-//! benchmarking for large clusters. `s = 2` costs more memory (18 bytes per point) than it saves
-//! work. Accepted: powers of two from [`MIN_LEAF_SIDE`] to [`MAX_LEAF_SIDE`] (powers of two make
-//! every cell corner, centre and decoded position an exact binary fraction, so the geometry used
-//! by the queries is exact).
+//! nodes per point. For unit-diameter particles `s = 4` holds 4 to 5 DLA particles per leaf and
+//! keeps the structure near 12 bytes per point in 2D; `s = 8` (about 12 particles per leaf)
+//! needs less memory and is one level shallower, so it is worth benchmarking for large clusters;
+//! `s = 2` costs more memory than it saves work (`docs/spatial.md` has the measured trade-off).
+//! Accepted: powers of two from [`MIN_LEAF_SIDE`] to [`MAX_LEAF_SIDE`] (powers of two make every
+//! cell corner, centre and decoded position an exact binary fraction, so the geometry used by
+//! the queries is exact).
 //!
 //! # Queries and complexity
 //!
@@ -133,6 +132,8 @@
 //! # Ok::<(), spatial::orthtree::OrthtreeError>(())
 //! ```
 
+mod insert;
+mod iter;
 mod pool;
 mod query;
 #[cfg(test)]
@@ -140,11 +141,14 @@ mod tests;
 
 use std::fmt;
 
+pub use iter::Points;
 use pool::LeafPool;
 pub use query::{Neighbour, VpEstimate, dist_sq};
 
-/// Default leaf side (seed 002, section 3.3: the leaf cell holding a chunk of particles), in
-/// particle diameters: a few to a dozen DLA particles per leaf. See the module docs for the
+/// The orthtree's default leaf side `s`, in particle diameters: the side of the leaf cells
+/// (the last level of the tree, where seed 002, section 3.3, keeps its chunks of particles)
+/// that [`Orthtree::new`] uses. With `s = 4`, a leaf holds 4 to 5 DLA particles. A model may
+/// choose another side through [`Orthtree::with_leaf_side`]; see the module docs for the
 /// trade-off.
 pub const DEFAULT_LEAF_SIDE: f64 = 4.0;
 
@@ -164,6 +168,14 @@ pub const PAPER_KAPPA: f64 = 2.0;
 
 /// Empty child slot.
 const EMPTY: u32 = u32::MAX;
+
+/// Whether `s` is an accepted leaf side: a power of two in [`MIN_LEAF_SIDE`,
+/// `MAX_LEAF_SIDE`] (a normal `f64` with a zero mantissa). `const`, so the default is checked
+/// at compile time.
+const fn is_valid_leaf_side(s: f64) -> bool {
+    let power_of_two = s.is_normal() && s > 0.0 && s.to_bits() & ((1u64 << 52) - 1) == 0;
+    power_of_two && MIN_LEAF_SIDE <= s && s <= MAX_LEAF_SIDE
+}
 
 /// Largest number of internal nodes or leaves (indices are `u32`, `u32::MAX` is reserved).
 const MAX_INDEX: u64 = u32::MAX as u64 - 1;
@@ -294,24 +306,24 @@ impl<const D: usize> Orthtree<D> {
 
     /// An empty tree with the default leaf side [`DEFAULT_LEAF_SIDE`] (seed 002, section 3.3).
     pub fn new() -> Self {
-        match Self::with_leaf_side(DEFAULT_LEAF_SIDE) {
-            Ok(t) => t,
-            Err(_) => unreachable!("the default leaf side is valid"),
-        }
+        const { assert!(is_valid_leaf_side(DEFAULT_LEAF_SIDE)) };
+        Self::empty(DEFAULT_LEAF_SIDE)
     }
 
     /// An empty tree whose leaf cells have side `leaf_side` (a power of two in
     /// [`MIN_LEAF_SIDE`, `MAX_LEAF_SIDE`], in particle diameters). See the module docs for the
     /// trade-off (seed 002, section 3.3).
     pub fn with_leaf_side(leaf_side: f64) -> Result<Self, OrthtreeError> {
-        const { assert!(D >= 1 && D <= 8, "Orthtree supports 1 to 8 dimensions") };
-        let power_of_two = leaf_side.is_normal()
-            && leaf_side > 0.0
-            && leaf_side.to_bits() & ((1u64 << 52) - 1) == 0;
-        if !(power_of_two && (MIN_LEAF_SIDE..=MAX_LEAF_SIDE).contains(&leaf_side)) {
+        if !is_valid_leaf_side(leaf_side) {
             return Err(OrthtreeError::InvalidLeafSide(leaf_side));
         }
-        Ok(Self {
+        Ok(Self::empty(leaf_side))
+    }
+
+    /// An empty tree with a leaf side already checked by [`is_valid_leaf_side`].
+    fn empty(leaf_side: f64) -> Self {
+        const { assert!(D >= 1 && D <= 8, "Orthtree supports 1 to 8 dimensions") };
+        Self {
             leaf_side,
             step: leaf_side / CODE_SCALE,
             sqrt_d_up: (D as f64).sqrt() * (1.0 + f64::EPSILON * 4.0),
@@ -323,7 +335,7 @@ impl<const D: usize> Orthtree<D> {
             leaves: Vec::new(),
             pool: LeafPool::new(),
             len: 0,
-        })
+        }
     }
 
     /// Checks a precision parameter for [`vpdist`](Self::vpdist) (seed 002, Listing 1, line 07):
@@ -398,46 +410,6 @@ impl<const D: usize> Orthtree<D> {
         }
     }
 
-    /// Leaf cell of `p` in leaf sides and the fixed-point offsets inside it, after checking the
-    /// point. Offsets are rounded to the nearest multiple of `s / 2^32`; one that rounds up to
-    /// the cell's upper face is stored as offset 0 of the next cell (the same position), so the
-    /// error stays within half a step on every axis.
-    fn locate(&self, p: &[f64; D]) -> Result<([i64; D], [u32; D]), OrthtreeError> {
-        let mut k = [0i64; D];
-        let mut code = [0u32; D];
-        let inv_step = CODE_SCALE / self.leaf_side;
-        for (axis, &x) in p.iter().enumerate() {
-            if !x.is_finite() {
-                return Err(OrthtreeError::NonFinite { axis, value: x });
-            }
-            let u = x / self.leaf_side;
-            if u.abs() >= COORD_LIMIT_LEAVES {
-                return Err(OrthtreeError::OutOfRange {
-                    axis,
-                    value: x,
-                    limit: COORD_LIMIT_LEAVES * self.leaf_side,
-                });
-            }
-            let cell = u.floor();
-            let t = ((x - cell * self.leaf_side) * inv_step).round();
-            if t >= CODE_SCALE {
-                k[axis] = cell as i64 + 1;
-                code[axis] = 0;
-            } else {
-                k[axis] = cell as i64;
-                // t is in [0, 2^32).
-                code[axis] = t as u32;
-            }
-        }
-        Ok((k, code))
-    }
-
-    /// Whether the leaf cell `k` lies inside the root.
-    fn root_contains(&self, k: &[i64; D]) -> bool {
-        let side = 1i64 << self.root_level;
-        (0..D).all(|i| k[i] >= self.root_origin[i] && k[i] < self.root_origin[i] + side)
-    }
-
     /// Child slot index of leaf cell `k` inside the node at `level` on its path (bits of
     /// `k - root_origin` at `level - 1`).
     #[inline]
@@ -449,174 +421,6 @@ impl<const D: usize> Orthtree<D> {
         }
         ci
     }
-
-    /// Length of the leaf for cell `k`, 0 if it does not exist yet (read-only).
-    fn existing_leaf_len(&self, k: &[i64; D]) -> u32 {
-        if self.root == EMPTY || !self.root_contains(k) {
-            return 0;
-        }
-        let mut node = self.root;
-        let mut level = self.root_level;
-        loop {
-            let child = self.children[node as usize * Self::FANOUT + self.child_index(k, level)];
-            if child == EMPTY {
-                return 0;
-            }
-            if level == 1 {
-                return self.leaves[child as usize].len;
-            }
-            node = child;
-            level -= 1;
-        }
-    }
-
-    /// Appends an internal node with no children.
-    fn new_node(&mut self) -> u32 {
-        let n = self.node_count() as u32;
-        pool::reserve_slowly(&mut self.children, Self::FANOUT);
-        self.children
-            .resize(self.children.len() + Self::FANOUT, EMPTY);
-        n
-    }
-
-    /// Doubles the root towards leaf cell `k` (seed 002 builds its tree over a fixed domain;
-    /// here the domain grows, the old root becoming a child of the new one).
-    fn grow_root(&mut self, k: &[i64; D]) {
-        let side = 1i64 << self.root_level;
-        let mut origin = self.root_origin;
-        let mut slot = 0;
-        for i in 0..D {
-            let lo = self.root_origin[i];
-            let down = if k[i] < lo {
-                true
-            } else if k[i] >= lo + side {
-                false
-            } else {
-                lo + side / 2 > self.anchor[i]
-            };
-            if down {
-                origin[i] = lo - side;
-                slot |= 1 << i;
-            }
-        }
-        let n = self.new_node();
-        self.children[n as usize * Self::FANOUT + slot] = self.root;
-        self.root = n;
-        self.root_level += 1;
-        self.root_origin = origin;
-    }
-
-    /// Inserts a particle centre (seed 002, section 3.3: the particle is stored in the leaf
-    /// containing it, in relative coordinates) and returns its stored position, which is what
-    /// every query sees: within `leaf_side / 2^33` of `p` per coordinate (plus `f64` rounding
-    /// at the coordinate's magnitude).
-    ///
-    /// Duplicate points are allowed. On error the tree is unchanged.
-    pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], OrthtreeError> {
-        let (k, code) = self.locate(&p)?;
-        // Capacity checks before any change, so that an error leaves the tree as it was.
-        if self.node_count() as u64 + 128 > MAX_INDEX {
-            return Err(OrthtreeError::CapacityExceeded("nodes"));
-        }
-        if self.leaves.len() as u64 + 1 > MAX_INDEX {
-            return Err(OrthtreeError::CapacityExceeded("leaves"));
-        }
-        let leaf_len = self.existing_leaf_len(&k);
-        if leaf_len == u32::MAX
-            || self.pool.slots.len() as u64 + LeafPool::<D>::push_needs(leaf_len)
-                > u64::from(u32::MAX)
-        {
-            return Err(OrthtreeError::CapacityExceeded("point slots"));
-        }
-
-        if self.root == EMPTY {
-            // Root of 2 x 2 leaf cells centred on the leaf-cell corner nearest to p.
-            for i in 0..D {
-                let frac = p[i] / self.leaf_side - k[i] as f64;
-                self.root_origin[i] = if frac < 0.5 { k[i] - 1 } else { k[i] };
-                self.anchor[i] = self.root_origin[i] + 1;
-            }
-            self.root_level = 1;
-            self.root = self.new_node();
-        }
-        while !self.root_contains(&k) {
-            self.grow_root(&k);
-        }
-
-        let mut node = self.root;
-        let mut level = self.root_level;
-        let leaf = loop {
-            let slot = node as usize * Self::FANOUT + self.child_index(&k, level);
-            let child = self.children[slot];
-            if level == 1 {
-                break if child == EMPTY {
-                    let l = self.leaves.len() as u32;
-                    pool::reserve_slowly(&mut self.leaves, 1);
-                    self.leaves.push(Leaf { start: 0, len: 0 });
-                    self.children[slot] = l;
-                    l
-                } else {
-                    child
-                };
-            }
-            node = if child == EMPTY {
-                let n = self.new_node();
-                self.children[slot] = n;
-                n
-            } else {
-                child
-            };
-            level -= 1;
-        };
-
-        let mut stored = [0.0; D];
-        for i in 0..D {
-            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
-        }
-        let mut rec = self.leaves[leaf as usize];
-        self.pool.push(&mut rec, code);
-        self.leaves[leaf as usize] = rec;
-        self.len += 1;
-        if self.pool.wants_compaction() {
-            self.pool.compact(&mut self.leaves);
-        }
-        Ok(stored)
-    }
-
-    /// The position [`insert`](Self::insert) would store for `p` (its fixed-point rounding),
-    /// without inserting it: PDLA computes it outside the tree's writer (seed 002, section
-    /// 3.4). Fails as `insert` would on a non-finite or out-of-range coordinate.
-    pub fn stored_position(&self, p: &[f64; D]) -> Result<[f64; D], OrthtreeError> {
-        let (k, code) = self.locate(p)?;
-        let mut stored = [0.0; D];
-        for i in 0..D {
-            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
-        }
-        Ok(stored)
-    }
-
-    /// Iterates over the stored positions of all points, leaf by leaf (seed 002, section 3.3:
-    /// base coordinates are rebuilt while traversing the tree).
-    pub fn iter(&self) -> Points<'_, D> {
-        let mut stack = Vec::new();
-        if self.root != EMPTY {
-            stack.reserve(self.root_level as usize);
-            stack.push(Frame {
-                node: self.root,
-                level: self.root_level,
-                origin: self.root_origin,
-                next: 0,
-            });
-        }
-        Points {
-            tree: self,
-            stack,
-            leaf: &[],
-            leaf_origin: [0.0; D],
-            pos: 0,
-            remaining: self.len,
-        }
-    }
 }
 
 /// Stored position of a fixed-point offset: the single formula used everywhere, so that every
@@ -624,89 +428,4 @@ impl<const D: usize> Orthtree<D> {
 #[inline(always)]
 fn decode(origin: f64, code: u32, step: f64) -> f64 {
     origin + f64::from(code) * step
-}
-
-/// A node on the iteration stack.
-#[derive(Debug, Clone, Copy)]
-struct Frame<const D: usize> {
-    node: u32,
-    level: u32,
-    origin: [i64; D],
-    next: usize,
-}
-
-/// Iterator over the stored positions of an [`Orthtree`], from [`Orthtree::iter`].
-#[derive(Debug, Clone)]
-pub struct Points<'a, const D: usize> {
-    tree: &'a Orthtree<D>,
-    stack: Vec<Frame<D>>,
-    leaf: &'a [[u32; D]],
-    leaf_origin: [f64; D],
-    pos: usize,
-    remaining: usize,
-}
-
-impl<const D: usize> Iterator for Points<'_, D> {
-    type Item = [f64; D];
-
-    fn next(&mut self) -> Option<[f64; D]> {
-        let tree = self.tree;
-        loop {
-            if let Some(code) = self.leaf.get(self.pos) {
-                self.pos += 1;
-                self.remaining -= 1;
-                let mut x = [0.0; D];
-                for i in 0..D {
-                    x[i] = decode(self.leaf_origin[i], code[i], tree.step);
-                }
-                return Some(x);
-            }
-            let top = self.stack.last_mut()?;
-            if top.next == Orthtree::<D>::FANOUT {
-                self.stack.pop();
-                continue;
-            }
-            let ci = top.next;
-            top.next += 1;
-            let child = tree.children[top.node as usize * Orthtree::<D>::FANOUT + ci];
-            if child == EMPTY {
-                continue;
-            }
-            let half = 1i64 << (top.level - 1);
-            let mut origin = top.origin;
-            for (i, o) in origin.iter_mut().enumerate() {
-                if ci >> i & 1 == 1 {
-                    *o += half;
-                }
-            }
-            if top.level == 1 {
-                self.leaf = tree.pool.points(tree.leaves[child as usize]);
-                self.leaf_origin = origin.map(|o| o as f64 * tree.leaf_side);
-                self.pos = 0;
-            } else {
-                let level = top.level - 1;
-                self.stack.push(Frame {
-                    node: child,
-                    level,
-                    origin,
-                    next: 0,
-                });
-            }
-        }
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        (self.remaining, Some(self.remaining))
-    }
-}
-
-impl<const D: usize> ExactSizeIterator for Points<'_, D> {}
-
-impl<'a, const D: usize> IntoIterator for &'a Orthtree<D> {
-    type Item = [f64; D];
-    type IntoIter = Points<'a, D>;
-
-    fn into_iter(self) -> Points<'a, D> {
-        self.iter()
-    }
 }
