@@ -1,8 +1,8 @@
 //! The scaling harness at a tiny size: every report, CSV and plot is produced and well formed,
 //! the papers' values appear beside ours, and the fit code recovers known slopes.
 
+use core_lattice::Fit;
 use core_lattice::rng::{stream, uniform01};
-use core_lattice::{LinearFit, LogLogFit};
 use std::path::Path;
 use xtask::scaling::{Experiment, Options, Scale, run};
 
@@ -160,7 +160,7 @@ fn fits_recover_known_slopes() {
     // Seed 000, Table I style: cost = 2.5e-7 N^1.35.
     let n: Vec<f64> = (0..12).map(|i| 1000.0 * 2f64.powi(i)).collect();
     let exact: Vec<f64> = n.iter().map(|x| 2.5e-7 * x.powf(1.35)).collect();
-    let f = LogLogFit::fit(&n, &exact).unwrap();
+    let f = Fit::log_log(&n, &exact).unwrap();
     assert!((f.slope - 1.35).abs() < 1e-12);
     assert!((f.prefactor() / 2.5e-7 - 1.0).abs() < 1e-9);
 
@@ -179,7 +179,7 @@ fn fits_recover_known_slopes() {
                 v * (0.05 * g).exp()
             })
             .collect();
-        let f = LogLogFit::fit(&n, &y).unwrap();
+        let f = Fit::log_log(&n, &y).unwrap();
         slopes.push(f.slope);
         errs.push(f.slope_stderr);
     }
@@ -198,6 +198,6 @@ fn fits_recover_known_slopes() {
 
     // Seed 002, Fig. 3 style: T = 3e-5 N - 6.9.
     let t: Vec<f64> = n.iter().map(|x| 3e-5 * x - 6.9).collect();
-    let f = LinearFit::fit(&n, &t).unwrap();
+    let f = Fit::linear(&n, &t).unwrap();
     assert!((f.slope - 3e-5).abs() < 1e-15 && (f.intercept + 6.9).abs() < 1e-9);
 }

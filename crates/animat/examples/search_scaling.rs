@@ -19,7 +19,7 @@
 
 use animat::GridBox;
 use animat::bench::{SearchCost, search_scaling_point_with};
-use core_lattice::stats::LogLogFit;
+use core_lattice::stats::Fit;
 
 const DENSITY: f64 = 0.2;
 const SEED: u64 = 1;
@@ -46,7 +46,7 @@ struct Series {
 }
 
 impl Series {
-    fn fit(&self) -> Option<LogLogFit> {
+    fn fit(&self) -> Option<Fit> {
         let x: Vec<f64> = self
             .points
             .iter()
@@ -57,7 +57,7 @@ impl Series {
             .iter()
             .map(|c| c.search_seconds_per_step)
             .collect();
-        LogLogFit::fit(&x, &y).ok()
+        Fit::log_log(&x, &y).ok()
     }
 }
 

@@ -27,6 +27,4 @@ pub mod stats;
 
 pub use lattice::{Blocked, Boundary, Coords, Direction, Lattice, LatticeError, MAX_DIM, Offset};
 pub use rng::{SimRng, stream, stream_id};
-pub use stats::{
-    Gyration, IntHistogram, LatticeGyration, LinearFit, LogHistogram, LogLogFit, Welford,
-};
+pub use stats::{Fit, FitScale, Gyration, IntHistogram, LatticeGyration, LogHistogram, Welford};

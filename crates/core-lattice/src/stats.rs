@@ -4,9 +4,9 @@
 //!   per-thread accumulators).
 //! - [`IntHistogram`] and [`LogHistogram`]: the candidate-count histograms of seed 000 (Figs. 4,
 //!   7, 8) and cluster-size distributions.
-//! - [`LinearFit`] and [`LogLogFit`]: ordinary least squares with standard errors; the log-log
-//!   gradients of seed 000 (Table I) and the fractal dimensions of seed 002 (Table 2, from
-//!   `log N = D log R_g + c`), the linear run-time fits of seed 002 (Fig. 3).
+//! - [`Fit`]: ordinary least squares with standard errors, on linear or log-log axes
+//!   ([`Fit::linear`], [`Fit::log_log`]): log-log gradients, fractal dimensions from
+//!   `ln N = D ln R_g + c`, linear run-time fits.
 //! - [`Gyration`]: the radius of gyration of a point set in `D` dimensions (seed 002 section 3.4),
 //!   accumulated with Welford updates so it stays accurate for clusters far from the origin.
 //! - [`LatticeGyration`]: the same for integer lattice coordinates (DLCA clusters, seed 000),
@@ -274,28 +274,46 @@ fn check_points(x: &[f64], y: &[f64]) -> Result<(), StatsError> {
     Ok(())
 }
 
-/// Ordinary least-squares line `y = slope * x + intercept`, with standard errors.
+/// The axes a [`Fit`] was made on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitScale {
+    /// `y = slope * x + intercept`.
+    Linear,
+    /// `ln y = slope * ln x + intercept`, the power law `y = A x^slope` with `A = exp(intercept)`.
+    LogLog,
+}
+
+/// An ordinary least-squares line with standard errors, on linear or log-log axes: the log-log
+/// gradients of Hawick, James & Scogings (2006, Table I), the fractal dimensions of DLA clusters
+/// (`ln N = D ln R_g + c`) and the linear run-time fits of Sosa-Herrera & Rodriguez-Romo (Fig. 3).
+///
+/// On log-log axes `intercept` is `ln A` (natural logarithm) and its standard error that of
+/// `ln A`; [`Fit::prefactor`] gives `A`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LinearFit {
-    /// Fitted slope.
+pub struct Fit {
+    /// Fitted slope (on log-log axes the exponent).
     pub slope: f64,
-    /// Fitted intercept.
+    /// Fitted intercept (on log-log axes `ln A`).
     pub intercept: f64,
     /// Standard error of the slope, `sqrt(s^2 / Sxx)` with `s^2 = SSR / (n - 2)`.
     pub slope_stderr: f64,
     /// Standard error of the intercept, `sqrt(s^2 (1/n + mean_x^2 / Sxx))`.
     pub intercept_stderr: f64,
-    /// Coefficient of determination, `1 - SSR / SST` (1 when every y is equal and fitted).
+    /// Coefficient of determination on the fitted axes, `1 - SSR / SST` (1 when every y is
+    /// equal and fitted).
     pub r2: f64,
     /// Number of points.
     pub n: usize,
+    /// The axes of the fit.
+    pub scale: FitScale,
 }
 
-impl LinearFit {
+impl Fit {
     /// Fit `y = slope * x + intercept` by least squares. Needs at least 3 finite points with
     /// at least two distinct x. Sums are taken about the means (two passes), so large offsets
     /// in x or y do not cancel.
-    pub fn fit(x: &[f64], y: &[f64]) -> Result<Self, StatsError> {
+    pub fn linear(x: &[f64], y: &[f64]) -> Result<Self, StatsError> {
         check_points(x, y)?;
         let n = x.len();
         let nf = n as f64;
@@ -322,7 +340,7 @@ impl LinearFit {
             })
             .sum();
         let s2 = ssr / (nf - 2.0);
-        Ok(LinearFit {
+        Ok(Fit {
             slope,
             intercept,
             slope_stderr: (s2 / sxx).sqrt(),
@@ -333,39 +351,14 @@ impl LinearFit {
                 (1.0 - ssr / syy).clamp(0.0, 1.0)
             },
             n,
+            scale: FitScale::Linear,
         })
     }
 
-    /// The fitted value at `x`.
-    pub fn predict(&self, x: f64) -> f64 {
-        self.slope * x + self.intercept
-    }
-}
-
-/// A power law `y = A x^slope` fitted by least squares on `(ln x, ln y)`: the log-log gradients
-/// of seed 000 (Table I) and the fractal dimensions of seed 002 (Table 2).
-///
-/// `intercept` is `ln A` (natural logarithm); [`LogLogFit::prefactor`] gives `A`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct LogLogFit {
-    /// Exponent (log-log gradient).
-    pub slope: f64,
-    /// `ln A`.
-    pub intercept: f64,
-    /// Standard error of the slope.
-    pub slope_stderr: f64,
-    /// Standard error of `ln A`.
-    pub intercept_stderr: f64,
-    /// Coefficient of determination of the fit on logarithms.
-    pub r2: f64,
-    /// Number of points.
-    pub n: usize,
-}
-
-impl LogLogFit {
-    /// Fit `ln y = slope ln x + intercept`. Refuses fewer than 3 points and any `x <= 0` or
-    /// `y <= 0` (or NaN/infinite values) with a typed error naming the first bad point.
-    pub fn fit(x: &[f64], y: &[f64]) -> Result<Self, StatsError> {
+    /// Fit the power law `y = A x^slope` as `ln y = slope ln x + intercept`. Refuses fewer than
+    /// 3 points and any `x <= 0` or `y <= 0` (or NaN/infinite values) with a typed error naming
+    /// the first bad point.
+    pub fn log_log(x: &[f64], y: &[f64]) -> Result<Self, StatsError> {
         check_points(x, y)?;
         for (index, (&xi, &yi)) in x.iter().zip(y).enumerate() {
             if xi <= 0.0 || yi <= 0.0 {
@@ -378,25 +371,27 @@ impl LogLogFit {
         }
         let lx: Vec<f64> = x.iter().map(|v| v.ln()).collect();
         let ly: Vec<f64> = y.iter().map(|v| v.ln()).collect();
-        let f = LinearFit::fit(&lx, &ly)?;
-        Ok(LogLogFit {
-            slope: f.slope,
-            intercept: f.intercept,
-            slope_stderr: f.slope_stderr,
-            intercept_stderr: f.intercept_stderr,
-            r2: f.r2,
-            n: f.n,
+        Ok(Fit {
+            scale: FitScale::LogLog,
+            ..Fit::linear(&lx, &ly)?
         })
     }
 
-    /// The prefactor `A = exp(intercept)`.
+    /// The prefactor `A = exp(intercept)` of a log-log fit's `y = A x^slope` (of a linear fit,
+    /// its intercept).
     pub fn prefactor(&self) -> f64 {
-        self.intercept.exp()
+        match self.scale {
+            FitScale::Linear => self.intercept,
+            FitScale::LogLog => self.intercept.exp(),
+        }
     }
 
-    /// The fitted value `A x^slope`.
+    /// The fitted value at `x`: `slope * x + intercept`, or `A x^slope` on log-log axes.
     pub fn predict(&self, x: f64) -> f64 {
-        (self.intercept + self.slope * x.ln()).exp()
+        match self.scale {
+            FitScale::Linear => self.slope * x + self.intercept,
+            FitScale::LogLog => (self.intercept + self.slope * x.ln()).exp(),
+        }
     }
 }
 
@@ -719,7 +714,7 @@ mod tests {
     fn fit_recovers_exact_power_law() {
         let x: Vec<f64> = (1..=20).map(|i| i as f64 * 10.0).collect();
         let y: Vec<f64> = x.iter().map(|x| 3.5 * x.powf(1.71)).collect();
-        let f = LogLogFit::fit(&x, &y).unwrap();
+        let f = Fit::log_log(&x, &y).unwrap();
         assert!((f.slope - 1.71).abs() < 1e-12);
         assert!((f.prefactor() - 3.5).abs() < 1e-10);
         assert!(f.slope_stderr < 1e-12);
@@ -731,7 +726,7 @@ mod tests {
     fn fit_standard_errors_match_textbook() {
         // Worked example: x = 1..5, y = 2, 4, 5, 4, 5 -> slope 0.6, intercept 2.2,
         // SSR = 2.4, s^2 = 0.8, Sxx = 10: se(slope) = sqrt(0.08), se(intercept) = sqrt(0.8*(1/5+9/10)).
-        let f = LinearFit::fit(&[1., 2., 3., 4., 5.], &[2., 4., 5., 4., 5.]).unwrap();
+        let f = Fit::linear(&[1., 2., 3., 4., 5.], &[2., 4., 5., 4., 5.]).unwrap();
         assert!((f.slope - 0.6).abs() < 1e-14);
         assert!((f.intercept - 2.2).abs() < 1e-14);
         assert!((f.slope_stderr - 0.08f64.sqrt()).abs() < 1e-14);
@@ -740,29 +735,54 @@ mod tests {
     }
 
     #[test]
+    fn predict_and_prefactor_follow_the_axes() {
+        let x = [1.0, 2.0, 4.0, 8.0];
+        let lin = Fit::linear(&x, &[3.0, 5.0, 9.0, 17.0]).unwrap();
+        assert_eq!(lin.scale, FitScale::Linear);
+        assert!((lin.predict(16.0) - 33.0).abs() < 1e-12);
+        assert!((lin.prefactor() - 1.0).abs() < 1e-12);
+        let pow = Fit::log_log(&x, &[3.0, 12.0, 48.0, 192.0]).unwrap();
+        assert_eq!(pow.scale, FitScale::LogLog);
+        assert!((pow.predict(16.0) - 768.0).abs() < 1e-9);
+        assert!((pow.prefactor() - 3.0).abs() < 1e-12);
+        // The same points on log axes give the same line as the linear fit of the logarithms.
+        let logs = |v: &[f64]| v.iter().map(|a| a.ln()).collect::<Vec<_>>();
+        let by_hand = Fit::linear(&logs(&x), &logs(&[3.0, 12.0, 48.0, 192.0])).unwrap();
+        assert_eq!(
+            (pow.slope, pow.intercept, pow.slope_stderr, pow.r2),
+            (
+                by_hand.slope,
+                by_hand.intercept,
+                by_hand.slope_stderr,
+                by_hand.r2
+            )
+        );
+    }
+
+    #[test]
     fn fit_refuses_bad_input() {
         assert_eq!(
-            LogLogFit::fit(&[1., 2.], &[1., 2.]),
+            Fit::log_log(&[1., 2.], &[1., 2.]),
             Err(StatsError::TooFewPoints(2))
         );
         assert!(matches!(
-            LogLogFit::fit(&[1., 0., 3.], &[1., 2., 3.]),
+            Fit::log_log(&[1., 0., 3.], &[1., 2., 3.]),
             Err(StatsError::NonPositive { index: 1, .. })
         ));
         assert!(matches!(
-            LogLogFit::fit(&[1., 2., 3.], &[1., -2., 3.]),
+            Fit::log_log(&[1., 2., 3.], &[1., -2., 3.]),
             Err(StatsError::NonPositive { index: 1, .. })
         ));
         assert!(matches!(
-            LogLogFit::fit(&[1., 2., f64::NAN], &[1., 2., 3.]),
+            Fit::log_log(&[1., 2., f64::NAN], &[1., 2., 3.]),
             Err(StatsError::NonFinite { index: 2, .. })
         ));
         assert!(matches!(
-            LinearFit::fit(&[2., 2., 2.], &[1., 2., 3.]),
+            Fit::linear(&[2., 2., 2.], &[1., 2., 3.]),
             Err(StatsError::Degenerate(_))
         ));
         assert!(matches!(
-            LinearFit::fit(&[1., 2., 3.], &[1., 2.]),
+            Fit::linear(&[1., 2., 3.], &[1., 2.]),
             Err(StatsError::LengthMismatch { .. })
         ));
     }

@@ -2,9 +2,7 @@
 //! far-from-origin radius-of-gyration accuracy test.
 
 use core_lattice::rng::{stream, uniform01, unit_vector};
-use core_lattice::{
-    Gyration, IntHistogram, LatticeGyration, LinearFit, LogHistogram, LogLogFit, Welford,
-};
+use core_lattice::{Fit, Gyration, IntHistogram, LatticeGyration, LogHistogram, Welford};
 use proptest::prelude::*;
 
 fn two_pass(xs: &[f64]) -> (f64, f64) {
@@ -115,7 +113,7 @@ proptest! {
         let s2 = ssr / (n - 2.0);
         let se_slope = (n * s2 / det).sqrt();
         let se_intercept = (s2 * sxx / det).sqrt();
-        let f = LinearFit::fit(&x, &y).unwrap();
+        let f = Fit::linear(&x, &y).unwrap();
         prop_assert!(close(f.slope, slope, 1e-8, 1e-10));
         prop_assert!(close(f.intercept, intercept, 1e-8, 1e-8));
         prop_assert!(close(f.slope_stderr, se_slope, 1e-6, 1e-10));
@@ -131,7 +129,7 @@ proptest! {
     ) {
         let x: Vec<f64> = xs.iter().map(|&v| f64::from(v)).collect();
         let y: Vec<f64> = x.iter().map(|v| prefactor * v.powf(slope)).collect();
-        let f = LogLogFit::fit(&x, &y).unwrap();
+        let f = Fit::log_log(&x, &y).unwrap();
         prop_assert!((f.slope - slope).abs() < 1e-9);
         prop_assert!(close(f.prefactor(), prefactor, 1e-8, 0.0));
         prop_assert!(f.slope_stderr < 1e-8);

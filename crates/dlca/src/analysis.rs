@@ -4,7 +4,7 @@
 
 use crate::sim::Simulation;
 use core_lattice::stats::StatsError;
-use core_lattice::{Direction, IntHistogram, LatticeGyration, LogLogFit, MAX_DIM};
+use core_lattice::{Direction, Fit, IntHistogram, LatticeGyration, MAX_DIM};
 use spatial::lattice::ItemId;
 use std::collections::{HashMap, VecDeque};
 
@@ -96,14 +96,11 @@ pub fn gyration(sim: &Simulation) -> Vec<ClusterMeasure> {
 
 /// Fit `log s = D log R_g + c` over the clusters of at least `min_size` particles that do not
 /// wrap; the slope is the fractal dimension `D`.
-pub fn fractal_dimension(
-    clusters: &[ClusterMeasure],
-    min_size: u64,
-) -> Result<LogLogFit, StatsError> {
+pub fn fractal_dimension(clusters: &[ClusterMeasure], min_size: u64) -> Result<Fit, StatsError> {
     let (rg, s): (Vec<f64>, Vec<f64>) = clusters
         .iter()
         .filter(|c| c.size >= min_size.max(2) && !c.wraps)
         .map(|c| (c.radius_of_gyration, c.size as f64))
         .unzip();
-    LogLogFit::fit(&rg, &s)
+    Fit::log_log(&rg, &s)
 }

@@ -8,7 +8,7 @@ use crate::report::{Table, pm, sig};
 use animat::bench::{scaling_params, step_throughput};
 use animat::{GridBox, World};
 use anyhow::Result;
-use core_lattice::LogLogFit;
+use core_lattice::Fit;
 
 /// Animats per cell of the start disc, the same for every population of the ladder: the
 /// default start's density (2300 animats on a disc of radius 60), as in `docs/benchmarks.md`.
@@ -166,8 +166,8 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         let x: Vec<f64> = pts.iter().map(|p| p.population).collect();
         let t: Vec<f64> = pts.iter().map(|p| p.search_seconds).collect();
         let e: Vec<f64> = pts.iter().map(|p| p.items_scanned.max(1.0)).collect();
-        let ft = LogLogFit::fit(&x, &t)?;
-        let fe = LogLogFit::fit(&x, &e)?;
+        let ft = Fit::log_log(&x, &t)?;
+        let fe = Fit::log_log(&x, &e)?;
         let paper = if cells {
             "— (not in the paper; target <= 1.10)".to_string()
         } else {

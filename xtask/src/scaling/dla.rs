@@ -6,7 +6,7 @@ use super::Ctx;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig, std_dev};
 use anyhow::Result;
-use core_lattice::LinearFit;
+use core_lattice::Fit;
 use dla_pdla::{Dim, Params, Sample, Simulation, Space};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -121,7 +121,7 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
                     format!("{:e}", s.seconds),
                 ]);
             }
-            let fit = LinearFit::fit(&x, &y)?;
+            let fit = Fit::linear(&x, &y)?;
             let paper = match (d, precision.is_finite(), distance_map) {
                 (_, true, true) => "(no distance maps or near cache in the paper)",
                 (2, true, false) => "T = 3e-5 N - 6.9 (30 us per particle), r^2 0.9981",

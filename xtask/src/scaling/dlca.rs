@@ -7,7 +7,7 @@ use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, mean_stderr, pm, sig};
 use anyhow::{Result, bail};
-use core_lattice::{Boundary, LogLogFit};
+use core_lattice::{Boundary, Fit};
 use dlca::record::SweepRecord;
 use dlca::{Init, Params, Search, Simulation};
 use rayon::prelude::*;
@@ -108,7 +108,7 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                 .filter(|s| s.sweep >= 10)
                 .map(|s| (s.sweep as f64, s.clusters as f64))
                 .unzip();
-            if let Ok(f) = LogLogFit::fit(&x, &y) {
+            if let Ok(f) = Fit::log_log(&x, &y) {
                 exponents.push(-f.slope);
             }
             if i < 3 {
@@ -474,7 +474,7 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             pts.push((n, per));
         }
         let (x, y): (Vec<f64>, Vec<f64>) = pts.iter().copied().unzip();
-        let fit = LogLogFit::fit(&x, &y)?;
+        let fit = Fit::log_log(&x, &y)?;
         table.row(vec![
             strategy.name().into(),
             {

@@ -33,7 +33,7 @@ use self::serial::Serial;
 use crate::cluster::Cluster;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use core_lattice::LogLogFit;
+use core_lattice::Fit;
 use spatial::orthtree::Orthtree;
 use std::path::Path;
 
@@ -48,9 +48,6 @@ pub struct Simulation<const D: usize> {
     serial: Serial<D>,
     pdla: PdlaStats,
 }
-
-/// The fitted fractal dimension (`log N = D log R_g + c`).
-pub type FractalFit = LogLogFit;
 
 impl<const D: usize> Simulation<D>
 where
@@ -243,7 +240,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Fractal dimension from `log N = D log R_g + c` over the samples with `N >= fit_from`.
-    pub fn fractal_dimension(&self) -> Result<FractalFit, core_lattice::stats::StatsError> {
+    pub fn fractal_dimension(&self) -> Result<Fit, core_lattice::stats::StatsError> {
         let (rg, n): (Vec<f64>, Vec<f64>) = self
             .growth
             .samples
@@ -251,6 +248,6 @@ impl<const D: usize> Simulation<D> {
             .filter(|s| s.n >= self.params.fit_from)
             .map(|s| (s.radius_of_gyration, s.n as f64))
             .unzip();
-        LogLogFit::fit(&rg, &n)
+        Fit::log_log(&rg, &n)
     }
 }
