@@ -26,6 +26,7 @@ pub mod params;
 pub mod record;
 mod rigid;
 pub mod sim;
+mod store;
 
 pub use params::{Init, ParamError, Params, Search};
 pub use sim::{Simulation, Snapshot};
