@@ -27,7 +27,6 @@
 //! own particles, so it stays on the lattice. Neighbour and probe coordinates reach one step
 //! beyond a particle's, so a probe can fall beyond a wall; such probes are skipped. Wall
 //! blocking is O(1) from the cluster's extent along the axis.
-
 //!
 //! This module owns the choice of kernel: [`RigidStore`] holds a [`Rigid`] store for the
 //! lattice's dimension and the frame that applies to it, and [`RigidStore::new`] is the one
@@ -35,7 +34,7 @@
 //! its dispatch are those where rigid clusters pay: beyond 3, a fractal cluster has nearly every
 //! particle on every face and about `2d - 1` probes per particle and direction, so the lists
 //! cost more than moving every particle, and the `lattice` strategy uses the plain occupancy
-//! lattice instead (see `crate::store`).
+//! lattice instead (`RigidError::Dimension`; see `crate::sim`'s strategy installation).
 
 mod clusters;
 mod frame;

@@ -5,7 +5,7 @@
 //! This module owns the run: parameters, the random stream, the sweep (every cluster in a fresh
 //! random order tries one move and merges with what it then touches) and the records. The
 //! clusters and the contact search live in the installed strategy (`crate::store`), chosen and
-//! installed by [`strategy`]; the initial state comes from [`placement`]; [`checkpoint`] holds
+//! installed by `strategy`; the initial state comes from `placement`; `checkpoint` holds
 //! the state saved between sweeps.
 //!
 //! Invariants (checked after every move by [`Simulation::with_invariant_checks`]): the particle

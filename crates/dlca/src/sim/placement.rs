@@ -106,11 +106,12 @@ mod tests {
     }
 
     #[test]
-    fn placement_is_distinct_and_seeded() {
+    fn placement_is_distinct_and_a_function_of_the_stream() {
         let l = Lattice::periodic(&[10, 10]).unwrap();
         let a = place_particles(&l, 90, &mut stream(1, 1));
         let b = place_particles(&l, 90, &mut stream(1, 1));
         assert_eq!(a, b);
+        assert_ne!(a, place_particles(&l, 90, &mut stream(2, 1)));
         // Sparse (hash set) and dense (bitset) tracking draw the same sites.
         let big = Lattice::periodic(&[1000, 1000]).unwrap();
         let sparse = place_particles(&big, 1000, &mut stream(2, 1));

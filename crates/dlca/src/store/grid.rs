@@ -35,6 +35,8 @@ impl GridStore {
     /// cluster's extent) or, by default, about the spacing of the clusters: in the dilute regime
     /// that keeps each halo to a few clusters (section V). Gives the arrays back, with a note,
     /// when that box already has `3A >= L` on some axis.
+    // Called once per installation: the size of the error (the arrays handed back) is no cost.
+    #[allow(clippy::result_large_err)]
     pub(crate) fn new(
         arrays: ClusterArrays,
         requested: Option<u64>,
