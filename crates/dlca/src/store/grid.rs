@@ -154,14 +154,17 @@ impl ClusterStore for GridStore {
         Some(self.inner.search().side())
     }
 
+    #[inline]
     fn live(&self) -> &[ItemId] {
         self.inner.sets().live()
     }
 
+    #[inline]
     fn contains(&self, id: ItemId) -> bool {
         self.inner.sets().contains(id)
     }
 
+    #[inline]
     fn len_of(&self, id: ItemId) -> usize {
         self.inner.sets().sites(id).len()
     }

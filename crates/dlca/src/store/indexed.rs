@@ -115,14 +115,17 @@ impl<S: SetSearch> ClusterStore for Indexed<S> {
         None
     }
 
+    #[inline]
     fn live(&self) -> &[ItemId] {
         self.arrays.sets.live()
     }
 
+    #[inline]
     fn contains(&self, id: ItemId) -> bool {
         self.arrays.sets.contains(id)
     }
 
+    #[inline]
     fn len_of(&self, id: ItemId) -> usize {
         self.arrays.sets.sites(id).len()
     }

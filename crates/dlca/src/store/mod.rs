@@ -68,14 +68,17 @@ impl ClusterStore for Engine {
         each!(self, s => s.grid_side())
     }
 
+    #[inline]
     fn live(&self) -> &[ItemId] {
         each!(self, s => s.live())
     }
 
+    #[inline]
     fn contains(&self, id: ItemId) -> bool {
         each!(self, s => s.contains(id))
     }
 
+    #[inline]
     fn len_of(&self, id: ItemId) -> usize {
         each!(self, s => s.len_of(id))
     }

@@ -41,14 +41,17 @@ impl ClusterStore for RigidClusters {
         None
     }
 
+    #[inline]
     fn live(&self) -> &[ItemId] {
         self.store.live()
     }
 
+    #[inline]
     fn contains(&self, id: ItemId) -> bool {
         self.store.contains(id)
     }
 
+    #[inline]
     fn len_of(&self, id: ItemId) -> usize {
         self.store.len_of(id)
     }
