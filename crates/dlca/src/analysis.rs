@@ -1,6 +1,7 @@
 //! Final-state measurements: the cluster size distribution and, with `--gyration`, each
 //! cluster's radius of gyration (unwrapped across periodic boundaries) and the fractal dimension
-//! `D` from the fit `log s = D log R_g + c` over the clusters (MODELS.md section 1).
+//! `D` from the fit `log s = D log R_g + c` over the clusters (docs/dlca.md,
+//! "Validation").
 
 use crate::sim::Simulation;
 use core_lattice::stats::StatsError;

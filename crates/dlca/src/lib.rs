@@ -1,10 +1,17 @@
 //! # dlca: diffusion-limited cluster-cluster aggregation
 //!
-//! The DLCA model of Hawick, James & Scogings (seed 000, sections II.A, III, IV.A), defined
-//! precisely in MODELS.md section 1: particles on a periodic or walled hypercubic lattice in
-//! 1 to 5 dimensions form clusters that random-walk one lattice step at a time and stick on
-//! contact. Three contact searches (all-pairs, grid boxes, occupancy lattice) give bit-identical
-//! trajectories.
+//! The DLCA model of Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
+//! Performance Optimisation" (sections II.A, III, IV.A), as defined in docs/dlca.md: particles
+//! on a periodic or walled hypercubic lattice in 1 to 5 dimensions form clusters that
+//! random-walk one lattice step at a time and stick on contact. Three contact searches
+//! (all-pairs, grid boxes, occupancy lattice) give bit-identical trajectories.
+//!
+//! Layout: [`params`] (validated parameters), [`sim`] (the run: placement, sweep, strategy
+//! choice, checkpoints), `store` (the strategies behind one `ClusterStore` interface), `rigid`
+//! (the rigid-cluster kernels of the `lattice` strategy, one per dimension), [`record`] (what a
+//! run records as it goes), [`analysis`] and [`output`] (final measurements and files). The
+//! library builds without the command line (`--no-default-features`); feature `cli` (default)
+//! adds clap's derives and the `dlca` binary.
 //!
 //! ```
 //! use dlca::{Params, Init, Simulation};
@@ -26,6 +33,7 @@ pub mod params;
 pub mod record;
 mod rigid;
 pub mod sim;
+mod store;
 
 pub use params::{Init, ParamError, Params, Search};
 pub use sim::{Simulation, Snapshot};

@@ -1,6 +1,7 @@
 //! `dlca`: diffusion-limited cluster-cluster aggregation on lattices of 1 to 5 dimensions
-//! (MODELS.md section 1; Hawick, James & Scogings 2006). A thin layer over the `dlca` library:
-//! parse flags, validate, run, write outputs.
+//! (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation Performance
+//! Optimisation"; docs/dlca.md). A thin layer over the `dlca` library: parse flags, validate,
+//! run, write outputs.
 
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
@@ -103,7 +104,7 @@ struct Cli {
     timing: bool,
 
     /// Record histograms of candidate clusters examined per move (histogram.csv) at the sweeps
-    /// of --histogram-sweeps (seed 000 Figs. 4, 7, 8).
+    /// of --histogram-sweeps (as in Figs. 4, 7, 8 of Hawick, James & Scogings 2006).
     #[arg(long)]
     histogram: bool,
 

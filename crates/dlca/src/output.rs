@@ -1,4 +1,4 @@
-//! Writing a finished run into its output directory (DESIGN.md, "Outputs"). Every file is
+//! Writing a finished run into its output directory (docs/dlca.md, "Outputs"). Every file is
 //! written atomically.
 //!
 //! | file | content |

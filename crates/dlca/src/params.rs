@@ -1,10 +1,13 @@
-//! Parameters of a DLCA run (MODELS.md section 1), validated before anything runs.
+//! Parameters of a DLCA run (docs/dlca.md, "The model"), validated before anything runs.
+//!
+//! Invariant: a [`Params`] that passed [`Params::validate`] describes a run the simulation can
+//! set up (dimension 1..=5, a valid lattice, 1 to 2^32 - 3 particles, every rate in range).
 
 use core_lattice::{Boundary, Lattice, LatticeError};
 use serde::{Deserialize, Serialize};
 
-/// Largest dimension the model accepts (seed 000 runs 2 to 5; 1 is included for tests and
-/// teaching).
+/// Largest dimension the model accepts (Hawick, James & Scogings 2006 run 2 to 5; 1 is
+/// included for tests and teaching).
 pub const MAX_MODEL_DIM: usize = 5;
 
 /// Default memory budget for the occupancy lattice: 4 GiB.
@@ -20,17 +23,18 @@ pub enum Init {
     Particles(u64),
 }
 
-/// The contact search (MODELS.md section 1, "Search strategies"). All give bit-identical
+/// The contact search (docs/dlca.md, "The search strategies"). All give bit-identical
 /// trajectories; they differ only in speed and memory.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Search {
     /// Pick by regime (memory, dimension, density) and log why.
     Auto,
-    /// Seed 000's all-pairs baseline.
+    /// The all-pairs baseline of Hawick, James & Scogings 2006.
     AllPairs,
-    /// Seed 000's grid boxes, doubling with the largest cluster, falling back to all-pairs once
-    /// `3A >= L` on some axis.
+    /// Grid boxes (Hawick, James & Scogings 2006), doubling with the largest cluster, falling
+    /// back to all-pairs once `3A >= L` on some axis.
     Grid,
     /// Occupancy lattice: a cluster id per site.
     Lattice,

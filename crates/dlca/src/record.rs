@@ -1,6 +1,7 @@
-//! What a DLCA run records as it goes (MODELS.md section 1, "Observables"): always the number of
+//! What a DLCA run records as it goes (docs/dlca.md, "Outputs"): always the number of
 //! clusters and the largest cluster per sweep; with `--timing` the wall time of each sweep; with
-//! `--histogram` the number of candidate clusters examined per move at chosen sweeps (seed 000
+//! `--histogram` the number of candidate clusters examined per move at chosen sweeps (Hawick,
+//! James & Scogings 2006, "Grid-Boxing for Spatial Simulation Performance Optimisation",
 //! Figs. 4, 7, 8). Observables that were not asked for cost one branch per sweep or move.
 
 use crate::params::Params;

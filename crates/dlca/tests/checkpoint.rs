@@ -1,5 +1,5 @@
 //! A run saved between sweeps and restored reaches the same final state as one never
-//! interrupted (DESIGN.md "Long runs"), for every strategy, through the checkpoint envelope.
+//! interrupted (docs/dlca.md, "Outputs"), for every strategy, through the checkpoint envelope.
 
 use core_lattice::Boundary;
 use core_lattice::io::checkpoint::{decode_checkpoint, encode_checkpoint};

@@ -1,8 +1,9 @@
-//! The fractal dimension of DLCA clusters against the literature (REFERENCE.md: lattice DLCA
-//! in 2D 1.42 +- 0.03, often quoted 1.44-1.45; in 3D 1.78 +- 0.05; Jullien, Kolb & Botet 1984).
+//! The fractal dimension of DLCA clusters against the literature (docs/dlca.md, "Validation":
+//! lattice DLCA in 2D 1.42 +- 0.03, often quoted 1.44-1.45; in 3D 1.78 +- 0.05; Jullien, Kolb &
+//! Botet 1984).
 //!
-//! Method (MODELS.md section 1, `--gyration`): run to a few tens of clusters at low fill (1% in
-//! 2D, 0.25% in 3D, as REFERENCE.md advises: D rises with concentration), measure every
+//! Method (`--gyration`): run to a few tens of clusters at low fill (1% in 2D, 0.25% in 3D: D
+//! rises with concentration and the literature value is the dilute limit), measure every
 //! final cluster's radius of gyration (unwrapped), pool the clusters of several seeds and fit
 //! `log s = D log R_g + c` over clusters of at least 10 particles.
 //!
@@ -55,9 +56,8 @@ fn fractal_dimension_2d_matches_literature() {
 
 #[test]
 fn fractal_dimension_3d_matches_literature() {
-    // 0.25% fill: in 3D the measured D still rises visibly with concentration at 1% (about
-    // 1.9 to 2.0 there, 1.88 at 0.5%, 1.80 at 0.25%, measured with
-    // `examples/fractal_dimension.rs`), and the literature value is the dilute limit.
+    // 0.25% fill: in 3D, D still rises visibly with concentration at 1% (docs/dlca.md,
+    // "Validation"), and the literature value is the dilute limit.
     let (d, se, n) = pooled_dimension(3, 128, 0.0025, 20, 12);
     eprintln!("3D DLCA: D = {d:.4} +- {se:.4} over {n} clusters");
     assert!(n >= 80, "only {n} clusters in the fit");

@@ -1,5 +1,5 @@
-//! Every contact search gives the same trajectory (MODELS.md section 1; DESIGN.md "Same seed, same
-//! result"), and the model's invariants hold after every move.
+//! Every contact search gives the same trajectory (docs/dlca.md, "The search strategies"), the
+//! same seed gives the same run, and the model's invariants hold after every move.
 
 use core_lattice::Boundary;
 use core_lattice::rng::{RngExt, stream};
@@ -184,8 +184,9 @@ fn initial_adjacent_particles_form_one_cluster() {
 
 #[test]
 fn power_of_two_periodic_lattices_match_all_pairs() {
-    // All-periodic power-of-two lattices take the lattice strategy's bit-field frame; sides of
-    // 1 and 2 are the edge cases of its field arithmetic.
+    // All-periodic power-of-two lattices take the lattice strategy's bit-field frame in 1D to 3D
+    // (4D and 5D use the plain occupancy lattice); sides of 1 and 2 are the edge cases of its
+    // field arithmetic.
     let sizes: [&[u64]; 7] = [
         &[256],
         // Large enough for clusters of more than 64 particles absorbing small ones (parts).

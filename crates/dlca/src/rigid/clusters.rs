@@ -1,36 +1,17 @@
-//! The `lattice` strategy's cluster store: rigid clusters as an origin plus relative sites, with
-//! per-direction face and probe lists, over an occupancy lattice of labels.
+//! The rigid-cluster store of the `lattice` strategy in `D` dimensions ([`Rigid`]): each
+//! cluster as an origin plus relative sites with its face and probe lists, over an occupancy
+//! lattice of labels (see the parent module for the method).
 //!
-//! A DLCA cluster never changes shape between merges, it only translates. So each cluster keeps
-//! its particles as coordinates *relative* to an origin, and a move changes the origin alone
-//! (O(1)) instead of rewriting every particle's k-index. What the occupancy lattice and the
-//! contact query need from a move by the unit vector `e` depends only on the shape `C` and `e`,
-//! so it is worked out once per shape (at the start and after each merge, N - 1 times in a
-//! run) and kept per direction:
-//!
-//! - the *face* `F(e) = {s in C : s + e not in C}`. A move by `e` covers exactly the sites
-//!   `F(e)` (in the new frame) and vacates exactly `F(-e)` (in the old frame): only those
-//!   occupancy cells are written; interior particles keep their label.
-//! - the *probes* `P(e) = {q in N(C) : q + e not in C or N(C)}`, where `N(C)` is the set of
-//!   sites face-adjacent to `C` and outside it. Before a move no other cluster is in `C` or
-//!   `N(C)` (clusters merge as soon as they touch), so after it the only sites that can hold a
-//!   cluster in contact are the new neighbours, `P(e)` in the new frame: one lookup each, each
-//!   such site once.
-//!
-//! On a fractal DLCA cluster about half the particles are on each face, and the probes number
-//! about as many, so a move costs a fraction of the particles in memory traffic and nothing
-//! per interior particle.
-//!
-//! Coordinates: along a periodic axis relative coordinates of particles lie in `[0, L)` (taken
-//! modulo `L`) and absolute ones are `origin + relative` reduced modulo `L`; along a wall axis
-//! they are plain differences (the cluster cannot wrap) and the origin is one of the cluster's
-//! own particles, so it stays on the lattice. Neighbour and probe coordinates reach one step
-//! beyond a particle's, so a probe can fall beyond a wall; such probes are skipped. Wall
-//! blocking is O(1) from the cluster's extent along the axis.
+//! Invariants, checked by [`Rigid::check`]: the occupancy bits hold exactly the live clusters'
+//! particles, each occupied cell holds the label of the cluster owning it, `id_of` maps every
+//! live cluster's label back to its id, each cluster's lists equal a fresh computation from its
+//! sites (unless it keeps parts, which then cover less than half of it), and the extent along
+//! every wall axis is exact.
 
-use core_lattice::{Blocked, Boundary, Direction, Lattice};
+use super::frame::Frame;
+use super::geometry::{Bits, Geometry, step};
+use core_lattice::{Blocked, Direction, Lattice};
 use spatial::lattice::{ItemId, SiteSets};
-use std::fmt::Debug;
 use std::sync::Arc;
 
 /// Marks an empty site.
@@ -40,14 +21,15 @@ const EMPTY: u32 = u32::MAX;
 const SMALL: u32 = 64;
 
 /// Largest side length this store handles (relative coordinates are `i32` with a margin).
-pub(crate) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
+pub(super) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
 
 /// The face and probe lists of one cluster shape, in one allocation (so a move follows one
 /// pointer from the cluster): `4d + 1` header entries holding the starts of the lists (encoded
 /// by [`Frame::start`]), then the faces by direction index, then the probes by direction index.
 /// List `i` is `lists[start(i)..start(i + 1)]`: face `i` for `i < 2d`, else probes `i - 2d`.
-type Lists<E> = Arc<[E]>;
+pub(super) type Lists<E> = Arc<[E]>;
 
+/// List `i` of `lists` (see [`Lists`]).
 #[inline(always)]
 fn list<const D: usize, F: Frame<D>>(lists: &[F::Entry], i: usize) -> &[F::Entry] {
     &lists[F::start_of(lists[i])..F::start_of(lists[i + 1])]
@@ -137,295 +119,6 @@ struct Cold<const D: usize> {
     sorted_len: usize,
 }
 
-/// How list entries are stored and turned into k-indices.
-pub(crate) trait Frame<const D: usize>: Debug + Clone {
-    /// A relative position as stored in the lists.
-    type Entry: Copy + Debug + PartialEq;
-    /// An origin in the form the entries are added to.
-    type Origin: Copy;
-    /// The frame for geometry `geo`, if it applies.
-    fn new(geo: &Geometry<D>) -> Option<Self>;
-    /// Origin coordinates `o` in this frame's form.
-    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> Self::Origin;
-    /// Relative coordinates `r` (at most two steps beyond a particle's) as an entry.
-    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> Self::Entry;
-    /// A list start stored as an entry (see [`Lists`]).
-    fn start(i: usize) -> Self::Entry;
-    /// The list start stored in `e`.
-    fn start_of(e: Self::Entry) -> usize;
-    /// k-index of a particle site.
-    fn site(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> usize;
-    /// k-index of a probe site, or `None` beyond a wall.
-    fn probe(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> Option<usize>;
-}
-
-/// Any lattice: entries are relative coordinates, wrapped or bounds-checked axis by axis.
-#[derive(Debug, Clone)]
-pub(crate) struct AnyFrame;
-
-impl<const D: usize> Frame<D> for AnyFrame {
-    type Entry = [i32; D];
-    type Origin = [i64; D];
-    fn new(_: &Geometry<D>) -> Option<Self> {
-        Some(AnyFrame)
-    }
-    #[inline(always)]
-    fn origin(&self, _: &Geometry<D>, o: &[i64; D]) -> [i64; D] {
-        *o
-    }
-    fn entry(&self, _: &Geometry<D>, r: &[i32; D]) -> [i32; D] {
-        *r
-    }
-    fn start(i: usize) -> [i32; D] {
-        let mut e = [0; D];
-        e[0] = i32::try_from(i).expect("lists shorter than 2^31");
-        e
-    }
-    #[inline(always)]
-    fn start_of(e: [i32; D]) -> usize {
-        e[0] as usize
-    }
-    #[inline(always)]
-    fn site(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> usize {
-        geo.site(&o, &e)
-    }
-    #[inline(always)]
-    fn probe(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> Option<usize> {
-        geo.probe(&o, &e)
-    }
-}
-
-/// Periodic lattices whose sides are all powers of two with at most 2^32 sites: an entry is
-/// the k-index of the relative position reduced modulo the sides, and the k-index of a site is
-/// the sum of origin and entry computed field by field (each axis a bit field of the k-index)
-/// with the carry between fields suppressed (SIMD within a register): four operations,
-/// whatever the dimension.
-#[derive(Debug, Clone)]
-pub(crate) struct Pow2Frame {
-    /// The top bit of every axis's field.
-    high: u32,
-}
-
-impl Pow2Frame {
-    #[inline(always)]
-    fn add(&self, a: u32, b: u32) -> u32 {
-        ((a & !self.high).wrapping_add(b & !self.high)) ^ ((a ^ b) & self.high)
-    }
-}
-
-impl<const D: usize> Frame<D> for Pow2Frame {
-    type Entry = u32;
-    type Origin = u32;
-    fn new(geo: &Geometry<D>) -> Option<Self> {
-        let fits = geo.size.iter().product::<i64>() <= 1 << 32;
-        let pow2 = geo.size.iter().all(|&l| (l as u64).is_power_of_two());
-        if !(fits && pow2 && geo.periodic.iter().all(|&p| p)) {
-            return None;
-        }
-        let mut high = 0;
-        for a in 0..D {
-            if geo.size[a] > 1 {
-                high |= ((geo.size[a] as u64 / 2) * geo.stride[a]) as u32;
-            }
-        }
-        Some(Pow2Frame { high })
-    }
-    #[inline(always)]
-    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {
-        (0..D).map(|a| o[a] as u64 * geo.stride[a]).sum::<u64>() as u32
-    }
-    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> u32 {
-        geo.any(&[0; D], r).expect("periodic") as u32
-    }
-    fn start(i: usize) -> u32 {
-        u32::try_from(i).expect("lists shorter than 2^32")
-    }
-    #[inline(always)]
-    fn start_of(e: u32) -> usize {
-        e as usize
-    }
-    #[inline(always)]
-    fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
-        self.add(o, e) as usize
-    }
-    #[inline(always)]
-    fn probe(&self, _: &Geometry<D>, o: u32, e: u32) -> Option<usize> {
-        Some(self.add(o, e) as usize)
-    }
-}
-
-/// The lattice geometry with the arithmetic the store needs.
-#[derive(Debug, Clone)]
-pub(crate) struct Geometry<const D: usize> {
-    size: [i64; D],
-    stride: [u64; D],
-    periodic: [bool; D],
-    /// Extended lattice for marking neighbour sites: one extra layer beyond each wall.
-    ext_stride: [u64; D],
-    ext_volume: u64,
-}
-
-impl<const D: usize> Geometry<D> {
-    fn new(lattice: &Lattice) -> Self {
-        assert_eq!(lattice.dim(), D);
-        let mut g = Geometry {
-            size: [0; D],
-            stride: [0; D],
-            periodic: [false; D],
-            ext_stride: [0; D],
-            ext_volume: 1,
-        };
-        for a in 0..D {
-            g.size[a] = lattice.size(a) as i64;
-            g.stride[a] = lattice.stride(a);
-            g.periodic[a] = lattice.boundary(a) == Boundary::Periodic;
-            g.ext_stride[a] = g.ext_volume;
-            g.ext_volume *= lattice.size(a) + if g.periodic[a] { 0 } else { 2 };
-        }
-        g
-    }
-
-    /// k-index of a particle (a site known to be on the lattice) at `r` relative to `o`.
-    #[inline(always)]
-    fn site(&self, o: &[i64; D], r: &[i32; D]) -> usize {
-        let mut k = 0u64;
-        for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
-                if x >= self.size[a] {
-                    x -= self.size[a];
-                } else if x < 0 {
-                    x += self.size[a];
-                }
-            }
-            k += x as u64 * self.stride[a];
-        }
-        k as usize
-    }
-
-    /// k-index of the site at `r` relative to `o` (`r` at most one step beyond a particle's
-    /// relative coordinates), or `None` beyond a wall.
-    #[inline(always)]
-    fn probe(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
-        let mut k = 0u64;
-        for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
-                if x >= self.size[a] {
-                    x -= self.size[a];
-                } else if x < 0 {
-                    x += self.size[a];
-                }
-            } else if x < 0 || x >= self.size[a] {
-                return None;
-            }
-            k += x as u64 * self.stride[a];
-        }
-        Some(k as usize)
-    }
-
-    /// Like [`Geometry::probe`] for any relative position (full modular reduction).
-    fn any(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
-        let mut k = 0u64;
-        for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
-                x = x.rem_euclid(self.size[a]);
-            } else if x < 0 || x >= self.size[a] {
-                return None;
-            }
-            k += x as u64 * self.stride[a];
-        }
-        Some(k as usize)
-    }
-
-    /// Index in the extended lattice (one layer beyond each wall) of the site at `r` relative
-    /// to `o`, or `None` further out.
-    fn ext(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
-        let mut k = 0u64;
-        for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
-                x = x.rem_euclid(self.size[a]);
-            } else if x < -1 || x > self.size[a] {
-                return None;
-            } else {
-                x += 1;
-            }
-            k += x as u64 * self.ext_stride[a];
-        }
-        Some(k as usize)
-    }
-
-    /// The origin of a part at `offset` from origin `o`.
-    #[inline(always)]
-    fn shifted(&self, o: &[i64; D], offset: &[i32; D]) -> [i64; D] {
-        let mut x = [0; D];
-        for a in 0..D {
-            x[a] = o[a] + i64::from(offset[a]);
-            if self.periodic[a] && x[a] >= self.size[a] {
-                x[a] -= self.size[a];
-            }
-        }
-        x
-    }
-
-    /// Relative coordinates of absolute coordinates `x` in the frame with origin `o`.
-    fn relative(&self, o: &[i64; D], x: &[i64; D]) -> [i32; D] {
-        let mut r = [0; D];
-        for a in 0..D {
-            let d = x[a] - o[a];
-            r[a] = if self.periodic[a] {
-                d.rem_euclid(self.size[a])
-            } else {
-                d
-            } as i32;
-        }
-        r
-    }
-
-    /// Absolute coordinates of the particle at `r` relative to `o`.
-    fn absolute(&self, o: &[i64; D], r: &[i32; D]) -> [i64; D] {
-        let mut x = [0; D];
-        for a in 0..D {
-            x[a] = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
-                x[a] = x[a].rem_euclid(self.size[a]);
-            }
-        }
-        x
-    }
-}
-
-/// A bitset over the lattice sites.
-#[derive(Debug, Clone)]
-struct Bits(Vec<u64>);
-
-impl Bits {
-    fn new(n: usize) -> Self {
-        Bits(vec![0; n.div_ceil(64)])
-    }
-    #[inline(always)]
-    fn get(&self, k: usize) -> bool {
-        self.0[k >> 6] & (1 << (k & 63)) != 0
-    }
-    #[inline(always)]
-    fn set(&mut self, k: usize) {
-        self.0[k >> 6] |= 1 << (k & 63);
-    }
-    #[inline(always)]
-    fn clear(&mut self, k: usize) {
-        self.0[k >> 6] &= !(1 << (k & 63));
-    }
-}
-
-#[inline(always)]
-fn step<const D: usize>(r: &[i32; D], dir: usize) -> [i32; D] {
-    let mut q = *r;
-    q[dir >> 1] += if dir & 1 == 1 { 1 } else { -1 };
-    q
-}
-
 /// Clusters, the occupancy lattice and the scratch space of the `lattice` strategy, in `D`
 /// dimensions.
 #[derive(Debug, Clone)]
@@ -444,7 +137,7 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     id_of: Vec<ItemId>,
     clusters: Vec<Cluster<D, F>>,
     cold: Vec<Cold<D>>,
-    live: Vec<ItemId>,
+    pub(super) live: Vec<ItemId>,
     position: Vec<u32>,
     /// Scratch for rebuilding face and probe lists.
     marks: Vec<u64>,
@@ -455,12 +148,10 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
 const DEAD: u32 = u32::MAX;
 
 impl<const D: usize, F: Frame<D>> Rigid<D, F> {
-    /// The store for the clusters of `sets` (ids kept), with their occupancy lattice, or `None`
-    /// if frame `F` does not apply to the lattice.
-    fn new(sets: &SiteSets) -> Option<Self> {
+    /// The store for the clusters of `sets` (ids kept), with their occupancy lattice, in frame
+    /// `frame` over `geo` (the geometry of the sets' lattice).
+    pub(super) fn new(sets: &SiteSets, geo: Geometry<D>, frame: F) -> Self {
         let lattice = sets.lattice().clone();
-        let geo = Geometry::<D>::new(&lattice);
-        let frame = F::new(&geo)?;
         let n = sets.id_bound();
         let mut r = Rigid {
             frame,
@@ -506,22 +197,22 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             let id = r.live[i];
             r.finish(id);
         }
-        Some(r)
+        r
     }
 
     #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
+    pub(super) fn len_of(&self, id: ItemId) -> usize {
         self.clusters[id as usize].len as usize
     }
 
     #[inline]
-    fn contains(&self, id: ItemId) -> bool {
+    pub(super) fn contains(&self, id: ItemId) -> bool {
         self.clusters.get(id as usize).is_some_and(|c| c.len != 0)
     }
 
     /// Move cluster `id` by `dir`: all or nothing (a wall blocks it). On success the clusters
     /// now in contact with it are written to `out`, in increasing id.
-    fn try_move(
+    pub(super) fn try_move(
         &mut self,
         id: ItemId,
         dir: Direction,
@@ -612,7 +303,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
 
     /// Merge cluster `from` into `into` (which keeps its id). Call [`Rigid::finish`] on `into`
     /// after the last merge of a move.
-    fn merge(&mut self, into: ItemId, from: ItemId) {
+    pub(super) fn merge(&mut self, into: ItemId, from: ItemId) {
         let (ni, nf) = (self.len_of(into), self.len_of(from));
         let lf = self.clusters[from as usize].label;
         // Relabel the smaller part only.
@@ -673,7 +364,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     /// After merges into cluster `id`: recompute its extent and its face and probe lists from
     /// its sites and the occupancy lattice (O(size)) if the parts merged in since the last time
     /// hold as many particles as the lists cover; otherwise keep the parts (see [`Part`]).
-    fn finish(&mut self, id: ItemId) {
+    pub(super) fn finish(&mut self, id: ItemId) {
         let c = &self.clusters[id as usize];
         let extra: u32 = c.parts.as_slice().iter().map(|p| p.len).sum();
         // Small clusters are recomputed at once: cheap, and it spares their moves the parts'
@@ -777,7 +468,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     }
 
     /// Absolute k-indices of the particles of `id`.
-    fn sites(&self, id: ItemId) -> Vec<u64> {
+    pub(super) fn sites(&self, id: ItemId) -> Vec<u64> {
         let c = &self.clusters[id as usize];
         self.cold[id as usize]
             .sites
@@ -788,7 +479,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
 
     /// Panic unless the occupancy lattice holds exactly the clusters' particles and every
     /// cluster's lists match a fresh computation. For tests.
-    fn check(&mut self) {
+    pub(super) fn check(&mut self) {
         let mut total = 0;
         for i in 0..self.live.len() {
             let id = self.live[i];
@@ -825,7 +516,8 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         assert_eq!(filled, total, "occupancy holds stray labels");
     }
 
-    fn to_sets(&self) -> SiteSets {
+    /// The clusters as k-index arrays (absolute sites), with the same ids.
+    pub(super) fn to_sets(&self) -> SiteSets {
         let mut sets = SiteSets::new(self.lattice.clone());
         for id in 0..self.clusters.len() as ItemId {
             sets.push(if self.contains(id) {
@@ -840,98 +532,5 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             }
         }
         sets
-    }
-}
-
-/// [`Rigid`] for the dimension of the lattice (1 to 3; see `RIGID_MAX_DIM` in `sim.rs`).
-#[derive(Debug, Clone)]
-pub(crate) enum RigidStore {
-    D1(Rigid<1, AnyFrame>),
-    D2(Rigid<2, AnyFrame>),
-    D3(Rigid<3, AnyFrame>),
-    P1(Rigid<1, Pow2Frame>),
-    P2(Rigid<2, Pow2Frame>),
-    P3(Rigid<3, Pow2Frame>),
-}
-
-macro_rules! each {
-    ($self:expr, $r:ident => $e:expr) => {
-        match $self {
-            RigidStore::D1($r) => $e,
-            RigidStore::D2($r) => $e,
-            RigidStore::D3($r) => $e,
-            RigidStore::P1($r) => $e,
-            RigidStore::P2($r) => $e,
-            RigidStore::P3($r) => $e,
-        }
-    };
-}
-
-impl RigidStore {
-    /// The store for the clusters of `sets` (same ids). `None` when the dimension is outside
-    /// 1..=3 or a side is larger than [`MAX_SIDE`].
-    pub(crate) fn new(sets: &SiteSets) -> Option<Self> {
-        let l = sets.lattice();
-        if l.sizes().iter().any(|&s| s > MAX_SIDE) {
-            return None;
-        }
-        // The power-of-two frame where it applies, else the general one.
-        match l.dim() {
-            1 => Rigid::new(sets)
-                .map(RigidStore::P1)
-                .or_else(|| Rigid::new(sets).map(RigidStore::D1)),
-            2 => Rigid::new(sets)
-                .map(RigidStore::P2)
-                .or_else(|| Rigid::new(sets).map(RigidStore::D2)),
-            3 => Rigid::new(sets)
-                .map(RigidStore::P3)
-                .or_else(|| Rigid::new(sets).map(RigidStore::D3)),
-            _ => None,
-        }
-    }
-
-    /// Live cluster ids.
-    pub(crate) fn live(&self) -> &[ItemId] {
-        each!(self, r => &r.live)
-    }
-
-    /// Number of particles of cluster `id`.
-    pub(crate) fn len_of(&self, id: ItemId) -> usize {
-        each!(self, r => r.len_of(id))
-    }
-
-    /// Whether `id` is live.
-    pub(crate) fn contains(&self, id: ItemId) -> bool {
-        each!(self, r => r.contains(id))
-    }
-
-    /// See [`Rigid::try_move`].
-    pub(crate) fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        out: &mut Vec<ItemId>,
-    ) -> Result<(), Blocked> {
-        each!(self, r => r.try_move(id, dir, out))
-    }
-
-    /// See [`Rigid::merge`].
-    pub(crate) fn merge(&mut self, into: ItemId, from: ItemId) {
-        each!(self, r => r.merge(into, from))
-    }
-
-    /// See [`Rigid::finish`].
-    pub(crate) fn finish(&mut self, id: ItemId) {
-        each!(self, r => r.finish(id))
-    }
-
-    /// Panic unless the store is consistent (see [`Rigid::check`]).
-    pub(crate) fn check(&mut self) {
-        each!(self, r => r.check())
-    }
-
-    /// The clusters as k-index arrays (absolute sites), with the same ids.
-    pub(crate) fn to_sets(&self) -> SiteSets {
-        each!(self, r => r.to_sets())
     }
 }

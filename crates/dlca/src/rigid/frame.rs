@@ -1,0 +1,126 @@
+//! How the face and probe lists of a rigid cluster store relative positions, and how an entry
+//! plus a cluster origin becomes a k-index: [`AnyFrame`] for every lattice, [`Pow2Frame`] for
+//! all-periodic lattices with power-of-two sides and at most 2^32 sites.
+//!
+//! Invariant: for the same origin and relative position, every frame gives the same k-index
+//! (so the choice of frame never changes a trajectory).
+
+use super::geometry::Geometry;
+use std::fmt::Debug;
+
+/// How list entries are stored and turned into k-indices.
+pub(crate) trait Frame<const D: usize>: Debug + Clone {
+    /// A relative position as stored in the lists.
+    type Entry: Copy + Debug + PartialEq;
+    /// An origin in the form the entries are added to.
+    type Origin: Copy;
+    /// The frame for geometry `geo`, if it applies.
+    fn new(geo: &Geometry<D>) -> Option<Self>;
+    /// Origin coordinates `o` in this frame's form.
+    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> Self::Origin;
+    /// Relative coordinates `r` (at most two steps beyond a particle's) as an entry.
+    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> Self::Entry;
+    /// A list start stored as an entry (see [`Lists`](super::clusters::Lists)).
+    fn start(i: usize) -> Self::Entry;
+    /// The list start stored in `e`.
+    fn start_of(e: Self::Entry) -> usize;
+    /// k-index of a particle site.
+    fn site(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> usize;
+    /// k-index of a probe site, or `None` beyond a wall.
+    fn probe(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> Option<usize>;
+}
+
+/// Any lattice: entries are relative coordinates, wrapped or bounds-checked axis by axis.
+#[derive(Debug, Clone)]
+pub(crate) struct AnyFrame;
+
+impl<const D: usize> Frame<D> for AnyFrame {
+    type Entry = [i32; D];
+    type Origin = [i64; D];
+    fn new(_: &Geometry<D>) -> Option<Self> {
+        Some(AnyFrame)
+    }
+    #[inline(always)]
+    fn origin(&self, _: &Geometry<D>, o: &[i64; D]) -> [i64; D] {
+        *o
+    }
+    fn entry(&self, _: &Geometry<D>, r: &[i32; D]) -> [i32; D] {
+        *r
+    }
+    fn start(i: usize) -> [i32; D] {
+        let mut e = [0; D];
+        e[0] = i32::try_from(i).expect("lists shorter than 2^31");
+        e
+    }
+    #[inline(always)]
+    fn start_of(e: [i32; D]) -> usize {
+        e[0] as usize
+    }
+    #[inline(always)]
+    fn site(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> usize {
+        geo.site(&o, &e)
+    }
+    #[inline(always)]
+    fn probe(&self, geo: &Geometry<D>, o: [i64; D], e: [i32; D]) -> Option<usize> {
+        geo.probe(&o, &e)
+    }
+}
+
+/// Periodic lattices whose sides are all powers of two with at most 2^32 sites: an entry is
+/// the k-index of the relative position reduced modulo the sides, and the k-index of a site is
+/// the sum of origin and entry computed field by field (each axis a bit field of the k-index)
+/// with the carry between fields suppressed (SIMD within a register): four operations,
+/// whatever the dimension.
+#[derive(Debug, Clone)]
+pub(crate) struct Pow2Frame {
+    /// The top bit of every axis's field.
+    high: u32,
+}
+
+impl Pow2Frame {
+    #[inline(always)]
+    fn add(&self, a: u32, b: u32) -> u32 {
+        ((a & !self.high).wrapping_add(b & !self.high)) ^ ((a ^ b) & self.high)
+    }
+}
+
+impl<const D: usize> Frame<D> for Pow2Frame {
+    type Entry = u32;
+    type Origin = u32;
+    fn new(geo: &Geometry<D>) -> Option<Self> {
+        let fits = geo.size.iter().product::<i64>() <= 1 << 32;
+        let pow2 = geo.size.iter().all(|&l| (l as u64).is_power_of_two());
+        if !(fits && pow2 && geo.periodic.iter().all(|&p| p)) {
+            return None;
+        }
+        let mut high = 0;
+        for a in 0..D {
+            if geo.size[a] > 1 {
+                high |= ((geo.size[a] as u64 / 2) * geo.stride[a]) as u32;
+            }
+        }
+        Some(Pow2Frame { high })
+    }
+    #[inline(always)]
+    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {
+        (0..D).map(|a| o[a] as u64 * geo.stride[a]).sum::<u64>() as u32
+    }
+    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> u32 {
+        geo.any(&[0; D], r).expect("periodic") as u32
+    }
+    fn start(i: usize) -> u32 {
+        u32::try_from(i).expect("lists shorter than 2^32")
+    }
+    #[inline(always)]
+    fn start_of(e: u32) -> usize {
+        e as usize
+    }
+    #[inline(always)]
+    fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
+        self.add(o, e) as usize
+    }
+    #[inline(always)]
+    fn probe(&self, _: &Geometry<D>, o: u32, e: u32) -> Option<usize> {
+        Some(self.add(o, e) as usize)
+    }
+}

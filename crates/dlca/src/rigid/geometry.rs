@@ -1,0 +1,181 @@
+//! Lattice arithmetic of the rigid-cluster store in `D` dimensions: k-indices of positions
+//! relative to an origin (wrapped on periodic axes, bounds-checked on wall axes), an extended
+//! lattice one layer beyond each wall for marking neighbour sites, and a bitset over the sites.
+//!
+//! Invariant: the [`Geometry`] describes exactly the lattice it was built from (same sides,
+//! strides and boundaries).
+
+use core_lattice::{Boundary, Lattice};
+
+/// The lattice geometry with the arithmetic the store needs.
+#[derive(Debug, Clone)]
+pub(crate) struct Geometry<const D: usize> {
+    pub(super) size: [i64; D],
+    pub(super) stride: [u64; D],
+    pub(super) periodic: [bool; D],
+    /// Extended lattice for marking neighbour sites: one extra layer beyond each wall.
+    ext_stride: [u64; D],
+    pub(super) ext_volume: u64,
+}
+
+impl<const D: usize> Geometry<D> {
+    pub(super) fn new(lattice: &Lattice) -> Self {
+        assert_eq!(lattice.dim(), D);
+        let mut g = Geometry {
+            size: [0; D],
+            stride: [0; D],
+            periodic: [false; D],
+            ext_stride: [0; D],
+            ext_volume: 1,
+        };
+        for a in 0..D {
+            g.size[a] = lattice.size(a) as i64;
+            g.stride[a] = lattice.stride(a);
+            g.periodic[a] = lattice.boundary(a) == Boundary::Periodic;
+            g.ext_stride[a] = g.ext_volume;
+            g.ext_volume *= lattice.size(a) + if g.periodic[a] { 0 } else { 2 };
+        }
+        g
+    }
+
+    /// k-index of a particle (a site known to be on the lattice) at `r` relative to `o`.
+    #[inline(always)]
+    pub(super) fn site(&self, o: &[i64; D], r: &[i32; D]) -> usize {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                if x >= self.size[a] {
+                    x -= self.size[a];
+                } else if x < 0 {
+                    x += self.size[a];
+                }
+            }
+            k += x as u64 * self.stride[a];
+        }
+        k as usize
+    }
+
+    /// k-index of the site at `r` relative to `o` (`r` at most one step beyond a particle's
+    /// relative coordinates), or `None` beyond a wall.
+    #[inline(always)]
+    pub(super) fn probe(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                if x >= self.size[a] {
+                    x -= self.size[a];
+                } else if x < 0 {
+                    x += self.size[a];
+                }
+            } else if x < 0 || x >= self.size[a] {
+                return None;
+            }
+            k += x as u64 * self.stride[a];
+        }
+        Some(k as usize)
+    }
+
+    /// Like [`Geometry::probe`] for any relative position (full modular reduction).
+    pub(super) fn any(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                x = x.rem_euclid(self.size[a]);
+            } else if x < 0 || x >= self.size[a] {
+                return None;
+            }
+            k += x as u64 * self.stride[a];
+        }
+        Some(k as usize)
+    }
+
+    /// Index in the extended lattice (one layer beyond each wall) of the site at `r` relative
+    /// to `o`, or `None` further out.
+    pub(super) fn ext(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        let mut k = 0u64;
+        for a in 0..D {
+            let mut x = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                x = x.rem_euclid(self.size[a]);
+            } else if x < -1 || x > self.size[a] {
+                return None;
+            } else {
+                x += 1;
+            }
+            k += x as u64 * self.ext_stride[a];
+        }
+        Some(k as usize)
+    }
+
+    /// The origin of a part at `offset` from origin `o`.
+    #[inline(always)]
+    pub(super) fn shifted(&self, o: &[i64; D], offset: &[i32; D]) -> [i64; D] {
+        let mut x = [0; D];
+        for a in 0..D {
+            x[a] = o[a] + i64::from(offset[a]);
+            if self.periodic[a] && x[a] >= self.size[a] {
+                x[a] -= self.size[a];
+            }
+        }
+        x
+    }
+
+    /// Relative coordinates of absolute coordinates `x` in the frame with origin `o`.
+    pub(super) fn relative(&self, o: &[i64; D], x: &[i64; D]) -> [i32; D] {
+        let mut r = [0; D];
+        for a in 0..D {
+            let d = x[a] - o[a];
+            r[a] = if self.periodic[a] {
+                d.rem_euclid(self.size[a])
+            } else {
+                d
+            } as i32;
+        }
+        r
+    }
+
+    /// Absolute coordinates of the particle at `r` relative to `o`.
+    pub(super) fn absolute(&self, o: &[i64; D], r: &[i32; D]) -> [i64; D] {
+        let mut x = [0; D];
+        for a in 0..D {
+            x[a] = o[a] + i64::from(r[a]);
+            if self.periodic[a] {
+                x[a] = x[a].rem_euclid(self.size[a]);
+            }
+        }
+        x
+    }
+}
+
+/// A bitset over the lattice sites.
+#[derive(Debug, Clone)]
+pub(super) struct Bits(Vec<u64>);
+
+impl Bits {
+    pub(super) fn new(n: usize) -> Self {
+        Bits(vec![0; n.div_ceil(64)])
+    }
+    #[inline(always)]
+    pub(super) fn get(&self, k: usize) -> bool {
+        self.0[k >> 6] & (1 << (k & 63)) != 0
+    }
+    #[inline(always)]
+    pub(super) fn set(&mut self, k: usize) {
+        self.0[k >> 6] |= 1 << (k & 63);
+    }
+    #[inline(always)]
+    pub(super) fn clear(&mut self, k: usize) {
+        self.0[k >> 6] &= !(1 << (k & 63));
+    }
+}
+
+/// `r` moved one step along direction index `dir` (axis `dir / 2`, positive when `dir` is odd).
+#[inline(always)]
+pub(super) fn step<const D: usize>(r: &[i32; D], dir: usize) -> [i32; D] {
+    let mut q = *r;
+    q[dir >> 1] += if dir & 1 == 1 { 1 } else { -1 };
+    q
+}
