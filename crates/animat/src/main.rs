@@ -7,8 +7,8 @@ use animat::output::{self, PopulationRow};
 use animat::{GridBox, Params, World};
 use anyhow::Context;
 use clap::Parser;
+use core_lattice::cli::LogArgs;
 use core_lattice::io::RunClock;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -74,13 +74,8 @@ struct Cli {
     #[arg(long)]
     positions: bool,
 
-    /// No progress bar or summary, warnings only.
-    #[arg(long, short)]
-    quiet: bool,
-
-    /// More log output (-v info, -vv debug); RUST_LOG overrides.
-    #[arg(short, action = clap::ArgAction::Count)]
-    verbose: u8,
+    #[command(flatten)]
+    log: LogArgs,
 }
 
 /// Builds validated parameters: defaults, then the config file, then the flags.
@@ -122,7 +117,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
 }
 
 fn main() -> ExitCode {
-    core_lattice::cli::main_with("animat", |c: &Cli| (c.quiet, c.verbose), params, run)
+    core_lattice::cli::main_with("animat", |c: &Cli| c.log, params, run)
 }
 
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
@@ -142,16 +137,10 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         output::write_snapshot(&path, w)?;
         Ok(())
     };
-    let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(cli.steps);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} steps, {msg}",
-            )
-            .expect("valid template"),
-        );
-        bar
-    });
+    let bar = cli.log.progress_bar(
+        cli.steps,
+        "{elapsed_precise} [{bar:40}] {pos}/{len} steps, {msg}",
+    );
     let mut rows = vec![PopulationRow {
         step: 0,
         foxes: world.foxes(),
@@ -204,7 +193,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         output::write_positions(&cli.out, &world)?;
     }
     let m = output::write_manifest(&cli.out, &world, cli.seed, &clock)?;
-    if !cli.quiet {
+    if !cli.log.quiet {
         eprintln!(
             "animat: {} foxes, {} rabbits after {} steps in {:.2} s (state {}); outputs in {}",
             world.foxes(),

@@ -4,14 +4,42 @@
 
 use std::process::ExitCode;
 
+/// The logging and progress flags every model binary takes (`#[command(flatten)]` them into
+/// the binary's flags).
+#[derive(Debug, Clone, Copy, Default, clap::Args)]
+pub struct LogArgs {
+    /// No progress bar or summary, warnings only.
+    #[arg(long, short)]
+    pub quiet: bool,
+
+    /// More log output (-v info, -vv debug); RUST_LOG overrides.
+    #[arg(short, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+}
+
+impl LogArgs {
+    /// A progress bar of `len` steps on stderr with the indicatif `template`, or `None` under
+    /// `--quiet` or when stderr is not a terminal (so redirected logs get no bar).
+    pub fn progress_bar(&self, len: u64, template: &str) -> Option<indicatif::ProgressBar> {
+        use std::io::IsTerminal;
+        (!self.quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = indicatif::ProgressBar::new(len);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(template)
+                    .expect("the binaries' progress templates are valid"),
+            );
+            bar
+        })
+    }
+}
+
 /// The whole life of a model binary: parse the flags (help, version and parse errors handled
-/// as in [`parse_or_exit`]), set up logging from the `quiet` and `verbose` flags that `logging`
-/// reads off them, turn the flags into validated parameters (an `Err` is bad input: one line,
+/// as in [`parse_or_exit`]), set up logging from the [`LogArgs`] that `logging` reads off them, turn the flags into validated parameters (an `Err` is bad input: one line,
 /// exit code 2, nothing written), then `run`; a run error prints its full chain on one line and
 /// exits with code 1.
 pub fn main_with<C: clap::Parser, P, E: std::fmt::Display>(
     program: &str,
-    logging: impl FnOnce(&C) -> (bool, u8),
+    logging: impl FnOnce(&C) -> LogArgs,
     params: impl FnOnce(&C) -> Result<P, String>,
     run: impl FnOnce(&C, P) -> Result<(), E>,
 ) -> ExitCode {
@@ -19,8 +47,8 @@ pub fn main_with<C: clap::Parser, P, E: std::fmt::Display>(
         Ok(cli) => cli,
         Err(code) => return code,
     };
-    let (quiet, verbose) = logging(&cli);
-    init_logging(quiet, verbose);
+    let log = logging(&cli);
+    init_logging(log.quiet, log.verbose);
     let params = match params(&cli) {
         Ok(p) => p,
         Err(msg) => return usage_error(program, &msg),
@@ -74,5 +102,7 @@ pub fn init_logging(quiet: bool, verbose: u8) {
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
+        // Colour codes only on a terminal: a redirected log stays plain text.
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
         .try_init();
 }

@@ -5,10 +5,10 @@
 
 use anyhow::Context;
 use clap::Parser;
+use core_lattice::cli::LogArgs;
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, Simulation, Space};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -113,13 +113,8 @@ struct Cli {
     #[arg(long)]
     png: bool,
 
-    /// No progress bar, warnings only.
-    #[arg(long, short)]
-    quiet: bool,
-
-    /// More log output (-v info, -vv debug); RUST_LOG overrides.
-    #[arg(short, action = clap::ArgAction::Count)]
-    verbose: u8,
+    #[command(flatten)]
+    log: LogArgs,
 }
 
 /// An on/off switch.
@@ -163,7 +158,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
 fn main() -> ExitCode {
     core_lattice::cli::main_with(
         "dla",
-        |c: &Cli| (c.quiet, c.verbose),
+        |c: &Cli| c.log,
         params,
         // The one run-time dimension dispatch: adding a dimension is one arm here (and its
         // `Space` implementation).
@@ -203,16 +198,10 @@ where
             sim
         }
     };
-    let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(total);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})",
-            )
-            .expect("valid template"),
-        );
-        bar
-    });
+    let bar = cli.log.progress_bar(
+        total,
+        "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})",
+    );
     let progress = |n| {
         if let Some(bar) = &bar {
             bar.set_position(n);
@@ -230,7 +219,7 @@ where
         tracing::warn!("no fractal dimension: {e}");
     }
     tracing::info!(discarded = sim.discarded_walkers(), "done");
-    if !cli.quiet {
+    if !cli.log.quiet {
         let d = m
             .results
             .get("fractal_dimension")

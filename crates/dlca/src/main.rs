@@ -6,13 +6,13 @@
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
+use core_lattice::cli::LogArgs;
 use core_lattice::io::RunClock;
 use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -129,13 +129,8 @@ struct Cli {
     #[arg(long)]
     png: bool,
 
-    /// No progress bar, warnings only.
-    #[arg(long, short)]
-    quiet: bool,
-
-    /// More log output (-v info, -vv debug); RUST_LOG overrides.
-    #[arg(short, action = clap::ArgAction::Count)]
-    verbose: u8,
+    #[command(flatten)]
+    log: LogArgs,
 }
 
 /// Side lengths as given to `--size`.
@@ -248,7 +243,7 @@ fn parse_boundary(s: &str) -> Result<Boundary, String> {
 }
 
 fn main() -> ExitCode {
-    core_lattice::cli::main_with("dlca", |c: &Cli| (c.quiet, c.verbose), params, run)
+    core_lattice::cli::main_with("dlca", |c: &Cli| c.log, params, run)
 }
 
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
@@ -275,16 +270,10 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     };
     tracing::info!("{}", sim.strategy_reason());
     let initial = sim.clusters();
-    let bar = (!cli.quiet && std::io::stderr().is_terminal()).then(|| {
-        let bar = indicatif::ProgressBar::new(initial.saturating_sub(target));
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
-            )
-            .expect("valid template"),
-        );
-        bar
-    });
+    let bar = cli.log.progress_bar(
+        initial.saturating_sub(target),
+        "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
+    );
     let mut saved = Ok(());
     sim.run_with(|s| {
         if let Some(n) = cli.checkpoint_every
@@ -306,7 +295,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     }
     saved.context("writing a checkpoint")?;
     let m = dlca::output::write_outputs(&sim, cli.seed, &clock, &cli.out, cli.png)?;
-    if !cli.quiet {
+    if !cli.log.quiet {
         eprintln!(
             "dlca: {} clusters (largest {}) after {} sweeps in {:.2} s with {}; outputs in {}",
             sim.clusters(),
