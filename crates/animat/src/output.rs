@@ -10,23 +10,10 @@
 
 use crate::params::Species;
 use crate::world::World;
-use core_lattice::io::image::ImageError;
 use core_lattice::io::{CsvWriter, RunClock, RunManifest, write_png_rgb};
 use std::path::Path;
 
-/// Errors writing an output file; each displays as the underlying error does.
-#[derive(Debug, thiserror::Error)]
-pub enum OutputError {
-    /// Creating, writing or renaming a file.
-    #[error(transparent)]
-    Io(#[from] std::io::Error),
-    /// Encoding a PNG snapshot.
-    #[error(transparent)]
-    Image(#[from] ImageError),
-    /// Serialising the manifest.
-    #[error(transparent)]
-    Json(#[from] serde_json::Error),
-}
+pub use core_lattice::io::OutputError;
 
 /// One row of `populations.csv`.
 #[derive(Debug, Clone, Copy, PartialEq)]

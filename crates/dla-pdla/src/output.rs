@@ -12,25 +12,12 @@
 
 use crate::sim::Simulation;
 use crate::space::{Dim, Space};
-use core_lattice::io::image::ImageError;
 use core_lattice::io::{AtomicFile, CsvField, CsvWriter, RunClock, RunManifest, write_png_gray};
 use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 
-/// Why an output could not be written.
-#[derive(Debug, thiserror::Error)]
-pub enum OutputError {
-    /// Creating, writing or renaming a file.
-    #[error(transparent)]
-    Io(#[from] std::io::Error),
-    /// Encoding the picture.
-    #[error(transparent)]
-    Image(#[from] ImageError),
-    /// Serialising the parameters into the manifest.
-    #[error(transparent)]
-    Json(#[from] serde_json::Error),
-}
+pub use core_lattice::io::OutputError;
 
 /// Format of the optional positions file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

@@ -13,7 +13,7 @@
 
 use crate::analysis::{ClusterMeasure, fractal_dimension, gyration, size_distribution};
 use crate::sim::Simulation;
-use core_lattice::io::{CsvField, CsvWriter, RunClock, write_png_rgb};
+use core_lattice::io::{CsvField, CsvWriter, OutputError, RunClock, write_png_rgb};
 use serde_json::json;
 use std::path::Path;
 
@@ -24,7 +24,7 @@ pub fn write_outputs(
     clock: &RunClock,
     dir: &Path,
     png: bool,
-) -> anyhow::Result<core_lattice::io::RunManifest> {
+) -> Result<core_lattice::io::RunManifest, OutputError> {
     let params = sim.params();
     let dim = sim.lattice().dim();
 
@@ -138,7 +138,7 @@ pub fn write_outputs(
     Ok(m)
 }
 
-fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> anyhow::Result<()> {
+fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputError> {
     let mut w = CsvWriter::create(
         dir.join("clusters.csv"),
         &["cluster", "size", "radius_of_gyration", "wraps"],
@@ -160,7 +160,7 @@ fn colour(id: u32) -> [u8; 3] {
 /// The final state as a picture: the lattice's first two axes (a projection for d >= 3; a strip
 /// for d = 1), one colour per cluster, scaled down by an integer factor so neither side exceeds
 /// 8192 pixels.
-fn write_picture(sim: &Simulation, path: &Path) -> anyhow::Result<()> {
+fn write_picture(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let l = sim.lattice();
     let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
     let factor = w0.max(h0).div_ceil(8192).max(1);

@@ -23,3 +23,21 @@ pub use hash::StateHasher;
 pub use image::{write_png_gray, write_png_rgb};
 pub use manifest::{ProcessUsage, RunClock, RunManifest};
 pub use table::{CsvField, CsvWriter};
+
+/// Why a model's output could not be written (every model's `output::write_outputs`); each
+/// displays as the underlying error does.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// Creating, writing or renaming a file.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// Encoding a picture.
+    #[error(transparent)]
+    Image(#[from] image::ImageError),
+    /// Serialising the manifest or the parameters in it.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+    /// A stored lattice site that does not decode: the model's state is inconsistent.
+    #[error(transparent)]
+    Lattice(#[from] crate::lattice::LatticeError),
+}
