@@ -121,10 +121,19 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "Table I's no-grid gradient"
     );
     let dlca = read(d, "dlca.md");
-    assert!(dlca.contains("about 30"), "seed 000's grid speed-up");
+    assert!(
+        dlca.contains("about 30"),
+        "the grid-boxing paper's grid speed-up"
+    );
     let dla = read(d, "dla.md");
-    assert!(dla.contains("3e-5 N - 6.9"), "seed 002's Fig. 3 fit");
-    assert!(dla.contains("97.5%"), "seed 002's parallel fraction");
+    assert!(
+        dla.contains("3e-5 N - 6.9"),
+        "the variable-precision paper's Fig. 3 fit"
+    );
+    assert!(
+        dla.contains("97.5%"),
+        "the variable-precision paper's parallel fraction"
+    );
     let acc = read(d, "accuracy.md");
     assert!(acc.contains("reference (most exact)") && acc.contains("| default |"));
 
@@ -157,7 +166,7 @@ fn only_runs_the_chosen_experiment() {
 /// error must also match the scatter it was given.
 #[test]
 fn fits_recover_known_slopes() {
-    // Seed 000, Table I style: cost = 2.5e-7 N^1.35.
+    // The grid-boxing paper, Table I style: cost = 2.5e-7 N^1.35.
     let n: Vec<f64> = (0..12).map(|i| 1000.0 * 2f64.powi(i)).collect();
     let exact: Vec<f64> = n.iter().map(|x| 2.5e-7 * x.powf(1.35)).collect();
     let f = Fit::log_log(&n, &exact).unwrap();
@@ -196,7 +205,7 @@ fn fits_recover_known_slopes() {
         "stderr {mean_err} vs spread {sd}"
     );
 
-    // Seed 002, Fig. 3 style: T = 3e-5 N - 6.9.
+    // The variable-precision paper, Fig. 3 style: T = 3e-5 N - 6.9.
     let t: Vec<f64> = n.iter().map(|x| 3e-5 * x - 6.9).collect();
     let f = Fit::linear(&n, &t).unwrap();
     assert!((f.slope - 3e-5).abs() < 1e-15 && (f.intercept + 6.9).abs() < 1e-9);

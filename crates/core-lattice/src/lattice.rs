@@ -1,6 +1,6 @@
 //! Hypercubic lattices addressed by k-index.
 //!
-//! Seed 000 (Hawick, James & Scogings), section III and Fig. 3: a site with Cartesian coordinates
+//! Hawick, James & Scogings (2006), section III and Fig. 3: a site with Cartesian coordinates
 //! `(x_1, ..., x_d)` on a lattice of side lengths `L_1, ..., L_d` is stored as the single integer
 //! k-index
 //!
@@ -9,7 +9,7 @@
 //! ```
 //!
 //! so that code written against k-indices does not depend on the dimension. This module adds what
-//! the DLCA model (seed 000, sections II.A and IV.A) needs on top: a boundary per axis (periodic or
+//! the DLCA model (the grid-boxing paper, sections II.A and IV.A) needs on top: a boundary per axis (periodic or
 //! wall), the `2d` face neighbours of a site, translation by a unit vector that reports
 //! [`Blocked`] at a wall, and minimum-image displacements on periodic axes.
 //!
@@ -26,7 +26,7 @@ pub const MAX_DIM: usize = 8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Boundary {
-    /// Site `L - 1` and site `0` are neighbours (a torus along this axis), as in seed 000.
+    /// Site `L - 1` and site `0` are neighbours (a torus along this axis), as in the grid-boxing paper.
     Periodic,
     /// The axis ends: there is no neighbour beyond `0` or `L - 1`, and a move across is blocked.
     Wall,
@@ -206,14 +206,14 @@ impl Direction {
     }
 }
 
-/// A translation was refused because it would cross a wall (seed 000 DLCA with closed
+/// A translation was refused because it would cross a wall (the grid-boxing paper DLCA with closed
 /// boundaries; `docs/dlca.md`, "The model", step 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("move blocked by a wall")]
 pub struct Blocked;
 
 /// The shape of a `d`-dimensional hypercubic lattice: a side length and a boundary per axis,
-/// and the strides of its k-index (seed 000, section III, Fig. 3).
+/// and the strides of its k-index (the grid-boxing paper, section III, Fig. 3).
 ///
 /// Built only through validating constructors, so every `Lattice` value has `1 <= d <= 8`,
 /// non-zero sides and a volume that fits in `u64`. Deserialisation validates too.
@@ -366,7 +366,7 @@ impl Lattice {
         self.volume
     }
 
-    /// The k-index of a site (seed 000, Fig. 3): `k = x_1 + x_2 L_1 + x_3 L_1 L_2 + ...`.
+    /// The k-index of a site (the grid-boxing paper, Fig. 3): `k = x_1 + x_2 L_1 + x_3 L_1 L_2 + ...`.
     pub fn encode(&self, x: &[u64]) -> Result<u64, LatticeError> {
         if x.len() != self.dim {
             return Err(LatticeError::CoordCount {
@@ -460,7 +460,7 @@ impl Lattice {
         (n != k).then_some(n)
     }
 
-    /// Translate site `k` by the unit vector `dir` (seed 000 DLCA moves, `docs/dlca.md`).
+    /// Translate site `k` by the unit vector `dir` (the grid-boxing paper DLCA moves, `docs/dlca.md`).
     ///
     /// On a periodic axis the move wraps around; on a wall axis a move past `0` or `L - 1`
     /// returns [`Blocked`]. On a periodic axis of length 1 the site moves onto itself.
@@ -561,7 +561,7 @@ mod tests {
 
     #[test]
     fn paper_fig3_example() {
-        // Seed 000, Fig. 3: a 12 x 6 lattice; site (x1, x2) = (3, 2) has k = 27.
+        // The grid-boxing paper, Fig. 3: a 12 x 6 lattice; site (x1, x2) = (3, 2) has k = 27.
         let l = Lattice::periodic(&[12, 6]).unwrap();
         assert_eq!(l.volume(), 72);
         assert_eq!(l.encode(&[3, 2]).unwrap(), 27);

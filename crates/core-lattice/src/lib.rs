@@ -3,7 +3,7 @@
 //! The foundation every model of the workspace stands on:
 //!
 //! - [`lattice`]: d-dimensional hypercubic lattices (d = 1..=8) addressed by the k-index of
-//!   Hawick, James & Scogings (seed 000, section III, Fig. 3), with periodic or wall boundaries
+//!   Hawick, James & Scogings (2006, section III, Fig. 3), with periodic or wall boundaries
 //!   per axis, face neighbours, unit translations and minimum-image displacements.
 //! - [`rng`]: deterministic `Pcg64Mcg` streams derived from `(seed, stream id)`, and the sampling
 //!   helpers the models share (isotropic unit vectors, weighted lattice directions, shuffles).

@@ -1,6 +1,6 @@
 //! Benchmarks of [`spatial::plane::PlaneGrid`]: the animat nearest-of-kind query with vision
 //! radius 60 at a fixed density of one animat per 100 cells, for 1e3 to 1e6 animats, grid boxes
-//! of side 60, 120 and 240 against the exhaustive "no grid" scan (seed 000, section IV.B,
+//! of side 60, 120 and 240 against the exhaustive "no grid" scan (the grid-boxing paper, section IV.B,
 //! Fig. 9 and Table I). Also: the overcrowding count and the unit-step move.
 //!
 //! Run with `cargo bench -p spatial --bench plane`. Each benchmark iteration is a batch of
@@ -21,7 +21,7 @@ enum Species {
     Rabbit,
 }
 
-/// Vision radius of the animat model (seed 000, section IV.B), squared.
+/// Vision radius of the animat model (the grid-boxing paper, section IV.B), squared.
 const VISION2: u64 = 60 * 60;
 /// Cells per animat.
 const CELLS_PER_ANIMAT: u64 = 100;

@@ -1,4 +1,4 @@
-//! Bytes per point of the orthtree (seed 002, section 3.3 reports memory per particle) on a
+//! Bytes per point of the orthtree (the variable-precision paper, section 3.3 reports memory per particle) on a
 //! DLA-like branched cluster of touching unit discs and on uniform points at unit density, for
 //! several leaf sides.
 //!

@@ -1,4 +1,4 @@
-//! Query cost of the orthtree by kind of query point (seed 002, section 3.2: walkers near the
+//! Query cost of the orthtree by kind of query point (the variable-precision paper, section 3.2: walkers near the
 //! cluster, inside the birth circle, outside it), against kiddo's nearest-one.
 //!
 //! ```text

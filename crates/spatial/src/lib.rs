@@ -2,15 +2,15 @@
 //!
 //! - [`orthtree`]: quadtree (D = 2), octree (D = 3), 2^D children in general, with an exact
 //!   nearest-distance query and the variable-precision distance search `vpdist` of
-//!   Sosa-Herrera & Rodriguez-Romo (seed 002, section 3.1, Listing 1).
+//!   Sosa-Herrera & Rodriguez-Romo (section 3.1, Listing 1).
 //! - [`distmap`]: a coarse distance map (Ball & Brady) in front of the orthtree: one byte per
 //!   cell bounding the distance to a growing point set, so DLA walkers far from the cluster
 //!   jump without a tree query.
 //! - [`lattice`]: contact search for items made of lattice sites (the DLCA clusters of Hawick,
-//!   James & Scogings, seed 000, sections II.A, III, IV.A): the all-pairs baseline, grid boxes
+//!   James & Scogings 2006, sections II.A, III, IV.A): the all-pairs baseline, grid boxes
 //!   over a periodic or walled lattice, and an occupancy lattice, all exact and interchangeable.
 //! - [`plane`]: grid boxes hashed over the unbounded integer plane, for the animat model of
-//!   Hawick, James & Scogings (seed 000, sections II.B and IV.B).
+//!   Hawick, James & Scogings (2006, sections II.B and IV.B).
 
 pub mod distmap;
 pub mod lattice;

@@ -1,4 +1,4 @@
-//! Property tests of the orthtree against brute force (seed 002, section 3.1, Listing 1 and its
+//! Property tests of the orthtree against brute force (the variable-precision paper, section 3.1, Listing 1 and its
 //! error analysis; storage of section 3.3).
 //!
 //! Brute force works on the stored positions returned by `insert` (they differ from the inserted

@@ -467,7 +467,7 @@ fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
         "{queries} query points uniform in the birth disc of a {n}-particle cluster, keeping \
          those farther than one diameter from every particle (where walkers query). The \
          relative error is (d - vpdist) / d with d the exact nearest distance; vpdist never \
-         overestimates. Seed 002's Listing 1 returns a node-centre estimate when the node is \
+         overestimates. Listing 1 of Sosa-Herrera & Rodriguez-Romo returns a node-centre estimate when the node is \
          far enough; our bound is the proven one (`docs/spatial.md`)."
     ));
     ctx.table(doc, &table, "accuracy_vpdist.csv")?;

@@ -1,4 +1,4 @@
-//! Seed 000, animats (sections II.B, IV.B): neighbour-search time per step against population
+//! Hawick, James & Scogings (2006), animats (sections II.B, IV.B): neighbour-search time per step against population
 //! for grid boxes of 60, 120 and 240 cells and no grid (Fig. 9), and the fitted log-log
 //! gradients (Table I).
 
@@ -14,7 +14,7 @@ use core_lattice::Fit;
 /// default start's density (2300 animats on a disc of radius 60), as in `docs/benchmarks.md`.
 pub const DENSITY: f64 = 0.2;
 
-/// Seed 000, Table I: fitted gradients and their errors, as printed.
+/// Hawick, James & Scogings (2006), Table I: fitted gradients and their errors, as printed.
 const TABLE_I: [(&str, f64, f64); 4] = [
     ("none", 1.96384, 0.0112363),
     ("240", 1.70614, 0.0359479),
@@ -108,13 +108,13 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         ),
     ];
     let mut doc =
-        ctx.doc("Seed 000: animats, neighbour-search cost against population (Fig. 9, Table I)");
+        ctx.doc("Hawick, James & Scogings (2006): animats, neighbour-search cost against population (Fig. 9, Table I)");
     doc.p(&format!(
         "Worlds of N animats (foxes and rabbits in the default ratio, default rules and \
          parameters, vision 60) placed uniformly on a disc at a fixed density of {DENSITY} \
          animats per cell (the default start's density), then {steps} timed steps. The search \
          time is the time spent inside perception queries (`--timing`). Rows marked *boxes* \
-         use seed 000's structure, grid boxes alone; the row marked *cells + boxes* is our \
+         use the paper's structure, grid boxes alone; the row marked *cells + boxes* is our \
          default, where a dense per-cell index answers adjacency, crowding and the first rings \
          of nearest/count queries before the grid boxes (`docs/animat.md`). The items the grid \
          searches examine are counted exactly (N per query without boxes, the halo's items \
@@ -136,7 +136,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         "populations",
         "gradient of search time (ours)",
         "gradient of items examined by the grid (ours)",
-        "gradient (seed 000, Table I)",
+        "gradient (paper, Table I)",
     ]);
     let mut series = Vec::new();
     for (grid, cells, max_n) in configs {
@@ -198,7 +198,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     ctx.table(&mut doc, &table, "animat_table1.csv")?;
     doc.p(
         "Gradients are least-squares slopes of log(cost) against log(population), ± their \
-         standard errors. Seed 000 fitted its curves over the populations its runs reached; our \
+         standard errors. The paper fitted its curves over the populations its runs reached; our \
          ladder is given in the table. Populations grow during the measured steps, so each \
          point's population is the mean over them. Target for 60-cell boxes: gradient <= 1.10.",
     );

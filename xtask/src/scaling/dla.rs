@@ -1,4 +1,4 @@
-//! Seed 002, DLA and PDLA (sections 3-4): run time against N with the exact search and with
+//! Sosa-Herrera & Rodriguez-Romo, DLA and PDLA (sections 3-4): run time against N with the exact search and with
 //! `vpdist` (Fig. 3), fractal dimensions in Table 2's layout, and the PDLA speed-up with the
 //! parallel fraction from Amdahl's law.
 
@@ -60,11 +60,12 @@ pub fn fit_from(n: u64) -> u64 {
 
 /// Run Fig. 3, Table 2 and the PDLA speed-up; write `dla.md`.
 pub fn run(ctx: &Ctx) -> Result<()> {
-    let mut doc = ctx.doc("Seed 002: off-lattice DLA and PDLA (Fig. 3, Table 2)");
+    let mut doc =
+        ctx.doc("Sosa-Herrera & Rodriguez-Romo: off-lattice DLA and PDLA (Fig. 3, Table 2)");
     doc.p(
-        "Off-lattice DLA on the orthtree (MODELS.md section 2) with the default parameters \
+        "Off-lattice DLA on the orthtree (`docs/dla.md`) with the default parameters \
          (birth gap 5, exact far-field return, step 0.5, vpdist precision 2) unless a table \
-         says otherwise. Seed 002 used the paper's jump-and-kill far field and 64-bit integer \
+         says otherwise. The paper used a jump-and-kill far field and 64-bit integer \
          coordinates; see `docs/dla.md` for what we changed and why.",
     );
     fig3(ctx, &mut doc)?;
@@ -85,7 +86,7 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
         "fitted T = a N + b: a (microseconds per particle)",
         "b (s)",
         "r^2",
-        "paper (seed 002, Fig. 3, 2008 hardware)",
+        "paper (Fig. 3, 2008 hardware)",
     ]);
     let mut data = Table::new(&["d", "search", "n", "seconds"]);
     let mut series = Vec::new();
@@ -218,10 +219,10 @@ fn table2(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
             let (m, se) = mean_stderr(&ds);
             let reference = match d {
                 2 => {
-                    "seed 002: 1.7106 (sigma 0.0047, N 1e9, P 1, E 10); 1.7125 (0.0129, 1e9, P 4, E 80); literature 1.71; about 1.66-1.67 below 1e6 (REFERENCE.md)"
+                    "paper: 1.7106 (sigma 0.0047, N 1e9, P 1, E 10); 1.7125 (0.0129, 1e9, P 4, E 80); literature 1.71; about 1.66-1.67 below 1e6 (finite size, `docs/dla.md`)"
                 }
                 _ => {
-                    "seed 002: 2.5312 (sigma 0.0082, N 1e8, P 1, E 50); 2.5032 (0.0172, 1e8, P 4, E 80); literature 2.50 +- 0.02"
+                    "paper: 2.5312 (sigma 0.0082, N 1e8, P 1, E 50); 2.5032 (0.0172, 1e8, P 4, E 80); literature 2.50 +- 0.02"
                 }
             };
             table.row(vec![
@@ -240,11 +241,11 @@ fn table2(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
     data.write_csv(&ctx.path("dla_table2_runs.csv"))?;
     doc.p(&format!(
         "D is the slope of log N against log R_g over the growth samples with N >= {} (about \
-         1000 log-spaced samples per cluster, as seed 002 took 1e3 R_g measurements per \
+         1000 log-spaced samples per cluster, as the paper took 1e3 R_g measurements per \
          cluster), averaged over E clusters; sigma is the standard deviation over clusters, as \
          in the paper, and the standard error is sigma / sqrt(E). Our clusters are far smaller \
          than the paper's 1e8-1e10, so D sits below the asymptotic value by the finite-size \
-         amount REFERENCE.md describes. Per-run values: \
+         amount `docs/dla.md` describes. Per-run values: \
          [`dla_table2_runs.csv`](dla_table2_runs.csv).",
         fit_from(n2)
     ));
@@ -264,7 +265,7 @@ fn speedup(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
         "speed-up over P = 1",
         "parallel fraction r_p",
         "discarded walkers per particle",
-        "paper (seed 002)",
+        "paper",
     ]);
     // Seed-major: each seed runs with 1 then 2 threads back to back, so a drift of the
     // machine's speed during the measurement affects both sides alike.

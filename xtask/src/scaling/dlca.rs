@@ -1,4 +1,4 @@
-//! Seed 000, DLCA (sections III, IV.A): clusters against sweeps (Fig. 5), time per sweep over
+//! Hawick, James & Scogings (2006), DLCA (sections III, IV.A): clusters against sweeps (Fig. 5), time per sweep over
 //! clusters for each strategy and the grid boxes' speed-up (Fig. 6), histograms of candidate
 //! clusters examined per move (Figs. 4, 7, 8), and the log-log gradient of the sweep cost
 //! against N for each strategy.
@@ -35,10 +35,9 @@ fn size_name(size: [u64; 2]) -> String {
 
 /// Run the DLCA experiments and write `dlca.md`.
 pub fn run(ctx: &Ctx) -> Result<()> {
-    let mut doc = ctx.doc("Seed 000: DLCA with grid boxes (Figs. 4-8)");
+    let mut doc = ctx.doc("Hawick, James & Scogings (2006): DLCA with grid boxes (Figs. 4-8)");
     doc.p(
-        "Diffusion-limited cluster-cluster aggregation on a periodic 2D lattice (MODELS.md \
-         section 1), unit temperature, no gravity, mobility exponent 0. A sweep is one update \
+        "Diffusion-limited cluster-cluster aggregation on a periodic 2D lattice (`docs/dlca.md`), unit temperature, no gravity, mobility exponent 0. A sweep is one update \
          step of the paper: every cluster is offered one move. All three contact searches \
          (`all-pairs`, `grid` boxes, occupancy `lattice`) give the same trajectory, so their \
          times are compared sweep by sweep on identical states.",
@@ -66,7 +65,7 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "runs",
         "sweeps to 100 clusters",
         "decay exponent z (n_c ~ t^-z)",
-        "paper (seed 000, Fig. 5)",
+        "paper (Fig. 5)",
     ]);
     let mut data = Table::new(&["fill", "seed", "sweep", "clusters", "largest"]);
     let mut series = Vec::new();
@@ -197,7 +196,7 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "speed-up over all-pairs (mean of per-sweep ratios)",
         "speed-up (ratio of totals)",
         "same cluster series",
-        "paper (seed 000, Fig. 6)",
+        "paper (Fig. 6)",
     ]);
     let mut data = Table::new(&[
         "fill",
@@ -342,7 +341,7 @@ fn histograms(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "mean candidates",
         "max",
         "moves with no candidate",
-        "paper (seed 000)",
+        "paper",
     ]);
     let mut data = Table::new(&["fill", "sweep", "candidates", "moves"]);
     let mut charts = Vec::new();
@@ -514,7 +513,7 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     )?;
     doc.p(&format!(
         "Mean wall time of sweeps 1-{k} at {}% fill on L x L/2 lattices; gradient ± its \
-         least-squares standard error. Seed 000 gives no such gradient for DLCA (its Table I is \
+         least-squares standard error. The paper gives no such gradient for DLCA (its Table I is \
          for animats); the expectations are the algorithms' own. Data: \
          [`dlca_cost.csv`](dlca_cost.csv).",
         fill * 100.0

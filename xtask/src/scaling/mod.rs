@@ -50,11 +50,11 @@ impl Scale {
 /// The experiments, in the order they run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Experiment {
-    /// Seed 000, DLCA: Figs. 4-8 and the sweep cost against N.
+    /// Hawick, James & Scogings (2006), DLCA: Figs. 4-8 and the sweep cost against N.
     Dlca,
-    /// Seed 000, animats: Fig. 9 and Table I.
+    /// Hawick, James & Scogings (2006), animats: Fig. 9 and Table I.
     Animat,
-    /// Seed 002, DLA: Fig. 3, Table 2, the PDLA speed-up.
+    /// Sosa-Herrera & Rodriguez-Romo, DLA: Fig. 3, Table 2, the PDLA speed-up.
     Dla,
     /// Accuracy against speed for DLA: precision, step length, far field.
     Accuracy,

@@ -1,4 +1,4 @@
-//! Grid boxes over a lattice (seed 000, section II, Fig. 1; section IV.A).
+//! Grid boxes over a lattice (the grid-boxing paper, section II, Fig. 1; section IV.A).
 
 use super::{ContactSearch, ItemId, SiteSets, StampSet, coords_of, touches};
 use core_lattice::{Boundary, Direction, Lattice, MAX_DIM};
@@ -20,7 +20,7 @@ pub enum GridError {
 }
 
 /// Grid boxes of side `A` (a power of two) over a periodic or walled lattice, holding the items
-/// registered in each box (seed 000's grid-boxing of the DLCA model).
+/// registered in each box (the grid-boxing paper's grid-boxing of the DLCA model).
 ///
 /// Each item is registered, with a particle count, in every box that holds one of its
 /// particles, so items larger than a box span several boxes. A contact query gathers the items
@@ -35,7 +35,7 @@ pub enum GridError {
 /// move's axis); a merge moves the merged item's registrations to the survivor. When items grow
 /// larger than a box the model doubles `A` with [`LatticeGridBoxes::set_side`], which rebuilds
 /// the boxes. Once `3A >= L` on some axis ([`LatticeGridBoxes::stops_paying`]) the halo covers
-/// the whole axis and grid boxes no longer save work (seed 000, section IV.A).
+/// the whole axis and grid boxes no longer save work (the grid-boxing paper, section IV.A).
 #[derive(Debug, Clone)]
 pub struct LatticeGridBoxes {
     lattice: Lattice,
@@ -134,7 +134,7 @@ impl LatticeGridBoxes {
         self.boxes.len()
     }
 
-    /// Whether `3A >= L` on some axis, where the halo spans the whole axis and seed 000 finds
+    /// Whether `3A >= L` on some axis, where the halo spans the whole axis and the grid-boxing paper finds
     /// grid-boxing stops paying.
     pub fn stops_paying(&self) -> bool {
         (0..self.lattice.dim()).any(|a| 3 * self.side >= self.lattice.size(a))

@@ -1,6 +1,6 @@
-//! Contact search for items made of lattice sites: the DLCA clusters of seed 000.
+//! Contact search for items made of lattice sites: the DLCA clusters of the grid-boxing paper.
 //!
-//! Seed 000 (Hawick, James & Scogings), sections II.A, III and IV.A: after a cluster moves one
+//! Hawick, James & Scogings (2006), sections II.A, III and IV.A: after a cluster moves one
 //! lattice step, the model must find every other cluster with a particle face-adjacent to one of
 //! its particles, and merge with them. This module holds the clusters and three interchangeable
 //! ways to answer that question, all giving exactly the same answer:
@@ -37,7 +37,7 @@ use core_lattice::{Direction, Lattice, MAX_DIM};
 /// clusters `0..N`.
 pub type ItemId = u32;
 
-/// The contact query shared by the three strategies (seed 000, section IV.A).
+/// The contact query shared by the three strategies (the grid-boxing paper, section IV.A).
 ///
 /// The caller keeps the [`SiteSets`] and the strategy in step: every change to the sets is
 /// reported to the strategy with the same arguments. Items must not share sites (in DLCA they
@@ -63,7 +63,7 @@ pub trait ContactSearch {
 
     /// The items other than `id` with a site face-adjacent to a site of `id`, in increasing
     /// id, without repeats, written to `out` (which is cleared first). Returns the number of
-    /// candidate items examined (the quantity histogrammed in seed 000, Figs. 4, 7, 8).
+    /// candidate items examined (the quantity histogrammed in the grid-boxing paper, Figs. 4, 7, 8).
     fn contacts(&mut self, sets: &SiteSets, id: ItemId, out: &mut Vec<ItemId>) -> usize;
 }
 
@@ -75,7 +75,7 @@ fn coords_of(lattice: &Lattice, k: u64) -> [u64; MAX_DIM] {
 
 /// Whether site coordinates `p` and `q` are face-adjacent, comparing one axis at a time and
 /// leaving at the first axis on which they are more than one step apart (the per-axis early
-/// exit of seed 000's all-pairs search).
+/// exit of the grid-boxing paper's all-pairs search).
 #[inline]
 fn adjacent_coords(lattice: &Lattice, p: &[u64; MAX_DIM], q: &[u64; MAX_DIM]) -> bool {
     let mut unit_axes = 0;

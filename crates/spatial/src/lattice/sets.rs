@@ -1,10 +1,10 @@
 //! The clusters themselves: arrays of k-indices, one per live item, with an indirect list of
-//! live items (seed 000, section III, Fig. 2).
+//! live items (the grid-boxing paper, section III, Fig. 2).
 
 use super::ItemId;
 use core_lattice::{Blocked, Boundary, Direction, Lattice};
 
-/// Items (clusters) as sets of lattice sites, stored as k-index arrays (seed 000, Fig. 2).
+/// Items (clusters) as sets of lattice sites, stored as k-index arrays (the grid-boxing paper, Fig. 2).
 ///
 /// Ids are handed out in increasing order from 0 and never reused. The live list plays the role
 /// of the paper's left-hand array: it makes iterating over the live items cheap although merged

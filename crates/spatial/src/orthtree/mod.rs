@@ -1,9 +1,9 @@
 //! Orthtree: quadtree (D = 2), octree (D = 3), 2^D children in general, with an exact nearest
 //! distance query and the variable-precision distance search `vpdist` of Sosa-Herrera &
 //! Rodriguez-Romo, *Variable precision distance search for random fractal cluster simulations*
-//! (seed 002, section 3.1 and Listing 1; storage after section 3.3).
+//! (the variable-precision paper, section 3.1 and Listing 1; storage after section 3.3).
 //!
-//! Built for off-lattice DLA/PDLA (seed 002, sections 3.3 and 3.4): particle centres in units
+//! Built for off-lattice DLA/PDLA (the variable-precision paper, sections 3.3 and 3.4): particle centres in units
 //! of particle diameters, inserted one at a time, queried millions of times by random walkers.
 //!
 //! # Structure
@@ -26,7 +26,7 @@
 //!   point (the error bound below relies on this).
 //! - **Leaves.** `Vec<Leaf>`, 8 bytes each: the start and length of the leaf's block in the pool.
 //! - **Points.** One pool of `[u32; D]` records: each coordinate is a fixed-point offset inside
-//!   the leaf cell, in units of `s / 2^32` (seed 002, section 3.3 stores relative coordinates in
+//!   the leaf cell, in units of `s / 2^32` (the variable-precision paper, section 3.3 stores relative coordinates in
 //!   one byte; that is far too coarse for contact within 1e-6, 32 bits give `s / 2^33`, about
 //!   5e-10 for `s = 4`). A leaf's points are contiguous; blocks come in size classes with free
 //!   lists (exact sizes up to 16 points, see `pool.rs`), so small leaves waste nothing. When
@@ -65,7 +65,7 @@
 //! |---|---|
 //! | [`insert`](Orthtree::insert) | O(h + points in the leaf) (a leaf's block is copied when it grows) |
 //! | [`nearest`](Orthtree::nearest), [`nearest_distance`](Orthtree::nearest_distance) | branch and bound: O(h) plus the nodes whose box is closer than the answer |
-//! | [`vpdist`](Orthtree::vpdist) | O(h) nodes times a constant depending on `kappa` and `D` only (seed 002, Listing 1) |
+//! | [`vpdist`](Orthtree::vpdist) | O(h) nodes times a constant depending on `kappa` and `D` only (the variable-precision paper, Listing 1) |
 //! | [`for_each_within`](Orthtree::for_each_within) | O(h + nodes meeting the ball + points reported) |
 //! | [`iter`](Orthtree::iter) | O(N + nodes) |
 //!
@@ -75,7 +75,7 @@
 //!
 //! # Variable-precision distance and its error bound
 //!
-//! [`vpdist`](Orthtree::vpdist) is Listing 1 of seed 002 in `D` dimensions with the precision
+//! [`vpdist`](Orthtree::vpdist) is Listing 1 of the variable-precision paper in `D` dimensions with the precision
 //! `kappa` as a parameter (the paper uses `kappa = 2`). Starting from the root, for each node `n`
 //! with centre `c` and half diagonal `r` (`DIAGONAL = 2 r`):
 //!
@@ -146,7 +146,7 @@ use pool::LeafPool;
 pub use query::{Neighbour, VpEstimate, dist_sq};
 
 /// The orthtree's default leaf side `s`, in particle diameters: the side of the leaf cells
-/// (the last level of the tree, where seed 002, section 3.3, keeps its chunks of particles)
+/// (the last level of the tree, where the variable-precision paper, section 3.3, keeps its chunks of particles)
 /// that [`Orthtree::new`] uses. With `s = 4`, a leaf holds 4 to 5 DLA particles. A model may
 /// choose another side through [`Orthtree::with_leaf_side`]; see the module docs for the
 /// trade-off.
@@ -163,7 +163,7 @@ pub const MAX_LEAF_SIDE: f64 = 2048.0;
 /// diameters for the default), so that all cell geometry is exact in `f64`.
 pub const COORD_LIMIT_LEAVES: f64 = 1_125_899_906_842_624.0;
 
-/// The precision used in the paper (seed 002, Listing 1, line 07: `DIAGONAL(node) * 2`).
+/// The precision used in the paper (Listing 1, line 07: `DIAGONAL(node) * 2`).
 pub const PAPER_KAPPA: f64 = 2.0;
 
 /// Empty child slot.
@@ -230,7 +230,7 @@ struct Leaf {
 }
 
 /// Quadtree (`D = 2`), octree (`D = 3`) or `2^D`-ary tree of points with exact nearest-distance
-/// and variable-precision distance queries (seed 002, sections 3.1 and 3.3, Listing 1).
+/// and variable-precision distance queries (the variable-precision paper, sections 3.1 and 3.3, Listing 1).
 ///
 /// See the [module documentation](self) for the layout, the complexity and the error bound of
 /// [`vpdist`](Self::vpdist). `D` must be in `1..=8`.
@@ -304,7 +304,7 @@ impl<const D: usize> Orthtree<D> {
     /// Children per internal node.
     const FANOUT: usize = 1 << D;
 
-    /// An empty tree with the default leaf side [`DEFAULT_LEAF_SIDE`] (seed 002, section 3.3).
+    /// An empty tree with the default leaf side [`DEFAULT_LEAF_SIDE`] (the variable-precision paper, section 3.3).
     pub fn new() -> Self {
         const { assert!(is_valid_leaf_side(DEFAULT_LEAF_SIDE)) };
         Self::empty(DEFAULT_LEAF_SIDE)
@@ -312,7 +312,7 @@ impl<const D: usize> Orthtree<D> {
 
     /// An empty tree whose leaf cells have side `leaf_side` (a power of two in
     /// [`MIN_LEAF_SIDE`, `MAX_LEAF_SIDE`], in particle diameters). See the module docs for the
-    /// trade-off (seed 002, section 3.3).
+    /// trade-off (the variable-precision paper, section 3.3).
     pub fn with_leaf_side(leaf_side: f64) -> Result<Self, OrthtreeError> {
         if !is_valid_leaf_side(leaf_side) {
             return Err(OrthtreeError::InvalidLeafSide(leaf_side));
@@ -338,7 +338,7 @@ impl<const D: usize> Orthtree<D> {
         }
     }
 
-    /// Checks a precision parameter for [`vpdist`](Self::vpdist) (seed 002, Listing 1, line 07):
+    /// Checks a precision parameter for [`vpdist`](Self::vpdist) (the variable-precision paper, Listing 1, line 07):
     /// `kappa > 1/2` (finite) or `+inf`. Use it when validating run parameters; `vpdist` itself
     /// accepts any value.
     pub fn check_kappa(kappa: f64) -> Result<f64, OrthtreeError> {
@@ -359,7 +359,7 @@ impl<const D: usize> Orthtree<D> {
         self.len == 0
     }
 
-    /// Side of the leaf cells (seed 002, section 3.1: the last level of the tree).
+    /// Side of the leaf cells (the variable-precision paper, section 3.1: the last level of the tree).
     pub fn leaf_side(&self) -> f64 {
         self.leaf_side
     }
@@ -384,7 +384,7 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// Heap and inline bytes of the structure: the capacities (not lengths) of the node, leaf
-    /// and point vectors, free blocks included, plus `size_of::<Self>()` (seed 002, section 3.3
+    /// and point vectors, free blocks included, plus `size_of::<Self>()` (the variable-precision paper, section 3.3
     /// reports memory per particle).
     pub fn memory_bytes(&self) -> usize {
         size_of::<Self>()

@@ -1,5 +1,5 @@
 //! Compact leaf storage: one pool of fixed-point point records, carved into per-leaf blocks by
-//! size class (seed 002, section 3.3: "pointers addressing list structures containing chunks of
+//! size class (the variable-precision paper, section 3.3: "pointers addressing list structures containing chunks of
 //! 10 particles", here contiguous blocks instead of linked chunks).
 //!
 //! A leaf holding `n` points owns one contiguous block of `cap(n)` slots, where `cap(n) = n` for

@@ -1,4 +1,4 @@
-//! Queries: exact nearest neighbour, variable-precision distance (seed 002, section 3.1,
+//! Queries: exact nearest neighbour, variable-precision distance (the variable-precision paper, section 3.1,
 //! Listing 1) and the fixed-radius range query.
 //!
 //! One recursive branch-and-bound walk serves the nearest and `vpdist` queries, monomorphised on
@@ -18,7 +18,7 @@ const FAR_SHRINK: f64 = 1.0 / 17_592_186_044_416.0;
 
 /// Visiting order of the children of a node, as masks XORed with the child containing the query
 /// point: by number of flipped axes (the paper's son, left and right siblings, then the opposite
-/// sibling; seed 002, Listing 1, lines 22-32), generalised to `D` axes.
+/// sibling; the variable-precision paper, Listing 1, lines 22-32), generalised to `D` axes.
 const CHILD_ORDER: [[u8; 256]; 9] = child_orders();
 
 const fn child_orders() -> [[u8; 256]; 9] {
@@ -54,7 +54,7 @@ pub struct Neighbour<const D: usize> {
 }
 
 /// A variable-precision distance with where it came from, from [`Orthtree::vpdist_detailed`]
-/// (seed 002, section 3.1: `d(p, q) in [d_app, d_app + 2r]`).
+/// (the variable-precision paper, section 3.1: `d(p, q) in [d_app, d_app + 2r]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VpEstimate {
     /// The value [`Orthtree::vpdist`] returns: a lower bound of the exact nearest distance.
@@ -86,7 +86,7 @@ impl<const D: usize> Orthtree<D> {
     /// Exact distance from `p` to the nearest stored point, `None` on an empty tree.
     ///
     /// Branch and bound over the tree: the child containing `p` first, then siblings whose box
-    /// is closer than the best distance so far (seed 002, Listing 1 with `kappa = inf`). The
+    /// is closer than the best distance so far (the variable-precision paper, Listing 1 with `kappa = inf`). The
     /// value equals, bit for bit, `sqrt` of the minimum over [`iter`](Self::iter) of the
     /// squared distance summed axis by axis.
     pub fn nearest_distance(&self, p: &[f64; D]) -> Option<f64> {
@@ -103,7 +103,7 @@ impl<const D: usize> Orthtree<D> {
             })
     }
 
-    /// Variable-precision distance from `p` to the stored points: seed 002, section 3.1,
+    /// Variable-precision distance from `p` to the stored points: the variable-precision paper, section 3.1,
     /// Listing 1, in `D` dimensions with precision `kappa` (the paper's value is
     /// [`PAPER_KAPPA`](super::PAPER_KAPPA) = 2). `None` on an empty tree.
     ///
@@ -130,7 +130,7 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// [`vpdist`](Self::vpdist) together with the half diagonal of the node that produced an
-    /// approximate answer (seed 002, section 3.1: `d(p, q) in [d_app, d_app + 2r]`), for
+    /// approximate answer (the variable-precision paper, section 3.1: `d(p, q) in [d_app, d_app + 2r]`), for
     /// accuracy studies and tests. Same walk and same value as `vpdist`.
     pub fn vpdist_detailed(&self, p: &[f64; D], kappa: f64) -> Option<VpEstimate> {
         let s = if kappa == f64::INFINITY || kappa.is_nan() {
@@ -147,7 +147,7 @@ impl<const D: usize> Orthtree<D> {
     /// Calls `f` with the stored position of every point at distance `<= r` from `p` (inclusive,
     /// comparing squared distances summed axis by axis, as
     /// [`nearest_distance`](Self::nearest_distance) does). Order unspecified. Nothing is called if `r` is negative
-    /// or NaN. Used by DLA to find the first contact along a step (seed 002, section 3.2,
+    /// or NaN. Used by DLA to find the first contact along a step (the variable-precision paper, section 3.2,
     /// Fig. 6).
     pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, mut f: F) {
         if self.root == EMPTY || r.is_nan() || r < 0.0 {

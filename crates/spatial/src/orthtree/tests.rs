@@ -266,7 +266,7 @@ fn relative_bound_is_tight() {
     }
 }
 
-/// The paper (seed 002, section 3.1) says the result is exact when `d(p, q) < 2 d_g` or when `p`
+/// The paper (section 3.1) says the result is exact when `d(p, q) < 2 d_g` or when `p`
 /// is closer than `2 d_g` to the centre of the leaf containing `q` (kappa = 2). Neither holds:
 /// another far leaf next to `p` undercuts `d`. The threshold `(kappa - 1/2) d_g` is sufficient
 /// (property tests) and `exact_radius_is_tight` shows it cannot be raised.

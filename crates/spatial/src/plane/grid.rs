@@ -43,7 +43,7 @@ fn box_key(side: Option<i64>, p: Pos) -> [i64; 2] {
 }
 
 /// Grid boxes over the unbounded 2D integer plane, holding point items with an id, a kind and a
-/// position (seed 000, section II.B: a list of animats per grid box; section III: the data
+/// position (the grid-boxing paper, section II.B: a list of animats per grid box; section III: the data
 /// structures; section IV.B, Fig. 9 and Table I: grid sizes against "no grid").
 ///
 /// `K` is the kind of an item (the animat species); any small `Copy + Eq` type works. Ids are
@@ -82,7 +82,7 @@ impl<K: Copy> Clone for PlaneGrid<K> {
 }
 
 impl<K: Copy + Eq> PlaneGrid<K> {
-    /// An empty grid with the given box size (seed 000, section IV.B: 60, 120, 240 or none).
+    /// An empty grid with the given box size (the grid-boxing paper, section IV.B: 60, 120, 240 or none).
     ///
     /// # Errors
     /// [`PlaneError::BadBoxSide`] if the side is zero or negative.
@@ -125,7 +125,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
         self.track_cells
     }
 
-    /// An empty grid with boxes of side `a` cells (seed 000, section II.B).
+    /// An empty grid with boxes of side `a` cells (the grid-boxing paper, section II.B).
     ///
     /// # Errors
     /// [`PlaneError::BadBoxSide`] if `a <= 0`.
@@ -134,7 +134,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// An empty grid without boxes: every query scans all items, the "no grid" baseline of
-    /// seed 000, Fig. 9 and Table I.
+    /// the grid-boxing paper, Fig. 9 and Table I.
     pub fn exhaustive() -> Self {
         Self::empty(None)
     }
@@ -149,7 +149,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
 
     /// Rebuilds the boxes with a new size, keeping every item (and all answers). O(N).
     ///
-    /// The animat model keeps its box size fixed (seed 000, section II.B); this serves
+    /// The animat model keeps its box size fixed (the grid-boxing paper, section II.B); this serves
     /// experiments that compare sizes on one population, and the box doubling of section II.A.
     ///
     /// # Errors
@@ -182,7 +182,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// Number of non-empty grid boxes (1 in [`BoxSize::None`] mode unless empty). Useful to
-    /// judge whether a box size suits the density (seed 000, section V).
+    /// judge whether a box size suits the density (the grid-boxing paper, section V).
     pub fn box_count(&self) -> usize {
         self.boxes.len()
     }

@@ -1,7 +1,7 @@
 //! Grid boxes hashed over the unbounded 2D integer plane, for the animat model.
 //!
 //! This module serves Hawick, James & Scogings, *Grid-Boxing for Spatial Simulation Performance
-//! Optimisation* (seed 000): the animat predator-prey model of section II.B lives on an unbounded
+//! Optimisation* (2006): the animat predator-prey model of section II.B lives on an unbounded
 //! plane, every animat needs its nearest neighbours of each species and a count of the animats
 //! around it, and section IV.B (Fig. 9, Table I) compares grid boxes of side 60, 120 and 240
 //! against the exhaustive "no grid" search. [`PlaneGrid`] offers both: boxes of any positive side
@@ -99,11 +99,11 @@ use std::str::FromStr;
 pub use grid::PlaneGrid;
 pub use stats::SearchStats;
 
-/// A cell of the unbounded integer plane, `[x, y]` (seed 000, section II.B: animats live on an
+/// A cell of the unbounded integer plane, `[x, y]` (the grid-boxing paper, section II.B: animats live on an
 /// unbounded plane, one per cell).
 pub type Pos = [i64; 2];
 
-/// Grid-box size of a [`PlaneGrid`] (seed 000, sections II.B and IV.B: grids of 60, 120 and 240
+/// Grid-box size of a [`PlaneGrid`] (the grid-boxing paper, sections II.B and IV.B: grids of 60, 120 and 240
 /// cells, or no grid at all).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BoxSize {

@@ -235,7 +235,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// Nearest item of `kind` to `p` with squared distance `<= r2`, excluding `exclude`, as
     /// `(id, dist2)`; equally near items are resolved by the lower id.
     ///
-    /// Serves the "move towards the nearest rabbit / fox" rules (seed 000, section II.B) and
+    /// Serves the "move towards the nearest rabbit / fox" rules (the grid-boxing paper, section II.B) and
     /// is the query timed in Fig. 9 and Table I (section IV.B). With boxes, it searches box
     /// rings outward from `p`'s box and stops as soon as no closer item can exist; in
     /// [`BoxSize::None`](super::BoxSize::None) mode it scans every item.
@@ -243,7 +243,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
         self.nearest_filtered(p, Some(kind), r2, exclude)
     }
 
-    /// Nearest item of any kind, as [`nearest`](Self::nearest) (seed 000, section II.B).
+    /// Nearest item of any kind, as [`nearest`](Self::nearest) (the grid-boxing paper, section II.B).
     pub fn nearest_any(&self, p: Pos, r2: u64, exclude: Option<u64>) -> Option<(u64, u64)> {
         self.nearest_filtered(p, None, r2, exclude)
     }
@@ -264,13 +264,13 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// Number of items of any kind with squared distance `<= r2` from `p`, excluding
-    /// `exclude` (seed 000, section II.B: counting the animats in the local area).
+    /// `exclude` (the grid-boxing paper, section II.B: counting the animats in the local area).
     pub fn count_within(&self, p: Pos, r2: u64, exclude: Option<u64>) -> usize {
         self.count_within_capped(p, None, r2, exclude, usize::MAX)
     }
 
     /// Number of items of `kind` with squared distance `<= r2` from `p`, excluding `exclude`
-    /// (seed 000, section II.B: "predators will not breed unless there is sufficient prey
+    /// (the grid-boxing paper, section II.B: "predators will not breed unless there is sufficient prey
     /// nearby").
     pub fn count_within_kind(&self, p: Pos, kind: K, r2: u64, exclude: Option<u64>) -> usize {
         self.count_within_capped(p, Some(kind), r2, exclude, usize::MAX)
@@ -280,7 +280,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// `None`) with squared distance `<= r2` from `p`, excluding `exclude`. Stops as soon as
     /// `cap` items are found, so an overcrowding test `count > crowd_max` costs only what it
     /// needs: `count_within_capped(p, None, r2, Some(me), crowd_max + 1) > crowd_max`
-    /// (seed 000, section II.B).
+    /// (the grid-boxing paper, section II.B).
     pub fn count_within_capped(
         &self,
         p: Pos,
@@ -304,7 +304,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// Whether at least `n` items (of `kind`, or of any kind when `None`) lie within squared
     /// distance `r2` of `p`, excluding `exclude`; stops at the `n`-th. `at_least(.., 0)` is
     /// `true`. Overcrowding is `at_least(p, None, r2, Some(me), crowd_max + 1)`; "enough prey"
-    /// is `at_least(p, Some(rabbit), v2, None, prey_needed)` (seed 000, section II.B).
+    /// is `at_least(p, Some(rabbit), v2, None, prey_needed)` (the grid-boxing paper, section II.B).
     pub fn at_least(
         &self,
         p: Pos,
@@ -318,7 +318,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
 
     /// Whether any item of `kind` lies within squared distance `r2` of `p`, excluding
     /// `exclude`; stops at the first hit. With `r2 = 2` this is "a rabbit / fox adjacent" (the 8
-    /// surrounding cells; seed 000, section II.B).
+    /// surrounding cells; the grid-boxing paper, section II.B).
     pub fn any_within(&self, p: Pos, kind: K, r2: u64, exclude: Option<u64>) -> bool {
         self.count_within_capped(p, Some(kind), r2, exclude, 1) >= 1
     }
@@ -344,7 +344,7 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// Distance evaluations (full squared-distance computations against candidate items) made
-    /// by queries since creation or the last reset: the work measure behind seed 000, Fig. 9
+    /// by queries since creation or the last reset: the work measure behind the grid-boxing paper, Fig. 9
     /// and Table I. Shorthand for `self.stats().distance_evals`.
     pub fn distance_evals(&self) -> u64 {
         self.stats.distance_evals.load(Ordering::Relaxed)
@@ -357,12 +357,12 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// Returns the distance-evaluation counter and resets it to zero in one step (per-step
-    /// accounting of seed 000, Fig. 9).
+    /// accounting of the grid-boxing paper, Fig. 9).
     pub fn take_distance_evals(&self) -> u64 {
         self.stats.distance_evals.swap(0, Ordering::Relaxed)
     }
 
-    /// All work counters of the queries since creation or the last reset (seed 000, Fig. 9 and
+    /// All work counters of the queries since creation or the last reset (the grid-boxing paper, Fig. 9 and
     /// Table I; see [`SearchStats`]).
     pub fn stats(&self) -> SearchStats {
         self.stats.load()

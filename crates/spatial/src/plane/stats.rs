@@ -7,7 +7,7 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Work done by the queries of a [`PlaneGrid`](super::PlaneGrid), for the scaling study of seed 000, section IV.B
+/// Work done by the queries of a [`PlaneGrid`](super::PlaneGrid), for the scaling study of the grid-boxing paper, section IV.B
 /// (Fig. 9, Table I): what the grid boxes save compared with the exhaustive scan.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
 pub struct SearchStats {
