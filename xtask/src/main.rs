@@ -1,6 +1,7 @@
 //! Project automation, run as `cargo xtask <command>` (the alias lives in `.cargo/config.toml`).
 //!
-//! - `cargo xtask ci`: the checks CI runs: formatting, clippy with warnings denied, rustdoc with
+//! - `cargo xtask ci`: the checks CI runs: formatting, clippy with warnings denied (also on the
+//!   model libraries without their `cli` feature), rustdoc with
 //!   warnings denied, and the test suite (the README's test command).
 //! - `cargo xtask scaling [--quick] [--only ...] [--out DIR]`: regenerate the papers' tables
 //!   and figures from our own runs (see `docs/results/README.md`).
@@ -28,7 +29,8 @@ struct Cli {
 #[derive(Subcommand)]
 enum Cmd {
     /// Run every CI check: `cargo fmt --check`, `cargo clippy --all-targets -- -D warnings`,
-    /// `cargo doc --no-deps` with warnings denied, and `cargo test --workspace`.
+    /// the model libraries' clippy without their `cli` feature, `cargo doc --no-deps` with
+    /// warnings denied, and `cargo test --workspace`.
     Ci {
         /// Skip the test suite (formatting, lints and docs only).
         #[arg(long)]
@@ -93,6 +95,23 @@ const CI_STEPS: &[Step] = &[
             "clippy",
             "--workspace",
             "--all-targets",
+            "--",
+            "-D",
+            "warnings",
+        ],
+        env: &[],
+    },
+    Step {
+        name: "libraries without the cli feature",
+        args: &[
+            "clippy",
+            "-p",
+            "dlca",
+            "-p",
+            "dla-pdla",
+            "-p",
+            "animat",
+            "--no-default-features",
             "--",
             "-D",
             "warnings",
