@@ -1,6 +1,7 @@
 //! Contact, determinism, growth-sample, PDLA, checkpoint and far-field-jump tests of whole
 //! runs.
 
+use dla_pdla::sim::OVERLAP_DISTANCE;
 use dla_pdla::{Dim, FarField, Params, Simulation, Space};
 
 fn grow<const D: usize>(n: u64, seed: u64, threads: usize) -> Simulation<D>
@@ -263,7 +264,7 @@ fn discard_guard_fails_loudly_instead_of_spinning() {
 }
 
 #[test]
-fn pdla_tree_holds_exactly_the_recorded_positions() {
+fn pdla_tree_holds_exactly_the_recorded_positions_touching_and_without_overlap() {
     let params = Params {
         particles: 5000,
         threads: 2,
@@ -282,6 +283,21 @@ fn pdla_tree_holds_exactly_the_recorded_positions() {
     a.sort_by(|x, y| x.partial_cmp(y).unwrap());
     b.sort_by(|x, y| x.partial_cmp(y).unwrap());
     assert_eq!(a, b);
+    // Threads stick walkers concurrently, yet no two particles overlap, and every particle
+    // but the seed touches an earlier one (it stuck at contact, to rounding).
+    let positions = sim.positions().unwrap();
+    for (i, p) in positions.iter().enumerate() {
+        let mut within_overlap = 0;
+        sim.tree()
+            .for_each_within(p, OVERLAP_DISTANCE, |_| within_overlap += 1);
+        assert_eq!(within_overlap, 1, "particle {i} at {p:?} overlaps another");
+        if i > 0 {
+            let touches = positions[..i]
+                .iter()
+                .any(|q| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt() <= 1.0 + 1e-6);
+            assert!(touches, "particle {i} at {p:?} touches no earlier particle");
+        }
+    }
 }
 
 /// Checkpoints a 3000-particle run after `stop` walkers, resumes it and grows it to the end:
