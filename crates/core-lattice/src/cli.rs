@@ -1,6 +1,6 @@
 //! Command-line plumbing shared by the model binaries (feature `cli`): the "errors, not panics"
-//! convention of `docs/architecture.md` for binaries (bad input is one line naming the value, exit code 2, nothing written)
-//! and its logging convention (`-v`, `RUST_LOG`, quiet by default).
+//! convention of `docs/architecture.md` for binaries (bad input is one line naming the value, exit
+//! code 2, nothing written) and its logging convention (`-v`, `RUST_LOG`, quiet by default).
 
 use std::process::ExitCode;
 
@@ -34,9 +34,9 @@ impl LogArgs {
 }
 
 /// The whole life of a model binary: parse the flags (help, version and parse errors handled
-/// as in [`parse_or_exit`]), set up logging from the [`LogArgs`] that `logging` reads off them, turn the flags into validated parameters (an `Err` is bad input: one line,
-/// exit code 2, nothing written), then `run`; a run error prints its full chain on one line and
-/// exits with code 1.
+/// as in [`parse_or_exit`]), set up logging from the [`LogArgs`] that `logging` reads off them,
+/// turn the flags into validated parameters (an `Err` is bad input: one line, exit code 2, nothing
+/// written), then `run`; a run error prints its full chain on one line and exits with code 1.
 pub fn main_with<C: clap::Parser, P, E: std::fmt::Display>(
     program: &str,
     logging: impl FnOnce(&C) -> LogArgs,

@@ -9,9 +9,9 @@
 //! ```
 //!
 //! so that code written against k-indices does not depend on the dimension. This module adds what
-//! the DLCA model (the grid-boxing paper, sections II.A and IV.A) needs on top: a boundary per axis (periodic or
-//! wall), the `2d` face neighbours of a site, translation by a unit vector that reports
-//! [`Blocked`] at a wall, and minimum-image displacements on periodic axes.
+//! the DLCA model (the grid-boxing paper, sections II.A and IV.A) needs on top: a boundary per axis
+//! (periodic or wall), the `2d` face neighbours of a site, translation by a unit vector that
+//! reports [`Blocked`] at a wall, and minimum-image displacements on periodic axes.
 //!
 //! Coordinates are 0-based. Axis 0 is `x_1`, the fastest-varying axis of the k-index.
 
@@ -26,7 +26,8 @@ pub const MAX_DIM: usize = 8;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Boundary {
-    /// Site `L - 1` and site `0` are neighbours (a torus along this axis), as in the grid-boxing paper.
+    /// Site `L - 1` and site `0` are neighbours (a torus along this axis), as in the grid-boxing
+    /// paper.
     Periodic,
     /// The axis ends: there is no neighbour beyond `0` or `L - 1`, and a move across is blocked.
     Wall,
@@ -366,7 +367,8 @@ impl Lattice {
         self.volume
     }
 
-    /// The k-index of a site (the grid-boxing paper, Fig. 3): `k = x_1 + x_2 L_1 + x_3 L_1 L_2 + ...`.
+    /// The k-index of a site (the grid-boxing paper, Fig. 3):
+    /// `k = x_1 + x_2 L_1 + x_3 L_1 L_2 + ...`.
     pub fn encode(&self, x: &[u64]) -> Result<u64, LatticeError> {
         if x.len() != self.dim {
             return Err(LatticeError::CoordCount {
@@ -460,7 +462,7 @@ impl Lattice {
         (n != k).then_some(n)
     }
 
-    /// Translate site `k` by the unit vector `dir` (the grid-boxing paper DLCA moves, `docs/dlca.md`).
+    /// Translate site `k` by the unit vector `dir` (a DLCA move, `docs/dlca.md`).
     ///
     /// On a periodic axis the move wraps around; on a wall axis a move past `0` or `L - 1`
     /// returns [`Blocked`]. On a periodic axis of length 1 the site moves onto itself.

@@ -15,8 +15,8 @@
 //! - `cli` (feature `cli`): one-line argument errors with exit code 2, and logging set-up, for
 //!   the model binaries.
 //!
-//! Conventions (see `docs/architecture.md`): a run is a pure function of its parameters and seed; bad input
-//! is a typed error, never a panic; every output file is written atomically.
+//! Conventions (see `docs/architecture.md`): a run is a pure function of its parameters and seed;
+//! bad input is a typed error, never a panic; every output file is written atomically.
 
 #[cfg(feature = "cli")]
 pub mod cli;

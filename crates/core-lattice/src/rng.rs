@@ -10,9 +10,10 @@
 //! The state of a stream is serialisable with serde, so a checkpoint restores it exactly.
 //!
 //! Sampling helpers: [`unit_vector`] (uniform direction on the unit sphere in `D` dimensions,
-//! for off-lattice walkers, the variable-precision paper section 3.3), [`DirectionSampler`] (a random unit lattice
-//! direction, optionally weighted, for DLCA moves with gravity, `docs/dlca.md`), and
-//! [`shuffle`] (the fresh random visiting order of every sweep or step, the grid-boxing paper).
+//! for off-lattice walkers, the variable-precision paper, section 3.3), [`DirectionSampler`] (a
+//! random unit lattice direction, optionally weighted, for DLCA moves with gravity,
+//! `docs/dlca.md`), and [`shuffle`] (the fresh random visiting order of every sweep or step, the
+//! grid-boxing paper).
 //!
 //! [`SplitMix64`] is the one small generator for fixed-seed synthetic data in tests, examples
 //! and benchmarks; its output function [`splitmix64`] is also the hash [`stream`] derives
@@ -107,7 +108,7 @@ pub fn uniform01<R: Rng + ?Sized>(rng: &mut R) -> f64 {
 }
 
 /// A direction drawn uniformly on the unit sphere `S^{D-1}` (an isotropic step of an
-/// off-lattice walker, the variable-precision paper section 3.3).
+/// off-lattice walker, the variable-precision paper, section 3.3).
 ///
 /// `D = 1`: +-1. `D = 2`: `(cos t, sin t)` with `t` uniform. `D = 3`: Archimedes' theorem,
 /// `z` uniform in `[-1, 1]` and a uniform azimuth (the paper's formula). `D >= 4`: a normalised

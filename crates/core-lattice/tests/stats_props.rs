@@ -221,8 +221,8 @@ fn far_from_origin_error(n: usize, shift: f64, radius: f64, seed: u64) -> f64 {
     (g.radius_squared() - reference).abs() / reference
 }
 
-/// The variable-precision paper measures R_g of clusters of up to 1e10 particles; the accumulator must not lose
-/// precision to a cluster's distance from the origin.
+/// The variable-precision paper measures R_g of clusters of up to 1e10 particles; the accumulator
+/// must not lose precision to a cluster's distance from the origin.
 ///
 /// The required case: 1e7 points spread over a radius of 1e4, shifted 1e6 from the origin,
 /// relative error <= 1e-9. The naive `sum x^2 / N - mean^2` is borderline there (about 4e-9 on

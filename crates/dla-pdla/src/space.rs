@@ -19,8 +19,8 @@
 //!
 //! 1. `impl Space<4> for Dim<4>` here, with a `direction` (any isotropic unit vector, for
 //!    example [`core_lattice::rng::unit_vector`]), a `return_to_sphere` (the harmonic measure
-//!    of the sphere in that dimension, next to the 2D and 3D ones in [`crate::farfield`]), map levels, an `expected_r_ext`
-//!    and axis names;
+//!    of the sphere in that dimension, next to the 2D and 3D ones in [`crate::farfield`]), map
+//!    levels, an `expected_r_ext` and axis names;
 //! 2. add the dimension to [`DIMENSIONS`];
 //! 3. add one arm to the dispatch in `main.rs` (`4 => run::<4>(cli, params)`).
 

@@ -6,9 +6,10 @@
 //!
 //! Invariants: a move never brings the walker's centre closer than 1 to a particle stored
 //! when the move starts (jumps stay within a lower bound of the distance minus 1, steps stop at
-//! the first contact); the walker's memory (`WalkState`) holds only bounds that stay valid while particles are
-//! added, and is reset for every new walker. The walk is a pure function of the random stream
-//! and the stored particles: the near cache and the tree give the same answers bit for bit.
+//! the first contact); the walker's memory (`WalkState`) holds only bounds that stay valid while
+//! particles are added, and is reset for every new walker. The walk is a pure function of the
+//! random stream and the stored particles: the near cache and the tree give the same answers bit
+//! for bit.
 
 use crate::cluster::Cluster;
 use crate::farfield::norm;
@@ -167,8 +168,8 @@ where
 }
 
 /// Smallest `t` in `[0, len]` with `|p + t u - q| = 1` over every stored centre `q` (`u` a unit
-/// vector): the first contact along the step (Sosa-Herrera & Rodriguez-Romo, section 3.2, Fig. 6). A centre already
-/// at distance <= 1 gives `t = 0`.
+/// vector): the first contact along the step (Sosa-Herrera & Rodriguez-Romo, section 3.2, Fig. 6).
+/// A centre already at distance <= 1 gives `t = 0`.
 pub fn first_contact<const D: usize>(
     tree: &Orthtree<D>,
     p: &[f64; D],

@@ -1,7 +1,7 @@
 //! Kolmogorov-Smirnov tests of the exact far-field return samplers against the harmonic
-//! densities (Poisson kernels of the circle and the sphere), integrated numerically (so the test does not reuse the sampler's
-//! closed-form inversion). The hit point is measured from the returned position, relative to
-//! the walker's direction, so a sampler that hits the wrong side fails.
+//! densities (Poisson kernels of the circle and the sphere), integrated numerically (so the test
+//! does not reuse the sampler's closed-form inversion). The hit point is measured from the returned
+//! position, relative to the walker's direction, so a sampler that hits the wrong side fails.
 
 use core_lattice::rng::stream;
 use dla_pdla::{Dim, Space};

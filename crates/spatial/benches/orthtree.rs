@@ -1,7 +1,7 @@
-//! Orthtree benchmarks (the variable-precision paper, sections 3.1 and 3.3): insert throughput and query throughput
-//! (exact nearest distance, `vpdist` at kappa = 1, 2, 4) at 1e5 and 1e6 points, on a DLA-like
-//! branched cluster of touching unit discs and on uniform points in a disc at unit density,
-//! against kiddo's nearest-one query (`ImmutableKdTree`, the fastest kiddo layout, and
+//! Orthtree benchmarks (the variable-precision paper, sections 3.1 and 3.3): insert throughput and
+//! query throughput (exact nearest distance, `vpdist` at kappa = 1, 2, 4) at 1e5 and 1e6 points, on
+//! a DLA-like branched cluster of touching unit discs and on uniform points in a disc at unit
+//! density, against kiddo's nearest-one query (`ImmutableKdTree`, the fastest kiddo layout, and
 //! `MutableKdTree`, which like the orthtree grows one point at a time) on the same query points.
 //!
 //! Query points are walker-like: half near the cluster (a stored point plus an offset of 1 to 6

@@ -1,7 +1,7 @@
 //! Benchmarks of [`spatial::plane::PlaneGrid`]: the animat nearest-of-kind query with vision
 //! radius 60 at a fixed density of one animat per 100 cells, for 1e3 to 1e6 animats, grid boxes
-//! of side 60, 120 and 240 against the exhaustive "no grid" scan (the grid-boxing paper, section IV.B,
-//! Fig. 9 and Table I). Also: the overcrowding count and the unit-step move.
+//! of side 60, 120 and 240 against the exhaustive "no grid" scan (the grid-boxing paper, section
+//! IV.B, Fig. 9 and Table I). Also: the overcrowding count and the unit-step move.
 //!
 //! Run with `cargo bench -p spatial --bench plane`. Each benchmark iteration is a batch of
 //! queries (throughput is reported per query); the work per query (distance evaluations, items

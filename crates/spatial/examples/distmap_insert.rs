@@ -1,5 +1,6 @@
 //! Times `DistanceMap::insert` on the positions of a DLA run (`dla --positions bin`), arrival
-//! order: `cargo run --release -p spatial --example distmap_insert -- OUT/positions.bin [cell:cap ...]`.
+//! order: `cargo run --release -p spatial --example distmap_insert -- OUT/positions.bin [cell:cap
+//! ...]`.
 use spatial::distmap::DistanceMap;
 use std::time::Instant;
 

@@ -1,6 +1,6 @@
-//! Bytes per point of the orthtree (the variable-precision paper, section 3.3 reports memory per particle) on a
-//! DLA-like branched cluster of touching unit discs and on uniform points at unit density, for
-//! several leaf sides.
+//! Bytes per point of the orthtree (the variable-precision paper, section 3.3 reports memory per
+//! particle) on a DLA-like branched cluster of touching unit discs and on uniform points at unit
+//! density, for several leaf sides.
 //!
 //! ```text
 //! cargo run --release -p spatial --example orthtree_memory -- [N ...]

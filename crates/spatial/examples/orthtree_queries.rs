@@ -1,5 +1,5 @@
-//! Query cost of the orthtree by kind of query point (the variable-precision paper, section 3.2: walkers near the
-//! cluster, inside the birth circle, outside it), against kiddo's nearest-one.
+//! Query cost of the orthtree by kind of query point (the variable-precision paper, section 3.2:
+//! walkers near the cluster, inside the birth circle, outside it), against kiddo's nearest-one.
 //!
 //! ```text
 //! cargo run --release -p spatial --example orthtree_queries -- [N] [leaf_side]

@@ -5,9 +5,9 @@
 //!
 //! This is the device of Ball & Brady (*J. Phys. A* 18, L809, 1985) and of the fast lattice DLA
 //! codes that followed (a "distance map" kept up to date as particles stick), applied here to
-//! off-lattice DLA (the variable-precision paper, section 3.3) in front of the orthtree of [`crate::orthtree`]: a
-//! walker a few diameters or more from the cluster jumps by the map's bound; only near the
-//! cluster (or where the map knows nothing) does it pay for a tree query.
+//! off-lattice DLA (the variable-precision paper, section 3.3) in front of the orthtree of
+//! [`crate::orthtree`]: a walker a few diameters or more from the cluster jumps by the map's bound;
+//! only near the cluster (or where the map knows nothing) does it pay for a tree query.
 //!
 //! # What is stored
 //!

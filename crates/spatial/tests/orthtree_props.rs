@@ -1,5 +1,5 @@
-//! Property tests of the orthtree against brute force (the variable-precision paper, section 3.1, Listing 1 and its
-//! error analysis; storage of section 3.3).
+//! Property tests of the orthtree against brute force (the variable-precision paper, section 3.1,
+//! Listing 1 and its error analysis; storage of section 3.3).
 //!
 //! Brute force works on the stored positions returned by `insert` (they differ from the inserted
 //! ones by at most `leaf_side / 2^33` per coordinate, checked here too) with the reference

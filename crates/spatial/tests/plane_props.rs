@@ -1,7 +1,7 @@
 //! Property tests of [`spatial::plane::PlaneGrid`] against a brute-force scan.
 //!
-//! Grid boxing is not an approximation (the grid-boxing paper, sections I and II.B): for every box size,
-//! after any sequence of inserts, removals and moves, every answer of `nearest`,
+//! Grid boxing is not an approximation (the grid-boxing paper, sections I and II.B): for every box
+//! size, after any sequence of inserts, removals and moves, every answer of `nearest`,
 //! `count_within`, `any_within`, `at_least` and `within` must equal an exhaustive scan over an
 //! independent model of the items, ties (lower id wins) included.
 //!

@@ -1,6 +1,6 @@
-//! Hawick, James & Scogings (2006), animats (sections II.B, IV.B): neighbour-search time per step against population
-//! for grid boxes of 60, 120 and 240 cells and no grid (Fig. 9), and the fitted log-log
-//! gradients (Table I).
+//! Hawick, James & Scogings (2006), animats (sections II.B, IV.B): neighbour-search time per step
+//! against population for grid boxes of 60, 120 and 240 cells and no grid (Fig. 9), and the fitted
+//! log-log gradients (Table I).
 
 use super::Ctx;
 use crate::plot::{self, Chart, Series, Style};

@@ -1,6 +1,6 @@
-//! Sosa-Herrera & Rodriguez-Romo, DLA and PDLA (sections 3-4): run time against N with the exact search and with
-//! `vpdist` (Fig. 3), fractal dimensions in Table 2's layout, and the PDLA speed-up with the
-//! parallel fraction from Amdahl's law.
+//! Sosa-Herrera & Rodriguez-Romo, DLA and PDLA (sections 3-4): run time against N with the exact
+//! search and with `vpdist` (Fig. 3), fractal dimensions in Table 2's layout, and the PDLA speed-up
+//! with the parallel fraction from Amdahl's law.
 
 use super::Ctx;
 use crate::plot::{self, Chart, Series, Style};

@@ -1,7 +1,7 @@
-//! Hawick, James & Scogings (2006), DLCA (sections III, IV.A): clusters against sweeps (Fig. 5), time per sweep over
-//! clusters for each strategy and the grid boxes' speed-up (Fig. 6), histograms of candidate
-//! clusters examined per move (Figs. 4, 7, 8), and the log-log gradient of the sweep cost
-//! against N for each strategy.
+//! Hawick, James & Scogings (2006), DLCA (sections III, IV.A): clusters against sweeps (Fig. 5),
+//! time per sweep over clusters for each strategy and the grid boxes' speed-up (Fig. 6), histograms
+//! of candidate clusters examined per move (Figs. 4, 7, 8), and the log-log gradient of the sweep
+//! cost against N for each strategy.
 
 use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};

@@ -162,8 +162,8 @@ pub struct World {
     order: Vec<u32>,
     /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
     crowd_offsets: Vec<[i64; 2]>,
-    /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see [`Near::rows`](near::Near::rows)), when
-    /// `crowd_radius <= 2`.
+    /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see
+    /// [`Near::rows`](near::Near::rows)), when `crowd_radius <= 2`.
     crowd_masks: [u64; NEAR_ROWS],
     /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
     /// by id. During a step the records of the animats alive at its start are stale: their

@@ -120,11 +120,11 @@ impl World {
         }
     }
 
-    /// Spreads the id buckets of the cell bytes ([`CellIndex::bucket`](crate::cells::CellIndex::bucket)) over the ids that can
-    /// be alive during the next step (the live ones, sorted in `recs`, and at most `n`
-    /// newborns) when the top bucket could overflow or the lower half of the buckets has
-    /// gone unused. Buckets only speed up tie-breaks; any non-decreasing map gives the same
-    /// answers.
+    /// Spreads the id buckets of the cell bytes
+    /// ([`CellIndex::bucket`](crate::cells::CellIndex::bucket)) over the ids that can be alive
+    /// during the next step (the live ones, sorted in `recs`, and at most `n` newborns) when the
+    /// top bucket could overflow or the lower half of the buckets has gone unused. Buckets only
+    /// speed up tie-breaks; any non-decreasing map gives the same answers.
     fn maybe_rebucket(&mut self, n: usize) {
         let Some(first) = self.recs.first() else {
             return;

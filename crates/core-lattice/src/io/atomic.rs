@@ -2,8 +2,8 @@
 //!
 //! Readers see either the old file or the complete new one, never a partial write, and a run
 //! that fails part-way leaves no half-written outputs (`docs/architecture.md`: every output file
-//! is written atomically). If an [`AtomicFile`] is dropped without [`AtomicFile::commit`], its temporary
-//! file is deleted.
+//! is written atomically). If an [`AtomicFile`] is dropped without [`AtomicFile::commit`], its
+//! temporary file is deleted.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};

@@ -6,7 +6,8 @@ use super::StatsError;
 use serde::{Deserialize, Serialize};
 
 /// A histogram of non-negative integers with one bin per value, growing as needed: the number of
-/// candidate clusters examined per move (Hawick, James & Scogings 2006, Figs. 4, 7, 8), cluster sizes.
+/// candidate clusters examined per move (Hawick, James & Scogings 2006, Figs. 4, 7, 8), cluster
+/// sizes.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct IntHistogram {
     counts: Vec<u64>,

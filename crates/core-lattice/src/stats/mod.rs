@@ -2,13 +2,14 @@
 //!
 //! - [`Welford`]: running mean and variance in one pass, numerically stable, mergeable (for
 //!   per-thread accumulators).
-//! - [`IntHistogram`] and [`LogHistogram`]: the candidate-count histograms of Hawick, James & Scogings (2006, Figs. 4,
-//!   7, 8) and cluster-size distributions.
+//! - [`IntHistogram`] and [`LogHistogram`]: the candidate-count histograms of Hawick, James &
+//!   Scogings (2006, Figs. 4, 7, 8) and cluster-size distributions.
 //! - [`Fit`]: ordinary least squares with standard errors, on linear or log-log axes
 //!   ([`Fit::linear`], [`Fit::log_log`]): log-log gradients, fractal dimensions from
 //!   `ln N = D ln R_g + c`, linear run-time fits.
-//! - [`Gyration`]: the radius of gyration of a point set in `D` dimensions (Sosa-Herrera & Rodriguez-Romo, section 3.4),
-//!   accumulated with Welford updates so it stays accurate for clusters far from the origin.
+//! - [`Gyration`]: the radius of gyration of a point set in `D` dimensions (Sosa-Herrera &
+//!   Rodriguez-Romo, section 3.4), accumulated with Welford updates so it stays accurate for
+//!   clusters far from the origin.
 //! - [`LatticeGyration`]: the same for integer lattice coordinates (DLCA clusters),
 //!   with exact integer sums.
 

@@ -32,7 +32,8 @@ impl ClusterArrays {
         &self.sets
     }
 
-    /// No clusters, on the same lattice (what a store leaves behind when it hands its clusters over).
+    /// No clusters, on the same lattice (what a store leaves behind when it hands its clusters
+    /// over).
     pub(super) fn empty_like(&self) -> Self {
         ClusterArrays::new(SiteSets::new(self.sets.lattice().clone()))
     }

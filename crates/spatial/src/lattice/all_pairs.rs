@@ -3,9 +3,9 @@
 use super::{ContactSearch, ItemId, SiteSets, coords_of, touches};
 use core_lattice::{Direction, MAX_DIM};
 
-/// The grid-boxing paper's all-pairs contact search: the mover is tested against every other live item,
-/// particle by particle, comparing one axis at a time and leaving at the first axis on which two
-/// particles are more than one step apart. Costs O(s * N) per move for a mover of `s` particles
+/// The grid-boxing paper's all-pairs contact search: the mover is tested against every other live
+/// item, particle by particle, comparing one axis at a time and leaving at the first axis on which
+/// two particles are more than one step apart. Costs O(s * N) per move for a mover of `s` particles
 /// among `N`; keeps no index, so insert, move and merge cost nothing.
 #[derive(Debug, Clone, Default)]
 pub struct AllPairs {

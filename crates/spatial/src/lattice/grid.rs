@@ -27,9 +27,9 @@ pub enum GridError {
 /// registered in the mover's boxes and their `3^d` neighbourhood (the *halo*; wrapping on
 /// periodic axes, stopping at walls), reports each candidate once, and tests candidates
 /// particle by particle (pairwise for small movers; for movers of more than 16 particles by
-/// looking up each candidate particle's neighbours among the mover's sorted sites). Since two face-adjacent sites are at most one box apart on each axis,
-/// every item in contact with the mover is among the candidates: the search is exact, only
-/// faster than [`super::AllPairs`].
+/// looking up each candidate particle's neighbours among the mover's sorted sites). Since two
+/// face-adjacent sites are at most one box apart on each axis, every item in contact with the mover
+/// is among the candidates: the search is exact, only faster than [`super::AllPairs`].
 ///
 /// A move updates only the particles that cross a box boundary (about one in `A` along the
 /// move's axis); a merge moves the merged item's registrations to the survivor. When items grow
@@ -134,8 +134,8 @@ impl LatticeGridBoxes {
         self.boxes.len()
     }
 
-    /// Whether `3A >= L` on some axis, where the halo spans the whole axis and the grid-boxing paper finds
-    /// grid-boxing stops paying.
+    /// Whether `3A >= L` on some axis, where the halo spans the whole axis and the grid-boxing
+    /// paper finds grid-boxing stops paying.
     pub fn stops_paying(&self) -> bool {
         (0..self.lattice.dim()).any(|a| 3 * self.side >= self.lattice.size(a))
     }

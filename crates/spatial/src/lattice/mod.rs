@@ -63,7 +63,8 @@ pub trait ContactSearch {
 
     /// The items other than `id` with a site face-adjacent to a site of `id`, in increasing
     /// id, without repeats, written to `out` (which is cleared first). Returns the number of
-    /// candidate items examined (the quantity histogrammed in the grid-boxing paper, Figs. 4, 7, 8).
+    /// candidate items examined (the quantity histogrammed in the grid-boxing paper, Figs. 4, 7,
+    /// 8).
     fn contacts(&mut self, sets: &SiteSets, id: ItemId, out: &mut Vec<ItemId>) -> usize;
 }
 

@@ -4,7 +4,8 @@
 use super::ItemId;
 use core_lattice::{Blocked, Boundary, Direction, Lattice};
 
-/// Items (clusters) as sets of lattice sites, stored as k-index arrays (the grid-boxing paper, Fig. 2).
+/// Items (clusters) as sets of lattice sites, stored as k-index arrays (the grid-boxing paper,
+/// Fig. 2).
 ///
 /// Ids are handed out in increasing order from 0 and never reused. The live list plays the role
 /// of the paper's left-hand array: it makes iterating over the live items cheap although merged

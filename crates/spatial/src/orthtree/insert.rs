@@ -81,8 +81,8 @@ impl<const D: usize> Orthtree<D> {
         n
     }
 
-    /// Doubles the root towards leaf cell `k` (the variable-precision paper builds its tree over a fixed domain;
-    /// here the domain grows, the old root becoming a child of the new one).
+    /// Doubles the root towards leaf cell `k` (the variable-precision paper builds its tree over a
+    /// fixed domain; here the domain grows, the old root becoming a child of the new one).
     fn grow_root(&mut self, k: &[i64; D]) {
         let side = 1i64 << self.root_level;
         let mut origin = self.root_origin;
@@ -108,10 +108,10 @@ impl<const D: usize> Orthtree<D> {
         self.root_origin = origin;
     }
 
-    /// Inserts a particle centre (the variable-precision paper, section 3.3: the particle is stored in the leaf
-    /// containing it, in relative coordinates) and returns its stored position, which is what
-    /// every query sees: within `leaf_side / 2^33` of `p` per coordinate (plus `f64` rounding
-    /// at the coordinate's magnitude).
+    /// Inserts a particle centre (the variable-precision paper, section 3.3: the particle is stored
+    /// in the leaf containing it, in relative coordinates) and returns its stored position, which
+    /// is what every query sees: within `leaf_side / 2^33` of `p` per coordinate (plus `f64`
+    /// rounding at the coordinate's magnitude).
     ///
     /// Duplicate points are allowed. On error the tree is unchanged.
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], OrthtreeError> {
@@ -186,8 +186,8 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// The position [`insert`](Self::insert) would store for `p` (its fixed-point rounding),
-    /// without inserting it: PDLA computes it outside the tree's writer (the variable-precision paper, section
-    /// 3.4). Fails as `insert` would on a non-finite or out-of-range coordinate.
+    /// without inserting it: PDLA computes it outside the tree's writer (the variable-precision
+    /// paper, section 3.4). Fails as `insert` would on a non-finite or out-of-range coordinate.
     pub fn stored_position(&self, p: &[f64; D]) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(p)?;
         let mut stored = [0.0; D];

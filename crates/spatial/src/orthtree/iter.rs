@@ -1,13 +1,13 @@
 //! Iteration over the stored positions: [`Points`], a depth-first walk with an explicit stack
-//! of `O(depth)` frames that rebuilds each leaf's origin from the path (the variable-precision paper, section 3.3:
-//! base coordinates are computed while traversing the tree), yielding exactly the decoded
-//! positions the queries see.
+//! of `O(depth)` frames that rebuilds each leaf's origin from the path (the variable-precision
+//! paper, section 3.3: base coordinates are computed while traversing the tree), yielding exactly
+//! the decoded positions the queries see.
 
 use super::{EMPTY, Orthtree, decode};
 
 impl<const D: usize> Orthtree<D> {
-    /// Iterates over the stored positions of all points, leaf by leaf (the variable-precision paper, section 3.3:
-    /// base coordinates are rebuilt while traversing the tree).
+    /// Iterates over the stored positions of all points, leaf by leaf (the variable-precision
+    /// paper, section 3.3: base coordinates are rebuilt while traversing the tree).
     pub fn iter(&self) -> Points<'_, D> {
         let mut stack = Vec::new();
         if self.root != EMPTY {

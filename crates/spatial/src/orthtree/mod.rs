@@ -3,8 +3,9 @@
 //! Rodriguez-Romo, *Variable precision distance search for random fractal cluster simulations*
 //! (the variable-precision paper, section 3.1 and Listing 1; storage after section 3.3).
 //!
-//! Built for off-lattice DLA/PDLA (the variable-precision paper, sections 3.3 and 3.4): particle centres in units
-//! of particle diameters, inserted one at a time, queried millions of times by random walkers.
+//! Built for off-lattice DLA/PDLA (the variable-precision paper, sections 3.3 and 3.4): particle
+//! centres in units of particle diameters, inserted one at a time, queried millions of times by
+//! random walkers.
 //!
 //! # Structure
 //!
@@ -26,9 +27,9 @@
 //!   point (the error bound below relies on this).
 //! - **Leaves.** `Vec<Leaf>`, 8 bytes each: the start and length of the leaf's block in the pool.
 //! - **Points.** One pool of `[u32; D]` records: each coordinate is a fixed-point offset inside
-//!   the leaf cell, in units of `s / 2^32` (the variable-precision paper, section 3.3 stores relative coordinates in
-//!   one byte; that is far too coarse for contact within 1e-6, 32 bits give `s / 2^33`, about
-//!   5e-10 for `s = 4`). A leaf's points are contiguous; blocks come in size classes with free
+//!   the leaf cell, in units of `s / 2^32` (the variable-precision paper, section 3.3, stores
+//!   relative coordinates in one byte; that is far too coarse for contact within 1e-6, 32 bits
+//!   give `s / 2^33`, about 5e-10 for `s = 4`). A leaf's points are contiguous; blocks come in size classes with free
 //!   lists (exact sizes up to 16 points, see `pool.rs`), so small leaves waste nothing. When
 //!   more than 1/8 of the pool sits on free lists (leaves that all grow at once, e.g. uniform
 //!   points inserted in random order), an insert compacts the pool in place: O(N) at that
@@ -75,9 +76,9 @@
 //!
 //! # Variable-precision distance and its error bound
 //!
-//! [`vpdist`](Orthtree::vpdist) is Listing 1 of the variable-precision paper in `D` dimensions with the precision
-//! `kappa` as a parameter (the paper uses `kappa = 2`). Starting from the root, for each node `n`
-//! with centre `c` and half diagonal `r` (`DIAGONAL = 2 r`):
+//! [`vpdist`](Orthtree::vpdist) is Listing 1 of the variable-precision paper in `D` dimensions with
+//! the precision `kappa` as a parameter (the paper uses `kappa = 2`). Starting from the root, for
+//! each node `n` with centre `c` and half diagonal `r` (`DIAGONAL = 2 r`):
 //!
 //! 1. if `|p - c| > kappa * 2 r` (the node is *far*), the node contributes the lower bound
 //!    `|p - c| - r` and is not descended (lines 07-11);
@@ -146,9 +147,9 @@ use pool::LeafPool;
 pub use query::{Neighbour, VpEstimate, dist_sq};
 
 /// The orthtree's default leaf side `s`, in particle diameters: the side of the leaf cells
-/// (the last level of the tree, where the variable-precision paper, section 3.3, keeps its chunks of particles)
-/// that [`Orthtree::new`] uses. With `s = 4`, a leaf holds 4 to 5 DLA particles. A model may
-/// choose another side through [`Orthtree::with_leaf_side`]; see the module docs for the
+/// (the last level of the tree, where the variable-precision paper, section 3.3, keeps its chunks
+/// of particles) that [`Orthtree::new`] uses. With `s = 4`, a leaf holds 4 to 5 DLA particles. A
+/// model may choose another side through [`Orthtree::with_leaf_side`]; see the module docs for the
 /// trade-off.
 pub const DEFAULT_LEAF_SIDE: f64 = 4.0;
 
@@ -230,7 +231,8 @@ struct Leaf {
 }
 
 /// Quadtree (`D = 2`), octree (`D = 3`) or `2^D`-ary tree of points with exact nearest-distance
-/// and variable-precision distance queries (the variable-precision paper, sections 3.1 and 3.3, Listing 1).
+/// and variable-precision distance queries (the variable-precision paper, sections 3.1 and 3.3,
+/// Listing 1).
 ///
 /// See the [module documentation](self) for the layout, the complexity and the error bound of
 /// [`vpdist`](Self::vpdist). `D` must be in `1..=8`.
@@ -304,7 +306,8 @@ impl<const D: usize> Orthtree<D> {
     /// Children per internal node.
     const FANOUT: usize = 1 << D;
 
-    /// An empty tree with the default leaf side [`DEFAULT_LEAF_SIDE`] (the variable-precision paper, section 3.3).
+    /// An empty tree with the default leaf side [`DEFAULT_LEAF_SIDE`] (the variable-precision
+    /// paper, section 3.3).
     pub fn new() -> Self {
         const { assert!(is_valid_leaf_side(DEFAULT_LEAF_SIDE)) };
         Self::empty(DEFAULT_LEAF_SIDE)
@@ -338,9 +341,9 @@ impl<const D: usize> Orthtree<D> {
         }
     }
 
-    /// Checks a precision parameter for [`vpdist`](Self::vpdist) (the variable-precision paper, Listing 1, line 07):
-    /// `kappa > 1/2` (finite) or `+inf`. Use it when validating run parameters; `vpdist` itself
-    /// accepts any value.
+    /// Checks a precision parameter for [`vpdist`](Self::vpdist) (the variable-precision paper,
+    /// Listing 1, line 07): `kappa > 1/2` (finite) or `+inf`. Use it when validating run
+    /// parameters; `vpdist` itself accepts any value.
     pub fn check_kappa(kappa: f64) -> Result<f64, OrthtreeError> {
         if kappa > 0.5 {
             Ok(kappa)
@@ -359,7 +362,8 @@ impl<const D: usize> Orthtree<D> {
         self.len == 0
     }
 
-    /// Side of the leaf cells (the variable-precision paper, section 3.1: the last level of the tree).
+    /// Side of the leaf cells (the variable-precision paper, section 3.1: the last level of the
+    /// tree).
     pub fn leaf_side(&self) -> f64 {
         self.leaf_side
     }
@@ -384,8 +388,8 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// Heap and inline bytes of the structure: the capacities (not lengths) of the node, leaf
-    /// and point vectors, free blocks included, plus `size_of::<Self>()` (the variable-precision paper, section 3.3
-    /// reports memory per particle).
+    /// and point vectors, free blocks included, plus `size_of::<Self>()` (the variable-precision
+    /// paper, section 3.3 reports memory per particle).
     pub fn memory_bytes(&self) -> usize {
         size_of::<Self>()
             + self.children.capacity() * size_of::<u32>()

@@ -1,6 +1,6 @@
 //! Compact leaf storage: one pool of fixed-point point records, carved into per-leaf blocks by
-//! size class (the variable-precision paper, section 3.3: "pointers addressing list structures containing chunks of
-//! 10 particles", here contiguous blocks instead of linked chunks).
+//! size class (the variable-precision paper, section 3.3: "pointers addressing list structures
+//! containing chunks of 10 particles", here contiguous blocks instead of linked chunks).
 //!
 //! A leaf holding `n` points owns one contiguous block of `cap(n)` slots, where `cap(n) = n` for
 //! `n <= 16` and `cap(n)` rounds `n` up to a quarter of the enclosing power of two above that

@@ -1,5 +1,5 @@
-//! Queries: exact nearest neighbour, variable-precision distance (the variable-precision paper, section 3.1,
-//! Listing 1) and the fixed-radius range query.
+//! Queries: exact nearest neighbour, variable-precision distance (the variable-precision paper,
+//! section 3.1, Listing 1) and the fixed-radius range query.
 //!
 //! One recursive branch-and-bound walk serves the nearest and `vpdist` queries, monomorphised on
 //! whether far nodes are approximated (`APPROX`) and whether the nearest point is tracked
@@ -86,9 +86,9 @@ impl<const D: usize> Orthtree<D> {
     /// Exact distance from `p` to the nearest stored point, `None` on an empty tree.
     ///
     /// Branch and bound over the tree: the child containing `p` first, then siblings whose box
-    /// is closer than the best distance so far (the variable-precision paper, Listing 1 with `kappa = inf`). The
-    /// value equals, bit for bit, `sqrt` of the minimum over [`iter`](Self::iter) of the
-    /// squared distance summed axis by axis.
+    /// is closer than the best distance so far (the variable-precision paper, Listing 1 with `kappa
+    /// = inf`). The value equals, bit for bit, `sqrt` of the minimum over [`iter`](Self::iter) of
+    /// the squared distance summed axis by axis.
     pub fn nearest_distance(&self, p: &[f64; D]) -> Option<f64> {
         self.walk::<false, false>(p, f64::INFINITY).map(|s| s.best)
     }
@@ -103,8 +103,8 @@ impl<const D: usize> Orthtree<D> {
             })
     }
 
-    /// Variable-precision distance from `p` to the stored points: the variable-precision paper, section 3.1,
-    /// Listing 1, in `D` dimensions with precision `kappa` (the paper's value is
+    /// Variable-precision distance from `p` to the stored points: the variable-precision paper,
+    /// section 3.1, Listing 1, in `D` dimensions with precision `kappa` (the paper's value is
     /// [`PAPER_KAPPA`](super::PAPER_KAPPA) = 2). `None` on an empty tree.
     ///
     /// A node whose centre `c` is farther from `p` than `kappa` times its diagonal gives the
@@ -130,8 +130,8 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// [`vpdist`](Self::vpdist) together with the half diagonal of the node that produced an
-    /// approximate answer (the variable-precision paper, section 3.1: `d(p, q) in [d_app, d_app + 2r]`), for
-    /// accuracy studies and tests. Same walk and same value as `vpdist`.
+    /// approximate answer (the variable-precision paper, section 3.1: `d(p, q) in [d_app, d_app +
+    /// 2r]`), for accuracy studies and tests. Same walk and same value as `vpdist`.
     pub fn vpdist_detailed(&self, p: &[f64; D], kappa: f64) -> Option<VpEstimate> {
         let s = if kappa == f64::INFINITY || kappa.is_nan() {
             self.walk::<false, false>(p, f64::INFINITY)
@@ -146,9 +146,9 @@ impl<const D: usize> Orthtree<D> {
 
     /// Calls `f` with the stored position of every point at distance `<= r` from `p` (inclusive,
     /// comparing squared distances summed axis by axis, as
-    /// [`nearest_distance`](Self::nearest_distance) does). Order unspecified. Nothing is called if `r` is negative
-    /// or NaN. Used by DLA to find the first contact along a step (the variable-precision paper, section 3.2,
-    /// Fig. 6).
+    /// [`nearest_distance`](Self::nearest_distance) does). Order unspecified. Nothing is called if
+    /// `r` is negative or NaN. Used by DLA to find the first contact along a step (the
+    /// variable-precision paper, section 3.2, Fig. 6).
     pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, mut f: F) {
         if self.root == EMPTY || r.is_nan() || r < 0.0 {
             return;

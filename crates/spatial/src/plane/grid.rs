@@ -43,16 +43,16 @@ fn box_key(side: Option<i64>, p: Pos) -> [i64; 2] {
 }
 
 /// Grid boxes over the unbounded 2D integer plane, holding point items with an id, a kind and a
-/// position (the grid-boxing paper, section II.B: a list of animats per grid box; section III: the data
-/// structures; section IV.B, Fig. 9 and Table I: grid sizes against "no grid").
+/// position (the grid-boxing paper, section II.B: a list of animats per grid box; section III: the
+/// data structures; section IV.B, Fig. 9 and Table I: grid sizes against "no grid").
 ///
 /// `K` is the kind of an item (the animat species); any small `Copy + Eq` type works. Ids are
 /// `u64` and must be unique among the items present. Several items may share a cell.
 ///
 /// Queries take an optional id to exclude (the querying animat itself) and an inclusive squared
 /// radius `r2`: an item at squared distance `d2` qualifies when `d2 <= r2`. See the
-/// [module documentation](crate::plane) for the layout, the cost of each operation and why every answer
-/// equals the exhaustive scan's.
+/// [module documentation](crate::plane) for the layout, the cost of each operation and why every
+/// answer equals the exhaustive scan's.
 #[derive(Debug)]
 pub struct PlaneGrid<K> {
     pub(super) side: Option<i64>,
@@ -82,7 +82,8 @@ impl<K: Copy> Clone for PlaneGrid<K> {
 }
 
 impl<K: Copy + Eq> PlaneGrid<K> {
-    /// An empty grid with the given box size (the grid-boxing paper, section IV.B: 60, 120, 240 or none).
+    /// An empty grid with the given box size (the grid-boxing paper, section IV.B: 60, 120, 240 or
+    /// none).
     ///
     /// # Errors
     /// [`PlaneError::BadBoxSide`] if the side is zero or negative.

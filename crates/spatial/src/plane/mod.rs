@@ -21,8 +21,8 @@
 //!   vector (a back-index), so removal is a `swap_remove` plus one back-index fix.
 //! - **Cells**: `FxHashMap<[i64; 2], u32>` counting the items on each cell, so "is this cell
 //!   free" ([`PlaneGrid::is_occupied`]) is one hash lookup in every mode.
-//! - **Counters**: [`AtomicU64`](std::sync::atomic::AtomicU64)s of distance evaluations, items scanned and boxes probed
-//!   ([`SearchStats`]).
+//! - **Counters**: [`AtomicU64`](std::sync::atomic::AtomicU64)s of distance evaluations, items
+//!   scanned and boxes probed ([`SearchStats`]).
 //!
 //! # Complexity (N items, expected-time hashing)
 //!
@@ -75,11 +75,11 @@
 //! halo's items with them) and [`SearchStats::boxes_probed`]: together they are the work
 //! measure behind Fig. 9 and Table I.
 //!
-//! The counters are [`AtomicU64`](std::sync::atomic::AtomicU64)s updated with `Relaxed` ordering once per query (each query
-//! tallies into local variables first). Queries take `&self`; atomics keep [`PlaneGrid`]
-//! `Sync`, so read-only queries may run on several threads at once (a `Cell` would forbid
-//! that). `Relaxed` suffices because the counters synchronise nothing else, and three atomic
-//! adds per query cost nothing measurable next to the hash lookups.
+//! The counters are [`AtomicU64`](std::sync::atomic::AtomicU64)s updated with `Relaxed` ordering
+//! once per query (each query tallies into local variables first). Queries take `&self`; atomics
+//! keep [`PlaneGrid`] `Sync`, so read-only queries may run on several threads at once (a `Cell`
+//! would forbid that). `Relaxed` suffices because the counters synchronise nothing else, and three
+//! atomic adds per query cost nothing measurable next to the hash lookups.
 //!
 //! # Implementation
 //!
@@ -99,12 +99,12 @@ use std::str::FromStr;
 pub use grid::PlaneGrid;
 pub use stats::SearchStats;
 
-/// A cell of the unbounded integer plane, `[x, y]` (the grid-boxing paper, section II.B: animats live on an
-/// unbounded plane, one per cell).
+/// A cell of the unbounded integer plane, `[x, y]` (the grid-boxing paper, section II.B: animats
+/// live on an unbounded plane, one per cell).
 pub type Pos = [i64; 2];
 
-/// Grid-box size of a [`PlaneGrid`] (the grid-boxing paper, sections II.B and IV.B: grids of 60, 120 and 240
-/// cells, or no grid at all).
+/// Grid-box size of a [`PlaneGrid`] (the grid-boxing paper, sections II.B and IV.B: grids of 60,
+/// 120 and 240 cells, or no grid at all).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum BoxSize {
     /// No grid boxes: every query is an exhaustive scan over all items, the paper's "no grid"

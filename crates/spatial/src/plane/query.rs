@@ -235,15 +235,16 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     /// Nearest item of `kind` to `p` with squared distance `<= r2`, excluding `exclude`, as
     /// `(id, dist2)`; equally near items are resolved by the lower id.
     ///
-    /// Serves the "move towards the nearest rabbit / fox" rules (the grid-boxing paper, section II.B) and
-    /// is the query timed in Fig. 9 and Table I (section IV.B). With boxes, it searches box
-    /// rings outward from `p`'s box and stops as soon as no closer item can exist; in
+    /// Serves the "move towards the nearest rabbit / fox" rules (the grid-boxing paper, section
+    /// II.B) and is the query timed in Fig. 9 and Table I (section IV.B). With boxes, it searches
+    /// box rings outward from `p`'s box and stops as soon as no closer item can exist; in
     /// [`BoxSize::None`](super::BoxSize::None) mode it scans every item.
     pub fn nearest(&self, p: Pos, kind: K, r2: u64, exclude: Option<u64>) -> Option<(u64, u64)> {
         self.nearest_filtered(p, Some(kind), r2, exclude)
     }
 
-    /// Nearest item of any kind, as [`nearest`](Self::nearest) (the grid-boxing paper, section II.B).
+    /// Nearest item of any kind, as [`nearest`](Self::nearest) (the grid-boxing paper, section
+    /// II.B).
     pub fn nearest_any(&self, p: Pos, r2: u64, exclude: Option<u64>) -> Option<(u64, u64)> {
         self.nearest_filtered(p, None, r2, exclude)
     }
@@ -270,8 +271,8 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// Number of items of `kind` with squared distance `<= r2` from `p`, excluding `exclude`
-    /// (the grid-boxing paper, section II.B: "predators will not breed unless there is sufficient prey
-    /// nearby").
+    /// (the grid-boxing paper, section II.B: "predators will not breed unless there is sufficient
+    /// prey nearby").
     pub fn count_within_kind(&self, p: Pos, kind: K, r2: u64, exclude: Option<u64>) -> usize {
         self.count_within_capped(p, Some(kind), r2, exclude, usize::MAX)
     }
@@ -344,8 +345,8 @@ impl<K: Copy + Eq> PlaneGrid<K> {
     }
 
     /// Distance evaluations (full squared-distance computations against candidate items) made
-    /// by queries since creation or the last reset: the work measure behind the grid-boxing paper, Fig. 9
-    /// and Table I. Shorthand for `self.stats().distance_evals`.
+    /// by queries since creation or the last reset: the work measure behind the grid-boxing paper,
+    /// Fig. 9 and Table I. Shorthand for `self.stats().distance_evals`.
     pub fn distance_evals(&self) -> u64 {
         self.stats.distance_evals.load(Ordering::Relaxed)
     }
@@ -362,8 +363,8 @@ impl<K: Copy + Eq> PlaneGrid<K> {
         self.stats.distance_evals.swap(0, Ordering::Relaxed)
     }
 
-    /// All work counters of the queries since creation or the last reset (the grid-boxing paper, Fig. 9 and
-    /// Table I; see [`SearchStats`]).
+    /// All work counters of the queries since creation or the last reset (the grid-boxing paper,
+    /// Fig. 9 and Table I; see [`SearchStats`]).
     pub fn stats(&self) -> SearchStats {
         self.stats.load()
     }

@@ -7,16 +7,18 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Work done by the queries of a [`PlaneGrid`](super::PlaneGrid), for the scaling study of the grid-boxing paper, section IV.B
-/// (Fig. 9, Table I): what the grid boxes save compared with the exhaustive scan.
+/// Work done by the queries of a [`PlaneGrid`](super::PlaneGrid), for the scaling study of the
+/// grid-boxing paper, section IV.B (Fig. 9, Table I): what the grid boxes save compared with the
+/// exhaustive scan.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash)]
 pub struct SearchStats {
     /// Full squared-distance evaluations against candidate items: items of the wanted kind, not
     /// excluded, that passed the per-axis early exit (`|dx|` and `|dy|` within the radius).
     pub distance_evals: u64,
     /// Items looked at (kind, exclusion and per-axis tests): every item of every box a query
-    /// scanned, up to the point where it stopped. In [`BoxSize::None`](super::BoxSize::None) mode this is N per query
-    /// (less for capped counts and `any_within`); with boxes, the items of the halo.
+    /// scanned, up to the point where it stopped. In [`BoxSize::None`](super::BoxSize::None) mode
+    /// this is N per query (less for capped counts and `any_within`); with boxes, the items of the
+    /// halo.
     pub items_scanned: u64,
     /// Box-map lookups and box visits: hash lookups of ring boxes (only for boxes that can hold
     /// an answer) plus occupied boxes examined by the one-pass fallback; 1 per query in
