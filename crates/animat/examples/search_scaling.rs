@@ -18,10 +18,9 @@
 //!   the mean search seconds per step (clock read around each animat's decision).
 
 use animat::GridBox;
-use animat::bench::{SearchCost, search_scaling_point_with};
+use animat::bench::{SCALING_DENSITY as DENSITY, SearchCost, search_scaling_point_with};
 use core_lattice::stats::Fit;
 
-const DENSITY: f64 = 0.2;
 const SEED: u64 = 1;
 
 fn ladder(max: u64) -> Vec<u64> {

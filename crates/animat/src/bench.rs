@@ -28,6 +28,10 @@ use crate::world::{StepStats, World, WorldError};
 use serde::Serialize;
 use std::time::Instant;
 
+/// Animats per cell of the start disc in the scaling study, the same for every population of
+/// its ladder: about the default start's density (2300 animats on a disc of radius 60).
+pub const SCALING_DENSITY: f64 = 0.2;
+
 /// Parameters of a scaling point: [`Params::default`] with `population` animats split between
 /// foxes and rabbits in the default ratio (foxes rounded, at least one of each when
 /// `population >= 2`), the start radius giving `density` animats per cell

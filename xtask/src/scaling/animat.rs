@@ -10,9 +10,8 @@ use animat::{GridBox, World};
 use anyhow::Result;
 use core_lattice::Fit;
 
-/// Animats per cell of the start disc, the same for every population of the ladder: the
-/// default start's density (2300 animats on a disc of radius 60), as in `docs/benchmarks.md`.
-pub const DENSITY: f64 = 0.2;
+/// Animats per cell of the start disc, the same for every population of the ladder.
+pub use animat::bench::SCALING_DENSITY as DENSITY;
 
 /// Hawick, James & Scogings (2006), Table I: fitted gradients and their errors, as printed.
 const TABLE_I: [(&str, f64, f64); 4] = [
