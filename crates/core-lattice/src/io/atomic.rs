@@ -33,10 +33,14 @@ impl AtomicFile {
                 format!("{} is not a file path", target.display()),
             )
         })?;
-        let tmp = tempfile::Builder::new()
-            .prefix(&format!(".{}.", name.to_string_lossy()))
-            .suffix(".tmp")
-            .tempfile_in(&dir)?;
+        let prefix = format!(".{}.", name.to_string_lossy());
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(".tmp");
+        // An output file is an ordinary file: created 0666 less the process umask (0644 under
+        // umask 022), as `File::create` would, not tempfile's private 0600.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let tmp = builder.tempfile_in(&dir)?;
         Ok(AtomicFile {
             target,
             writer: BufWriter::with_capacity(1 << 16, tmp),
@@ -130,6 +134,27 @@ mod tests {
             assert!(!p.exists());
         }
         assert!(entries(dir.path()).is_empty());
+    }
+
+    /// The process umask, from `/proc/self/status` (Linux 4.7 and later).
+    #[cfg(target_os = "linux")]
+    fn umask() -> Option<u32> {
+        let status = std::fs::read_to_string("/proc/self/status").ok()?;
+        let line = status.lines().find(|l| l.starts_with("Umask:"))?;
+        u32::from_str_radix(line["Umask:".len()..].trim(), 8).ok()
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn files_get_the_ordinary_mode_under_the_umask() {
+        use std::os::unix::fs::PermissionsExt;
+        let Some(mask) = umask() else { return };
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("out.txt");
+        write_atomic(&p, b"x").unwrap();
+        let mode = std::fs::metadata(&p).unwrap().permissions().mode() & 0o777;
+        // 0644 under the usual umask 022, where tempfile alone would give 0600.
+        assert_eq!(mode, 0o666 & !mask, "mode {mode:o} under umask {mask:03o}");
     }
 
     #[test]
