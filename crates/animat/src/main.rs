@@ -113,6 +113,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
     p.validate().map_err(|e| e.to_string())?;
+    core_lattice::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
 
@@ -124,7 +125,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     let clock = RunClock::start();
     let mut world = World::new(params, cli.seed).context("setting up the run")?;
     world.set_timing(cli.timing);
-    std::fs::create_dir_all(&cli.out)
+    core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     tracing::info!(
         foxes = world.foxes(),

@@ -152,6 +152,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             ));
         }
     }
+    core_lattice::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
 
@@ -175,7 +176,7 @@ where
     Dim<D>: Space<D>,
 {
     let clock = RunClock::start();
-    std::fs::create_dir_all(&cli.out)
+    core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     let total = params.particles;
     tracing::info!(?params, seed = cli.seed, "starting growth");

@@ -140,3 +140,43 @@ fn checkpointed_and_resumed_runs_end_with_the_same_state_hash() {
         .unwrap();
     assert!(!o.status.success());
 }
+
+#[test]
+fn unusable_out_is_a_usage_error_that_creates_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("a-file");
+    std::fs::write(&file, b"keep me").unwrap();
+    for out in [file.clone(), file.join("sub")] {
+        let o = dla()
+            .args(["--particles", "100", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "--out {}", out.display());
+        let err = String::from_utf8(o.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains("--out") && err.contains("not a directory"),
+            "{err}"
+        );
+    }
+    assert_eq!(std::fs::read(&file).unwrap(), b"keep me");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn a_run_removes_temporaries_an_interrupted_write_left() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    let stale = out.join(".checkpoint.bin.Ab3xYz.tmp");
+    std::fs::write(&stale, b"half a checkpoint").unwrap();
+    let st = dla()
+        .args(["--particles", "100", "--quiet", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    assert!(!stale.exists());
+    assert!(out.join("run.json").exists());
+}

@@ -234,6 +234,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         fit_min_size: cli.fit_min_size,
     };
     p.validate().map_err(|e| e.to_string())?;
+    core_lattice::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
 
@@ -249,7 +250,7 @@ fn main() -> ExitCode {
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     let clock = RunClock::start();
     // Created before the run so a long run cannot end with nowhere to write.
-    std::fs::create_dir_all(&cli.out)
+    core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     let target = params.target_clusters;
     let mut sim = match &cli.resume {

@@ -75,6 +75,38 @@ impl Write for AtomicFile {
     }
 }
 
+/// Whether `name` is a temporary file of an [`AtomicFile`]: `.{target}.{6 random
+/// characters}.tmp`.
+fn is_atomic_temporary(name: &str) -> bool {
+    let Some(stem) = name.strip_prefix('.').and_then(|n| n.strip_suffix(".tmp")) else {
+        return false;
+    };
+    match stem.rsplit_once('.') {
+        Some((target, random)) => {
+            !target.is_empty()
+                && random.len() == 6
+                && random.bytes().all(|b| b.is_ascii_alphanumeric())
+        }
+        None => false,
+    }
+}
+
+/// Delete the temporary files that [`AtomicFile`]s left in `dir` when their process was killed
+/// mid-write (a dropped `AtomicFile` deletes its own), and return their paths. Only names of
+/// the form `.{target}.{6 random characters}.tmp` are touched.
+pub fn remove_stale_temporaries(dir: &Path) -> io::Result<Vec<PathBuf>> {
+    let mut removed = Vec::new();
+    for entry in std::fs::read_dir(dir)? {
+        let entry = entry?;
+        let name = entry.file_name();
+        if entry.file_type()?.is_file() && name.to_str().is_some_and(is_atomic_temporary) {
+            std::fs::remove_file(entry.path())?;
+            removed.push(entry.path());
+        }
+    }
+    Ok(removed)
+}
+
 /// Best-effort `fsync` of the directory holding `path` (POSIX needs it for a durable rename;
 /// other systems do not allow opening directories, so errors are ignored).
 fn sync_parent_dir(path: &Path) {
@@ -134,6 +166,32 @@ mod tests {
             assert!(!p.exists());
         }
         assert!(entries(dir.path()).is_empty());
+    }
+
+    #[test]
+    fn stale_temporaries_are_removed_and_nothing_else() {
+        let dir = tempfile::tempdir().unwrap();
+        // A temporary left by a killed write, next to files that only look alike.
+        let mut stale = AtomicFile::create(dir.path().join("checkpoint.bin")).unwrap();
+        stale.write_all(b"partial").unwrap();
+        let (_, kept) = stale.writer.into_inner().unwrap().keep().unwrap();
+        let keep = [
+            ".hidden.tmp",
+            "run.json",
+            ".x.abc.tmp",
+            "a.b12345.tmp",
+            ".y.ab-def.tmp",
+        ];
+        for name in keep {
+            std::fs::write(dir.path().join(name), b"x").unwrap();
+        }
+        std::fs::create_dir(dir.path().join(".d.abcdef.tmp")).unwrap();
+        let removed = remove_stale_temporaries(dir.path()).unwrap();
+        assert_eq!(removed, vec![kept]);
+        let mut expected: Vec<String> = keep.iter().map(|s| s.to_string()).collect();
+        expected.push(".d.abcdef.tmp".into());
+        expected.sort();
+        assert_eq!(entries(dir.path()), expected);
     }
 
     /// The process umask, from `/proc/self/status` (Linux 4.7 and later).

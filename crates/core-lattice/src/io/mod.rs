@@ -17,7 +17,7 @@ pub mod image;
 pub mod manifest;
 pub mod table;
 
-pub use atomic::{AtomicFile, write_atomic};
+pub use atomic::{AtomicFile, remove_stale_temporaries, write_atomic};
 pub use checkpoint::{CheckpointError, read_checkpoint, write_checkpoint};
 pub use hash::StateHasher;
 pub use image::{write_png_gray, write_png_rgb};
