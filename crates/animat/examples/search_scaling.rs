@@ -18,7 +18,7 @@
 //!   the mean search seconds per step (clock read around each animat's decision).
 
 use animat::GridBox;
-use animat::bench::{SCALING_DENSITY as DENSITY, SearchCost, search_scaling_point_with};
+use animat::bench::{SCALING_DENSITY, SearchCost, search_scaling_point_with};
 use core_lattice::stats::Fit;
 
 const SEED: u64 = 1;
@@ -67,7 +67,7 @@ fn run(label: &str, grid: GridBox, cells: bool, max: u64, repeats: u32) -> Serie
         // shared machine the noise (preemption, cache sharing) only adds time.
         let c = (0..repeats.max(1))
             .map(|_| {
-                search_scaling_point_with(n, DENSITY, grid, steps_for(n), SEED, cells)
+                search_scaling_point_with(n, SCALING_DENSITY, grid, steps_for(n), SEED, cells)
                     .expect("valid parameters")
             })
             .min_by(|a, b| {

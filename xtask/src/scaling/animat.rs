@@ -5,13 +5,10 @@
 use super::Ctx;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, pm, sig};
-use animat::bench::{scaling_params, step_throughput};
+use animat::bench::{SCALING_DENSITY, scaling_params, step_throughput};
 use animat::{GridBox, World};
 use anyhow::Result;
 use core_lattice::Fit;
-
-/// Animats per cell of the start disc, the same for every population of the ladder.
-pub use animat::bench::SCALING_DENSITY as DENSITY;
 
 /// Hawick, James & Scogings (2006), Table I: fitted gradients and their errors, as printed.
 const TABLE_I: [(&str, f64, f64); 4] = [
@@ -45,11 +42,11 @@ pub struct Point {
     pub step_seconds: f64,
 }
 
-/// Build a world of `animats` at [`DENSITY`] (`animat::bench::scaling_params`), run `steps`
+/// Build a world of `animats` at [`SCALING_DENSITY`] (`animat::bench::scaling_params`), run `steps`
 /// steps with the per-query search timer, the cell index on or off, and return the per-step
 /// costs.
 pub fn measure(animats: u64, grid: GridBox, cells: bool, steps: u64, seed: u64) -> Result<Point> {
-    let mut world = World::new(scaling_params(animats, DENSITY, grid), seed)?;
+    let mut world = World::new(scaling_params(animats, SCALING_DENSITY, grid), seed)?;
     world.set_timing(true);
     world.set_cell_search(cells);
     let (mut pop, mut search, mut evals) = (0.0, 0.0, 0.0);
@@ -110,7 +107,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         ctx.doc("Hawick, James & Scogings (2006): animats, neighbour-search cost against population (Fig. 9, Table I)");
     doc.p(&format!(
         "Worlds of N animats (foxes and rabbits in the default ratio, default rules and \
-         parameters, vision 60) placed uniformly on a disc at a fixed density of {DENSITY} \
+         parameters, vision 60) placed uniformly on a disc at a fixed density of {SCALING_DENSITY} \
          animats per cell (the default start's density), then {steps} timed steps. The search \
          time is the time spent inside perception queries (`--timing`). Rows marked *boxes* \
          use the paper's structure, grid boxes alone; the row marked *cells + boxes* is our \
@@ -231,7 +228,14 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     ]);
     for &n in ladder.iter().filter(|&&n| n <= 100_000) {
         ctx.log(&format!("throughput: {n} animats"));
-        let r = step_throughput(n, DENSITY, GridBox::Side(60), warmup, tsteps, ctx.seed)?;
+        let r = step_throughput(
+            n,
+            SCALING_DENSITY,
+            GridBox::Side(60),
+            warmup,
+            tsteps,
+            ctx.seed,
+        )?;
         t.row(vec![
             n.to_string(),
             sig(r.animat_steps_per_second, 3),
