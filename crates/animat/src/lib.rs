@@ -26,4 +26,4 @@ pub mod params;
 pub mod world;
 
 pub use params::{FoxRule, GridBox, Params, ParamsError, RabbitRule, Species};
-pub use world::{Animat, QueryCounts, StepStats, World, WorldError};
+pub use world::{Animat, QueryCounts, Snapshot, StepStats, World, WorldError};

@@ -4,12 +4,13 @@
 //! outputs. Built with the `cli` feature (on by default).
 
 use animat::output::{self, PopulationRow};
-use animat::{GridBox, Params, World};
+use animat::params::MAX_RADIUS;
+use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::LogArgs;
-use core_lattice::io::RunClock;
-use std::path::PathBuf;
+use core_lattice::cli::{LogArgs, flag_differences, usage};
+use core_lattice::io::{RunClock, read_checkpoint, write_checkpoint};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Foxes and rabbits on an unbounded plane, each running its rule list in priority order.
@@ -74,6 +75,17 @@ struct Cli {
     #[arg(long)]
     positions: bool,
 
+    /// Save the run to OUT/checkpoint.bin every N steps and at the end (atomically), for
+    /// --resume.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    checkpoint_every: Option<u64>,
+
+    /// Continue the run saved in DIR/checkpoint.bin (by --checkpoint-every) to the same state
+    /// as an uninterrupted run: the model parameters and --seed must be those of the saved run
+    /// (--steps may grow; output flags may change).
+    #[arg(long, value_name = "DIR")]
+    resume: Option<PathBuf>,
+
     #[command(flatten)]
     log: LogArgs,
 }
@@ -99,7 +111,14 @@ fn params(cli: &Cli) -> Result<Params, String> {
                 "--density {d} is outside the accepted range (0, 0.5]"
             ));
         }
-        p.start_radius = Params::radius_for_density(p.foxes.saturating_add(p.rabbits), d);
+        let animats = p.foxes.saturating_add(p.rabbits);
+        p.start_radius = Params::radius_for_density(animats, d);
+        if p.start_radius > MAX_RADIUS {
+            return Err(format!(
+                "--density {d:e} spreads {animats} animats over a start disc of radius {:.3e} cells, above the largest accepted {MAX_RADIUS}; raise --density",
+                (animats as f64 / (std::f64::consts::PI * d)).sqrt()
+            ));
+        }
     }
     if let Some(v) = cli.vision {
         p.vision = v;
@@ -112,18 +131,115 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.snapshot_every == Some(0) {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
-    p.validate().map_err(|e| e.to_string())?;
+    p.validate().map_err(|e| culprit(cli, &e))?;
     core_lattice::cli::check_out_dir(&cli.out)?;
     Ok(p)
+}
+
+/// The message of a parameter error, naming where the value came from: a flag
+/// (`--vision 0 is outside ...`) or the config file.
+fn culprit(cli: &Cli, e: &ParamsError) -> String {
+    let text = e.to_string();
+    let by_flag = |name: &str| match name {
+        "foxes" => cli.foxes.is_some(),
+        "rabbits" => cli.rabbits.is_some(),
+        "start_radius" => cli.start_radius.is_some() || cli.density.is_some(),
+        "vision" => cli.vision.is_some(),
+        "grid_box" => cli.grid_box.is_some(),
+        _ => false,
+    };
+    match e {
+        ParamsError::Range { name, .. } if by_flag(name) => text.replacen(
+            &format!("{name} = "),
+            &format!("--{} ", name.replace('_', "-")),
+            1,
+        ),
+        ParamsError::StartTooDense { .. } if cli.config.is_none() => text,
+        _ => match &cli.config {
+            Some(path) => format!("config {}: {text}", path.display()),
+            None => text,
+        },
+    }
 }
 
 fn main() -> ExitCode {
     core_lattice::cli::main_with("animat", |c: &Cli| c.log, params, run)
 }
 
+/// File name of checkpoints in the output directory.
+const CHECKPOINT: &str = "checkpoint.bin";
+/// Model name in the checkpoint envelope.
+const CHECKPOINT_MODEL: &str = "animat";
+
+/// What a checkpoint of the binary holds: the world and the population rows so far.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Saved {
+    world: Snapshot,
+    rows: Vec<PopulationRow>,
+}
+
+/// The run saved in `DIR/checkpoint.bin`, if it is one these flags continue; anything else is
+/// a usage error naming the file, or the parameters that differ with both values.
+fn resume(
+    dir: &Path,
+    params: &Params,
+    seed: u64,
+    steps: u64,
+) -> anyhow::Result<(World, Vec<PopulationRow>)> {
+    let path = dir.join(CHECKPOINT);
+    let at = || format!("--resume {}", path.display());
+    let saved: Saved =
+        read_checkpoint(&path, CHECKPOINT_MODEL).map_err(|e| usage(format!("{}: {e}", at())))?;
+    let mut differ = flag_differences(saved.world.params(), params, &[]);
+    if saved.world.seed() != seed {
+        differ.push(format!(
+            "--seed {} in the checkpoint, {seed} given",
+            saved.world.seed()
+        ));
+    }
+    if !differ.is_empty() {
+        return Err(usage(format!(
+            "{}: the parameters differ from the saved run's: {}",
+            at(),
+            differ.join("; ")
+        )));
+    }
+    if saved.world.steps() > steps {
+        return Err(usage(format!(
+            "{}: the saved run has done {} steps, more than --steps {steps}",
+            at(),
+            saved.world.steps()
+        )));
+    }
+    let world = World::restore(saved.world).map_err(|e| usage(format!("{}: {e}", at())))?;
+    if saved.rows.last().map(|r| r.step) != Some(world.steps()) {
+        return Err(usage(format!(
+            "{}: the population rows do not end at step {}",
+            at(),
+            world.steps()
+        )));
+    }
+    tracing::info!(step = world.steps(), "resumed");
+    Ok((world, saved.rows))
+}
+
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     let clock = RunClock::start();
-    let mut world = World::new(params, cli.seed).context("setting up the run")?;
+    // Everything that can refuse the run happens before --out is created.
+    let (mut world, mut rows) = match &cli.resume {
+        Some(dir) => resume(dir, &params, cli.seed, cli.steps)?,
+        None => {
+            let world = World::new(params, cli.seed).context("setting up the run")?;
+            let start = PopulationRow {
+                step: 0,
+                foxes: world.foxes(),
+                rabbits: world.rabbits(),
+                search_seconds: 0.0,
+                distance_evals: 0,
+            };
+            (world, vec![start])
+        }
+    };
     world.set_timing(cli.timing);
     core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
@@ -133,26 +249,31 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         grid = %world.grid().box_size(),
         "start"
     );
+    let save = |world: &World, rows: &[PopulationRow]| -> anyhow::Result<()> {
+        let saved = Saved {
+            world: world.snapshot(),
+            rows: rows.to_vec(),
+        };
+        write_checkpoint(cli.out.join(CHECKPOINT), CHECKPOINT_MODEL, &saved)
+            .context("writing a checkpoint")?;
+        Ok(())
+    };
     let snapshot = |w: &World| -> anyhow::Result<()> {
         let path = cli.out.join(format!("snapshot_{:06}.png", w.steps()));
         output::write_snapshot(&path, w)?;
         Ok(())
     };
-    let bar = cli.log.progress_bar(
+    let progress = cli.log.progress(
+        "animat",
         cli.steps,
+        "steps",
         "{elapsed_precise} [{bar:40}] {pos}/{len} steps, {msg}",
     );
-    let mut rows = vec![PopulationRow {
-        step: 0,
-        foxes: world.foxes(),
-        rabbits: world.rabbits(),
-        search_seconds: 0.0,
-        distance_evals: 0,
-    }];
-    if cli.snapshot_every.is_some() {
+    if cli.snapshot_every.is_some() && cli.resume.is_none() {
         snapshot(&world)?;
     }
-    for _ in 0..cli.steps {
+    progress.set_position(world.steps().min(cli.steps));
+    while world.steps() < cli.steps {
         if world.foxes() + world.rabbits() == 0 {
             tracing::info!(step = world.steps(), "every animat has died");
             break;
@@ -170,19 +291,24 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
                 snapshot(&world)?;
             }
         }
-        if let Some(bar) = &bar {
-            bar.inc(1);
-            if world.steps() % 16 == 0 {
-                bar.set_message(format!(
-                    "{} foxes, {} rabbits",
-                    world.foxes(),
-                    world.rabbits()
-                ));
-            }
+        if let Some(n) = cli.checkpoint_every
+            && world.steps() % n == 0
+            && world.steps() < cli.steps
+        {
+            save(&world, &rows)?;
         }
+        if world.steps() % 16 == 0 {
+            progress.set_message(format!(
+                "{} foxes, {} rabbits",
+                world.foxes(),
+                world.rabbits()
+            ));
+        }
+        progress.inc(1);
     }
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
+    progress.finish();
+    if cli.checkpoint_every.is_some() {
+        save(&world, &rows)?;
     }
     if let Some(k) = cli.snapshot_every {
         if world.steps() % k != 0 {
@@ -194,7 +320,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         output::write_positions(&cli.out, &world)?;
     }
     let m = output::write_manifest(&cli.out, &world, cli.seed, &clock)?;
-    if !cli.log.quiet {
+    if !cli.log.is_quiet() {
         eprintln!(
             "animat: {} foxes, {} rabbits after {} steps in {:.2} s (state {}); outputs in {}",
             world.foxes(),

@@ -16,7 +16,7 @@ use std::path::Path;
 pub use core_lattice::io::OutputError;
 
 /// One row of `populations.csv`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PopulationRow {
     /// Step number (0 = the start).
     pub step: u64,

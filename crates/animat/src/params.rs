@@ -162,7 +162,7 @@ impl std::str::FromStr for GridBox {
     }
 }
 
-/// How [`GridBox`] appears in config files and `run.json`.
+/// How [`GridBox`] appears in config files and `run.json` (human-readable formats).
 #[derive(Serialize, Deserialize)]
 #[serde(untagged)]
 enum GridBoxRepr {
@@ -170,8 +170,25 @@ enum GridBoxRepr {
     Name(String),
 }
 
+/// How [`GridBox`] appears in binary formats (checkpoints), which cannot read an untagged
+/// enum.
+#[derive(Serialize, Deserialize)]
+enum GridBoxTagged {
+    Side(i64),
+    Vision,
+    None,
+}
+
 impl Serialize for GridBox {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        if !s.is_human_readable() {
+            return match *self {
+                GridBox::Side(a) => GridBoxTagged::Side(a),
+                GridBox::Vision => GridBoxTagged::Vision,
+                GridBox::None => GridBoxTagged::None,
+            }
+            .serialize(s);
+        }
         match self {
             GridBox::Side(a) => GridBoxRepr::Side(*a),
             other => GridBoxRepr::Name(other.to_string()),
@@ -182,6 +199,13 @@ impl Serialize for GridBox {
 
 impl<'de> Deserialize<'de> for GridBox {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        if !d.is_human_readable() {
+            return Ok(match GridBoxTagged::deserialize(d)? {
+                GridBoxTagged::Side(a) => GridBox::Side(a),
+                GridBoxTagged::Vision => GridBox::Vision,
+                GridBoxTagged::None => GridBox::None,
+            });
+        }
         match GridBoxRepr::deserialize(d)? {
             GridBoxRepr::Side(a) => Ok(GridBox::Side(a)),
             GridBoxRepr::Name(n) => n.parse().map_err(serde::de::Error::custom),
@@ -230,10 +254,30 @@ pub enum ParamsError {
         /// The repeated name.
         name: String,
     },
+    /// A species that starts with animats but has no rules: they would never act.
+    #[error(
+        "{species}_rules is empty, so a {species} would never act; give at least one of: {accepted}"
+    )]
+    NoRules {
+        /// `fox` or `rabbit`.
+        species: &'static str,
+        /// The accepted names, comma separated.
+        accepted: String,
+    },
+    /// `hungry_at` above `starve`: a fox would starve before it is ever hungry.
+    #[error(
+        "hungry_at = {hungry_at} is above starve = {starve}: a fox would starve before it is ever hungry (hunting and eating would never run); use hungry_at <= starve"
+    )]
+    NeverHungry {
+        /// `hungry_at`.
+        hungry_at: u32,
+        /// `starve`.
+        starve: u32,
+    },
     /// More animats than the start disc can hold at half occupancy.
     #[error(
         "{animats} animats do not fit in a start disc of radius {radius} \
-         (at most {max} = half its cells); raise start_radius or lower the populations"
+         (at most {max} = half its cells); raise start_radius (--start-radius) or lower the populations (--foxes, --rabbits)"
     )]
     StartTooDense {
         /// Foxes plus rabbits.
@@ -340,6 +384,14 @@ fn check_range(name: &'static str, value: i128, min: i128, max: i128) -> Result<
     }
 }
 
+/// The names of `all` rules, comma separated.
+fn rule_names<R: Copy>(all: &[R], name_of: fn(R) -> &'static str) -> String {
+    all.iter()
+        .map(|&r| name_of(r))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 fn parse_rules<R: Copy + PartialEq>(
     species: &'static str,
     names: &[String],
@@ -355,11 +407,7 @@ fn parse_rules<R: Copy + PartialEq>(
             .ok_or_else(|| ParamsError::UnknownRule {
                 species,
                 name: n.clone(),
-                accepted: all
-                    .iter()
-                    .map(|&r| name_of(r))
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                accepted: rule_names(all, name_of),
             })?;
         if out.contains(&rule) {
             return Err(ParamsError::DuplicateRule {
@@ -430,6 +478,25 @@ impl Params {
         check_prob("rabbit_breed_p", self.rabbit_breed_p)?;
         self.fox_rule_list()?;
         self.rabbit_rule_list()?;
+        // An empty list is accepted for a species with no animats (a hand-built scene).
+        if self.fox_rules.is_empty() && self.foxes > 0 {
+            return Err(ParamsError::NoRules {
+                species: "fox",
+                accepted: rule_names(&FoxRule::ALL, FoxRule::name),
+            });
+        }
+        if self.rabbit_rules.is_empty() && self.rabbits > 0 {
+            return Err(ParamsError::NoRules {
+                species: "rabbit",
+                accepted: rule_names(&RabbitRule::ALL, RabbitRule::name),
+            });
+        }
+        if self.hungry_at > self.starve {
+            return Err(ParamsError::NeverHungry {
+                hungry_at: self.hungry_at,
+                starve: self.starve,
+            });
+        }
         let animats = self.foxes.saturating_add(self.rabbits);
         let max = self.start_capacity();
         if animats > max {
@@ -509,6 +576,26 @@ mod tests {
             p.validate(),
             Err(ParamsError::DuplicateRule { .. })
         ));
+        let p = Params {
+            fox_rules: vec![],
+            ..Params::default()
+        };
+        assert_eq!(
+            p.validate().unwrap_err().to_string(),
+            "fox_rules is empty, so a fox would never act; give at least one of: eat, breed, hunt, seek_mate, wander"
+        );
+        let p = Params {
+            rabbit_rules: vec![],
+            rabbits: 0,
+            ..Params::default()
+        };
+        assert_eq!(p.validate(), Ok(()));
+        let p = Params {
+            hungry_at: 31,
+            starve: 30,
+            ..Params::default()
+        };
+        assert!(matches!(p.validate(), Err(ParamsError::NeverHungry { .. })));
         let p = Params {
             start_radius: 10,
             ..Params::default()

@@ -1,5 +1,5 @@
-//! The `animat` binary: outputs, config files, and one-line errors with exit code 2 and
-//! nothing written.
+//! The `animat` binary: outputs, config files, checkpoints and resume after kill -9 (bad
+//! inputs: `tests/bad_input.rs`).
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -108,48 +108,165 @@ fn default_config_file_reproduces_the_defaults() {
     assert_eq!(run_json(&a)["params"], run_json(&b)["params"]);
 }
 
+/// `populations.csv` and the state hash of a finished run in `dir`.
+fn result(dir: &Path) -> (String, String) {
+    let hash = run_json(dir)["results"]["state_hash"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    (
+        std::fs::read_to_string(dir.join("populations.csv")).unwrap(),
+        hash,
+    )
+}
+
 #[test]
-fn bad_input_is_one_line_exit_2_nothing_written() {
+fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
     let tmp = tempfile::tempdir().unwrap();
-    let write = |name: &str, text: &str| {
-        let p = tmp.path().join(name);
-        std::fs::write(&p, text).unwrap();
-        p.to_str().unwrap().to_string()
-    };
-    let unknown_key = write("k.toml", "foxes = 3\n\nwolves = 2\n");
-    let malformed = write("m.toml", "foxes = 3\nrabbits = = 4\n");
-    let bad_rule = write("r.toml", "rabbit_rules = [\"flee\", \"dig\"]\n");
-    let bad_p = write("p.toml", "fox_breed_p = 1.5\n");
-    let cases: Vec<(Vec<String>, &str)> = vec![
-        (vec!["--grid-box".into(), "0".into()], "grid_box = 0"),
-        (vec!["--grid-box".into(), "big".into()], "--grid-box"),
-        (vec!["--vision".into(), "0".into()], "vision = 0"),
-        (
-            vec!["--config".into(), unknown_key],
-            "line 3: unknown field `wolves`",
-        ),
-        (vec!["--config".into(), malformed], "line 2:"),
-        (
-            vec!["--config".into(), bad_rule],
-            "unknown rabbit rule \"dig\"",
-        ),
-        (
-            vec!["--config".into(), bad_p],
-            "fox_breed_p = 1.5 is outside the accepted range [0, 1]",
-        ),
-        (vec!["--density".into(), "0.9".into()], "--density 0.9"),
-        (vec!["--steps".into(), "many".into()], "invalid value"),
+    let world = [
+        "--foxes",
+        "300",
+        "--rabbits",
+        "3000",
+        "--start-radius",
+        "100",
     ];
-    for (i, (args, want)) in cases.into_iter().enumerate() {
-        let out = tmp.path().join(format!("out{i}"));
-        let mut all = args.clone();
-        all.extend(["--out".into(), out.to_str().unwrap().into()]);
-        let all: Vec<&str> = all.iter().map(String::as_str).collect();
-        let o = animat(&all);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        assert!(err.contains(want), "{args:?}: {err}");
-        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    let steps = ["--steps", "400", "--seed", "5", "-qq"];
+    let whole = tmp.path().join("whole");
+    let o = animat(&[&world[..], &steps[..], &["--out", whole.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    // The same run with a checkpoint every 5 steps, killed (SIGKILL) once a checkpoint exists.
+    let cut = tmp.path().join("cut");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_animat"))
+        .args(world)
+        .args(steps)
+        .args(["--checkpoint-every", "5", "--out", cut.to_str().unwrap()])
+        .spawn()
+        .unwrap();
+    let checkpoint = cut.join("checkpoint.bin");
+    while !checkpoint.exists() {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
     }
+    let killed = child.try_wait().unwrap().is_none();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    if !killed {
+        eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
+    }
+
+    let resumed = tmp.path().join("resumed");
+    let o = animat(
+        &[
+            &world[..],
+            &steps[..],
+            &[
+                "--resume",
+                cut.to_str().unwrap(),
+                "--out",
+                resumed.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(result(&resumed), result(&whole));
+
+    // A finished run extends: 400 steps resumed to 450 equal 450 steps made at once.
+    let ext = tmp.path().join("ext");
+    let more = ["--steps", "450", "--seed", "5", "-qq"];
+    let ck = tmp.path().join("ck");
+    let o = animat(
+        &[
+            &world[..],
+            &steps[..],
+            &["--checkpoint-every", "100", "--out", ck.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success());
+    let o = animat(
+        &[
+            &world[..],
+            &more[..],
+            &[
+                "--resume",
+                ck.to_str().unwrap(),
+                "--out",
+                ext.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let direct = tmp.path().join("direct");
+    let o = animat(&[&world[..], &more[..], &["--out", direct.to_str().unwrap()]].concat());
+    assert!(o.status.success());
+    assert_eq!(result(&ext), result(&direct));
+}
+
+#[test]
+fn a_run_removes_temporaries_an_interrupted_checkpoint_write_left() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    // What a kill during the atomic write of a checkpoint leaves: the temporary, not yet
+    // renamed.
+    let stale = out.join(".checkpoint.bin.k9Xq2Z.tmp");
+    std::fs::write(&stale, b"half a checkpoint").unwrap();
+    let o = animat(
+        &[
+            &SMALL[..],
+            &[
+                "--checkpoint-every",
+                "10",
+                "-q",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().all(|n| !n.ends_with(".tmp")), "{names:?}");
+    assert!(out.join("checkpoint.bin").exists());
+}
+
+#[test]
+fn a_quiet_run_without_a_terminal_sends_a_heartbeat_and_qq_silences_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = |quiet: &str, out: &str| {
+        let out = tmp.path().join(out);
+        animat(
+            &[
+                &SMALL[..],
+                &[
+                    quiet,
+                    "--heartbeat",
+                    "0.001",
+                    "--out",
+                    out.to_str().unwrap(),
+                ],
+            ]
+            .concat(),
+        )
+    };
+    let o = run("-q", "a");
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("animat: ") && l.contains("/40 steps (")),
+        "{err}"
+    );
+    let o = run("-qq", "b");
+    assert!(o.status.success());
+    assert_eq!(String::from_utf8_lossy(&o.stderr), "");
 }

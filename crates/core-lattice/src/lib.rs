@@ -12,8 +12,9 @@
 //!   far from the origin.
 //! - [`io`]: atomic file writes, the run manifest `run.json`, the checkpoint envelope, PNG and
 //!   CSV writers, and the stable state hash.
-//! - `cli` (feature `cli`): one-line argument errors with exit code 2, and logging set-up, for
-//!   the model binaries.
+//! - `cli` (feature `cli`): the model binaries' contract (usage errors: one line, exit code 2,
+//!   nothing created; failed runs: exit code 1), `--out` checks, logging, progress and heartbeat.
+//! - `testing` (feature `test-support`): the bad-input harness of the binaries' tests.
 //!
 //! Conventions (see `docs/architecture.md`): a run is a pure function of its parameters and seed;
 //! bad input is a typed error, never a panic; every output file is written atomically.
@@ -24,6 +25,8 @@ pub mod io;
 pub mod lattice;
 pub mod rng;
 pub mod stats;
+#[cfg(feature = "test-support")]
+pub mod testing;
 
 pub use lattice::{Blocked, Boundary, Coords, Direction, Lattice, LatticeError, MAX_DIM, Offset};
 pub use rng::{SimRng, stream, stream_id};

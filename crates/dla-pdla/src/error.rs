@@ -12,8 +12,8 @@ pub enum SimError {
     /// Invalid parameters.
     #[error(transparent)]
     Params(#[from] ParamsError),
-    /// `D` does not match `params.dim`.
-    #[error("Simulation<{0}> built with --dim {1}")]
+    /// `D` (first) does not match `params.dim` (second).
+    #[error("parameters for {1} dimensions given to a {0}-dimensional simulation")]
     DimMismatch(usize, usize),
     /// The orthtree refused a particle (coordinate range or capacity).
     #[error("storing a particle: {0}")]
@@ -21,12 +21,12 @@ pub enum SimError {
     /// The distance map refused a particle (too large a cluster for its memory).
     #[error("distance map: {0}")]
     Map(#[from] DistanceMapError),
-    /// A checkpoint could not be written or read.
-    #[error("checkpoint: {0}")]
+    /// A checkpoint could not be written or read (the message says so).
+    #[error(transparent)]
     Checkpoint(#[from] core_lattice::io::CheckpointError),
     /// Checkpoints need one thread and the positions kept in memory; or a checkpoint does not
-    /// match the run it should continue.
-    #[error("checkpoint: {0}")]
+    /// match the run it should continue (the message says which).
+    #[error("{0}")]
     CheckpointUsage(String),
     /// PDLA discarded [`MAX_CONSECUTIVE_DISCARDS`](crate::sim::MAX_CONSECUTIVE_DISCARDS)
     /// walkers in a row without storing one.

@@ -5,11 +5,11 @@
 
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::LogArgs;
+use core_lattice::cli::{LogArgs, flag_differences, usage};
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, Simulation, Space};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA), 2D and 3D.
@@ -156,6 +156,37 @@ fn params(cli: &Cli) -> Result<Params, String> {
     Ok(p)
 }
 
+/// The progress bar of a run on a terminal.
+const PROGRESS_TEMPLATE: &str =
+    "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})";
+
+/// The run checkpointed in `DIR/checkpoint.bin`, if it is one these flags continue; anything
+/// else is a usage error naming the file, or the flags that differ with both values.
+fn resume<const D: usize>(dir: &Path, params: &Params, seed: u64) -> anyhow::Result<Simulation<D>>
+where
+    Dim<D>: Space<D>,
+{
+    let path = dir.join("checkpoint.bin");
+    let sim = Simulation::<D>::resume(&path)
+        .map_err(|e| usage(format!("--resume {}: {e}", path.display())))?;
+    let mut differ = flag_differences(sim.params(), params, &[("keep_positions", None)]);
+    if sim.seed() != seed {
+        differ.push(format!(
+            "--seed {} in the checkpoint, {seed} given",
+            sim.seed()
+        ));
+    }
+    if !differ.is_empty() {
+        return Err(usage(format!(
+            "--resume {}: the flags differ from the checkpointed run's: {}",
+            dir.display(),
+            differ.join("; ")
+        )));
+    }
+    tracing::info!(particles = sim.particles(), "resumed");
+    Ok(sim)
+}
+
 fn main() -> ExitCode {
     core_lattice::cli::main_with(
         "dla",
@@ -176,51 +207,30 @@ where
     Dim<D>: Space<D>,
 {
     let clock = RunClock::start();
-    core_lattice::cli::prepare_out_dir(&cli.out)
-        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     let total = params.particles;
     tracing::info!(?params, seed = cli.seed, "starting growth");
+    // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
         None => Simulation::<D>::new(params, cli.seed).context("setting up the run")?,
-        Some(dir) => {
-            let path = dir.join("checkpoint.bin");
-            let sim = Simulation::<D>::resume(&path)
-                .with_context(|| format!("resuming from {}", path.display()))?;
-            let mut same = sim.params().clone();
-            same.keep_positions = params.keep_positions;
-            anyhow::ensure!(
-                same == params && sim.seed() == cli.seed,
-                "--resume {}: the flags differ from the checkpointed run's ({:?}, seed {})",
-                dir.display(),
-                sim.params(),
-                sim.seed()
-            );
-            tracing::info!(particles = sim.particles(), "resumed");
-            sim
-        }
+        Some(dir) => resume::<D>(dir, &params, cli.seed)?,
     };
-    let bar = cli.log.progress_bar(
-        total,
-        "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})",
-    );
-    let progress = |n| {
-        if let Some(bar) = &bar {
-            bar.set_position(n);
-        }
-    };
+    core_lattice::cli::prepare_out_dir(&cli.out)
+        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    let progress = cli
+        .log
+        .progress("dla", total, "particles", PROGRESS_TEMPLATE);
+    let report = |n| progress.set_position(n);
     match cli.checkpoint_every {
-        Some(every) => sim.run_checkpointed(every, &cli.out.join("checkpoint.bin"), &progress)?,
-        None => sim.run_with(&progress)?,
+        Some(every) => sim.run_checkpointed(every, &cli.out.join("checkpoint.bin"), &report)?,
+        None => sim.run_with(&report)?,
     }
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    progress.finish();
     let m = write_outputs(&sim, &clock, &cli.out, cli.positions, cli.png)?;
     if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
         tracing::warn!("no fractal dimension: {e}");
     }
     tracing::info!(discarded = sim.discarded_walkers(), "done");
-    if !cli.log.quiet {
+    if !cli.log.is_quiet() {
         let d = m
             .results
             .get("fractal_dimension")

@@ -149,6 +149,11 @@ pub enum ParamsError {
     /// `leaf_side` not a power of two in [1, 64].
     #[error("--leaf-side {0} is outside the accepted range {{1, 2, 4, 8, 16, 32, 64}}")]
     LeafSide(f64),
+    /// `fit_from` below 2: a single particle has no radius of gyration to fit.
+    #[error(
+        "--fit-from {0} is outside the accepted range 2.. (a single particle has no radius of gyration)"
+    )]
+    FitFrom(u64),
     /// `threads` is 0 or absurd.
     #[error("--threads {0} is outside the accepted range 1..=1024")]
     Threads(usize),
@@ -177,6 +182,9 @@ impl Params {
         }
         if self.threads == 0 || self.threads > 1024 {
             return Err(ParamsError::Threads(self.threads));
+        }
+        if self.fit_from < 2 {
+            return Err(ParamsError::FitFrom(self.fit_from));
         }
         let l = self.leaf_side;
         if !((1.0..=64.0).contains(&l) && l.log2().fract() == 0.0) {

@@ -6,14 +6,14 @@
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
-use core_lattice::cli::LogArgs;
+use core_lattice::cli::{LogArgs, flag_differences, usage};
 use core_lattice::io::RunClock;
 use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Diffusion-limited cluster-cluster aggregation (DLCA) on a periodic or walled lattice.
@@ -243,36 +243,61 @@ fn parse_boundary(s: &str) -> Result<Boundary, String> {
         .map_err(|e| format!("--boundary: {e}"))
 }
 
+/// The run saved in `DIR/checkpoint.bin`, if it is one these flags continue (only
+/// --target-clusters and --max-sweeps may change); anything else is a usage error naming the
+/// file, or the flags that differ with both values.
+fn resume(dir: &Path, params: Params, seed: u64) -> anyhow::Result<Simulation> {
+    let path = dir.join(CHECKPOINT);
+    let at = || format!("--resume {}", path.display());
+    let mut snapshot: Snapshot =
+        read_checkpoint(&path, "dlca").map_err(|e| usage(format!("{}: {e}", at())))?;
+    snapshot.set_stop(params.target_clusters, params.max_sweeps);
+    let mut differ = flag_differences(
+        snapshot.params(),
+        &params,
+        &[
+            ("init", Some("--fill/--particles")),
+            ("histogram_sweeps", Some("--histogram/--histogram-sweeps")),
+        ],
+    );
+    if snapshot.seed() != seed {
+        differ.push(format!(
+            "--seed {} in the checkpoint, {seed} given",
+            snapshot.seed()
+        ));
+    }
+    if !differ.is_empty() {
+        return Err(usage(format!(
+            "{}: the flags differ from the saved run's (only --target-clusters and --max-sweeps may change): {}",
+            at(),
+            differ.join("; ")
+        )));
+    }
+    tracing::info!("resuming after sweep {}", snapshot.sweeps());
+    Simulation::restore(snapshot).map_err(|e| usage(format!("{}: {e}", at())))
+}
+
 fn main() -> ExitCode {
     core_lattice::cli::main_with("dlca", |c: &Cli| c.log, params, run)
 }
 
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     let clock = RunClock::start();
+    let target = params.target_clusters;
+    // Everything that can refuse the run happens before --out is created.
+    let mut sim = match &cli.resume {
+        Some(dir) => resume(dir, params, cli.seed)?,
+        None => Simulation::new(params, cli.seed).context("setting up the run")?,
+    };
     // Created before the run so a long run cannot end with nowhere to write.
     core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
-    let target = params.target_clusters;
-    let mut sim = match &cli.resume {
-        Some(dir) => {
-            let path = dir.join(CHECKPOINT);
-            let mut snapshot: Snapshot = read_checkpoint(&path, "dlca")
-                .with_context(|| format!("reading checkpoint {}", path.display()))?;
-            snapshot.set_stop(params.target_clusters, params.max_sweeps);
-            anyhow::ensure!(
-                snapshot.params() == &params && snapshot.seed() == cli.seed,
-                "--resume: {} holds a different run (its parameters or seed differ from these flags; only --target-clusters and --max-sweeps may change)",
-                path.display()
-            );
-            tracing::info!("resuming after sweep {}", snapshot.sweeps());
-            Simulation::restore(snapshot).context("restoring the checkpoint")?
-        }
-        None => Simulation::new(params, cli.seed).context("setting up the run")?,
-    };
     tracing::info!("{}", sim.strategy_reason());
     let initial = sim.clusters();
-    let bar = cli.log.progress_bar(
+    let progress = cli.log.progress(
+        "dlca",
         initial.saturating_sub(target),
+        "merges",
         "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
     );
     let mut saved = Ok(());
@@ -284,19 +309,15 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         {
             saved = write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot());
         }
-        if let Some(bar) = &bar {
-            if s.sweeps() % 16 == 0 || s.is_done() {
-                bar.set_position(initial - s.clusters().max(target).min(initial));
-                bar.set_message(format!("sweep {}, {} clusters", s.sweeps(), s.clusters()));
-            }
+        if s.sweeps() % 16 == 0 || s.is_done() {
+            progress.set_message(format!("sweep {}, {} clusters", s.sweeps(), s.clusters()));
+            progress.set_position(initial - s.clusters().max(target).min(initial));
         }
     });
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    progress.finish();
     saved.context("writing a checkpoint")?;
     let m = dlca::output::write_outputs(&sim, cli.seed, &clock, &cli.out, cli.png)?;
-    if !cli.log.quiet {
+    if !cli.log.is_quiet() {
         eprintln!(
             "dlca: {} clusters (largest {}) after {} sweeps in {:.2} s with {}; outputs in {}",
             sim.clusters(),

@@ -118,16 +118,18 @@ impl Default for Params {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
     /// Dimension outside 1..=5.
-    #[error("dimension {0} is outside the accepted range 1..={MAX_MODEL_DIM}")]
+    #[error("--dim {0} is outside the accepted range 1..={MAX_MODEL_DIM}")]
     Dimension(usize),
     /// The lattice itself is invalid.
     #[error("{0}")]
     Lattice(#[from] LatticeError),
     /// Fill fraction outside (0, 1).
-    #[error("fill {0} is outside the accepted range (0, 1)")]
+    #[error("--fill {0} is outside the accepted range (0, 1)")]
     Fill(f64),
     /// Fill too small to place a single particle.
-    #[error("fill {fill} of {sites} sites places no particle; use a larger fill or --particles")]
+    #[error(
+        "--fill {fill} of {sites} sites places no particle; use a larger --fill or --particles"
+    )]
     EmptyFill {
         /// Fill asked for.
         fill: f64,
@@ -136,7 +138,7 @@ pub enum ParamError {
     },
     /// Particle count outside 1..=sites.
     #[error(
-        "{particles} particles is outside the accepted range 1..={sites} (the number of sites)"
+        "--particles {particles} is outside the accepted range 1..={sites} (the number of sites)"
     )]
     Particles {
         /// Particles asked for.
@@ -145,19 +147,19 @@ pub enum ParamError {
         sites: u64,
     },
     /// Temperature outside (0, 1].
-    #[error("temperature {0} is outside the accepted range (0, 1]")]
+    #[error("--temperature {0} is outside the accepted range (0, 1]")]
     Temperature(f64),
     /// Gravity outside [0, 1).
-    #[error("gravity {0} is outside the accepted range [0, 1)")]
+    #[error("--gravity {0} is outside the accepted range [0, 1)")]
     Gravity(f64),
     /// Negative or non-finite mobility exponent.
-    #[error("mobility exponent {0} is outside the accepted range [0, inf)")]
+    #[error("--mobility-exponent {0} is outside the accepted range [0, inf)")]
     MobilityExponent(f64),
     /// Target of zero clusters.
-    #[error("target clusters {0} is outside the accepted range 1..")]
+    #[error("--target-clusters {0} is outside the accepted range 1..")]
     TargetClusters(u64),
     /// Grid-box side not a power of two.
-    #[error("grid box {0} is not a power of two >= 1")]
+    #[error("--grid-box {0} is not a power of two >= 1")]
     GridBox(u64),
     /// The occupancy lattice does not fit the memory budget.
     #[error(
@@ -171,6 +173,25 @@ pub enum ParamError {
         /// The budget.
         budget: u64,
     },
+    /// A grid box so large that it does not split the lattice: `3A >= L` on the shortest axis
+    /// (the grid would be all-pairs from the start).
+    #[error(
+        "--grid-box {side} does not split the lattice: grid boxes need 3 x side < {shortest} (the shortest lattice side); use a smaller box or --search all-pairs"
+    )]
+    GridBoxTooLarge {
+        /// The box side asked for.
+        side: u64,
+        /// The shortest side of the lattice.
+        shortest: u64,
+    },
+    /// A grid box given to a strategy that has none.
+    #[error("--grid-box is used by --search grid and auto only, not {0}")]
+    GridBoxUnused(&'static str),
+    /// Too small a smallest size for the fractal-dimension fit.
+    #[error(
+        "--fit-min-size {0} is outside the accepted range 2.. (a single particle has no radius of gyration)"
+    )]
+    FitMinSize(u64),
     /// Particle count too large to number.
     #[error("{0} particles is more than this implementation supports (2^32 - 2)")]
     TooManyParticles(u64),
@@ -239,6 +260,16 @@ impl Params {
             if !a.is_power_of_two() {
                 return Err(ParamError::GridBox(a));
             }
+            if matches!(self.search, Search::AllPairs | Search::Lattice) {
+                return Err(ParamError::GridBoxUnused(self.search.name()));
+            }
+            let shortest = self.size.iter().copied().min().unwrap_or(0);
+            if a.saturating_mul(3) >= shortest {
+                return Err(ParamError::GridBoxTooLarge { side: a, shortest });
+            }
+        }
+        if self.fit_min_size < 2 {
+            return Err(ParamError::FitMinSize(self.fit_min_size));
         }
         if self.search == Search::Lattice {
             let bytes = spatial::lattice::Occupancy::bytes_needed(&lattice);
@@ -319,6 +350,26 @@ mod tests {
             with(|p| p.grid_box = Some(12)),
             Err(ParamError::GridBox(12))
         );
+        assert_eq!(
+            with(|p| {
+                p.size = vec![1024, 96];
+                p.grid_box = Some(32);
+            }),
+            Err(ParamError::GridBoxTooLarge {
+                side: 32,
+                shortest: 96
+            })
+        );
+        assert_eq!(
+            with(|p| {
+                p.grid_box = Some(16);
+                p.search = Search::AllPairs;
+            }),
+            Err(ParamError::GridBoxUnused("all-pairs"))
+        );
+        assert_eq!(with(|p| p.grid_box = Some(256)), Ok(()));
+        assert_eq!(with(|p| p.fit_min_size = 0), Err(ParamError::FitMinSize(0)));
+        assert_eq!(with(|p| p.fit_min_size = 1), Err(ParamError::FitMinSize(1)));
         assert!(matches!(
             with(|p| {
                 p.size = vec![1 << 20, 1 << 20];

@@ -1,4 +1,4 @@
-//! The `dlca` binary: outputs, and one-line errors with exit code 2 and nothing written.
+//! The `dlca` binary: outputs, strategies and resume (bad inputs: `tests/bad_input.rs`).
 
 use std::path::Path;
 use std::process::Command;
@@ -117,73 +117,6 @@ fn strategies_agree_through_the_cli() {
         .collect();
     assert_eq!(hashes[0], hashes[1]);
     assert_eq!(hashes[0], hashes[2]);
-}
-
-#[test]
-fn bad_input_is_one_line_exit_2_and_writes_nothing() {
-    let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("never");
-    let cases: &[(&[&str], &str)] = &[
-        (&["--dim", "0", "--size", "8", "--fill", "0.1"], "--dim 0"),
-        (&["--dim", "6", "--size", "8", "--fill", "0.1"], "--dim 6"),
-        (&["--size", "0", "--fill", "0.1"], "length on axis 0 is 0"),
-        (&["--size", "16", "--fill", "0"], "fill 0 is outside"),
-        (&["--size", "16", "--fill", "1"], "fill 1 is outside"),
-        (&["--size", "16", "--particles", "257"], "257 particles"),
-        (
-            &["--size", "16", "--fill", "0.1", "--gravity", "1"],
-            "gravity 1 is outside",
-        ),
-        (
-            &["--size", "16", "--fill", "0.1", "--gravity", "-0.2"],
-            "gravity -0.2",
-        ),
-        (
-            &[
-                "--size",
-                "100000",
-                "--particles",
-                "10",
-                "--search",
-                "lattice",
-            ],
-            "--max-memory",
-        ),
-        (
-            &["--size", "16", "--fill", "0.1", "--boundary", "sticky"],
-            "unknown boundary",
-        ),
-        (
-            &["--size", "16x16x16", "--fill", "0.1"],
-            "--size has 3 axes",
-        ),
-        (
-            &["--size", "16", "--fill", "0.1", "--grid-box", "3"],
-            "power of two",
-        ),
-        (&["--size", "16"], "required"),
-        (
-            &["--size", "16", "--fill", "0.1", "--frobnicate"],
-            "frobnicate",
-        ),
-    ];
-    for (args, expect) in cases {
-        let mut a: Vec<&str> = args.to_vec();
-        a.extend(["--out", out.to_str().unwrap()]);
-        let o = dlca(&a);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert_eq!(
-            err.trim_end().lines().count(),
-            1,
-            "{args:?}: not one line: {err}"
-        );
-        assert!(
-            err.contains(expect),
-            "{args:?}: '{err}' does not mention '{expect}'"
-        );
-        assert!(!out.exists(), "{args:?} wrote {}", out.display());
-    }
 }
 
 #[test]

@@ -11,6 +11,7 @@
 //! - `rules`: the fox and rabbit rule lists, the action each chooses and how actions apply;
 //! - `perception`: the neighbour queries the rules ask, from the cell index or the grid boxes;
 //! - `near`: the per-turn cache of the cells around the acting animat and its bit tricks;
+//! - `checkpoint`: the [`Snapshot`] of a world between steps and its exact restore;
 //! - `tests`: hand-built scenes.
 //!
 //! Invariants between steps: `recs` holds exactly the live animats, sorted by id, with
@@ -19,6 +20,7 @@
 //! the live animats; every id is below `next_id` and none is reused. During a step `grid` may
 //! lag behind `cells` by the changes logged in `pending` (see `step`).
 
+mod checkpoint;
 mod near;
 mod perception;
 mod rules;
@@ -33,6 +35,8 @@ use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
 use near::{NEAR_ROWS, disc_mask};
 use rustc_hash::FxHashSet;
 use spatial::plane::{PlaneError, PlaneGrid, Pos};
+
+pub use checkpoint::Snapshot;
 
 /// Random stream purposes of a run (each its own stream of the run seed).
 const STREAM_PLACEMENT: u32 = 1;
@@ -125,6 +129,9 @@ pub enum WorldError {
     /// The cell is already occupied (at most one animat per cell).
     #[error("cell [{}, {}] is already occupied", .0[0], .0[1])]
     Occupied(Pos),
+    /// A snapshot no world could have written (ids out of order, a rabbit with hunger).
+    #[error("impossible snapshot: {0}")]
+    BadSnapshot(String),
     /// An error of the search structure.
     #[error(transparent)]
     Plane(#[from] PlaneError),
@@ -144,6 +151,8 @@ pub struct StepStats {
 #[derive(Debug, Clone)]
 pub struct World {
     params: Params,
+    /// The run seed (its random streams are derived from it).
+    seed: u64,
     fox_rules: Vec<FoxRule>,
     rabbit_rules: Vec<RabbitRule>,
     vision2: u64,
@@ -254,6 +263,7 @@ impl World {
             total_distance_evals: 0,
             foxes: 0,
             rabbits: 0,
+            seed,
             params,
         })
     }
@@ -373,6 +383,11 @@ impl World {
     /// The parameters.
     pub fn params(&self) -> &Params {
         &self.params
+    }
+
+    /// The run seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
     }
 
     /// Steps done.

@@ -327,6 +327,7 @@ fn cell_search_and_grid_boxes_agree_on_hand_built_ties() {
 fn starvation_and_old_age() {
     let p = Params {
         starve: 3,
+        hungry_at: 3,
         fox_max_age: 10,
         rabbit_max_age: 2,
         ..only(&[], &[])

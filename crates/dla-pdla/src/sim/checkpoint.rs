@@ -80,11 +80,14 @@ where
     let snap: Snapshot = core_lattice::io::read_checkpoint(path, CHECKPOINT_MODEL)?;
     snap.params.validate()?;
     if snap.params.dim != D {
-        return Err(SimError::DimMismatch(D, snap.params.dim));
+        return Err(SimError::CheckpointUsage(format!(
+            "--dim {} in the checkpoint, {D} given",
+            snap.params.dim
+        )));
     }
     if snap.positions.len() % D != 0 || snap.positions.is_empty() {
         return Err(SimError::CheckpointUsage(format!(
-            "{} coordinates is not a whole number of {D}D positions",
+            "checkpoint holds {} coordinates, not a whole number of {D}D positions",
             snap.positions.len()
         )));
     }

@@ -1,0 +1,228 @@
+//! Command-line plumbing shared by the model binaries (feature `cli`), so that every binary
+//! keeps one contract:
+//!
+//! - **Usage errors** (a flag, a config file, a checkpoint to resume, an output location that
+//!   cannot be written) are found before the first step of work, print one line
+//!   `PROGRAM: error: ...` naming the flag or file and what is accepted, exit with code 2 and
+//!   leave nothing behind. A binary reports them by returning `Err` from its `params` step or a
+//!   [`UsageError`] (see [`usage`]) from its `run` step before it creates `--out`.
+//! - **Runtime failures** (a full disk mid-run, a livelock guard) print one line
+//!   `PROGRAM: run failed: ...` and exit with code 1.
+//! - **Logging**: warnings only by default, `-v` info, `-vv` debug, `RUST_LOG` overrides; a
+//!   progress bar on a terminal, and a one-line heartbeat every `--heartbeat` seconds when
+//!   there is no bar (a redirected log, or `--quiet`), so a long run is told from a hang;
+//!   `-qq` silences it ([`LogArgs`], [`Progress`]).
+
+mod out_dir;
+mod progress;
+mod resume;
+
+pub use out_dir::{check_out_dir, prepare_out_dir};
+pub use progress::Progress;
+pub use resume::flag_differences;
+
+use std::process::ExitCode;
+
+/// Exit code of a usage error (bad flags, config, checkpoint or output location).
+pub const EXIT_USAGE: u8 = 2;
+/// Exit code of a run that failed after it started (I/O error, livelock guard).
+pub const EXIT_RUN_FAILED: u8 = 1;
+
+/// The logging and progress flags every model binary takes (`#[command(flatten)]` them into
+/// the binary's flags).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct LogArgs {
+    /// No progress bar or summary, warnings only (the heartbeat stays); -qq also silences the
+    /// heartbeat.
+    #[arg(long, short, action = clap::ArgAction::Count)]
+    pub quiet: u8,
+
+    /// More log output (-v info, -vv debug); RUST_LOG overrides.
+    #[arg(short, action = clap::ArgAction::Count)]
+    pub verbose: u8,
+
+    /// Without a progress bar (stderr is not a terminal, or --quiet), print a one-line
+    /// progress report on stderr every this many seconds; 0 never.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = parse_heartbeat)]
+    pub heartbeat: f64,
+}
+
+impl Default for LogArgs {
+    fn default() -> Self {
+        LogArgs {
+            quiet: 0,
+            verbose: 0,
+            heartbeat: 60.0,
+        }
+    }
+}
+
+fn parse_heartbeat(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "'{s}' is not a number of seconds >= 0 (0 turns the heartbeat off)"
+        )),
+    }
+}
+
+impl LogArgs {
+    /// `--quiet` given (at least once): no progress bar and no summary line.
+    pub fn is_quiet(&self) -> bool {
+        self.quiet > 0
+    }
+
+    /// Progress of a run of `len` `unit`s: a bar with the indicatif `template` on a terminal
+    /// (unless `--quiet`), else a heartbeat line every `--heartbeat` seconds (unless `-qq` or
+    /// `--heartbeat 0`), else nothing.
+    pub fn progress(&self, program: &str, len: u64, unit: &str, template: &str) -> Progress {
+        use std::io::IsTerminal;
+        if self.quiet == 0 && std::io::stderr().is_terminal() {
+            Progress::bar(len, template)
+        } else if self.quiet < 2 && self.heartbeat > 0.0 {
+            Progress::heartbeat(program, len, unit, self.heartbeat)
+        } else {
+            Progress::silent()
+        }
+    }
+}
+
+/// A usage error found by a binary's `run` step before it has created anything (a checkpoint
+/// that does not fit the flags, say): [`main_with`] prints it as one line and exits with code
+/// 2. Build one with [`usage`].
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// A [`UsageError`] as an `anyhow::Error`, for `run` steps that return `anyhow::Result`.
+pub fn usage(message: impl Into<String>) -> anyhow::Error {
+    UsageError(message.into()).into()
+}
+
+/// The whole life of a model binary: parse the flags (help, version and parse errors handled
+/// as in [`parse_or_exit`]), set up logging from the [`LogArgs`] that `logging` reads off them,
+/// turn the flags into validated parameters (an `Err` is a usage error), then `run`. A
+/// [`UsageError`] from `run` is a usage error too (exit code 2); any other error is a failed
+/// run (exit code 1). Either prints one line.
+pub fn main_with<C: clap::Parser, P>(
+    program: &str,
+    logging: impl FnOnce(&C) -> LogArgs,
+    params: impl FnOnce(&C) -> Result<P, String>,
+    run: impl FnOnce(&C, P) -> anyhow::Result<()>,
+) -> ExitCode {
+    let cli: C = match parse_or_exit(program) {
+        Ok(cli) => cli,
+        Err(code) => return code,
+    };
+    let log = logging(&cli);
+    init_logging(log.quiet > 0, log.verbose);
+    let params = match params(&cli) {
+        Ok(p) => p,
+        Err(msg) => return usage_error(program, &msg),
+    };
+    match run(&cli, params) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => match e.downcast_ref::<UsageError>() {
+            Some(u) => usage_error(program, &u.0),
+            None => {
+                eprintln!("{program}: run failed: {}", error_line(&e));
+                ExitCode::from(EXIT_RUN_FAILED)
+            }
+        },
+    }
+}
+
+/// An error and its causes on one line, `outer: cause: root`, leaving out a cause whose text
+/// the message before it already contains (errors that print their source, as many
+/// `thiserror` types do, would otherwise show it twice); line breaks are folded.
+pub fn error_line(e: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
+/// Parse the command line into `C`. Help and version requests print and return
+/// `Err(ExitCode::SUCCESS)`; any parse error prints clap's message folded onto one line,
+/// prefixed by `program`, and returns `Err` with exit code 2.
+pub fn parse_or_exit<C: clap::Parser>(program: &str) -> Result<C, ExitCode> {
+    C::try_parse().map_err(|e| {
+        use clap::error::ErrorKind;
+        if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        // clap's message up to its blank line, folded onto one line.
+        let text = e.to_string();
+        let message: Vec<&str> = text
+            .lines()
+            .take_while(|l| !l.trim().is_empty())
+            .map(str::trim)
+            .collect();
+        usage_error(program, message.join(" ").trim_start_matches("error: "))
+    })
+}
+
+/// Print `program: error: msg` on one line and return exit code 2 (bad input).
+pub fn usage_error(program: &str, msg: &str) -> ExitCode {
+    let msg = msg.split_whitespace().collect::<Vec<_>>().join(" ");
+    eprintln!("{program}: error: {msg}");
+    ExitCode::from(EXIT_USAGE)
+}
+
+/// Log to stderr with `tracing`: warnings only when `quiet` or without `-v`, info with `-v`,
+/// debug with `-vv`; `RUST_LOG` overrides.
+pub fn init_logging(quiet: bool, verbose: u8) {
+    let default = match (quiet, verbose) {
+        (true, _) | (false, 0) => "warn",
+        (false, 1) => "info",
+        _ => "debug",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(default));
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        // Colour codes only on a terminal: a redirected log stays plain text.
+        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .try_init();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("checkpoint I/O: {0}")]
+    struct Wrapping(#[from] std::io::Error);
+
+    #[test]
+    fn error_line_shows_each_cause_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = anyhow::Error::from(Wrapping(io)).context("reading x.bin");
+        assert_eq!(
+            error_line(&e),
+            "reading x.bin: checkpoint I/O: no such file"
+        );
+        let e = anyhow::anyhow!("two\n lines").context("outer");
+        assert_eq!(error_line(&e), "outer: two lines");
+    }
+
+    #[test]
+    fn usage_errors_survive_context_and_downcast() {
+        let e = usage("--resume d: not a checkpoint");
+        assert_eq!(
+            e.downcast_ref::<UsageError>().map(|u| u.0.as_str()),
+            Some("--resume d: not a checkpoint")
+        );
+    }
+}

@@ -1,0 +1,108 @@
+//! Test support for the model binaries (feature `test-support`, for their integration tests
+//! only): drive a binary with bad inputs and check the usage-error contract of
+//! [`cli`](crate::cli): exit code 2, one line on stderr naming the culprit, nothing created.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+/// Every file and directory under `dir` (relative paths) with the file sizes.
+pub fn tree(dir: &Path) -> BTreeMap<PathBuf, u64> {
+    let mut out = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let path = e.path();
+            let meta = e.metadata().expect("metadata of a listed entry");
+            let rel = path.strip_prefix(dir).expect("under dir").to_path_buf();
+            if meta.is_dir() {
+                todo.push(path);
+                out.insert(rel, 0);
+            } else {
+                out.insert(rel, meta.len());
+            }
+        }
+    }
+    out
+}
+
+/// Runs `binary` (whose messages start `program: error: `) in the working directory `dir`
+/// once per case `(args, culprit)`, and checks each is refused as a usage error: exit code 2,
+/// exactly one line on stderr, starting `program: error: ` and containing `culprit`, and no
+/// file or directory created or changed under `dir`. Returns one description per case that
+/// broke the contract (empty when all held), so a test reports every failure at once.
+pub fn refusals(
+    binary: &Path,
+    program: &str,
+    dir: &Path,
+    cases: &[(&[&str], &str)],
+) -> Vec<String> {
+    let mut failures = Vec::new();
+    for (args, culprit) in cases {
+        let before = tree(dir);
+        let out = Command::new(binary)
+            .args(*args)
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .output()
+            .expect("the binary runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let lines: Vec<&str> = stderr.lines().collect();
+        let after = tree(dir);
+        let mut wrong = Vec::new();
+        if out.status.code() != Some(2) {
+            wrong.push(format!("exit {:?}, not 2", out.status.code()));
+        }
+        if lines.len() != 1 {
+            wrong.push(format!("{} stderr lines, not 1", lines.len()));
+        }
+        let prefix = format!("{program}: error: ");
+        if !lines
+            .first()
+            .is_some_and(|l| l.starts_with(&prefix) && l.contains(culprit))
+        {
+            wrong.push(format!("stderr does not name {culprit:?} after {prefix:?}"));
+        }
+        if before != after {
+            let created: Vec<_> = after.keys().filter(|k| !before.contains_key(*k)).collect();
+            wrong.push(format!("files changed (new: {created:?})"));
+        }
+        if !wrong.is_empty() {
+            failures.push(format!(
+                "{program} {}: {}; stderr: {}",
+                args.join(" "),
+                wrong.join(", "),
+                stderr.trim()
+            ));
+        }
+    }
+    failures
+}
+
+/// Whether this process can create a file in a directory without write permission (root
+/// can): tests of unwritable output locations skip themselves then.
+pub fn permissions_are_bypassed() -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let Ok(dir) = tempfile::tempdir() else {
+            return true;
+        };
+        let ro = dir.path().join("ro");
+        if std::fs::create_dir(&ro).is_err()
+            || std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).is_err()
+        {
+            return true;
+        }
+        let bypassed = std::fs::write(ro.join("probe"), b"").is_ok();
+        let _ = std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755));
+        bypassed
+    }
+    #[cfg(not(unix))]
+    {
+        true
+    }
+}

@@ -1,0 +1,169 @@
+//! The usage-error contract of `dla`: every bad flag, checkpoint or output location is refused
+//! before any work with exit code 2, one line on stderr naming the culprit, and nothing created.
+
+use core_lattice::testing::{permissions_are_bypassed, refusals};
+use std::path::Path;
+use std::process::Command;
+
+const DLA: &str = env!("CARGO_BIN_EXE_dla");
+
+/// A run of `args` in `dir` that must succeed (fixtures).
+fn run_ok(dir: &Path, args: &[&str]) {
+    let o = Command::new(DLA)
+        .args(args)
+        .arg("-qq")
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// Fixtures: a regular file, an empty directory, a good 2D checkpoint of 300 particles (seed
+/// 1, defaults) in `ck/`, a 3D one in `ck3/`, and broken copies: truncated, one byte flipped,
+/// another model's.
+fn fixtures(dir: &Path) {
+    std::fs::write(dir.join("file"), b"not a directory").unwrap();
+    std::fs::create_dir(dir.join("empty")).unwrap();
+    run_ok(
+        dir,
+        &[
+            "--particles",
+            "300",
+            "--checkpoint-every",
+            "100",
+            "--out",
+            "ck",
+        ],
+    );
+    run_ok(
+        dir,
+        &[
+            "--dim",
+            "3",
+            "--particles",
+            "300",
+            "--checkpoint-every",
+            "100",
+            "--out",
+            "ck3",
+        ],
+    );
+    let good = std::fs::read(dir.join("ck/checkpoint.bin")).unwrap();
+    for (name, bytes) in [
+        ("trunc", good[..good.len() / 2].to_vec()),
+        ("flip", {
+            let mut b = good.clone();
+            let i = b.len() / 2;
+            b[i] ^= 0x10;
+            b
+        }),
+    ] {
+        std::fs::create_dir(dir.join(name)).unwrap();
+        std::fs::write(dir.join(name).join("checkpoint.bin"), bytes).unwrap();
+    }
+    std::fs::create_dir(dir.join("other")).unwrap();
+    core_lattice::io::write_checkpoint(dir.join("other/checkpoint.bin"), "animat", &(1u64, 2u64))
+        .unwrap();
+}
+
+#[test]
+fn bad_inputs_are_refused_before_any_work() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    fixtures(dir);
+    // Every case but the first two names --particles and --out where it needs them.
+    let p = ["--particles", "300", "--out", "out"];
+    let with = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut v: Vec<&'static str> = p.to_vec();
+        v.extend_from_slice(extra);
+        v
+    };
+    let owned: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["--out", "out"], "--particles"),
+        (vec!["--particles", "300"], "--out"),
+        (vec!["--particles", "0", "--out", "out"], "--particles 0"),
+        (vec!["--particles", "abc", "--out", "out"], "abc"),
+        (vec!["--particles", "-5", "--out", "out"], "-5"),
+        (with(&["--dim", "4"]), "--dim 4"),
+        (with(&["--dim", "1"]), "--dim 1"),
+        (with(&["--step-min", "0"]), "--step-min 0"),
+        (with(&["--step-min", "NaN"]), "--step-min NaN"),
+        (with(&["--precision", "0.5"]), "--precision 0.5"),
+        (with(&["--birth-gap", "0.5"]), "--birth-gap 0.5"),
+        (with(&["--death-ratio", "1"]), "--death-ratio 1"),
+        (with(&["--leaf-side", "3"]), "--leaf-side 3"),
+        (with(&["--threads", "0"]), "--threads 0"),
+        (with(&["--far-field", "teleport"]), "teleport"),
+        (with(&["--positions", "pdf"]), "pdf"),
+        (with(&["--distance-map", "maybe"]), "maybe"),
+        (with(&["--fit-from", "0"]), "--fit-from 0"),
+        (with(&["--checkpoint-every", "0"]), "--checkpoint-every 0"),
+        (
+            with(&["--checkpoint-every", "100", "--threads", "2"]),
+            "--threads 2",
+        ),
+        (with(&["--heartbeat", "-1"]), "-1"),
+        (with(&["--no-such-flag"]), "--no-such-flag"),
+        (vec!["--particles", "300", "--out", "file"], "--out file"),
+        (
+            vec!["--particles", "300", "--out", "file/sub"],
+            "--out file/sub",
+        ),
+        (with(&["--resume", "empty"]), "empty/checkpoint.bin"),
+        (with(&["--resume", "nowhere"]), "nowhere/checkpoint.bin"),
+        (with(&["--resume", "trunc"]), "truncated"),
+        (with(&["--resume", "flip"]), "corrupted"),
+        (with(&["--resume", "other"]), "'animat', not 'dla'"),
+        (
+            with(&["--resume", "ck3"]),
+            "--dim 3 in the checkpoint, 2 given",
+        ),
+        (
+            with(&["--resume", "ck", "--seed", "2"]),
+            "--seed 1 in the checkpoint, 2 given",
+        ),
+        (
+            with(&["--resume", "ck", "--step-min", "0.25"]),
+            "--step-min 0.5 in the checkpoint, 0.25 given",
+        ),
+        (
+            vec!["--particles", "400", "--out", "out", "--resume", "ck"],
+            "--particles 300 in the checkpoint, 400 given",
+        ),
+    ];
+    let cases: Vec<(&[&str], &str)> = owned.iter().map(|(a, c)| (a.as_slice(), *c)).collect();
+    assert!(cases.len() >= 30);
+    let failures = refusals(Path::new(DLA), "dla", dir, &cases);
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
+
+#[cfg(unix)]
+#[test]
+fn an_unwritable_out_is_refused_before_any_work() {
+    use std::os::unix::fs::PermissionsExt;
+    if permissions_are_bypassed() {
+        eprintln!("skipped: this user writes into read-only directories (root)");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let ro = tmp.path().join("ro");
+    std::fs::create_dir(&ro).unwrap();
+    std::fs::create_dir(ro.join("existing")).unwrap();
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
+    std::fs::set_permissions(ro.join("existing"), std::fs::Permissions::from_mode(0o555)).unwrap();
+    let cases: [(&[&str], &str); 2] = [
+        (&["--particles", "300", "--out", "ro/new"], "--out ro/new"),
+        (
+            &["--particles", "300", "--out", "ro/existing"],
+            "--out ro/existing",
+        ),
+    ];
+    let failures = refusals(Path::new(DLA), "dla", tmp.path(), &cases);
+    std::fs::set_permissions(ro.join("existing"), std::fs::Permissions::from_mode(0o755)).unwrap();
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert!(failures.is_empty(), "\n{}", failures.join("\n"));
+}
