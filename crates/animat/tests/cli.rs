@@ -138,23 +138,11 @@ fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
 
     // The same run with a checkpoint every 5 steps, killed (SIGKILL) once a checkpoint exists.
     let cut = tmp.path().join("cut");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_animat"))
-        .args(world)
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_animat"));
+    cmd.args(world)
         .args(steps)
-        .args(["--checkpoint-every", "5", "--out", cut.to_str().unwrap()])
-        .spawn()
-        .unwrap();
-    let checkpoint = cut.join("checkpoint.bin");
-    while !checkpoint.exists() {
-        if child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(5));
-    }
-    let killed = child.try_wait().unwrap().is_none();
-    child.kill().unwrap();
-    child.wait().unwrap();
-    if !killed {
+        .args(["--checkpoint-every", "5", "--out", cut.to_str().unwrap()]);
+    if !core_lattice::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
         eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
     }
 

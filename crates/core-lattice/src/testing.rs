@@ -106,3 +106,25 @@ pub fn permissions_are_bypassed() -> bool {
         true
     }
 }
+
+/// Starts `cmd`, waits until `file` exists (a first checkpoint, say), then kills the process
+/// with SIGKILL, as a crash or an out-of-memory kill would. Returns whether the process was
+/// still running when killed (false: it had ended first, so nothing was interrupted).
+pub fn kill_once_written(cmd: &mut Command, file: &Path) -> bool {
+    let mut child = cmd
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the binary starts");
+    while !file.exists() {
+        if child.try_wait().expect("wait on the child").is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let running = child.try_wait().expect("wait on the child").is_none();
+    // `Child::kill` sends SIGKILL on Unix.
+    let _ = child.kill();
+    let _ = child.wait();
+    running
+}

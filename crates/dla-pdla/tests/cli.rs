@@ -128,3 +128,96 @@ fn a_run_removes_temporaries_an_interrupted_write_left() {
     assert!(!stale.exists());
     assert!(out.join("run.json").exists());
 }
+
+/// The state hash in `DIR/run.json`.
+fn state_hash(dir: &std::path::Path) -> String {
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();
+    m["results"]["state_hash"].as_str().unwrap().to_string()
+}
+
+#[test]
+fn a_run_killed_mid_growth_and_resumed_ends_like_the_uninterrupted_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = ["--particles", "150000", "--seed", "9", "-qq"];
+    let whole = dir.path().join("whole");
+    assert!(
+        dla()
+            .args(run)
+            .arg("--out")
+            .arg(&whole)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let cut = dir.path().join("cut");
+    let mut cmd = dla();
+    cmd.args(run)
+        .args(["--checkpoint-every", "20000", "--out"])
+        .arg(&cut);
+    if !core_lattice::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+        eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
+    }
+    let resumed = dir.path().join("resumed");
+    let o = dla()
+        .args(run)
+        .arg("--resume")
+        .arg(&cut)
+        .arg("--out")
+        .arg(&resumed)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(state_hash(&resumed), state_hash(&whole));
+}
+
+#[cfg(unix)]
+#[test]
+fn outputs_are_created_with_the_umask_0644_and_0755_under_022() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out/nested");
+    let st = Command::new("sh")
+        .arg("-c")
+        .arg("umask 022 && exec \"$0\" \"$@\"")
+        .arg(env!("CARGO_BIN_EXE_dla"))
+        .args(["--particles", "300", "--png", "--positions", "csv"])
+        .args(["--checkpoint-every", "100", "-qq", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let mode = |p: &std::path::Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode(&out), 0o755);
+    assert_eq!(mode(out.parent().unwrap()), 0o755);
+    let mut files = 0;
+    for e in std::fs::read_dir(&out).unwrap() {
+        let p = e.unwrap().path();
+        assert_eq!(mode(&p), 0o644, "{}", p.display());
+        files += 1;
+    }
+    assert_eq!(
+        files, 5,
+        "run.json, growth.csv, positions.csv, dla.png, checkpoint.bin"
+    );
+}
+
+#[test]
+fn a_failure_after_the_start_is_one_line_with_exit_code_1() {
+    // A directory where run.json should go: the run works, then cannot write its manifest.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    std::fs::create_dir_all(out.join("run.json")).unwrap();
+    let o = dla()
+        .args(["--particles", "300", "-q", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("dla: run failed: ") && err.contains("run.json"),
+        "{err}"
+    );
+}

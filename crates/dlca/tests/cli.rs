@@ -165,3 +165,46 @@ fn resume_from_a_checkpoint_ends_like_the_uninterrupted_run() {
     args.extend_from_slice(&["--resume", &cut, "--out", &other]);
     assert!(!dlca(&args).status.success());
 }
+
+#[test]
+fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = [
+        "--size",
+        "512",
+        "--fill",
+        "0.03",
+        "--target-clusters",
+        "1",
+        "--seed",
+        "4",
+        "-qq",
+    ];
+    let whole = tmp.path().join("whole");
+    let o = dlca(&[&run[..], &["--out", whole.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let cut = tmp.path().join("cut");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_dlca"));
+    cmd.args(run)
+        .args(["--checkpoint-every", "50", "--out", cut.to_str().unwrap()]);
+    if !core_lattice::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+        eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
+    }
+    let resumed = tmp.path().join("resumed");
+    let o = dlca(
+        &[
+            &run[..],
+            &[
+                "--resume",
+                cut.to_str().unwrap(),
+                "--out",
+                resumed.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (a, b) = (run_json(&whole), run_json(&resumed));
+    assert_eq!(a["results"]["state_hash"], b["results"]["state_hash"]);
+    assert_eq!(a["results"]["sweeps"], b["results"]["sweeps"]);
+}

@@ -40,7 +40,7 @@ impl AtomicFile {
         // umask 022), as `File::create` would, not tempfile's private 0600.
         #[cfg(unix)]
         builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-        let tmp = builder.tempfile_in(&dir)?;
+        let tmp = builder.tempfile_in(&dir).map_err(|e| naming(&target, e))?;
         Ok(AtomicFile {
             target,
             writer: BufWriter::with_capacity(1 << 16, tmp),
@@ -55,23 +55,35 @@ impl AtomicFile {
     /// Flush, `fsync` the data, rename over the target, and `fsync` the directory so the rename
     /// itself is durable.
     pub fn commit(self) -> io::Result<()> {
-        let tmp = self.writer.into_inner().map_err(|e| e.into_error())?;
-        tmp.as_file().sync_all()?;
-        tmp.persist(&self.target).map_err(|e| e.error)?;
-        sync_parent_dir(&self.target);
+        let target = self.target;
+        let tmp = self
+            .writer
+            .into_inner()
+            .map_err(|e| naming(&target, e.into_error()))?;
+        tmp.as_file().sync_all().map_err(|e| naming(&target, e))?;
+        tmp.persist(&target).map_err(|e| naming(&target, e.error))?;
+        sync_parent_dir(&target);
         Ok(())
     }
 }
 
+/// `e` with the file it concerns in front (`out/run.json: No space left on device`), so a
+/// failed write says which output it was.
+fn naming(path: &Path, e: io::Error) -> io::Error {
+    io::Error::new(e.kind(), format!("{}: {e}", path.display()))
+}
+
 impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.writer.write(buf)
+        self.writer.write(buf).map_err(|e| naming(&self.target, e))
     }
     fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
-        self.writer.write_all(buf)
+        self.writer
+            .write_all(buf)
+            .map_err(|e| naming(&self.target, e))
     }
     fn flush(&mut self) -> io::Result<()> {
-        self.writer.flush()
+        self.writer.flush().map_err(|e| naming(&self.target, e))
     }
 }
 
