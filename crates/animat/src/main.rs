@@ -229,7 +229,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     let (mut world, mut rows) = match &cli.resume {
         Some(dir) => resume(dir, &params, cli.seed, cli.steps)?,
         None => {
-            let world = World::new(params, cli.seed).context("setting up the run")?;
+            // Every error of the set-up is a parameter the run cannot take.
+            let world = World::new(params, cli.seed).map_err(|e| usage(e.to_string()))?;
             let start = PopulationRow {
                 step: 0,
                 foxes: world.foxes(),

@@ -8,7 +8,7 @@ use clap::Parser;
 use core_lattice::cli::{LogArgs, flag_differences, usage};
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, write_outputs};
-use dla_pdla::{Dim, FarField, Params, ParamsError, Simulation, Space};
+use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -47,9 +47,9 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = FarField::Return)]
     far_field: FarField,
 
-    /// Death radius R_d = death-ratio * R_b for `--far-field jump` (> 1).
-    #[arg(long, default_value_t = 100.0)]
-    death_ratio: f64,
+    /// Death radius R_d = death-ratio * R_b for `--far-field jump` (> 1) [default: 100].
+    #[arg(long)]
+    death_ratio: Option<f64>,
 
     /// Near-field step length in diameters (> 0): used when the distance to the cluster minus
     /// one is at most this. Smaller is closer to Brownian motion and slower.
@@ -130,7 +130,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         particles: cli.particles,
         birth_gap: cli.birth_gap,
         far_field: cli.far_field,
-        death_ratio: cli.death_ratio,
+        death_ratio: cli.death_ratio.unwrap_or(Params::default().death_ratio),
         step_min: cli.step_min,
         precision: cli.precision,
         threads: cli.threads,
@@ -144,6 +144,19 @@ fn params(cli: &Cli) -> Result<Params, String> {
         near_cache: cli.near_cache == Toggle::On,
     };
     p.validate().map_err(|e| e.to_string())?;
+    // Flags that would be silently ignored are refused instead.
+    if cli.death_ratio.is_some() && p.far_field != FarField::Jump {
+        return Err(
+            "--death-ratio is used by --far-field jump only (the default `return` has no death radius)"
+                .into(),
+        );
+    }
+    if p.serial_until > 0 && p.threads == 1 {
+        return Err(format!(
+            "--serial-until {} is used with --threads > 1 only (one thread is serial throughout)",
+            p.serial_until
+        ));
+    }
     if let Some(n) = cli.checkpoint_every {
         if n == 0 || p.threads != 1 {
             return Err(format!(
@@ -211,7 +224,10 @@ where
     tracing::info!(?params, seed = cli.seed, "starting growth");
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
-        None => Simulation::<D>::new(params, cli.seed).context("setting up the run")?,
+        None => Simulation::<D>::new(params, cli.seed).map_err(|e| match e {
+            SimError::Params(e) => usage(e.to_string()),
+            other => anyhow::Error::from(other).context("setting up the run"),
+        })?,
         Some(dir) => resume::<D>(dir, &params, cli.seed)?,
     };
     core_lattice::cli::prepare_out_dir(&cli.out)

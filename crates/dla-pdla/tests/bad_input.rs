@@ -95,6 +95,11 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--precision", "0.5"]), "--precision 0.5"),
         (with(&["--birth-gap", "0.5"]), "--birth-gap 0.5"),
         (with(&["--death-ratio", "1"]), "--death-ratio 1"),
+        (
+            with(&["--death-ratio", "50"]),
+            "--death-ratio is used by --far-field jump",
+        ),
+        (with(&["--serial-until", "100"]), "--serial-until 100"),
         (with(&["--leaf-side", "3"]), "--leaf-side 3"),
         (with(&["--threads", "0"]), "--threads 0"),
         (with(&["--far-field", "teleport"]), "teleport"),

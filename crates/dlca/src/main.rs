@@ -111,6 +111,7 @@ struct Cli {
     /// Sweeps at which --histogram records, comma separated.
     #[arg(
         long,
+        requires = "histogram",
         value_delimiter = ',',
         default_value = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000"
     )]
@@ -287,7 +288,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
         Some(dir) => resume(dir, params, cli.seed)?,
-        None => Simulation::new(params, cli.seed).context("setting up the run")?,
+        // Every error of the set-up is a parameter the run cannot take.
+        None => Simulation::new(params, cli.seed).map_err(|e| usage(e.to_string()))?,
     };
     // Created before the run so a long run cannot end with nowhere to write.
     core_lattice::cli::prepare_out_dir(&cli.out)
