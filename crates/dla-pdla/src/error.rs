@@ -28,6 +28,10 @@ pub enum SimError {
     /// match the run it should continue (the message says which).
     #[error("{0}")]
     CheckpointUsage(String),
+    /// Writing `positions.npy` or `growth.csv` as the run grows failed (the message names the
+    /// file).
+    #[error("{0}")]
+    Stream(String),
     /// PDLA discarded [`MAX_CONSECUTIVE_DISCARDS`](crate::sim::MAX_CONSECUTIVE_DISCARDS)
     /// walkers in a row without storing one.
     #[error(

@@ -5,7 +5,7 @@
 
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::{LogArgs, flag_differences, usage};
+use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
@@ -93,19 +93,23 @@ struct Cli {
     #[arg(long, default_value_t = 1000)]
     fit_from: u64,
 
-    /// Write the positions in arrival order: positions.csv, positions.bin or positions.xyz
-    /// (keeps 8 bytes per coordinate per particle in memory).
+    /// Write the positions in arrival order. They stream to positions.npy (float64, shape
+    /// (N, D), NumPy's format) as the cluster grows, never held in memory; csv, bin and xyz are
+    /// made from it at the end (csv and xyz take about 50 bytes per particle on disk).
     #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
     positions: PositionsFormat,
 
-    /// Write DIR/checkpoint.bin (DIR = --out) every N particles and at the end, atomically;
-    /// needs --threads 1 and keeps the positions in memory (8 bytes per coordinate per
-    /// particle). A run continued with --resume ends with the same state_hash.
+    /// Write DIR/checkpoint.bin (DIR = --out) every N particles and at the end, atomically: a
+    /// few kilobytes, as the positions stream to positions.npy (so this writes that too).
+    /// Needs --threads 1. SIGINT or SIGTERM then checkpoint and stop (exit code 130). A run
+    /// continued with --resume ends with the same state_hash.
     #[arg(long, value_name = "N")]
     checkpoint_every: Option<u64>,
 
-    /// Continue the run checkpointed in DIR/checkpoint.bin. The run flags (and --seed) must be
-    /// those of the checkpointed run; outputs go to --out as usual.
+    /// Continue the run checkpointed in DIR (checkpoint.bin and positions.npy). The run flags
+    /// (and --seed) must be those of the checkpointed run, except --particles, which may grow:
+    /// the run then ends as one made to that size directly. Outputs go to --out as usual (the
+    /// same DIR continues in place; another copies positions.npy).
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
 
@@ -136,9 +140,8 @@ fn params(cli: &Cli) -> Result<Params, String> {
         threads: cli.threads,
         serial_until: cli.serial_until,
         fit_from: cli.fit_from,
-        keep_positions: cli.png
-            || cli.positions != PositionsFormat::None
-            || cli.checkpoint_every.is_some(),
+        // Positions stream to positions.npy instead (see `run`).
+        keep_positions: false,
         leaf_side: cli.leaf_side,
         distance_map: cli.distance_map == Toggle::On,
         near_cache: cli.near_cache == Toggle::On,
@@ -179,9 +182,13 @@ fn resume<const D: usize>(dir: &Path, params: &Params, seed: u64) -> anyhow::Res
 where
     Dim<D>: Space<D>,
 {
-    let path = dir.join("checkpoint.bin");
-    let sim = Simulation::<D>::resume(&path)
-        .map_err(|e| usage(format!("--resume {}: {e}", path.display())))?;
+    let sim = Simulation::<D>::resume(dir, Some(params.particles)).map_err(|e| {
+        usage(format!(
+            "--resume {}: {e}",
+            dir.join(dla_pdla::sim::CHECKPOINT_FILE).display()
+        ))
+    })?;
+    // --particles may grow (checked by `resume`).
     let mut differ = flag_differences(sim.params(), params, &[("keep_positions", None)]);
     if sim.seed() != seed {
         differ.push(format!(
@@ -232,15 +239,44 @@ where
     };
     core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    let positions =
+        cli.png || cli.positions != PositionsFormat::None || cli.checkpoint_every.is_some();
+    if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {
+        tracing::warn!(
+            "--positions {} for {total} particles writes about {} GB of text; positions.npy holds them in {} GB",
+            if cli.positions == PositionsFormat::Csv {
+                "csv"
+            } else {
+                "xyz"
+            },
+            total * 25 * D as u64 / 1_000_000_000,
+            total * 8 * D as u64 / 1_000_000_000
+        );
+    }
+    sim.stream_into(&cli.out, positions)?;
     let progress = cli
         .log
         .progress("dla", total, "particles", PROGRESS_TEMPLATE);
     let report = |n| progress.set_position(n);
     match cli.checkpoint_every {
-        Some(every) => sim.run_checkpointed(every, &cli.out.join("checkpoint.bin"), &report)?,
+        Some(every) => {
+            let stop =
+                core_lattice::cli::stop_on_signals().context("installing signal handlers")?;
+            if !sim.run_checkpointed(every, &stop, &report)? {
+                progress.finish();
+                return Err(Interrupted(format!(
+                    "interrupted at {} of {total} particles; checkpoint in {}: continue with --resume {}",
+                    sim.particles(),
+                    cli.out.display(),
+                    cli.out.display()
+                ))
+                .into());
+            }
+        }
         None => sim.run_with(&report)?,
     }
     progress.finish();
+    sim.sync_streams()?;
     let m = write_outputs(&sim, &clock, &cli.out, cli.positions, cli.png)?;
     if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
         tracing::warn!("no fractal dimension: {e}");

@@ -1,18 +1,24 @@
-//! Writing a finished run into its output directory (see `docs/dla.md`, "Outputs"); every file
-//! is written atomically, so a file is either complete or absent.
+//! Writing a finished run into its output directory (see `docs/dla.md`, "Outputs"). The run
+//! streamed `growth.csv` and, when positions are needed, `positions.npy` as it grew (see
+//! [`Simulation::stream_into`]); the other files are written here, atomically, so each is
+//! either complete or absent. Positions files other than `positions.npy` are made by reading
+//! it back row by row, so no output needs the positions in memory.
 //!
 //! | file | content |
 //! |---|---|
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results |
-//! | `growth.csv` | `n,radius_of_gyration,r_ext,seconds` at about 1000 log-spaced sizes |
+//! | `growth.csv` | `n,radius_of_gyration,r_ext,seconds`, 200 log-spaced sizes per decade |
+//! | `positions.npy` | every position, arrival order, float64 `(N, D)` (NumPy `.npy`) |
 //! | `positions.csv` | `--positions csv`: `x,y` or `x,y,z`, arrival order |
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
 //! | `positions.xyz` | `--positions xyz`: XYZ point cloud, element `C` |
 //! | `dla.png` | `--png`: the cluster shaded by arrival order (3D: projection on x, y) |
 
-use crate::sim::Simulation;
+use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
-use core_lattice::io::{AtomicFile, CsvField, CsvWriter, RunClock, RunManifest, write_png_gray};
+use core_lattice::io::{
+    AtomicFile, CsvField, CsvWriter, NpyReader, RunClock, RunManifest, write_png_gray,
+};
 use serde_json::json;
 use std::io::Write;
 use std::path::Path;
@@ -26,6 +32,8 @@ pub use core_lattice::io::OutputError;
 pub enum PositionsFormat {
     /// No positions file (positions are not kept in memory).
     None,
+    /// `positions.npy` only (written as the cluster grows).
+    Npy,
     /// `positions.csv`.
     Csv,
     /// `positions.bin`.
@@ -35,7 +43,8 @@ pub enum PositionsFormat {
 }
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest. When the
-/// fractal dimension cannot be fitted, its results are null and `fit_error` says why.
+/// fractal dimension cannot be fitted, its results are null and `fit_error` says why. Call
+/// [`Simulation::sync_streams`] first when the run streams into `dir`.
 pub fn write_outputs<const D: usize>(
     sim: &Simulation<D>,
     clock: &RunClock,
@@ -46,46 +55,44 @@ pub fn write_outputs<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
-    let mut w = CsvWriter::create(
-        dir.join("growth.csv"),
-        &["n", "radius_of_gyration", "r_ext", "seconds"],
-    )?;
-    for s in sim.samples() {
-        w.row(&[&s.n, &s.radius_of_gyration, &s.r_ext, &s.seconds])?;
+    if !sim.streams_growth() {
+        let mut w = CsvWriter::create(dir.join("growth.csv"), &GROWTH_COLUMNS)?;
+        for s in sim.samples() {
+            w.row(&[&s.n, &s.radius_of_gyration, &s.r_ext, &s.seconds])?;
+        }
+        w.finish()?;
     }
-    w.finish()?;
-
-    if let Some(pos) = sim.positions() {
-        match positions {
-            PositionsFormat::None => {}
-            PositionsFormat::Csv => {
-                let mut w = CsvWriter::create(dir.join("positions.csv"), &Dim::<D>::AXES)?;
-                for p in pos {
-                    let f: Vec<&dyn CsvField> = p.iter().map(|x| x as &dyn CsvField).collect();
-                    w.row(&f)?;
-                }
-                w.finish()?;
-            }
-            PositionsFormat::Bin => write_positions_bin(&dir.join("positions.bin"), pos)?,
-            PositionsFormat::Xyz => {
-                let mut f = AtomicFile::create(dir.join("positions.xyz"))?;
-                {
-                    let mut b = std::io::BufWriter::new(&mut f);
-                    writeln!(b, "{}", pos.len())?;
-                    writeln!(b, "DLA cluster, seed {}, arrival order", sim.seed())?;
-                    for p in pos {
-                        // XYZ holds three coordinates: z = 0 in the plane.
-                        let z = p.get(2).copied().unwrap_or(0.0);
-                        writeln!(b, "C {} {} {}", p[0], p[1], z)?;
-                    }
-                    b.flush()?;
-                }
-                f.commit()?;
-            }
+    match positions {
+        PositionsFormat::None | PositionsFormat::Npy => {}
+        PositionsFormat::Csv => {
+            let mut w = CsvWriter::create(dir.join("positions.csv"), &Dim::<D>::AXES)?;
+            each_position(sim, dir, |_, p: &[f64; D]| {
+                let f: Vec<&dyn CsvField> = p.iter().map(|x| x as &dyn CsvField).collect();
+                w.row(&f)?;
+                Ok(())
+            })?;
+            w.finish()?;
         }
-        if png {
-            write_picture(pos, &dir.join("dla.png"))?;
+        PositionsFormat::Bin => write_positions_bin(sim, dir)?,
+        PositionsFormat::Xyz => {
+            let mut f = AtomicFile::create(dir.join("positions.xyz"))?;
+            {
+                let mut b = std::io::BufWriter::new(&mut f);
+                writeln!(b, "{}", sim.particles())?;
+                writeln!(b, "DLA cluster, seed {}, arrival order", sim.seed())?;
+                each_position(sim, dir, |_, p: &[f64; D]| {
+                    // XYZ holds three coordinates: z = 0 in the plane.
+                    let z = p.get(2).copied().unwrap_or(0.0);
+                    writeln!(b, "C {} {} {}", p[0], p[1], z)?;
+                    Ok(())
+                })?;
+                b.flush()?;
+            }
+            f.commit()?;
         }
+    }
+    if png {
+        write_picture(sim, dir, &dir.join("dla.png"))?;
     }
 
     let fit = sim.fractal_dimension();
@@ -131,23 +138,62 @@ where
     Ok(m)
 }
 
+/// Calls `f(i, p)` with every stored position `p` in arrival order (`i` from 0): from memory
+/// (`keep_positions`) or from `positions.npy` in `dir`, read row by row.
+///
+/// # Errors
+/// Neither source holds the positions, the file does not read, or `f` fails.
+pub fn each_position<const D: usize>(
+    sim: &Simulation<D>,
+    dir: &Path,
+    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    if let Some(pos) = sim.positions() {
+        for (i, p) in pos.iter().enumerate() {
+            f(i as u64, p)?;
+        }
+        return Ok(());
+    }
+    let npy = |e: core_lattice::io::NpyError| std::io::Error::other(e.to_string());
+    let path = dir.join(POSITIONS_FILE);
+    let mut r = NpyReader::open(&path).map_err(npy)?;
+    if r.cols() != D || r.rows() != sim.particles() {
+        return Err(std::io::Error::other(format!(
+            "{}: shape ({}, {}), not ({}, {D})",
+            path.display(),
+            r.rows(),
+            r.cols(),
+            sim.particles()
+        ))
+        .into());
+    }
+    let mut p = [0.0; D];
+    let mut i = 0;
+    while r.next_row(&mut p).map_err(npy)? {
+        f(i, &p)?;
+        i += 1;
+    }
+    Ok(())
+}
+
 /// `positions.bin`: little-endian; the 8 bytes `DLAPOS01`, `u32` dimension `D`, `u64` count
 /// `N`, then `N * D` `f64` coordinates, particle by particle in arrival order.
 pub fn write_positions_bin<const D: usize>(
-    path: &Path,
-    pos: &[[f64; D]],
+    sim: &Simulation<D>,
+    dir: &Path,
 ) -> Result<(), OutputError> {
-    let mut f = AtomicFile::create(path)?;
+    let mut f = AtomicFile::create(dir.join("positions.bin"))?;
     {
         let mut b = std::io::BufWriter::new(&mut f);
         b.write_all(b"DLAPOS01")?;
         b.write_all(&(D as u32).to_le_bytes())?;
-        b.write_all(&(pos.len() as u64).to_le_bytes())?;
-        for p in pos {
+        b.write_all(&sim.particles().to_le_bytes())?;
+        each_position(sim, dir, |_, p: &[f64; D]| {
             for x in p {
                 b.write_all(&x.to_le_bytes())?;
             }
-        }
+            Ok(())
+        })?;
         b.flush()?;
     }
     f.commit()?;
@@ -156,18 +202,19 @@ pub fn write_positions_bin<const D: usize>(
 
 /// The cluster as a grayscale picture on black, projected on (x, y), each particle a disc of
 /// diameter 1 (at least one pixel) shaded from dark (first) to white (last) by arrival order.
-fn write_picture<const D: usize>(pos: &[[f64; D]], path: &Path) -> Result<(), OutputError> {
-    let extent = pos
-        .iter()
-        .map(|p| p[0].abs().max(p[1].abs()))
-        .fold(0.0, f64::max)
-        + 1.0;
+fn write_picture<const D: usize>(
+    sim: &Simulation<D>,
+    dir: &Path,
+    path: &Path,
+) -> Result<(), OutputError> {
+    // Every centre lies within R_ext of the origin.
+    let extent = sim.r_ext() + 1.0;
     let side = ((2.0 * extent).ceil() as u32).clamp(64, 4096);
     let scale = f64::from(side) / (2.0 * extent);
     let mut px = vec![0u8; (side as usize) * (side as usize)];
-    let n = pos.len().max(2) as f64;
+    let n = sim.particles().max(2) as f64;
     let rad = (0.5 * scale).max(0.5);
-    for (i, p) in pos.iter().enumerate() {
+    each_position(sim, dir, |i, p: &[f64; D]| {
         let shade = (55.0 + 200.0 * i as f64 / (n - 1.0)) as u8;
         let cx = (p[0] + extent) * scale;
         let cy = (extent - p[1]) * scale;
@@ -188,7 +235,8 @@ fn write_picture<const D: usize>(pos: &[[f64; D]], path: &Path) -> Result<(), Ou
                 }
             }
         }
-    }
+        Ok(())
+    })?;
     write_png_gray(path, side, side, &px)?;
     Ok(())
 }

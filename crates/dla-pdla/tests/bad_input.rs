@@ -24,7 +24,7 @@ fn run_ok(dir: &Path, args: &[&str]) {
 
 /// Fixtures: a regular file, an empty directory, a good 2D checkpoint of 300 particles (seed
 /// 1, defaults) in `ck/`, a 3D one in `ck3/`, and broken copies: truncated, one byte flipped,
-/// another model's.
+/// another model's, without its positions log, with another run's log.
 fn fixtures(dir: &Path) {
     std::fs::write(dir.join("file"), b"not a directory").unwrap();
     std::fs::create_dir(dir.join("empty")).unwrap();
@@ -65,6 +65,37 @@ fn fixtures(dir: &Path) {
         std::fs::create_dir(dir.join(name)).unwrap();
         std::fs::write(dir.join(name).join("checkpoint.bin"), bytes).unwrap();
     }
+    // A checkpoint without its positions log, and one with another run's log.
+    std::fs::create_dir(dir.join("nolog")).unwrap();
+    std::fs::copy(
+        dir.join("ck/checkpoint.bin"),
+        dir.join("nolog/checkpoint.bin"),
+    )
+    .unwrap();
+    run_ok(
+        dir,
+        &[
+            "--particles",
+            "300",
+            "--seed",
+            "2",
+            "--positions",
+            "npy",
+            "--out",
+            "seed2",
+        ],
+    );
+    std::fs::create_dir(dir.join("badlog")).unwrap();
+    std::fs::copy(
+        dir.join("ck/checkpoint.bin"),
+        dir.join("badlog/checkpoint.bin"),
+    )
+    .unwrap();
+    std::fs::copy(
+        dir.join("seed2/positions.npy"),
+        dir.join("badlog/positions.npy"),
+    )
+    .unwrap();
     std::fs::create_dir(dir.join("other")).unwrap();
     core_lattice::io::write_checkpoint(dir.join("other/checkpoint.bin"), "animat", &(1u64, 2u64))
         .unwrap();
@@ -136,8 +167,13 @@ fn bad_inputs_are_refused_before_any_work() {
             "--step-min 0.5 in the checkpoint, 0.25 given",
         ),
         (
-            vec!["--particles", "400", "--out", "out", "--resume", "ck"],
-            "--particles 300 in the checkpoint, 400 given",
+            vec!["--particles", "200", "--out", "out", "--resume", "ck"],
+            "--particles 200 is below the 300 particles the checkpoint holds",
+        ),
+        (with(&["--resume", "nolog"]), "nolog/positions.npy"),
+        (
+            with(&["--resume", "badlog"]),
+            "does not belong to the checkpoint",
         ),
     ];
     let cases: Vec<(&[&str], &str)> = owned.iter().map(|(a, c)| (a.as_slice(), *c)).collect();

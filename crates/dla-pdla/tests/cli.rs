@@ -101,15 +101,31 @@ fn checkpointed_and_resumed_runs_end_with_the_same_state_hash() {
     assert!(ck.join("checkpoint.bin").exists());
     let resumed = run(&dir.path().join("c"), &["--resume", ck.to_str().unwrap()]);
     assert_eq!(resumed, plain);
-    // Different flags are refused.
-    let o = dla()
-        .args(["--particles", "1600", "--quiet", "--seed", "4", "--resume"])
-        .arg(&ck)
-        .arg("--out")
-        .arg(dir.path().join("d"))
-        .output()
-        .unwrap();
-    assert!(!o.status.success());
+    // A finished run extends, in place, to more particles: the state of a run made to that
+    // size directly, and the positions of that run in positions.npy.
+    let more = |out: &std::path::Path, extra: &[&str]| {
+        let st = dla()
+            .args(["--particles", "2500", "--quiet", "--seed", "4", "--out"])
+            .arg(out)
+            .args(extra)
+            .status()
+            .unwrap();
+        assert!(st.success(), "{extra:?}");
+        state_hash(out)
+    };
+    let direct = dir.path().join("d");
+    let extended = more(
+        &ck,
+        &["--resume", ck.to_str().unwrap(), "--positions", "bin"],
+    );
+    assert_eq!(extended, more(&direct, &["--positions", "bin"]));
+    assert_eq!(
+        std::fs::read(ck.join("positions.bin")).unwrap(),
+        std::fs::read(direct.join("positions.bin")).unwrap()
+    );
+    let npy = std::fs::read(ck.join("positions.npy")).unwrap();
+    assert_eq!(npy.len(), 128 + 2500 * 16);
+    assert!(String::from_utf8_lossy(&npy[..128]).contains("'shape': (2500, 2)"));
 }
 
 #[test]
@@ -169,6 +185,46 @@ fn a_run_killed_mid_growth_and_resumed_ends_like_the_uninterrupted_run() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(state_hash(&resumed), state_hash(&whole));
+
+    // SIGTERM: a final checkpoint, exit code 130, a line saying how to continue; resumed in
+    // place, the run ends as the uninterrupted one.
+    let term = dir.path().join("term");
+    let mut child = dla()
+        .args(run)
+        .args(["--checkpoint-every", "20000", "--out"])
+        .arg(&term)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    while !term.join("checkpoint.bin").exists() && child.try_wait().unwrap().is_none() {
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let running = child.try_wait().unwrap().is_none();
+    let st = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if running {
+        assert_eq!(o.status.code(), Some(130), "{err}");
+        assert!(
+            err.contains("interrupted at") && err.contains("--resume"),
+            "{err}"
+        );
+        assert!(!term.join("run.json").exists());
+    }
+    let o = dla()
+        .args(run)
+        .args(["--checkpoint-every", "20000", "--resume"])
+        .arg(&term)
+        .arg("--out")
+        .arg(&term)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(state_hash(&term), state_hash(&whole));
 }
 
 #[cfg(unix)]
@@ -197,8 +253,8 @@ fn outputs_are_created_with_the_umask_0644_and_0755_under_022() {
         files += 1;
     }
     assert_eq!(
-        files, 5,
-        "run.json, growth.csv, positions.csv, dla.png, checkpoint.bin"
+        files, 6,
+        "run.json, growth.csv, positions.npy, positions.csv, dla.png, checkpoint.bin"
     );
 }
 

@@ -8,6 +8,8 @@
 //!   [`UsageError`] (see [`usage`]) from its `run` step before it creates `--out`.
 //! - **Runtime failures** (a full disk mid-run, a livelock guard) print one line
 //!   `PROGRAM: run failed: ...` and exit with code 1.
+//! - **Interrupted runs** (SIGINT or SIGTERM, where a binary polls [`stop_on_signals`]) save
+//!   what they can, print one line saying how to continue, and exit with code 130.
 //! - **Logging**: warnings only by default, `-v` info, `-vv` debug, `RUST_LOG` overrides; a
 //!   progress bar on a terminal, and a one-line heartbeat every `--heartbeat` seconds when
 //!   there is no bar (a redirected log, or `--quiet`), so a long run is told from a hang;
@@ -27,6 +29,9 @@ use std::process::ExitCode;
 pub const EXIT_USAGE: u8 = 2;
 /// Exit code of a run that failed after it started (I/O error, livelock guard).
 pub const EXIT_RUN_FAILED: u8 = 1;
+/// Exit code of a run stopped by SIGINT or SIGTERM after saving what it could (128 + SIGINT,
+/// as shells report an interrupted command).
+pub const EXIT_INTERRUPTED: u8 = 130;
 
 /// The logging and progress flags every model binary takes (`#[command(flatten)]` them into
 /// the binary's flags).
@@ -94,6 +99,30 @@ impl LogArgs {
 #[error("{0}")]
 pub struct UsageError(pub String);
 
+/// A run stopped early by SIGINT or SIGTERM (see [`stop_on_signals`]) after saving what it
+/// could: [`main_with`] prints the message (what was saved, how to continue) as one line and
+/// exits with code 130.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Interrupted(pub String);
+
+/// A flag that SIGINT and SIGTERM set instead of killing the process, for a run that polls it
+/// to checkpoint and stop cleanly. A second signal of the same kind ends the process at once,
+/// as usual, so a run that does not stop can still be interrupted.
+///
+/// # Errors
+/// The handlers could not be installed.
+pub fn stop_on_signals() -> std::io::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        // Registered first, so it runs when the flag is already set: the second signal.
+        signal_hook::flag::register_conditional_default(sig, std::sync::Arc::clone(&stop))?;
+        signal_hook::flag::register(sig, std::sync::Arc::clone(&stop))?;
+    }
+    Ok(stop)
+}
+
 /// A [`UsageError`] as an `anyhow::Error`, for `run` steps that return `anyhow::Result`.
 pub fn usage(message: impl Into<String>) -> anyhow::Error {
     UsageError(message.into()).into()
@@ -124,6 +153,10 @@ pub fn main_with<C: clap::Parser, P>(
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => match e.downcast_ref::<UsageError>() {
             Some(u) => usage_error(program, &u.0),
+            None if e.downcast_ref::<Interrupted>().is_some() => {
+                eprintln!("{program}: {e}");
+                ExitCode::from(EXIT_INTERRUPTED)
+            }
             None => {
                 eprintln!("{program}: run failed: {}", error_line(&e));
                 ExitCode::from(EXIT_RUN_FAILED)

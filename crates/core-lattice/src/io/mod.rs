@@ -9,12 +9,15 @@
 //! - [`image`]: grayscale and RGB PNG.
 //! - [`table`]: CSV with a header line.
 //! - [`hash`]: the stable 64-bit state hash models report as `state_hash`.
+//! - [`npy`]: rows of `f64` streamed to a NumPy `.npy` file as a run goes (the exception to
+//!   atomic writes: an arrival log that a checkpoint refers to).
 
 pub mod atomic;
 pub mod checkpoint;
 pub mod hash;
 pub mod image;
 pub mod manifest;
+pub mod npy;
 pub mod table;
 
 pub use atomic::{AtomicFile, remove_stale_temporaries, write_atomic};
@@ -22,6 +25,7 @@ pub use checkpoint::{CheckpointError, read_checkpoint, write_checkpoint};
 pub use hash::StateHasher;
 pub use image::{write_png_gray, write_png_rgb};
 pub use manifest::{ProcessUsage, RunClock, RunManifest};
+pub use npy::{NpyError, NpyReader, NpyWriter};
 pub use table::{CsvField, CsvWriter};
 
 /// Why a model's output could not be written (every model's `output::write_outputs`); each

@@ -1,23 +1,34 @@
-//! Checkpoints of serial runs: the parameters, the seed, the walk's random stream, every
-//! position in arrival order and the growth samples, as bincode 2 in `core_lattice`'s atomic
-//! `AGGSIMCK` envelope (model [`CHECKPOINT_MODEL`]).
+//! Checkpoints of serial runs without a second copy of the cluster. The positions already
+//! stream, in arrival order, to `positions.npy` in the run's directory; a checkpoint
+//! (`checkpoint.bin`, beside it) holds only what is not in that file: the parameters, the seed,
+//! the walk's random stream, the particle count `n` and the state hash after the first `n`
+//! rows, the growth samples and the seconds grown. It is a few kilobytes at any size, written
+//! atomically in `core_lattice`'s checksummed `AGGSIMCK` envelope (model
+//! [`CHECKPOINT_MODEL`]) after `positions.npy` has been flushed and synced.
 //!
-//! Invariant: restoring stores the checkpointed positions again in arrival order, so the tree,
-//! `R_g`, `R_ext` and the state hash are bit-identical to those of the run that wrote it, and
-//! a resumed run ends with the state hash of an uninterrupted one.
+//! Invariant: restoring stores the first `n` rows of `positions.npy` again in arrival order,
+//! which rebuilds the tree, `R_g`, `R_ext` and the state hash bit-identically; the rebuilt
+//! hash must equal the recorded one, so a log that does not belong to the checkpoint is
+//! refused. A resumed run ends with the state hash of an uninterrupted one, and one resumed
+//! with a larger target with that of a run made to the larger target directly.
 
 use super::growth::{Growth, Sample};
 use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
+use core_lattice::io::NpyReader;
 use core_lattice::rng::SimRng;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// Model name in the checkpoint envelope.
 pub const CHECKPOINT_MODEL: &str = "dla";
+/// File name of a checkpoint in a run's directory.
+pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
+/// File name of the streamed positions (the arrival log) in a run's directory.
+pub const POSITIONS_FILE: &str = "positions.npy";
 
 /// The state a checkpoint holds.
 #[derive(Serialize, Deserialize)]
@@ -25,10 +36,13 @@ struct Snapshot {
     params: Params,
     seed: u64,
     rng: SimRng,
-    /// Positions in arrival order, `D` coordinates each.
-    positions: Vec<f64>,
+    /// Particles stored: the first `n` rows of `positions.npy`.
+    n: u64,
+    /// The state hash after those `n` particles.
+    state_hash: String,
     samples: Vec<Sample>,
     next_sample: u64,
+    last_off_schedule: bool,
     /// Wall seconds of growth so far (the `seconds` column of `growth.csv` continues).
     seconds: f64,
 }
@@ -40,67 +54,125 @@ pub(crate) struct Restored<const D: usize> {
     pub(crate) rng: SimRng,
     pub(crate) cluster: Cluster<D>,
     pub(crate) growth: Growth<D>,
+    /// The `positions.npy` the cluster was rebuilt from.
+    pub(crate) log: PathBuf,
 }
 
-/// Writes the state of a serial run to `path`, atomically. Needs `threads == 1` and the
-/// positions kept in `growth`.
+/// Writes the checkpoint of a serial run streaming its positions into `dir`: syncs the
+/// streams, then writes `dir/checkpoint.bin` atomically.
 pub(crate) fn write<const D: usize>(
-    path: &Path,
+    dir: &Path,
     params: &Params,
     seed: u64,
     rng: &SimRng,
-    growth: &Growth<D>,
+    growth: &mut Growth<D>,
 ) -> Result<(), SimError> {
-    let positions = growth.positions.as_ref().ok_or_else(|| {
-        SimError::CheckpointUsage("a checkpoint needs the positions kept in memory".into())
-    })?;
     if params.threads != 1 {
         return Err(SimError::CheckpointUsage(
             "checkpoints are for one thread (PDLA is not deterministic)".into(),
         ));
     }
+    let streams = growth
+        .streams
+        .as_mut()
+        .filter(|s| s.positions.is_some())
+        .ok_or_else(|| {
+            SimError::CheckpointUsage(
+                "a checkpoint needs the positions streamed to positions.npy (Simulation::stream_into)"
+                    .into(),
+            )
+        })?;
+    streams.sync()?;
     let snap = Snapshot {
         params: params.clone(),
         seed,
         rng: rng.clone(),
-        positions: positions.iter().flatten().copied().collect(),
+        n: growth.n,
+        state_hash: growth.hasher.finish_hex(),
         samples: growth.samples.clone(),
         next_sample: growth.next_sample,
+        last_off_schedule: growth.last_off_schedule,
         seconds: growth.started.elapsed().as_secs_f64(),
     };
-    core_lattice::io::write_checkpoint(path, CHECKPOINT_MODEL, &snap)?;
+    core_lattice::io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &snap)?;
     Ok(())
 }
 
-/// Reads the checkpoint at `path` and rebuilds its run in `D` dimensions.
-pub(crate) fn read<const D: usize>(path: &Path) -> Result<Restored<D>, SimError>
+/// Reads the checkpoint in `dir` and rebuilds its run in `D` dimensions from
+/// `dir/positions.npy`, with the target raised to `particles` if given (at least the
+/// particles stored).
+pub(crate) fn read<const D: usize>(
+    dir: &Path,
+    particles: Option<u64>,
+) -> Result<Restored<D>, SimError>
 where
     Dim<D>: Space<D>,
 {
-    let snap: Snapshot = core_lattice::io::read_checkpoint(path, CHECKPOINT_MODEL)?;
-    snap.params.validate()?;
-    if snap.params.dim != D {
+    let snap: Snapshot =
+        core_lattice::io::read_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL)?;
+    let mut params = snap.params;
+    params.validate()?;
+    if params.dim != D {
         return Err(SimError::CheckpointUsage(format!(
             "--dim {} in the checkpoint, {D} given",
-            snap.params.dim
+            params.dim
         )));
     }
-    if snap.positions.len() % D != 0 || snap.positions.is_empty() {
+    let extended = particles.is_some_and(|m| m != params.particles);
+    if let Some(m) = particles {
+        if m < snap.n {
+            return Err(SimError::CheckpointUsage(format!(
+                "--particles {m} is below the {} particles the checkpoint holds",
+                snap.n
+            )));
+        }
+        params.particles = m;
+        params.validate()?;
+    }
+    if snap.n == 0 || snap.n > params.particles {
         return Err(SimError::CheckpointUsage(format!(
-            "checkpoint holds {} coordinates, not a whole number of {D}D positions",
-            snap.positions.len()
+            "the checkpoint holds {} particles, outside 1..={}",
+            snap.n, params.particles
         )));
     }
-    let params = snap.params;
+    let log = dir.join(POSITIONS_FILE);
+    let bad_log = |why: String| SimError::CheckpointUsage(format!("{}: {why}", log.display()));
+    let mut reader = NpyReader::open(&log).map_err(|e| SimError::CheckpointUsage(e.to_string()))?;
+    if reader.cols() != D {
+        return Err(bad_log(format!("{} columns, not {D}", reader.cols())));
+    }
     let mut cluster = Cluster::new(&params)?;
     let mut growth = Growth::new(&params);
-    for c in snap.positions.chunks_exact(D) {
-        let mut p = [0.0; D];
-        p.copy_from_slice(c);
+    let mut p = [0.0; D];
+    for i in 0..snap.n {
+        let more = reader
+            .read_beyond(&mut p)
+            .map_err(|e| SimError::CheckpointUsage(e.to_string()))?;
+        if !more {
+            return Err(bad_log(format!(
+                "holds {i} positions, the checkpoint needs {}",
+                snap.n
+            )));
+        }
         growth.add(&mut cluster, p, params.particles)?;
+    }
+    if growth.hasher.finish_hex() != snap.state_hash {
+        return Err(bad_log(format!(
+            "does not belong to the checkpoint: its first {} positions hash to {}, the checkpoint recorded {}",
+            snap.n,
+            growth.hasher.finish_hex(),
+            snap.state_hash
+        )));
     }
     growth.samples = snap.samples;
     growth.next_sample = snap.next_sample;
+    growth.last_off_schedule = snap.last_off_schedule;
+    // The sample taken only because the old target was reached is not one a run made to the
+    // new target takes.
+    if extended && growth.last_off_schedule {
+        growth.samples.pop();
+        growth.last_off_schedule = false;
+    }
     if let Some(t) =
         Instant::now().checked_sub(Duration::from_secs_f64(snap.seconds.clamp(0.0, 1e9)))
     {
@@ -112,5 +184,6 @@ where
         rng: snap.rng,
         cluster,
         growth,
+        log,
     })
 }

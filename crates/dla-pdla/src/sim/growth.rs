@@ -1,21 +1,32 @@
 //! What a stored particle changes: the particle count, `R_ext`, the radius of gyration, the
-//! state hash, the kept positions, and the log-spaced growth samples of `growth.csv`.
+//! state hash, the kept positions, the log-spaced growth samples of `growth.csv`, and the
+//! streams a run writes as it grows (`positions.npy`, `growth.csv`).
 //!
 //! Invariants: every stored particle is accounted for exactly once, in arrival order (the
-//! state hash is a hash of the stored positions in that order); a sample is taken at the first
-//! particle, at every `ceil(N ratio)` after it, and at the final size.
+//! state hash is a hash of the stored positions in that order, and `positions.npy` holds them
+//! in that order); a sample is taken at the first particle, at every
+//! `max(N + 1, ceil(N r))` after it with `r = 10^(1 / SAMPLES_PER_DECADE)` (a schedule that
+//! does not depend on the target size, so a run extended to more particles samples as a run
+//! made to that size directly), and at the final size.
 
 use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::farfield::norm;
 use crate::params::Params;
 use core_lattice::Gyration;
-use core_lattice::io::StateHasher;
+use core_lattice::io::{NpyWriter, StateHasher};
 use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
 use std::time::Instant;
 
-/// Number of log-spaced growth samples aimed at.
-pub const GROWTH_SAMPLES: f64 = 1000.0;
+/// Growth samples per decade of N (every N up to about 87, where the log spacing exceeds one
+/// particle; 1,200 samples to 1e6 and 1,800 to 1e9).
+pub const SAMPLES_PER_DECADE: f64 = 200.0;
+
+/// The column names of `growth.csv`.
+pub const GROWTH_COLUMNS: [&str; 4] = ["n", "radius_of_gyration", "r_ext", "seconds"];
 
 /// One row of `growth.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -30,6 +41,74 @@ pub struct Sample {
     pub seconds: f64,
 }
 
+/// The first sample size after `n` on the schedule.
+pub(crate) fn next_on_schedule(n: u64) -> u64 {
+    let ratio = 10f64.powf(1.0 / SAMPLES_PER_DECADE);
+    (n + 1).max((n as f64 * ratio).ceil() as u64)
+}
+
+/// The files a run streams into its output directory as it grows.
+#[derive(Debug)]
+pub(crate) struct Streams {
+    /// `positions.npy`: every stored position, in arrival order.
+    pub(crate) positions: Option<NpyWriter>,
+    /// `growth.csv`, a line per sample, flushed as it is taken.
+    pub(crate) growth: BufWriter<File>,
+    /// The first write error (the run goes on; it is reported at the next checkpoint or at the
+    /// end).
+    pub(crate) error: Option<std::io::Error>,
+}
+
+impl Streams {
+    /// `growth.csv` in `dir` holding `samples`, and `positions` as given.
+    pub(crate) fn open(
+        dir: &Path,
+        samples: &[Sample],
+        positions: Option<NpyWriter>,
+    ) -> std::io::Result<Self> {
+        let path = dir.join("growth.csv");
+        let file = File::create(&path)
+            .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+        let mut s = Streams {
+            positions,
+            growth: BufWriter::new(file),
+            error: None,
+        };
+        writeln!(s.growth, "{}", GROWTH_COLUMNS.join(","))?;
+        for row in samples {
+            s.sample(row);
+        }
+        s.growth.flush()?;
+        Ok(s)
+    }
+
+    fn sample(&mut self, s: &Sample) {
+        let line = writeln!(
+            self.growth,
+            "{},{},{},{}",
+            s.n, s.radius_of_gyration, s.r_ext, s.seconds
+        );
+        if let Err(e) = line.and_then(|()| self.growth.flush()) {
+            self.error.get_or_insert(e);
+        }
+    }
+
+    /// Flushes both files and records the row count in `positions.npy` (a complete array
+    /// after this); the first error of the run so far, if any.
+    pub(crate) fn sync(&mut self) -> Result<(), SimError> {
+        if let Some(e) = self.error.take() {
+            return Err(SimError::Stream(e.to_string()));
+        }
+        self.growth
+            .flush()
+            .map_err(|e| SimError::Stream(e.to_string()))?;
+        if let Some(p) = &mut self.positions {
+            p.sync().map_err(|e| SimError::Stream(e.to_string()))?;
+        }
+        Ok(())
+    }
+}
+
 /// Everything that changes when a particle sticks (kept together under PDLA's write lock).
 #[derive(Debug)]
 pub(crate) struct Growth<const D: usize> {
@@ -42,12 +121,15 @@ pub(crate) struct Growth<const D: usize> {
     /// Positions in arrival order, if kept.
     pub(crate) positions: Option<Vec<[f64; D]>>,
     pub(crate) samples: Vec<Sample>,
-    /// The particle count of the next sample.
+    /// The particle count of the next scheduled sample.
     pub(crate) next_sample: u64,
-    /// Ratio between successive sample sizes, `particles^(1 / GROWTH_SAMPLES)`.
-    ratio: f64,
+    /// Whether the last sample was taken only because the target was reached (not on the
+    /// schedule): a run extended past it drops it.
+    pub(crate) last_off_schedule: bool,
     /// The start of growth (moved back on resume by the seconds already grown).
     pub(crate) started: Instant,
+    /// What the run streams to its output directory, once opened.
+    pub(crate) streams: Option<Streams>,
 }
 
 impl<const D: usize> Growth<D> {
@@ -60,8 +142,9 @@ impl<const D: usize> Growth<D> {
             positions: params.keep_positions.then(Vec::new),
             samples: Vec::new(),
             next_sample: 1,
-            ratio: (params.particles as f64).powf(1.0 / GROWTH_SAMPLES),
+            last_off_schedule: false,
             started: Instant::now(),
+            streams: None,
         }
     }
 
@@ -88,14 +171,29 @@ impl<const D: usize> Growth<D> {
         if let Some(v) = &mut self.positions {
             v.push(q);
         }
-        if self.n >= self.next_sample || self.n == target {
-            self.samples.push(Sample {
+        if let Some(s) = &mut self.streams
+            && let Some(log) = &mut s.positions
+            && s.error.is_none()
+            && let Err(e) = log.push(&q)
+        {
+            s.error = Some(std::io::Error::other(e.to_string()));
+        }
+        let scheduled = self.n >= self.next_sample;
+        if scheduled || self.n == target {
+            let sample = Sample {
                 n: self.n,
                 radius_of_gyration: self.gyration.radius(),
                 r_ext: self.r_ext,
                 seconds: self.started.elapsed().as_secs_f64(),
-            });
-            self.next_sample = (self.n + 1).max((self.n as f64 * self.ratio).ceil() as u64);
+            };
+            self.samples.push(sample);
+            if let Some(s) = &mut self.streams {
+                s.sample(&sample);
+            }
+            self.last_off_schedule = !scheduled;
+        }
+        if scheduled {
+            self.next_sample = next_on_schedule(self.n);
         }
     }
 }

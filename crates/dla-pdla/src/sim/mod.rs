@@ -20,22 +20,24 @@ mod serial;
 #[cfg(test)]
 mod tests;
 
-pub use self::checkpoint::CHECKPOINT_MODEL;
-pub use self::growth::{GROWTH_SAMPLES, Sample};
+pub use self::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_MODEL, POSITIONS_FILE};
+pub use self::growth::{GROWTH_COLUMNS, SAMPLES_PER_DECADE, Sample};
 pub use self::pdla::{DiscardGuard, MAX_CONSECUTIVE_DISCARDS, OVERLAP_DISTANCE, PURPOSE_PDLA};
 pub use self::serial::PURPOSE_WALK;
 pub use crate::error::SimError;
 pub use crate::walker::{FAR_FIELD_MARGIN, MAP_JUMP_MIN, Walker, direction, first_contact};
 
-use self::growth::Growth;
+use self::growth::{Growth, Streams};
 use self::pdla::PdlaStats;
 use self::serial::Serial;
 use crate::cluster::Cluster;
 use crate::params::Params;
 use crate::space::{Dim, Space};
 use core_lattice::Fit;
+use core_lattice::io::NpyWriter;
 use spatial::orthtree::Orthtree;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A DLA/PDLA run in `D` dimensions (any `D` with `Dim<D>: Space<D>`), a pure function of
 /// `(Params, seed)` for one thread.
@@ -47,6 +49,10 @@ pub struct Simulation<const D: usize> {
     growth: Growth<D>,
     serial: Serial<D>,
     pdla: PdlaStats,
+    /// The directory the run streams into ([`Simulation::stream_into`]), if any.
+    stream_dir: Option<PathBuf>,
+    /// The `positions.npy` a resumed run was rebuilt from, until it streams again.
+    resumed_from: Option<PathBuf>,
 }
 
 impl<const D: usize> Simulation<D>
@@ -69,6 +75,8 @@ where
             cluster,
             growth,
             pdla: PdlaStats::default(),
+            stream_dir: None,
+            resumed_from: None,
         })
     }
 
@@ -112,20 +120,20 @@ where
             .add_one(&self.params, &mut self.cluster, &mut self.growth)
     }
 
-    /// Serial DLA with a checkpoint written to `path` every `every` particles (and at the
-    /// end), atomically, in the `AGGSIMCK` envelope (model `dla`). Needs `threads == 1` and
-    /// `keep_positions` (the checkpoint holds every position in arrival order, from which
-    /// [`resume`](Self::resume) rebuilds the tree, `R_g`, `R_ext` and the state hash exactly).
-    /// A resumed run ends with the same `state_hash` as an uninterrupted one.
+    /// Serial DLA with a checkpoint (see [`write_checkpoint`](Self::write_checkpoint)) every
+    /// `every` particles and at the end, stopping early, after a final checkpoint, once `stop`
+    /// is set (a signal handler sets it). Needs `threads == 1` and the positions streamed
+    /// ([`stream_into`](Self::stream_into)). Returns whether the run reached its target. A
+    /// resumed run ends with the same `state_hash` as an uninterrupted one.
     pub fn run_checkpointed(
         &mut self,
         every: u64,
-        path: &Path,
+        stop: &AtomicBool,
         progress: &(dyn Fn(u64) + Sync),
-    ) -> Result<(), SimError> {
-        if self.params.threads != 1 || self.growth.positions.is_none() || every == 0 {
+    ) -> Result<bool, SimError> {
+        if self.params.threads != 1 || every == 0 {
             return Err(SimError::CheckpointUsage(format!(
-                "checkpoints need --threads 1, kept positions and every >= 1 (got threads {}, every {every})",
+                "checkpoints need --threads 1 and every >= 1 (got threads {}, every {every})",
                 self.params.threads
             )));
         }
@@ -134,33 +142,66 @@ where
             self.add_one()?;
             if self.growth.n % 1024 == 0 {
                 progress(self.growth.n);
+                if stop.load(Ordering::Relaxed) {
+                    break;
+                }
             }
             if self.growth.n % every == 0 && self.growth.n < target {
-                self.write_checkpoint(path)?;
+                self.write_checkpoint()?;
             }
         }
-        self.write_checkpoint(path)?;
+        self.write_checkpoint()?;
         progress(self.growth.n);
-        Ok(())
+        Ok(self.growth.n == target)
     }
 
-    /// Writes the run's state to `path` (see [`run_checkpointed`](Self::run_checkpointed)).
-    pub fn write_checkpoint(&self, path: &Path) -> Result<(), SimError> {
+    /// Writes the run's state to `checkpoint.bin` in the directory it streams into, after
+    /// flushing and syncing `positions.npy` and `growth.csv` there: a few kilobytes, however
+    /// large the cluster (the positions are in `positions.npy`).
+    ///
+    /// # Errors
+    /// [`SimError::CheckpointUsage`] without positions streamed or with more than one thread;
+    /// I/O errors.
+    pub fn write_checkpoint(&mut self) -> Result<(), SimError> {
+        let dir = self.stream_dir.clone().ok_or_else(|| {
+            SimError::CheckpointUsage(
+                "a checkpoint needs the positions streamed to positions.npy (Simulation::stream_into)"
+                    .into(),
+            )
+        })?;
         checkpoint::write(
-            path,
+            &dir,
             &self.params,
             self.seed,
             &self.serial.rng,
-            &self.growth,
+            &mut self.growth,
         )
     }
 
-    /// Continues a run from a checkpoint written by
-    /// [`run_checkpointed`](Self::run_checkpointed): the tree, `R_g`, `R_ext` and the state
-    /// hash are rebuilt by storing the checkpointed positions again in arrival order, so they
-    /// are bit-identical to those of the run that wrote it.
-    pub fn resume(path: &Path) -> Result<Self, SimError> {
-        let r = checkpoint::read::<D>(path)?;
+    /// Flushes what the run streams (`growth.csv`, `positions.npy`, whose header then counts
+    /// every stored particle); the first write error of the run so far, if any. A no-op for a
+    /// run that streams nothing.
+    pub fn sync_streams(&mut self) -> Result<(), SimError> {
+        match &mut self.growth.streams {
+            Some(s) => s.sync(),
+            None => Ok(()),
+        }
+    }
+
+    /// Continues the run checkpointed in `dir` (`checkpoint.bin` and `positions.npy`, as
+    /// [`write_checkpoint`](Self::write_checkpoint) left them): the tree, `R_g`, `R_ext` and
+    /// the state hash are rebuilt by storing the first `n` positions of `positions.npy` again in
+    /// arrival order, so they are bit-identical to those of the run that wrote it. With
+    /// `particles`, the run's target becomes that (at least the particles stored): a run
+    /// extended so ends as a run made to that size directly. Nothing is written; call
+    /// [`stream_into`](Self::stream_into) to go on streaming (into `dir` or elsewhere).
+    ///
+    /// # Errors
+    /// The checkpoint's errors; [`SimError::CheckpointUsage`] for another dimension, a target
+    /// below the particles stored, or a `positions.npy` that is short or not the one the
+    /// checkpoint was written with.
+    pub fn resume(dir: &Path, particles: Option<u64>) -> Result<Self, SimError> {
+        let r = checkpoint::read::<D>(dir, particles)?;
         Ok(Simulation {
             serial: Serial::with_rng(&r.params, r.rng),
             params: r.params,
@@ -168,7 +209,71 @@ where
             cluster: r.cluster,
             growth: r.growth,
             pdla: PdlaStats::default(),
+            stream_dir: None,
+            resumed_from: Some(r.log),
         })
+    }
+
+    /// Streams the run's history into `dir` from now on: `growth.csv` (rewritten with the
+    /// samples so far, then a line per sample as it is taken) and, with `positions`,
+    /// `positions.npy` (every stored position, arrival order, `(N, D)` float64, readable by
+    /// `numpy.load(..., mmap_mode="r")`), which checkpoints need. The positions stored so far
+    /// come from the resumed run's `positions.npy` (copied unless it is this file), from memory
+    /// (`keep_positions`), or are the seed particle alone.
+    ///
+    /// # Errors
+    /// I/O errors naming the file; [`SimError::CheckpointUsage`] if positions were stored that
+    /// none of those sources holds.
+    pub fn stream_into(&mut self, dir: &Path, positions: bool) -> Result<(), SimError> {
+        let stream_error = |e: &dyn std::fmt::Display| SimError::Stream(e.to_string());
+        let log = if positions {
+            let path = dir.join(POSITIONS_FILE);
+            let log = match &self.resumed_from {
+                Some(src) => {
+                    let same = std::fs::canonicalize(src)
+                        .ok()
+                        .is_some_and(|a| std::fs::canonicalize(&path).ok().is_some_and(|b| a == b));
+                    if !same {
+                        std::fs::copy(src, &path).map_err(|e| {
+                            SimError::Stream(format!(
+                                "copying {} to {}: {e}",
+                                src.display(),
+                                path.display()
+                            ))
+                        })?;
+                    }
+                    NpyWriter::resume(&path, D, self.growth.n).map_err(|e| stream_error(&e))?
+                }
+                None => {
+                    let mut w = NpyWriter::create(&path, D).map_err(|e| stream_error(&e))?;
+                    match &self.growth.positions {
+                        Some(v) => {
+                            for p in v {
+                                w.push(p).map_err(|e| stream_error(&e))?;
+                            }
+                        }
+                        None if self.growth.n == 1 => {
+                            w.push(&[0.0; D]).map_err(|e| stream_error(&e))?;
+                        }
+                        None => {
+                            return Err(SimError::CheckpointUsage(format!(
+                                "{} positions are stored but not kept: stream positions before growing",
+                                self.growth.n
+                            )));
+                        }
+                    }
+                    w
+                }
+            };
+            Some(log)
+        } else {
+            None
+        };
+        self.growth.streams =
+            Some(Streams::open(dir, &self.growth.samples, log).map_err(|e| stream_error(&e))?);
+        self.stream_dir = Some(dir.to_path_buf());
+        self.resumed_from = None;
+        Ok(())
     }
 }
 
@@ -219,9 +324,14 @@ impl<const D: usize> Simulation<D> {
         self.growth.hasher.finish_hex()
     }
 
-    /// The growth samples (about 1000, log-spaced in N, the last at the final size).
+    /// The growth samples ([`SAMPLES_PER_DECADE`] per decade of N, the last at the final size).
     pub fn samples(&self) -> &[Sample] {
         &self.growth.samples
+    }
+
+    /// Whether the run streams `growth.csv` ([`stream_into`](Self::stream_into)).
+    pub fn streams_growth(&self) -> bool {
+        self.growth.streams.is_some()
     }
 
     /// Positions in arrival order, if `params.keep_positions`.
