@@ -95,6 +95,11 @@ impl<const D: usize> Cluster<D> {
         &self.tree
     }
 
+    /// See [`Orthtree::set_index_limit`].
+    pub fn set_tree_index_limit(&mut self, limit: u64) {
+        self.tree.set_index_limit(limit);
+    }
+
     /// The distance maps, finest first (empty when off).
     pub fn maps(&self) -> &[DistanceMap<D>] {
         &self.maps

@@ -117,6 +117,8 @@ where
         .set_result("pdla_lock_wait_seconds", sim.lock_wait_seconds())
         .set_result("state_hash", sim.state_hash())
         .set_result("tree_memory_bytes", sim.tree().memory_bytes() as u64)
+        // Against the 2^32 - 2 the tree's 32-bit indices can number: the headroom left.
+        .set_result("tree_point_slots", sim.tree().stats().point_slots as u64)
         .set_result(
             "distance_map_bytes",
             (sim.cluster().memory_bytes() - sim.tree().memory_bytes()) as u64,

@@ -472,3 +472,32 @@ fn checkpoints_refuse_pdla_and_missing_positions() {
     assert!(t.run_checkpointed(10, &stop, &|_| {}).is_err());
     assert!(!dir.path().join("checkpoint.bin").exists());
 }
+
+#[test]
+fn a_tree_out_of_indices_stops_the_run_with_a_typed_error() {
+    for threads in [1, 2] {
+        let mut sim = Simulation::<2>::new(
+            Params {
+                particles: 100_000,
+                threads,
+                ..Params::default()
+            },
+            3,
+        )
+        .unwrap();
+        sim.set_tree_index_limit(2000);
+        let e = sim.run().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                SimError::Tree(spatial::orthtree::OrthtreeError::CapacityExceeded(_))
+            ),
+            "{e}"
+        );
+        assert!(
+            sim.particles() > 100 && sim.particles() < 2000,
+            "{}",
+            sim.particles()
+        );
+    }
+}

@@ -344,6 +344,14 @@ impl<const D: usize> Simulation<D> {
         self.cluster.tree()
     }
 
+    /// Lowers the number of nodes, leaves and point slots the orthtree may use (see
+    /// [`Orthtree::set_index_limit`]): a run that needs more stops with
+    /// [`SimError::Tree`]`(`[`OrthtreeError::CapacityExceeded`](spatial::orthtree::OrthtreeError::CapacityExceeded)`)`.
+    /// For tests of that error without billions of particles.
+    pub fn set_tree_index_limit(&mut self, limit: u64) {
+        self.cluster.set_tree_index_limit(limit);
+    }
+
     /// The cluster (orthtree and distance map).
     pub fn cluster(&self) -> &Cluster<D> {
         &self.cluster

@@ -67,6 +67,10 @@ where
     let target = params.particles;
     let threads = params.threads;
     let start = growth.n as usize;
+    // The replicas share one set of distance maps, sized for the final cluster now (they
+    // cannot grow once shared). Before anything is moved out of `growth` and `cluster`, so an
+    // error leaves them as they were.
+    cluster.reserve_maps(Dim::<D>::expected_r_ext(target).max(growth.r_ext) + params.birth_gap)?;
     let log = Mutex::new(Log {
         points: Vec::new(),
         base: start,
@@ -79,9 +83,6 @@ where
     let applied: Vec<AtomicUsize> = (0..threads).map(|_| AtomicUsize::new(start)).collect();
     let stop = AtomicBool::new(false);
     let r_ext0 = log.lock().growth.r_ext;
-    // The replicas share one set of distance maps, sized for the final cluster now (they
-    // cannot grow once shared).
-    cluster.reserve_maps(Dim::<D>::expected_r_ext(target).max(r_ext0) + params.birth_gap)?;
     let mut replicas: Vec<Cluster<D>> = (1..threads).map(|_| cluster.clone()).collect();
     replicas.insert(0, std::mem::take(cluster));
     let wait_nanos = AtomicU64::new(0);
@@ -126,18 +127,19 @@ where
     let mut log = log.into_inner();
     let mut first = clusters.swap_remove(0);
     drop(clusters);
-    // Thread 0 may have stopped before applying the last particles of the others.
+    // Thread 0 may have stopped before applying the last particles of the others. Their
+    // threads lowered the shared maps already. An error here (the tree out of indices, say)
+    // is reported after the cluster and the growth accounting are back in place.
     let done = applied[0].load(Ordering::Relaxed);
-    for q in &log.points[done - log.base..] {
-        // Their threads lowered the shared maps already.
-        first.insert_tree(*q)?;
-    }
+    let caught_up = log.points[done - log.base..]
+        .iter()
+        .try_for_each(|q| first.insert_tree(*q).map(drop));
     *cluster = first;
     stats.discarded += log.guard.total;
     *growth = log.growth;
-    match log.error.take() {
-        Some(e) => Err(e),
-        None => Ok(()),
+    match (log.error.take(), caught_up) {
+        (Some(e), _) | (None, Err(e)) => Err(e),
+        (None, Ok(())) => Ok(()),
     }
 }
 

@@ -7,9 +7,7 @@
 //! the path to at least one stored point.
 
 use super::pool::{self, LeafPool};
-use super::{
-    CODE_SCALE, COORD_LIMIT_LEAVES, EMPTY, Leaf, MAX_INDEX, Orthtree, OrthtreeError, decode,
-};
+use super::{CODE_SCALE, COORD_LIMIT_LEAVES, EMPTY, Leaf, Orthtree, OrthtreeError, decode};
 
 impl<const D: usize> Orthtree<D> {
     /// Leaf cell of `p` in leaf sides and the fixed-point offsets inside it, after checking the
@@ -117,16 +115,16 @@ impl<const D: usize> Orthtree<D> {
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(&p)?;
         // Capacity checks before any change, so that an error leaves the tree as it was.
-        if self.node_count() as u64 + 128 > MAX_INDEX {
+        // 128 nodes: the most one insert can add (root growth and a path down to a leaf).
+        if self.node_count() as u64 + 128 > self.index_limit {
             return Err(OrthtreeError::CapacityExceeded("nodes"));
         }
-        if self.leaves.len() as u64 + 1 > MAX_INDEX {
+        if self.leaves.len() as u64 + 1 > self.index_limit {
             return Err(OrthtreeError::CapacityExceeded("leaves"));
         }
         let leaf_len = self.existing_leaf_len(&k);
         if leaf_len == u32::MAX
-            || self.pool.slots.len() as u64 + LeafPool::<D>::push_needs(leaf_len)
-                > u64::from(u32::MAX)
+            || self.pool.slots.len() as u64 + LeafPool::<D>::push_needs(leaf_len) > self.index_limit
         {
             return Err(OrthtreeError::CapacityExceeded("point slots"));
         }

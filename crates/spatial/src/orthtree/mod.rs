@@ -216,8 +216,9 @@ pub enum OrthtreeError {
         "kappa {0} is invalid; expected kappa > 0.5 (paper value 2) or +inf for the exact search"
     )]
     InvalidKappa(f64),
-    /// The tree is full: more than `u32::MAX - 1` nodes, leaves or point slots.
-    #[error("orthtree capacity exceeded: more than 2^32 - 2 {0}")]
+    /// The tree is full: its 32-bit indices (or a limit set by
+    /// [`Orthtree::set_index_limit`]) cannot number another node, leaf or point slot.
+    #[error("orthtree capacity exceeded: no index left for more {0}")]
     CapacityExceeded(&'static str),
 }
 
@@ -260,10 +261,13 @@ pub struct Orthtree<const D: usize> {
     pool: LeafPool<D>,
     /// Number of stored points.
     len: usize,
+    /// Largest number of nodes, leaves or point slots ([`MAX_INDEX`] unless lowered by
+    /// [`Orthtree::set_index_limit`]).
+    index_limit: u64,
 }
 
-/// Counts describing an [`Orthtree`]'s shape and memory, for diagnostics and benchmarks (seed
-/// 002, section 3.3 reports bytes per particle).
+/// Counts describing an [`Orthtree`]'s shape and memory, for diagnostics and benchmarks (the
+/// variable-precision paper, section 3.3, reports bytes per particle).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct OrthtreeStats {
     /// Stored points.
@@ -338,6 +342,7 @@ impl<const D: usize> Orthtree<D> {
             leaves: Vec::new(),
             pool: LeafPool::new(),
             len: 0,
+            index_limit: MAX_INDEX,
         }
     }
 
@@ -385,6 +390,14 @@ impl<const D: usize> Orthtree<D> {
     /// Number of leaves (non-empty leaf cells).
     pub fn leaf_count(&self) -> usize {
         self.leaves.len()
+    }
+
+    /// Lowers the number of nodes, leaves and point slots the tree may use to `limit` (capped at
+    /// the 32-bit maximum, `2^32 - 2`), so that the capacity error can be met in a test without
+    /// billions of points. Inserts that would pass it fail with
+    /// [`OrthtreeError::CapacityExceeded`] and leave the tree unchanged.
+    pub fn set_index_limit(&mut self, limit: u64) {
+        self.index_limit = limit.min(MAX_INDEX);
     }
 
     /// Heap and inline bytes of the structure: the capacities (not lengths) of the node, leaf

@@ -447,3 +447,36 @@ fn offsets_rounding_to_the_upper_face_carry_into_the_next_cell() {
     assert_eq!(t.leaf_count(), 2);
     assert_eq!(t.nearest_distance(&[0.0, 7.5]), Some(0.0));
 }
+
+#[test]
+fn running_out_of_indices_is_a_typed_error_that_changes_nothing() {
+    for limit in [200u64, 1000] {
+        let mut t = Orthtree::<2>::with_leaf_side(1.0).unwrap();
+        t.set_index_limit(limit);
+        let mut rng = Rng::new(limit);
+        let mut stored = 0usize;
+        let err = loop {
+            let p = [rng.uniform() * 1e4, rng.uniform() * 1e4];
+            match t.insert(p) {
+                Ok(_) => stored += 1,
+                Err(e) => break e,
+            }
+            assert!(stored < 10 * limit as usize, "the limit was never reached");
+        };
+        assert!(matches!(err, OrthtreeError::CapacityExceeded(_)), "{err}");
+        assert_eq!(t.len(), stored);
+        let before = t.stats();
+        // Every further insert is refused the same way and leaves the tree as it was.
+        for _ in 0..10 {
+            let p = [rng.uniform() * 1e4, rng.uniform() * 1e4];
+            assert!(matches!(
+                t.insert(p),
+                Err(OrthtreeError::CapacityExceeded(_))
+            ));
+        }
+        assert_eq!(t.stats(), before);
+        let s = t.stats();
+        assert!(s.nodes as u64 <= limit && s.leaves as u64 <= limit);
+        assert!(s.point_slots as u64 <= limit);
+    }
+}
