@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::io::RunClock;
-use dla_pdla::output::{PositionsFormat, write_outputs};
+use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -115,9 +115,14 @@ struct Cli {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
 
-    /// Write dla.png: the cluster shaded by arrival order (3D: projected on x, y).
+    /// Write dla.png: the cluster shaded by arrival order, or, when a pixel spans more than a
+    /// diameter, the number of particles per pixel on a log scale (3D: projected on x, y).
     #[arg(long)]
     png: bool,
+
+    /// Side of dla.png in pixels, 16 to 65536 (default: one pixel per diameter, 512 to 4096).
+    #[arg(long, value_name = "PX", requires = "png", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    png_size: Option<u32>,
 
     #[command(flatten)]
     log: LogArgs,
@@ -279,7 +284,11 @@ where
     }
     progress.finish();
     sim.sync_streams()?;
-    let m = write_outputs(&sim, &clock, &cli.out, cli.positions, cli.png)?;
+    let png = cli.png.then(|| {
+        cli.png_size
+            .unwrap_or_else(|| default_png_side(sim.r_ext()))
+    });
+    let m = write_outputs(&sim, &clock, &cli.out, cli.positions, png)?;
     if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
         tracing::warn!("no fractal dimension: {e}");
     }

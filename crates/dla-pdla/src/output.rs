@@ -12,7 +12,7 @@
 //! | `positions.csv` | `--positions csv`: `x,y` or `x,y,z`, arrival order |
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
 //! | `positions.xyz` | `--positions xyz`: XYZ point cloud, element `C` |
-//! | `dla.png` | `--png`: the cluster shaded by arrival order (3D: projection on x, y) |
+//! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: projection on x, y) |
 
 use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
@@ -42,15 +42,16 @@ pub enum PositionsFormat {
     Xyz,
 }
 
-/// Write every output of `sim` into `dir` (which must exist) and return the manifest. When the
-/// fractal dimension cannot be fitted, its results are null and `fit_error` says why. Call
-/// [`Simulation::sync_streams`] first when the run streams into `dir`.
+/// Write every output of `sim` into `dir` (which must exist) and return the manifest; `png` is
+/// the side of `dla.png` in pixels, if one is wanted. When the fractal dimension cannot be
+/// fitted, its results are null and `fit_error` says why. Call [`Simulation::sync_streams`]
+/// first when the run streams into `dir`.
 pub fn write_outputs<const D: usize>(
     sim: &Simulation<D>,
     clock: &RunClock,
     dir: &Path,
     positions: PositionsFormat,
-    png: bool,
+    png: Option<u32>,
 ) -> Result<RunManifest, OutputError>
 where
     Dim<D>: Space<D>,
@@ -91,8 +92,8 @@ where
             f.commit()?;
         }
     }
-    if png {
-        write_picture(sim, dir, &dir.join("dla.png"))?;
+    if let Some(side) = png {
+        write_picture(sim, dir, &dir.join("dla.png"), side)?;
     }
 
     let fit = sim.fractal_dimension();
@@ -202,43 +203,97 @@ pub fn write_positions_bin<const D: usize>(
     Ok(())
 }
 
-/// The cluster as a grayscale picture on black, projected on (x, y), each particle a disc of
-/// diameter 1 (at least one pixel) shaded from dark (first) to white (last) by arrival order.
+/// Side of `dla.png` in pixels when none is asked for: one pixel per diameter across the
+/// cluster, at least [`PNG_MIN_SIDE`] and at most [`PNG_MAX_SIDE`].
+pub fn default_png_side(r_ext: f64) -> u32 {
+    ((2.0 * (r_ext + 1.0)).ceil() as u32).clamp(PNG_MIN_SIDE, PNG_MAX_SIDE)
+}
+
+/// Smallest default side of `dla.png`.
+pub const PNG_MIN_SIDE: u32 = 512;
+/// Largest default side of `dla.png` (any side up to 65536 may be asked for).
+pub const PNG_MAX_SIDE: u32 = 4096;
+
+/// The cluster as a grayscale picture of `side` x `side` pixels on black, projected on (x, y).
+/// While a pixel is at most a diameter wide, each particle is a disc of diameter 1 shaded from
+/// dark (first) to white (last) by arrival order; when a pixel spans more than a diameter (a
+/// large cluster), each pixel shows how many particles it holds, log-scaled from dark (one) to
+/// white (the most), which shows the structure where dots would merge into a blot.
 fn write_picture<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
     path: &Path,
+    side: u32,
 ) -> Result<(), OutputError> {
     // Every centre lies within R_ext of the origin.
     let extent = sim.r_ext() + 1.0;
-    let side = ((2.0 * extent).ceil() as u32).clamp(64, 4096);
     let scale = f64::from(side) / (2.0 * extent);
-    let mut px = vec![0u8; (side as usize) * (side as usize)];
-    let n = sim.particles().max(2) as f64;
-    let rad = (0.5 * scale).max(0.5);
-    each_position(sim, dir, |i, p: &[f64; D]| {
-        let shade = (55.0 + 200.0 * i as f64 / (n - 1.0)) as u8;
-        let cx = (p[0] + extent) * scale;
-        let cy = (extent - p[1]) * scale;
-        let (x0, x1) = (
-            (cx - rad).floor().max(0.0) as u32,
-            ((cx + rad).ceil() as u32).min(side - 1),
-        );
-        let (y0, y1) = (
-            (cy - rad).floor().max(0.0) as u32,
-            ((cy + rad).ceil() as u32).min(side - 1),
-        );
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
-                if dx * dx + dy * dy <= rad * rad || (x1 == x0 && y1 == y0) {
-                    let at = y as usize * side as usize + x as usize;
-                    px[at] = px[at].max(shade);
+    let s = side as usize;
+    let px = if scale >= 1.0 {
+        let mut px = vec![0u8; s * s];
+        let n = sim.particles().max(2) as f64;
+        let rad = 0.5 * scale;
+        each_position(sim, dir, |i, p: &[f64; D]| {
+            let shade = (55.0 + 200.0 * i as f64 / (n - 1.0)) as u8;
+            let cx = (p[0] + extent) * scale;
+            let cy = (extent - p[1]) * scale;
+            let (x0, x1) = (
+                (cx - rad).floor().max(0.0) as u32,
+                ((cx + rad).ceil() as u32).min(side - 1),
+            );
+            let (y0, y1) = (
+                (cy - rad).floor().max(0.0) as u32,
+                ((cy + rad).ceil() as u32).min(side - 1),
+            );
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
+                    if dx * dx + dy * dy <= rad * rad || (x1 == x0 && y1 == y0) {
+                        let at = y as usize * s + x as usize;
+                        px[at] = px[at].max(shade);
+                    }
                 }
             }
-        }
-        Ok(())
-    })?;
+            Ok(())
+        })?;
+        px
+    } else {
+        let mut counts = vec![0u32; s * s];
+        each_position(sim, dir, |_, p: &[f64; D]| {
+            let x = (((p[0] + extent) * scale) as usize).min(s - 1);
+            let y = (((extent - p[1]) * scale) as usize).min(s - 1);
+            let c = &mut counts[y * s + x];
+            *c = c.saturating_add(1);
+            Ok(())
+        })?;
+        density_shades(&counts)
+    };
     write_png_gray(path, side, side, &px)?;
     Ok(())
+}
+
+/// Gray levels of per-pixel counts: 0 black, 1 to the largest count mapped to 60-255 by
+/// `ln(count)`.
+fn density_shades(counts: &[u32]) -> Vec<u8> {
+    let top = f64::from(counts.iter().copied().max().unwrap_or(0).max(2)).ln();
+    counts
+        .iter()
+        .map(|&c| match c {
+            0 => 0,
+            c => (60.0 + 195.0 * f64::from(c).ln() / top).round() as u8,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn density_shades_are_log_scaled_and_keep_empty_pixels_black() {
+        assert_eq!(density_shades(&[0, 1, 10, 100]), vec![0, 60, 158, 255]);
+        assert_eq!(density_shades(&[0, 1]), vec![0, 60]);
+        assert_eq!(default_png_side(10.0), PNG_MIN_SIDE);
+        assert_eq!(default_png_side(1e6), PNG_MAX_SIDE);
+    }
 }

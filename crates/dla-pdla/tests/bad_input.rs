@@ -135,6 +135,8 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--threads", "0"]), "--threads 0"),
         (with(&["--far-field", "teleport"]), "teleport"),
         (with(&["--positions", "pdf"]), "pdf"),
+        (with(&["--png", "--png-size", "8"]), "8"),
+        (with(&["--png-size", "1024"]), "--png"),
         (with(&["--distance-map", "maybe"]), "maybe"),
         (with(&["--fit-from", "0"]), "--fit-from 0"),
         (with(&["--checkpoint-every", "0"]), "--checkpoint-every 0"),
