@@ -140,10 +140,6 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--distance-map", "maybe"]), "maybe"),
         (with(&["--fit-from", "0"]), "--fit-from 0"),
         (with(&["--checkpoint-every", "0"]), "--checkpoint-every 0"),
-        (
-            with(&["--checkpoint-every", "100", "--threads", "2"]),
-            "--threads 2",
-        ),
         (with(&["--heartbeat", "-1"]), "-1"),
         (with(&["--no-such-flag"]), "--no-such-flag"),
         (vec!["--particles", "300", "--out", "file"], "--out file"),

@@ -264,6 +264,28 @@ fn discard_guard_fails_loudly_instead_of_spinning() {
     assert!(e.to_string().contains("livelock"), "{e}");
 }
 
+/// No two particles of `positions` overlap, and every particle but the first touches an
+/// earlier one (it stuck at contact, to rounding); `tree` holds exactly these positions.
+fn assert_valid_cluster(tree: &spatial::orthtree::Orthtree<2>, positions: &[[f64; 2]]) {
+    assert_eq!(tree.len(), positions.len());
+    let mut a: Vec<[f64; 2]> = tree.iter().collect();
+    let mut b = positions.to_vec();
+    a.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    b.sort_by(|x, y| x.partial_cmp(y).unwrap());
+    assert_eq!(a, b);
+    for (i, p) in positions.iter().enumerate() {
+        let mut within_overlap = 0;
+        tree.for_each_within(p, OVERLAP_DISTANCE, |_| within_overlap += 1);
+        assert_eq!(within_overlap, 1, "particle {i} at {p:?} overlaps another");
+        if i > 0 {
+            let touches = positions[..i]
+                .iter()
+                .any(|q| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt() <= 1.0 + 1e-6);
+            assert!(touches, "particle {i} at {p:?} touches no earlier particle");
+        }
+    }
+}
+
 #[test]
 fn pdla_tree_holds_exactly_the_recorded_positions_touching_and_without_overlap() {
     let params = Params {
@@ -276,29 +298,50 @@ fn pdla_tree_holds_exactly_the_recorded_positions_touching_and_without_overlap()
     let mut sim = Simulation::<2>::new(params, 9).unwrap();
     sim.run().unwrap();
     assert_eq!(sim.particles(), 5000);
-    assert_eq!(sim.tree().len(), 5000);
     assert_eq!(sim.positions().unwrap().len(), 5000);
-    // The tree holds exactly the recorded positions.
-    let mut a: Vec<[f64; 2]> = sim.tree().iter().collect();
-    let mut b = sim.positions().unwrap().to_vec();
-    a.sort_by(|x, y| x.partial_cmp(y).unwrap());
-    b.sort_by(|x, y| x.partial_cmp(y).unwrap());
-    assert_eq!(a, b);
     // Threads stick walkers concurrently, yet no two particles overlap, and every particle
-    // but the seed touches an earlier one (it stuck at contact, to rounding).
-    let positions = sim.positions().unwrap();
-    for (i, p) in positions.iter().enumerate() {
-        let mut within_overlap = 0;
-        sim.tree()
-            .for_each_within(p, OVERLAP_DISTANCE, |_| within_overlap += 1);
-        assert_eq!(within_overlap, 1, "particle {i} at {p:?} overlaps another");
-        if i > 0 {
-            let touches = positions[..i]
-                .iter()
-                .any(|q| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt() <= 1.0 + 1e-6);
-            assert!(touches, "particle {i} at {p:?} touches no earlier particle");
-        }
-    }
+    // but the seed touches an earlier one.
+    assert_valid_cluster(sim.tree(), sim.positions().unwrap());
+}
+
+#[test]
+fn pdla_checkpointed_stopped_and_resumed_is_a_valid_cluster() {
+    let params = Params {
+        particles: 12_000,
+        threads: 2,
+        serial_until: 500,
+        ..Params::default()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let halt = std::sync::atomic::AtomicBool::new(false);
+    let mut sim = Simulation::<2>::new(params, 4).unwrap();
+    sim.stream_into(dir.path(), true).unwrap();
+    // Stopped (as by a signal) once past 5000 particles, in the parallel phase.
+    let finished = sim
+        .run_checkpointed(3000, &halt, &|n| {
+            if n > 5000 {
+                halt.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        })
+        .unwrap();
+    assert!(!finished);
+    let stopped_at = sim.particles();
+    assert!(stopped_at > 5000 && stopped_at < 12_000, "{stopped_at}");
+    drop(sim);
+    let mut resumed = Simulation::<2>::resume(dir.path(), None).unwrap();
+    assert_eq!(resumed.particles(), stopped_at);
+    resumed.stream_into(dir.path(), true).unwrap();
+    let go_on = std::sync::atomic::AtomicBool::new(false);
+    assert!(resumed.run_checkpointed(3000, &go_on, &|_| {}).unwrap());
+    assert_eq!(resumed.particles(), 12_000);
+    let mut positions = Vec::new();
+    dla_pdla::output::each_position(&resumed, dir.path(), |_, p: &[f64; 2]| {
+        positions.push(*p);
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(positions.len(), 12_000);
+    assert_valid_cluster(resumed.tree(), &positions);
 }
 
 /// Checkpoints a 3000-particle run after `stop` walkers, resumes it and grows it to the end:
@@ -446,31 +489,31 @@ fn a_positions_log_that_is_not_the_checkpoints_is_refused() {
 }
 
 #[test]
-fn checkpoints_refuse_pdla_and_missing_positions() {
-    let dir = tempfile::tempdir().unwrap();
+fn checkpoints_need_the_positions_streamed() {
     let stop = std::sync::atomic::AtomicBool::new(false);
-    let mut s = Simulation::<2>::new(
-        Params {
-            particles: 100,
-            ..Params::default()
-        },
-        1,
-    )
-    .unwrap();
-    // Nothing streamed: no checkpoint.
-    assert!(s.run_checkpointed(10, &stop, &|_| {}).is_err());
-    let mut t = Simulation::<2>::new(
-        Params {
-            particles: 100,
-            threads: 2,
-            ..Params::default()
-        },
-        1,
-    )
-    .unwrap();
-    t.stream_into(dir.path(), true).unwrap();
-    assert!(t.run_checkpointed(10, &stop, &|_| {}).is_err());
-    assert!(!dir.path().join("checkpoint.bin").exists());
+    for threads in [1, 2] {
+        let mut s = Simulation::<2>::new(
+            Params {
+                particles: 100,
+                threads,
+                ..Params::default()
+            },
+            1,
+        )
+        .unwrap();
+        assert!(matches!(
+            s.run_checkpointed(10, &stop, &|_| {}),
+            Err(SimError::CheckpointUsage(_))
+        ));
+        assert!(matches!(
+            s.write_checkpoint(),
+            Err(SimError::CheckpointUsage(_))
+        ));
+        let dir = tempfile::tempdir().unwrap();
+        s.stream_into(dir.path(), false).unwrap();
+        assert!(s.run_checkpointed(10, &stop, &|_| {}).is_err());
+        assert!(!dir.path().join("checkpoint.bin").exists());
+    }
 }
 
 #[test]

@@ -1,7 +1,8 @@
-//! Checkpoints of serial runs without a second copy of the cluster. The positions already
+//! Checkpoints of runs without a second copy of the cluster (serial runs between two walkers,
+//! PDLA at a quiescent point between two parallel phases). The positions already
 //! stream, in arrival order, to `positions.npy` in the run's directory; a checkpoint
 //! (`checkpoint.bin`, beside it) holds only what is not in that file: the parameters, the seed,
-//! the walk's random stream, the particle count `n` and the state hash after the first `n`
+//! the walk's random stream, the number of parallel phases run, the particle count `n` and the state hash after the first `n`
 //! rows, the growth samples and the seconds grown. It is a few kilobytes at any size, written
 //! atomically in `core_lattice`'s checksummed `AGGSIMCK` envelope (model
 //! [`CHECKPOINT_MODEL`]) after `positions.npy` has been flushed and synced.
@@ -36,6 +37,8 @@ struct Snapshot {
     params: Params,
     seed: u64,
     rng: SimRng,
+    /// Parallel (PDLA) phases run so far: a resumed run's phases draw from new streams.
+    pdla_rounds: u32,
     /// Particles stored: the first `n` rows of `positions.npy`.
     n: u64,
     /// The state hash after those `n` particles.
@@ -52,6 +55,7 @@ pub(crate) struct Restored<const D: usize> {
     pub(crate) params: Params,
     pub(crate) seed: u64,
     pub(crate) rng: SimRng,
+    pub(crate) pdla_rounds: u32,
     pub(crate) cluster: Cluster<D>,
     pub(crate) growth: Growth<D>,
     /// The `positions.npy` the cluster was rebuilt from.
@@ -65,13 +69,9 @@ pub(crate) fn write<const D: usize>(
     params: &Params,
     seed: u64,
     rng: &SimRng,
+    pdla_rounds: u32,
     growth: &mut Growth<D>,
 ) -> Result<(), SimError> {
-    if params.threads != 1 {
-        return Err(SimError::CheckpointUsage(
-            "checkpoints are for one thread (PDLA is not deterministic)".into(),
-        ));
-    }
     let streams = growth
         .streams
         .as_mut()
@@ -87,6 +87,7 @@ pub(crate) fn write<const D: usize>(
         params: params.clone(),
         seed,
         rng: rng.clone(),
+        pdla_rounds,
         n: growth.n,
         state_hash: growth.hasher.finish_hex(),
         samples: growth.samples.clone(),
@@ -182,6 +183,7 @@ where
         params,
         seed: snap.seed,
         rng: snap.rng,
+        pdla_rounds: snap.pdla_rounds,
         cluster,
         growth,
         log,

@@ -49,6 +49,8 @@ pub struct Simulation<const D: usize> {
     growth: Growth<D>,
     serial: Serial<D>,
     pdla: PdlaStats,
+    /// Parallel phases run so far (each draws from its own random streams).
+    pdla_rounds: u32,
     /// The directory the run streams into ([`Simulation::stream_into`]), if any.
     stream_dir: Option<PathBuf>,
     /// The `positions.npy` a resumed run was rebuilt from, until it streams again.
@@ -75,6 +77,7 @@ where
             cluster,
             growth,
             pdla: PdlaStats::default(),
+            pdla_rounds: 0,
             stream_dir: None,
             resumed_from: None,
         })
@@ -84,29 +87,50 @@ where
     /// particles.
     pub fn run_with(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), SimError> {
         let target = self.params.particles;
-        let serial_to = if self.params.threads == 1 {
-            target
-        } else {
-            self.params.serial_until.clamp(1, target)
-        };
-        while self.growth.n < serial_to {
+        while self.growth.n < self.serial_to() {
             self.add_one()?;
             if self.growth.n % 1024 == 0 {
                 progress(self.growth.n);
             }
         }
         if self.growth.n < target {
-            pdla::grow_parallel(
-                &self.params,
-                self.seed,
-                &mut self.cluster,
-                &mut self.growth,
-                &mut self.pdla,
-                progress,
-            )?;
+            self.grow_parallel(target, &AtomicBool::new(false), progress)?;
         }
         progress(self.growth.n);
         Ok(())
+    }
+
+    /// The size up to which the run grows with one walker: the target with one thread,
+    /// `serial_until` (at least the seed particle) with more.
+    fn serial_to(&self) -> u64 {
+        let target = self.params.particles;
+        if self.params.threads == 1 {
+            target
+        } else {
+            self.params.serial_until.clamp(1, target)
+        }
+    }
+
+    /// PDLA up to `until`, or to a quiescent point once `halt` is set.
+    fn grow_parallel(
+        &mut self,
+        until: u64,
+        halt: &AtomicBool,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(), SimError> {
+        let round = self.pdla_rounds;
+        self.pdla_rounds += 1;
+        pdla::grow_parallel(
+            &self.params,
+            self.seed,
+            round,
+            until,
+            halt,
+            &mut self.cluster,
+            &mut self.growth,
+            &mut self.pdla,
+            progress,
+        )
     }
 
     /// Grow to `params.particles` without progress reports.
@@ -120,39 +144,63 @@ where
             .add_one(&self.params, &mut self.cluster, &mut self.growth)
     }
 
-    /// Serial DLA with a checkpoint (see [`write_checkpoint`](Self::write_checkpoint)) every
+    /// Grows with a checkpoint (see [`write_checkpoint`](Self::write_checkpoint)) every
     /// `every` particles and at the end, stopping early, after a final checkpoint, once `stop`
-    /// is set (a signal handler sets it). Needs `threads == 1` and the positions streamed
-    /// ([`stream_into`](Self::stream_into)). Returns whether the run reached its target. A
-    /// resumed run ends with the same `state_hash` as an uninterrupted one.
+    /// is set (a signal handler sets it). Needs the positions streamed
+    /// ([`stream_into`](Self::stream_into)). Returns whether the run reached its target.
+    ///
+    /// With one thread a resumed run ends with the same `state_hash` as an uninterrupted one.
+    /// With more (PDLA), each stretch of `every` particles is one parallel phase that ends at a
+    /// quiescent point (every stored particle applied everywhere, walkers on their way
+    /// dropped), where the checkpoint is taken; a resumed PDLA run is a valid PDLA cluster (no
+    /// overlap, every particle in contact), not a copy of the uninterrupted one, which PDLA
+    /// never is.
     pub fn run_checkpointed(
         &mut self,
         every: u64,
         stop: &AtomicBool,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<bool, SimError> {
-        if self.params.threads != 1 || every == 0 {
-            return Err(SimError::CheckpointUsage(format!(
-                "checkpoints need --threads 1 and every >= 1 (got threads {}, every {every})",
-                self.params.threads
-            )));
+        if every == 0 {
+            return Err(SimError::CheckpointUsage(
+                "checkpoints need every >= 1".into(),
+            ));
+        }
+        if !self.streams_positions() {
+            return Err(SimError::CheckpointUsage(
+                "a checkpoint needs the positions streamed to positions.npy (Simulation::stream_into)"
+                    .into(),
+            ));
         }
         let target = self.params.particles;
-        while self.growth.n < target {
+        while self.growth.n < self.serial_to() && !stop.load(Ordering::Relaxed) {
             self.add_one()?;
             if self.growth.n % 1024 == 0 {
                 progress(self.growth.n);
-                if stop.load(Ordering::Relaxed) {
-                    break;
-                }
             }
             if self.growth.n % every == 0 && self.growth.n < target {
+                self.write_checkpoint()?;
+            }
+        }
+        while self.growth.n < target && !stop.load(Ordering::Relaxed) {
+            let until = ((self.growth.n / every + 1) * every).min(target);
+            self.grow_parallel(until, stop, progress)?;
+            if self.growth.n < target {
                 self.write_checkpoint()?;
             }
         }
         self.write_checkpoint()?;
         progress(self.growth.n);
         Ok(self.growth.n == target)
+    }
+
+    /// Whether `positions.npy` is being written ([`stream_into`](Self::stream_into) with
+    /// positions).
+    pub fn streams_positions(&self) -> bool {
+        self.growth
+            .streams
+            .as_ref()
+            .is_some_and(|s| s.positions.is_some())
     }
 
     /// Writes the run's state to `checkpoint.bin` in the directory it streams into, after
@@ -174,6 +222,7 @@ where
             &self.params,
             self.seed,
             &self.serial.rng,
+            self.pdla_rounds,
             &mut self.growth,
         )
     }
@@ -209,6 +258,7 @@ where
             cluster: r.cluster,
             growth: r.growth,
             pdla: PdlaStats::default(),
+            pdla_rounds: r.pdla_rounds,
             stream_dir: None,
             resumed_from: Some(r.log),
         })

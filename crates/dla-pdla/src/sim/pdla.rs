@@ -39,8 +39,13 @@ pub(crate) struct PdlaStats {
     pub(crate) lock_wait_seconds: f64,
 }
 
-/// Grows `cluster` (holding `growth.n` particles) to `params.particles` with
-/// `params.threads` walkers at once, adding to `stats`.
+/// Grows `cluster` (holding `growth.n` particles) to `until` (at most `params.particles`, the
+/// run's final size) with `params.threads` walkers at once, adding to `stats`; returns early,
+/// at a quiescent point, once `halt` is set. Every thread stops at a quiescent point: the
+/// particles of the log are applied everywhere and walkers still on their way are dropped
+/// (walkers are independent, so a new one born later is as good), which is where a PDLA
+/// checkpoint is taken. `round` numbers the calls of a run, so that each draws from its own
+/// random streams.
 ///
 /// Each thread walks on its own replica of the orthtree, so walking takes no lock and touches
 /// no shared cache line but one atomic counter; stuck particles go through a shared log (a
@@ -53,9 +58,13 @@ pub(crate) struct PdlaStats {
 /// (a move can end inside a particle stored during it); if one does the walker is discarded
 /// and counted. The replicas receive the same points in the same order, so they are
 /// identical; thread 0's becomes the simulation's tree.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn grow_parallel<const D: usize>(
     params: &Params,
     seed: u64,
+    round: u32,
+    until: u64,
+    halt: &AtomicBool,
     cluster: &mut Cluster<D>,
     growth: &mut Growth<D>,
     stats: &mut PdlaStats,
@@ -64,13 +73,15 @@ pub(crate) fn grow_parallel<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
-    let target = params.particles;
+    let target = until.min(params.particles);
     let threads = params.threads;
     let start = growth.n as usize;
     // The replicas share one set of distance maps, sized for the final cluster now (they
     // cannot grow once shared). Before anything is moved out of `growth` and `cluster`, so an
     // error leaves them as they were.
-    cluster.reserve_maps(Dim::<D>::expected_r_ext(target).max(growth.r_ext) + params.birth_gap)?;
+    cluster.reserve_maps(
+        Dim::<D>::expected_r_ext(params.particles).max(growth.r_ext) + params.birth_gap,
+    )?;
     let log = Mutex::new(Log {
         points: Vec::new(),
         base: start,
@@ -92,7 +103,9 @@ where
         published: &published,
         applied: &applied,
         stop: &stop,
+        halt,
         target,
+        final_target: params.particles,
         wait_nanos: &wait_nanos,
     };
     let mut clusters: Vec<Cluster<D>> = std::thread::scope(|s| {
@@ -109,7 +122,9 @@ where
                         index: t,
                         walk: WalkState::new(params),
                     };
-                    let mut rng = stream(seed, stream_id(PURPOSE_PDLA, t as u32));
+                    // Round 0 draws from the streams of a run without checkpoints.
+                    let index = round.wrapping_mul(1024).wrapping_add(t as u32);
+                    let mut rng = stream(seed, stream_id(PURPOSE_PDLA, index));
                     ctx.walk(&mut rep, params, &mut rng, progress);
                     // Whatever was taken from the log is counted as applied.
                     ctx.insert_pending(&mut rep);
@@ -209,7 +224,12 @@ struct Ctx<'a, const D: usize> {
     published: &'a AtomicUsize,
     applied: &'a [AtomicUsize],
     stop: &'a AtomicBool,
+    /// Set from outside (a signal): stop at the next quiescent point.
+    halt: &'a AtomicBool,
+    /// Where this call stops.
     target: u64,
+    /// The run's final size (the last growth sample is taken there).
+    final_target: u64,
     /// Nanoseconds threads spent waiting for the log's mutex (summed over threads).
     wait_nanos: &'a AtomicU64,
 }
@@ -259,7 +279,7 @@ where
     /// Brings `rep` up to date if another thread stored particles; `false` to stop.
     #[inline]
     fn sync(&self, rep: &mut Replica<D>) -> bool {
-        if self.stop.load(Ordering::Relaxed) {
+        if self.stop.load(Ordering::Relaxed) || self.halt.load(Ordering::Relaxed) {
             return false;
         }
         if self.published.load(Ordering::Acquire) == rep.applied {
@@ -313,7 +333,10 @@ where
                 .tree()
                 .for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
             let mut guard = self.lock();
-            if guard.growth.n >= self.target || self.stop.load(Ordering::Relaxed) {
+            if guard.growth.n >= self.target
+                || self.stop.load(Ordering::Relaxed)
+                || self.halt.load(Ordering::Relaxed)
+            {
                 return;
             }
             self.take_pending(&guard, rep);
@@ -332,7 +355,7 @@ where
                 continue;
             }
             let log = &mut *guard;
-            log.growth.account(q, self.target);
+            log.growth.account(q, self.final_target);
             log.points.push(q);
             rep.pending.push(q);
             rep.applied += 1;
