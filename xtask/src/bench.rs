@@ -175,7 +175,9 @@ pub struct Ratio {
     pub hash_changed: bool,
 }
 
-fn target_dir(root: &Path) -> PathBuf {
+/// The cargo target directory: `$CARGO_TARGET_DIR` (relative to `root` unless absolute) or
+/// `root/target`.
+pub fn target_dir(root: &Path) -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .map(|p| if p.is_absolute() { p } else { root.join(p) })
@@ -183,7 +185,7 @@ fn target_dir(root: &Path) -> PathBuf {
 }
 
 /// Build the release binaries the workloads need.
-fn build(root: &Path, cargo: &str) -> Result<()> {
+pub fn build(root: &Path, cargo: &str) -> Result<()> {
     eprintln!("==> building release binaries");
     let status = Command::new(cargo)
         .args([

@@ -1,11 +1,13 @@
 //! Library behind `cargo xtask`: the scaling experiments that regenerate the papers' tables and
-//! figures (`scaling`), the headline benchmarks (`bench`), and the tables and plots they write.
+//! figures (`scaling`), the headline benchmarks (`bench`), DLA at the papers' scale (`scale`),
+//! and the tables and plots they write.
 //! The binary (`src/main.rs`) parses the command line and calls in here; the harness's own
 //! test (`tests/scaling.rs`) runs it at a tiny size.
 
 pub mod bench;
 pub mod plot;
 pub mod report;
+pub mod scale;
 pub mod scaling;
 
 use std::path::PathBuf;

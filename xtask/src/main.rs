@@ -56,6 +56,17 @@ enum Cmd {
         #[arg(long, value_enum, hide = true)]
         scale: Option<Scale>,
     },
+    /// DLA at the papers' scale: 2D 1e7 and 1e8, 3D 1e6 and 1e7, one and two threads (about
+    /// an hour and a half on 2 cores); time, memory, D_f, and projections to 2D 1e9 and 3D
+    /// 1e8. Writes scale.md and scale.csv under --out.
+    Scale {
+        /// 2D 1e5 and 1e6, 3D 1e5 and 1e6 (about a minute); default output docs/results/quick/.
+        #[arg(long)]
+        quick: bool,
+        /// Output directory (default docs/results/, or docs/results/quick/ with --quick).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Run the headline workloads as release binaries and print JSON: seconds, peak RSS,
     /// per-item rates.
     Bench {
@@ -200,6 +211,7 @@ fn main() -> Result<()> {
             );
             Ok(())
         }
+        Cmd::Scale { quick, out } => xtask::scale::run(&workspace_root(), &cargo(), quick, out),
         Cmd::Bench {
             save,
             against,
