@@ -180,18 +180,15 @@ fn params(cli: &Cli) -> Result<Params, String> {
 const PROGRESS_TEMPLATE: &str =
     "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})";
 
-/// The run checkpointed in `DIR/checkpoint.bin`, if it is one these flags continue; anything
-/// else is a usage error naming the file, or the flags that differ with both values.
+/// The run checkpointed in `DIR` (`checkpoint.bin`, `positions.npy`), if it is one these flags
+/// continue; anything else is a usage error naming the file, or the flags that differ with both
+/// values.
 fn resume<const D: usize>(dir: &Path, params: &Params, seed: u64) -> anyhow::Result<Simulation<D>>
 where
     Dim<D>: Space<D>,
 {
-    let sim = Simulation::<D>::resume(dir, Some(params.particles)).map_err(|e| {
-        usage(format!(
-            "--resume {}: {e}",
-            dir.join(dla_pdla::sim::CHECKPOINT_FILE).display()
-        ))
-    })?;
+    let sim = Simulation::<D>::resume(dir, Some(params.particles))
+        .map_err(|e| usage(format!("--resume {}: {e}", dir.display())))?;
     // --particles may grow (checked by `resume`).
     let mut differ = flag_differences(sim.params(), params, &[("keep_positions", None)]);
     if sim.seed() != seed {

@@ -192,10 +192,14 @@ pub fn write_checkpoint<T: Serialize>(
     Ok(())
 }
 
-/// Read the checkpoint at `path`, which must be one of `model`'s.
+/// Read the checkpoint at `path`, which must be one of `model`'s. A file that cannot be read is
+/// a [`CheckpointError::Io`] naming the path.
 pub fn read_checkpoint<T: DeserializeOwned>(
     path: impl AsRef<Path>,
     model: &str,
 ) -> Result<T, CheckpointError> {
-    decode_checkpoint(&std::fs::read(path)?, model)
+    let path = path.as_ref();
+    let bytes = std::fs::read(path)
+        .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
+    decode_checkpoint(&bytes, model)
 }
