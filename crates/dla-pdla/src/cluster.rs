@@ -105,15 +105,16 @@ impl<const D: usize> Cluster<D> {
         &self.maps
     }
 
-    /// A lower bound of the distance from `p` to the nearest particle from the distance maps:
-    /// the finest map that covers `p` with a cell that is not capped, or else the last capped
-    /// bound found. `None` when the maps are off or none covers `p`.
+    /// A lower bound of the distance from `p` to the nearest particle from the distance maps,
+    /// and whether it is capped: the finest map that covers `p` with a cell that is not capped
+    /// (`false`), or else the last capped bound found (`true`: the distance may be far larger).
+    /// `None` when the maps are off or none covers `p`.
     #[inline]
-    pub fn map_bound(&self, p: &[f64; D]) -> Option<f64> {
+    pub fn map_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
         let mut best = None;
         for map in self.maps.iter() {
             if let Some((lb, capped)) = map.lower_bound(p) {
-                best = Some(lb);
+                best = Some((lb, capped));
                 if !capped {
                     break;
                 }

@@ -89,9 +89,16 @@ where
             return None;
         }
         // Near field. First the distance map: one byte read bounds the distance to the
-        // cluster from below; a walker at least a few diameters out jumps by it.
-        if let Some(lb) = cluster.map_bound(&self.p) {
-            if lb - 1.0 > MAP_JUMP_MIN {
+        // cluster from below; a walker at least a few diameters out jumps by it. A bound capped
+        // by the coarsest map only says "at least its cap": in the large empty regions of a big
+        // cluster the walker may be much farther from it, and jumps of the cap would take
+        // (region / cap)^2 moves to cross them, a cost growing with the cluster. There the
+        // tree's distance, a few hundred nanoseconds, gives the long jump instead.
+        let mut floor = 0.0;
+        if let Some((lb, capped)) = cluster.map_bound(&self.p) {
+            if capped {
+                floor = lb;
+            } else if lb - 1.0 > MAP_JUMP_MIN {
                 self.jump(lb - 1.0, rng);
                 state.upper += (lb - 1.0) * (1.0 + 1e-9);
                 return None;
@@ -113,10 +120,11 @@ where
                 .expect("the cluster is never empty"),
         };
         state.anchor = nearest;
-        let delta = est.distance;
-        // The exact distance is at most delta + 2 r (the gap of a far node's bound), with a
-        // relative margin for the rounding of that bound.
-        state.upper = (delta + 2.0 * est.half_diagonal.unwrap_or(0.0)) * (1.0 + 1e-9) + 1e-9;
+        // The exact distance is at most the estimate + 2 r (the gap of a far node's bound), with
+        // a relative margin for the rounding of that bound.
+        state.upper = (est.distance + 2.0 * est.half_diagonal.unwrap_or(0.0)) * (1.0 + 1e-9) + 1e-9;
+        // Both the tree's estimate and a capped map bound are lower bounds: jump by the larger.
+        let delta = est.distance.max(floor);
         if delta - 1.0 > params.step_min {
             self.jump(delta - 1.0, rng);
             state.upper += (delta - 1.0) * (1.0 + 1e-9);

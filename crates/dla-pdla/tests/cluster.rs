@@ -37,7 +37,7 @@ where
             .iter()
             .map(|q| (0..D).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt())
             .fold(f64::INFINITY, f64::min);
-        if let Some(lb) = cluster.map_bound(&p) {
+        if let Some((lb, _)) = cluster.map_bound(&p) {
             assert!(
                 lb <= exact,
                 "{D}D: map bound {lb} above exact {exact} at {p:?}"
