@@ -8,10 +8,11 @@ use animat::params::MAX_RADIUS;
 use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::{LogArgs, flag_differences, usage};
+use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::io::{RunClock, read_checkpoint, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::Ordering;
 
 /// Foxes and rabbits on an unbounded plane, each running its rule list in priority order.
 ///
@@ -76,7 +77,8 @@ struct Cli {
     positions: bool,
 
     /// Save the run to OUT/checkpoint.bin every N steps and at the end (atomically), for
-    /// --resume.
+    /// --resume; SIGINT or SIGTERM then save it after the current step and stop (exit code
+    /// 130).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     checkpoint_every: Option<u64>,
 
@@ -274,7 +276,25 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         snapshot(&world)?;
     }
     progress.set_position(world.steps().min(cli.steps));
+    // With checkpoints, SIGINT/SIGTERM save the run after the current step and stop it.
+    let stop = match cli.checkpoint_every {
+        Some(_) => {
+            Some(core_lattice::cli::stop_on_signals().context("installing signal handlers")?)
+        }
+        None => None,
+    };
     while world.steps() < cli.steps {
+        if stop.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+            progress.finish();
+            save(&world, &rows)?;
+            return Err(Interrupted(format!(
+                "interrupted after step {}; checkpoint in {}: continue with --resume {}",
+                world.steps(),
+                cli.out.display(),
+                cli.out.display()
+            ))
+            .into());
+        }
         if world.foxes() + world.rabbits() == 0 {
             tracing::info!(step = world.steps(), "every animat has died");
             break;

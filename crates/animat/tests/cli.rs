@@ -163,6 +163,34 @@ fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(result(&resumed), result(&whole));
 
+    // SIGTERM: a checkpoint after the current step, exit code 130; resumed in place, the same
+    // end.
+    let term = tmp.path().join("term");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_animat"));
+    cmd.args(world)
+        .args(steps)
+        .args(["--checkpoint-every", "5", "--out", term.to_str().unwrap()]);
+    let (running, code) =
+        core_lattice::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+    if running {
+        assert_eq!(code, Some(130));
+    }
+    let o = animat(
+        &[
+            &world[..],
+            &steps[..],
+            &[
+                "--resume",
+                term.to_str().unwrap(),
+                "--out",
+                term.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(result(&term), result(&whole));
+
     // A finished run extends: 400 steps resumed to 450 equal 450 steps made at once.
     let ext = tmp.path().join("ext");
     let more = ["--steps", "450", "--seed", "5", "-qq"];

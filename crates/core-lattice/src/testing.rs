@@ -128,3 +128,30 @@ pub fn kill_once_written(cmd: &mut Command, file: &Path) -> bool {
     let _ = child.wait();
     running
 }
+
+/// Starts `cmd`, waits until `file` exists, then sends it SIGTERM (as a batch system's time
+/// limit does) and waits for it. Returns whether it was still running when signalled, and its
+/// exit code.
+pub fn terminate_once_written(cmd: &mut Command, file: &Path) -> (bool, Option<i32>) {
+    let mut child = cmd
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("the binary starts");
+    while !file.exists() {
+        if child.try_wait().expect("wait on the child").is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let running = child.try_wait().expect("wait on the child").is_none();
+    if running {
+        let sent = Command::new("kill")
+            .args(["-TERM", &child.id().to_string()])
+            .status()
+            .expect("kill runs");
+        assert!(sent.success(), "kill -TERM failed");
+    }
+    let status = child.wait().expect("wait on the child");
+    (running, status.code())
+}

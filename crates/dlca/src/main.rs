@@ -6,10 +6,11 @@
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
-use core_lattice::cli::{LogArgs, flag_differences, usage};
+use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::io::RunClock;
 use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
+use std::sync::atomic::Ordering;
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
@@ -49,7 +50,8 @@ struct Cli {
     #[arg(long)]
     out: PathBuf,
 
-    /// Save the run's state to OUT/checkpoint.bin every N sweeps (atomically), for --resume.
+    /// Save the run's state to OUT/checkpoint.bin every N sweeps (atomically), for --resume;
+    /// SIGINT or SIGTERM then save it after the current sweep and stop (exit code 130).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     checkpoint_every: Option<u64>,
 
@@ -302,22 +304,44 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         "merges",
         "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
     );
-    let mut saved = Ok(());
-    sim.run_with(|s| {
+    // With checkpoints, SIGINT/SIGTERM save the run after the current sweep and stop it.
+    let stop = match cli.checkpoint_every {
+        Some(_) => {
+            Some(core_lattice::cli::stop_on_signals().context("installing signal handlers")?)
+        }
+        None => None,
+    };
+    let save = |s: &Simulation| {
+        write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot())
+            .context("writing a checkpoint")
+    };
+    while !sim.is_done() {
+        sim.sweep();
+        let s = &sim;
         if let Some(n) = cli.checkpoint_every
             && s.sweeps() % n == 0
             && !s.is_done()
-            && saved.is_ok()
         {
-            saved = write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot());
+            save(s)?;
         }
         if s.sweeps() % 16 == 0 || s.is_done() {
             progress.set_message(format!("sweep {}, {} clusters", s.sweeps(), s.clusters()));
             progress.set_position(initial - s.clusters().max(target).min(initial));
         }
-    });
+        if !s.is_done() && stop.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+            progress.finish();
+            save(s)?;
+            return Err(Interrupted(format!(
+                "interrupted after sweep {} ({} clusters); checkpoint in {}: continue with --resume {}",
+                s.sweeps(),
+                s.clusters(),
+                cli.out.display(),
+                cli.out.display()
+            ))
+            .into());
+        }
+    }
     progress.finish();
-    saved.context("writing a checkpoint")?;
     let m = dlca::output::write_outputs(&sim, cli.seed, &clock, &cli.out, cli.png)?;
     if !cli.log.is_quiet() {
         eprintln!(

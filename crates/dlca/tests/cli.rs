@@ -207,4 +207,33 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
     let (a, b) = (run_json(&whole), run_json(&resumed));
     assert_eq!(a["results"]["state_hash"], b["results"]["state_hash"]);
     assert_eq!(a["results"]["sweeps"], b["results"]["sweeps"]);
+
+    // SIGTERM: a checkpoint after the current sweep, exit code 130; resumed in place, the same
+    // end.
+    let term = tmp.path().join("term");
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_dlca"));
+    cmd.args(run)
+        .args(["--checkpoint-every", "50", "--out", term.to_str().unwrap()]);
+    let (running, code) =
+        core_lattice::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+    if running {
+        assert_eq!(code, Some(130));
+    }
+    let o = dlca(
+        &[
+            &run[..],
+            &[
+                "--resume",
+                term.to_str().unwrap(),
+                "--out",
+                term.to_str().unwrap(),
+            ],
+        ]
+        .concat(),
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        run_json(&term)["results"]["state_hash"],
+        a["results"]["state_hash"]
+    );
 }
