@@ -146,12 +146,22 @@ pub fn terminate_once_written(cmd: &mut Command, file: &Path) -> (bool, Option<i
     }
     let running = child.try_wait().expect("wait on the child").is_none();
     if running {
-        let sent = Command::new("kill")
-            .args(["-TERM", &child.id().to_string()])
-            .status()
-            .expect("kill runs");
-        assert!(sent.success(), "kill -TERM failed");
+        send_sigterm(child.id());
     }
     let status = child.wait().expect("wait on the child");
     (running, status.code())
+}
+
+/// Sends SIGTERM to process `pid`.
+pub fn send_sigterm(pid: u32) {
+    #[cfg(unix)]
+    {
+        let pid = nix::unistd::Pid::from_raw(i32::try_from(pid).expect("a process id fits i32"));
+        nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGTERM).expect("SIGTERM is sent");
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = pid;
+        panic!("SIGTERM is a Unix signal");
+    }
 }

@@ -200,11 +200,7 @@ fn a_run_killed_mid_growth_and_resumed_ends_like_the_uninterrupted_run() {
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
     let running = child.try_wait().unwrap().is_none();
-    let st = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(st.success());
+    core_lattice::testing::send_sigterm(child.id());
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     if running {
