@@ -107,22 +107,26 @@ pub fn permissions_are_bypassed() -> bool {
     }
 }
 
-/// Starts `cmd`, waits until `file` exists (a first checkpoint, say), then kills the process
-/// with SIGKILL, as a crash or an out-of-memory kill would. Returns whether the process was
-/// still running when killed (false: it had ended first, so nothing was interrupted).
-pub fn kill_once_written(cmd: &mut Command, file: &Path) -> bool {
+/// Starts `cmd` (output discarded) and waits until `file` exists or the process ends; returns
+/// the child and whether it is still running.
+fn spawn_until_written(cmd: &mut Command, file: &Path) -> (std::process::Child, bool) {
     let mut child = cmd
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .expect("the binary starts");
-    while !file.exists() {
-        if child.try_wait().expect("wait on the child").is_some() {
-            break;
-        }
+    while !file.exists() && child.try_wait().expect("wait on the child").is_none() {
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
     let running = child.try_wait().expect("wait on the child").is_none();
+    (child, running)
+}
+
+/// Starts `cmd`, waits until `file` exists (a first checkpoint, say), then kills the process
+/// with SIGKILL, as a crash or an out-of-memory kill would. Returns whether the process was
+/// still running when killed (false: it had ended first, so nothing was interrupted).
+pub fn kill_once_written(cmd: &mut Command, file: &Path) -> bool {
+    let (mut child, running) = spawn_until_written(cmd, file);
     // `Child::kill` sends SIGKILL on Unix.
     let _ = child.kill();
     let _ = child.wait();
@@ -133,23 +137,31 @@ pub fn kill_once_written(cmd: &mut Command, file: &Path) -> bool {
 /// limit does) and waits for it. Returns whether it was still running when signalled, and its
 /// exit code.
 pub fn terminate_once_written(cmd: &mut Command, file: &Path) -> (bool, Option<i32>) {
-    let mut child = cmd
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("the binary starts");
-    while !file.exists() {
-        if child.try_wait().expect("wait on the child").is_some() {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(2));
-    }
-    let running = child.try_wait().expect("wait on the child").is_none();
+    let (mut child, running) = spawn_until_written(cmd, file);
     if running {
         send_sigterm(child.id());
     }
     let status = child.wait().expect("wait on the child");
     (running, status.code())
+}
+
+/// Next to the good checkpoint `dir/ck/checkpoint.bin`, the broken ones every bad-input table
+/// tries: `trunc/` (its first half), `flip/` (one byte of its middle changed) and `other/` (a
+/// valid checkpoint of the model `foreign`).
+pub fn broken_checkpoints(dir: &Path, foreign: &str) {
+    let good = std::fs::read(dir.join("ck/checkpoint.bin")).expect("the good checkpoint");
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 0x10;
+    for (name, bytes) in [
+        ("trunc", good[..good.len() / 2].to_vec()),
+        ("flip", flipped),
+    ] {
+        std::fs::create_dir(dir.join(name)).expect("a fixture directory");
+        std::fs::write(dir.join(name).join("checkpoint.bin"), bytes).expect("a fixture");
+    }
+    std::fs::create_dir(dir.join("other")).expect("a fixture directory");
+    crate::io::write_checkpoint(dir.join("other/checkpoint.bin"), foreign, &(1u64, 2u64))
+        .expect("a foreign checkpoint");
 }
 
 /// Sends SIGTERM to process `pid`.

@@ -52,19 +52,7 @@ fn fixtures(dir: &Path) {
             "ck3",
         ],
     );
-    let good = std::fs::read(dir.join("ck/checkpoint.bin")).unwrap();
-    for (name, bytes) in [
-        ("trunc", good[..good.len() / 2].to_vec()),
-        ("flip", {
-            let mut b = good.clone();
-            let i = b.len() / 2;
-            b[i] ^= 0x10;
-            b
-        }),
-    ] {
-        std::fs::create_dir(dir.join(name)).unwrap();
-        std::fs::write(dir.join(name).join("checkpoint.bin"), bytes).unwrap();
-    }
+    core_lattice::testing::broken_checkpoints(dir, "animat");
     // A checkpoint without its positions log, and one with another run's log.
     std::fs::create_dir(dir.join("nolog")).unwrap();
     std::fs::copy(
@@ -96,9 +84,6 @@ fn fixtures(dir: &Path) {
         dir.join("badlog/positions.npy"),
     )
     .unwrap();
-    std::fs::create_dir(dir.join("other")).unwrap();
-    core_lattice::io::write_checkpoint(dir.join("other/checkpoint.bin"), "animat", &(1u64, 2u64))
-        .unwrap();
 }
 
 #[test]

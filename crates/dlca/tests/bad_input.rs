@@ -20,22 +20,7 @@ fn fixtures(dir: &Path) {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let good = std::fs::read(dir.join("ck/checkpoint.bin")).unwrap();
-    for (name, bytes) in [
-        ("trunc", good[..good.len() / 2].to_vec()),
-        ("flip", {
-            let mut b = good.clone();
-            let i = b.len() / 2;
-            b[i] ^= 0x01;
-            b
-        }),
-    ] {
-        std::fs::create_dir(dir.join(name)).unwrap();
-        std::fs::write(dir.join(name).join("checkpoint.bin"), bytes).unwrap();
-    }
-    std::fs::create_dir(dir.join("other")).unwrap();
-    core_lattice::io::write_checkpoint(dir.join("other/checkpoint.bin"), "dla", &(1u64, 2u64))
-        .unwrap();
+    core_lattice::testing::broken_checkpoints(dir, "dla");
 }
 
 #[test]
