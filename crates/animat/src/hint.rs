@@ -1,5 +1,6 @@
-//! A cache prefetch hint: the workspace's only `unsafe` code (`unsafe_code` is denied
-//! everywhere else). Stable Rust has no safe non-blocking prefetch: `_mm_prefetch` is a
+//! A cache prefetch hint: one of the workspace's two places of `unsafe` code (the other is
+//! the orthtree's arena in `spatial`; `unsafe_code` is denied everywhere else). Stable Rust has no
+//! safe non-blocking prefetch: `_mm_prefetch` is a
 //! `#[target_feature]` function and `std::hint::prefetch_read` is unstable.
 
 /// Asks the CPU to start loading the cache line holding `r` into every cache level, without

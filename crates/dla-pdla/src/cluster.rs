@@ -19,10 +19,12 @@ use std::sync::Arc;
 
 /// The cluster: its orthtree and, when `params.distance_map` is on, the distance maps.
 ///
-/// A clone shares the maps (PDLA: every thread has its own replica of the tree and all threads
-/// share one set of maps, which each stuck particle lowers once, atomically, through
-/// [`update_maps`](Self::update_maps)); a cluster that is the maps' only owner updates them in
-/// [`insert`](Self::insert) and grows them as needed.
+/// In serial growth [`insert`](Self::insert) stores a particle in the tree and the maps and
+/// grows both as needed. In PDLA all threads share one cluster: between
+/// [`prepare_shared`](Self::prepare_shared) and [`finish_shared`](Self::finish_shared) a
+/// particle enters the tree through [`insert_shared`](Self::insert_shared) and lowers the maps
+/// through [`update_maps`](Self::update_maps), both while other threads query. A clone shares
+/// the maps, which then no longer grow.
 #[derive(Debug, Clone, Default)]
 pub struct Cluster<const D: usize> {
     tree: Orthtree<D>,
@@ -52,7 +54,7 @@ impl<const D: usize> Cluster<D> {
     /// orthtree's fixed-point rounding of `p`, which is what the maps and every observable
     /// see). With shared maps they are updated through [`update_maps`](Self::update_maps).
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], SimError> {
-        let q = self.insert_tree(p)?;
+        let q = self.tree.insert(p)?;
         match Arc::get_mut(&mut self.maps) {
             Some(maps) => {
                 for map in maps {
@@ -64,10 +66,15 @@ impl<const D: usize> Cluster<D> {
         Ok(q)
     }
 
-    /// Stores a particle in the tree only (a PDLA replica applying a particle whose maps
-    /// update is another call's job); returns its stored position.
-    pub fn insert_tree(&mut self, p: [f64; D]) -> Result<[f64; D], SimError> {
-        Ok(self.tree.insert(p)?)
+    /// Reserves the tree's room for a PDLA phase of about `points` particles within `radius`
+    /// of the origin (see [`Orthtree::prepare_shared`]).
+    pub fn prepare_shared(&mut self, points: usize, radius: f64) -> Result<(), SimError> {
+        Ok(self.tree.prepare_shared(points, radius)?)
+    }
+
+    /// Ends a PDLA phase (see [`Orthtree::finish_shared`]).
+    pub fn finish_shared(&mut self) {
+        self.tree.finish_shared();
     }
 
     /// Lowers the (possibly shared) maps for a stored particle `q`, atomically; the maps do not

@@ -118,12 +118,10 @@ where
         halt: &AtomicBool,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<(), SimError> {
-        let round = self.pdla_rounds;
-        self.pdla_rounds += 1;
         pdla::grow_parallel(
             &self.params,
             self.seed,
-            round,
+            &mut self.pdla_rounds,
             until,
             halt,
             &mut self.cluster,
@@ -367,6 +365,12 @@ impl<const D: usize> Simulation<D> {
     /// serialised part of PDLA; 0 for one thread).
     pub fn lock_wait_seconds(&self) -> f64 {
         self.pdla.lock_wait_seconds
+    }
+
+    /// PDLA phases run: one per growth call or checkpoint interval, plus one each time the
+    /// shared tree needed more room than reserved (0 with one thread).
+    pub fn pdla_phases(&self) -> u64 {
+        self.pdla.phases
     }
 
     /// Hash of the stored positions in arrival order (f64 bits): equal runs, equal hashes.

@@ -1,14 +1,12 @@
 //! Parallel DLA (PDLA; Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for
-//! random fractal cluster simulations", section 3.4): `params.threads` walkers at once, each
-//! thread on its own replica of the cluster, stuck particles published through one shared
-//! log, and a re-check at sticking that discards a walker overlapping a particle stored
-//! meanwhile.
+//! random fractal cluster simulations", section 3.4): `params.threads` walkers at once on one
+//! shared tree, stuck particles stored and published under one lock, and a re-check at
+//! sticking that discards a walker overlapping a particle stored meanwhile.
 //!
-//! Invariants: the log holds the stored particles in one total order, and every replica
-//! applies them in that order, so the replicas' trees are identical once they have applied
-//! the same prefix; a particle is stored only if no particle stored before it (in log order)
-//! lies within [`OVERLAP_DISTANCE`]; every stored particle is accounted for once, under the
-//! log's lock; a run that only discards stops with [`SimError::DiscardLivelock`].
+//! Invariants: the log holds the stored particles in one total order, the order in which they
+//! entered the tree; a particle is stored only if no particle stored before it lies within
+//! [`OVERLAP_DISTANCE`]; every stored particle is accounted for once, under the log's lock; a
+//! run that only discards stops with [`SimError::DiscardLivelock`].
 
 use super::growth::Growth;
 use crate::cluster::Cluster;
@@ -19,7 +17,7 @@ use crate::space::{Dim, Space};
 use crate::walker::{WalkState, Walker};
 use core_lattice::rng::{Rng, stream, stream_id};
 use parking_lot::Mutex;
-use spatial::orthtree::dist_sq;
+use spatial::orthtree::{OrthtreeError, dist_sq};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -37,32 +35,54 @@ pub(crate) struct PdlaStats {
     pub(crate) seconds: f64,
     /// Seconds threads waited for the log's mutex, summed over threads.
     pub(crate) lock_wait_seconds: f64,
+    /// Parallel phases run (one per call, more when the tree needed more room).
+    pub(crate) phases: u64,
+}
+
+/// The first phase reserves the tree's root for this many times the expected radius of the
+/// final cluster (later phases for 1.5 times the radius reached).
+const FIRST_RADIUS: f64 = 1.25;
+
+#[cfg(test)]
+thread_local! {
+    /// Overrides [`FIRST_RADIUS`] in unit tests, to make phases run out of room.
+    pub(crate) static FIRST_RADIUS_IN_TESTS: std::cell::Cell<f64> =
+        const { std::cell::Cell::new(FIRST_RADIUS) };
+}
+
+fn first_radius() -> f64 {
+    #[cfg(test)]
+    return FIRST_RADIUS_IN_TESTS.get();
+    #[cfg(not(test))]
+    FIRST_RADIUS
 }
 
 /// Grows `cluster` (holding `growth.n` particles) to `until` (at most `params.particles`, the
 /// run's final size) with `params.threads` walkers at once, adding to `stats`; returns early,
 /// at a quiescent point, once `halt` is set. Every thread stops at a quiescent point: the
-/// particles of the log are applied everywhere and walkers still on their way are dropped
-/// (walkers are independent, so a new one born later is as good), which is where a PDLA
-/// checkpoint is taken. `round` numbers the calls of a run, so that each draws from its own
-/// random streams.
+/// stored particles are all in the tree and walkers still on their way are dropped (walkers
+/// are independent, so a new one born later is as good), which is where a PDLA checkpoint is
+/// taken. `rounds` numbers the parallel phases of a run (each draws from its own random
+/// streams) and is advanced for each.
 ///
-/// Each thread walks on its own replica of the orthtree, so walking takes no lock and touches
-/// no shared cache line but one atomic counter; stuck particles go through a shared log (a
-/// mutex held only to copy the new entries, re-check against them, append and account for one
-/// particle; inserting into the replica happens after the mutex is released). Before every
-/// move a thread applies the particles other threads appended since its last move, so it walks
-/// on the cluster as it was at most one move ago, as in the paper's shared tree. At sticking it
-/// re-checks, under the log's lock, that none of the particles stored since its last move lies
-/// within [`OVERLAP_DISTANCE`] (section 3.4), and against its replica before taking the lock
-/// (a move can end inside a particle stored during it); if one does the walker is discarded
-/// and counted. The replicas receive the same points in the same order, so they are
-/// identical; thread 0's becomes the simulation's tree.
+/// All threads walk on one orthtree (the paper's shared tree), which takes no lock to query:
+/// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared) lets a query run
+/// while a particle is inserted, and a walker's view is at most one insert behind. Stuck
+/// particles go through a shared log under a mutex held to re-check, insert, append and
+/// account for one particle. At sticking a thread re-checks (section 3.4) that no particle
+/// stored since its walker's last look at the tree lies within [`OVERLAP_DISTANCE`]: against
+/// the tree before taking the lock, and under the lock against the particles stored since;
+/// if one does the walker is discarded and counted. Before every move a thread adds the
+/// particles others stored to its walker's near cache.
+///
+/// The tree's room for the phase is reserved up front (address space, not memory); a particle
+/// that needs more, or lands outside the reserved root, ends the phase at a quiescent point and
+/// the next phase reserves again.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn grow_parallel<const D: usize>(
     params: &Params,
     seed: u64,
-    round: u32,
+    rounds: &mut u32,
     until: u64,
     halt: &AtomicBool,
     cluster: &mut Cluster<D>,
@@ -74,87 +94,113 @@ where
     Dim<D>: Space<D>,
 {
     let target = until.min(params.particles);
-    let threads = params.threads;
-    let start = growth.n as usize;
-    // The replicas share one set of distance maps, sized for the final cluster now (they
-    // cannot grow once shared). Before anything is moved out of `growth` and `cluster`, so an
-    // error leaves them as they were.
+    // The threads share one set of distance maps, sized for the final cluster now (they
+    // cannot grow once shared).
     cluster.reserve_maps(
         Dim::<D>::expected_r_ext(params.particles).max(growth.r_ext) + params.birth_gap,
     )?;
+    let mut radius = Dim::<D>::expected_r_ext(params.particles) * first_radius();
+    while growth.n < target && !halt.load(Ordering::Relaxed) {
+        radius = radius.max(growth.r_ext * 1.5) + params.birth_gap;
+        let points = (target - growth.n) as usize;
+        cluster.prepare_shared(points, radius)?;
+        let round = *rounds;
+        *rounds += 1;
+        stats.phases += 1;
+        let phase = phase(
+            params, seed, round, target, halt, cluster, growth, stats, progress,
+        );
+        cluster.finish_shared();
+        match phase? {
+            PhaseEnd::Done => break,
+            PhaseEnd::NeedsRoom => {}
+        }
+    }
+    Ok(())
+}
+
+/// How a parallel phase ended.
+enum PhaseEnd {
+    /// The target was reached, `halt` was set, or the run failed.
+    Done,
+    /// A particle needs more room in the tree than was reserved.
+    NeedsRoom,
+}
+
+/// One parallel phase of [`grow_parallel`] on a tree prepared for shared inserts.
+#[allow(clippy::too_many_arguments)]
+fn phase<const D: usize>(
+    params: &Params,
+    seed: u64,
+    round: u32,
+    target: u64,
+    halt: &AtomicBool,
+    cluster: &Cluster<D>,
+    growth: &mut Growth<D>,
+    stats: &mut PdlaStats,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<PhaseEnd, SimError>
+where
+    Dim<D>: Space<D>,
+{
+    let threads = params.threads;
+    let start = growth.n as usize;
     let log = Mutex::new(Log {
         points: Vec::new(),
         base: start,
         growth: std::mem::replace(growth, Growth::new(params)),
         guard: DiscardGuard::default(),
         error: None,
+        needs_room: false,
     });
-    // Particles stored so far (log positions are absolute: the serial ones come first).
+    // Particles stored so far (log positions are absolute: the earlier ones come first).
     let published = AtomicUsize::new(start);
     let applied: Vec<AtomicUsize> = (0..threads).map(|_| AtomicUsize::new(start)).collect();
+    let epochs: Vec<Announced> = (0..threads).map(|_| Announced::default()).collect();
     let stop = AtomicBool::new(false);
     let r_ext0 = log.lock().growth.r_ext;
-    let mut replicas: Vec<Cluster<D>> = (1..threads).map(|_| cluster.clone()).collect();
-    replicas.insert(0, std::mem::take(cluster));
     let wait_nanos = AtomicU64::new(0);
     let started = Instant::now();
     let ctx = Ctx {
+        cluster,
         log: &log,
         published: &published,
         applied: &applied,
+        epochs: &epochs,
         stop: &stop,
         halt,
         target,
         final_target: params.particles,
         wait_nanos: &wait_nanos,
     };
-    let mut clusters: Vec<Cluster<D>> = std::thread::scope(|s| {
-        let handles: Vec<_> = replicas
-            .into_iter()
-            .enumerate()
-            .map(|(t, cluster)| {
-                s.spawn(move || {
-                    let mut rep = Replica {
-                        cluster,
-                        r_ext: r_ext0,
-                        applied: start,
-                        pending: Vec::new(),
-                        index: t,
-                        walk: WalkState::new(params),
-                    };
-                    // Round 0 draws from the streams of a run without checkpoints.
-                    let index = round.wrapping_mul(1024).wrapping_add(t as u32);
-                    let mut rng = stream(seed, stream_id(PURPOSE_PDLA, index));
-                    ctx.walk(&mut rep, params, &mut rng, progress);
-                    // Whatever was taken from the log is counted as applied.
-                    ctx.insert_pending(&mut rep);
-                    rep.cluster
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("a PDLA thread panicked"))
-            .collect()
+    std::thread::scope(|s| {
+        for t in 0..threads {
+            s.spawn(move || {
+                let mut me = Thread {
+                    r_ext: r_ext0,
+                    applied: start,
+                    pending: Vec::new(),
+                    index: t,
+                    walk: WalkState::new(params),
+                };
+                // Round 0 draws from the streams of a run without checkpoints.
+                let index = round.wrapping_mul(1024).wrapping_add(t as u32);
+                let mut rng = stream(seed, stream_id(PURPOSE_PDLA, index));
+                ctx.walk(&mut me, params, &mut rng, progress);
+                // A finished thread no longer holds anything from the tree.
+                ctx.epochs[t].0.store(u64::MAX, Ordering::Release);
+            });
+        }
     });
     stats.seconds += started.elapsed().as_secs_f64();
     stats.lock_wait_seconds += wait_nanos.into_inner() as f64 * 1e-9;
     let mut log = log.into_inner();
-    let mut first = clusters.swap_remove(0);
-    drop(clusters);
-    // Thread 0 may have stopped before applying the last particles of the others. Their
-    // threads lowered the shared maps already. An error here (the tree out of indices, say)
-    // is reported after the cluster and the growth accounting are back in place.
-    let done = applied[0].load(Ordering::Relaxed);
-    let caught_up = log.points[done - log.base..]
-        .iter()
-        .try_for_each(|q| first.insert_tree(*q).map(drop));
-    *cluster = first;
     stats.discarded += log.guard.total;
     *growth = log.growth;
-    match (log.error.take(), caught_up) {
-        (Some(e), _) | (None, Err(e)) => Err(e),
-        (None, Ok(())) => Ok(()),
+    match log.error.take() {
+        Some(e) => Err(e),
+        None if log.needs_room => Ok(PhaseEnd::NeedsRoom),
+        None => Ok(PhaseEnd::Done),
     }
 }
 
@@ -194,35 +240,45 @@ impl DiscardGuard {
 
 /// The shared side of PDLA: stored particles in order, and everything a stored particle changes.
 struct Log<const D: usize> {
-    /// Stored positions from absolute index `base` on (older ones every thread has applied are
+    /// Stored positions from absolute index `base` on (older ones every thread has seen are
     /// dropped).
     points: Vec<[f64; D]>,
     base: usize,
     growth: Growth<D>,
     guard: DiscardGuard,
     error: Option<SimError>,
+    /// A particle needed more room in the tree than the phase reserved.
+    needs_room: bool,
 }
 
-/// One thread's copy of the cluster.
-struct Replica<const D: usize> {
-    cluster: Cluster<D>,
-    /// Largest centre distance over the applied particles.
+/// One thread's side of PDLA.
+struct Thread<const D: usize> {
+    /// Largest centre distance over the particles seen.
     r_ext: f64,
     /// Particles taken from the log (an absolute log index).
     applied: usize,
-    /// Taken from the log but not yet inserted (filled under the lock, inserted after it).
+    /// Taken from the log but not yet given to the walker (filled under the lock).
     pending: Vec<[f64; D]>,
     index: usize,
     /// The memory of the thread's current walker.
     walk: WalkState<D>,
 }
 
+/// The reclamation epoch a thread announced at its walker's birth (see
+/// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared)), on a cache line of
+/// its own.
+#[derive(Default)]
+#[repr(align(128))]
+struct Announced(AtomicU64);
+
 /// References shared by the PDLA threads.
 #[derive(Clone, Copy)]
 struct Ctx<'a, const D: usize> {
+    cluster: &'a Cluster<D>,
     log: &'a Mutex<Log<D>>,
     published: &'a AtomicUsize,
     applied: &'a [AtomicUsize],
+    epochs: &'a [Announced],
     stop: &'a AtomicBool,
     /// Set from outside (a signal): stop at the next quiescent point.
     halt: &'a AtomicBool,
@@ -234,7 +290,7 @@ struct Ctx<'a, const D: usize> {
     wait_nanos: &'a AtomicU64,
 }
 
-/// Log entries are dropped once every thread has applied them and this many have piled up.
+/// Log entries are dropped once every thread has seen them and this many have piled up.
 const LOG_TRIM: usize = 4096;
 
 impl<const D: usize> Ctx<'_, D>
@@ -254,43 +310,38 @@ where
         g
     }
 
-    /// Copies the log entries `rep` has not seen into `rep.pending` (the caller holds the
-    /// lock; inserting them into the replica happens after it is released).
-    fn take_pending(&self, log: &Log<D>, rep: &mut Replica<D>) {
-        rep.pending
-            .extend_from_slice(&log.points[rep.applied - log.base..]);
-        rep.applied = log.base + log.points.len();
-        self.applied[rep.index].store(rep.applied, Ordering::Relaxed);
+    /// Copies the log entries `me` has not seen into `me.pending` (the caller holds the lock).
+    fn take_pending(&self, log: &Log<D>, me: &mut Thread<D>) {
+        me.pending
+            .extend_from_slice(&log.points[me.applied - log.base..]);
+        me.applied = log.base + log.points.len();
+        self.applied[me.index].store(me.applied, Ordering::Relaxed);
     }
 
-    /// Inserts `rep.pending` into the replica, in log order (no lock held).
-    fn insert_pending(&self, rep: &mut Replica<D>) -> bool {
-        for q in rep.pending.drain(..) {
-            if let Err(e) = rep.cluster.insert_tree(q) {
-                self.fail(&mut self.lock(), e);
-                return false;
-            }
-            rep.walk.particle_added(&q);
-            rep.r_ext = rep.r_ext.max(norm(&q));
+    /// Gives `me.pending` to the walker's near cache (no lock held).
+    fn see_pending(&self, me: &mut Thread<D>) {
+        for q in me.pending.drain(..) {
+            me.walk.particle_added(&q);
+            me.r_ext = me.r_ext.max(norm(&q));
         }
-        true
     }
 
-    /// Brings `rep` up to date if another thread stored particles; `false` to stop.
+    /// Brings `me` up to date if another thread stored particles; `false` to stop.
     #[inline]
-    fn sync(&self, rep: &mut Replica<D>) -> bool {
+    fn sync(&self, me: &mut Thread<D>) -> bool {
         if self.stop.load(Ordering::Relaxed) || self.halt.load(Ordering::Relaxed) {
             return false;
         }
-        if self.published.load(Ordering::Acquire) == rep.applied {
+        if self.published.load(Ordering::Acquire) == me.applied {
             return true;
         }
         let done = {
             let log = self.lock();
-            self.take_pending(&log, rep);
+            self.take_pending(&log, me);
             log.growth.n >= self.target
         };
-        self.insert_pending(rep) && !done
+        self.see_pending(me);
+        !done
     }
 
     fn fail(&self, log: &mut Log<D>, e: SimError) {
@@ -298,40 +349,49 @@ where
         self.stop.store(true, Ordering::Relaxed);
     }
 
+    /// The smallest epoch the threads announced (see [`Announced`]).
+    fn readers_epoch(&self) -> u64 {
+        self.epochs
+            .iter()
+            .map(|e| e.0.load(Ordering::Acquire))
+            .min()
+            .unwrap_or(u64::MAX)
+    }
+
     /// One thread's walkers until the cluster is complete or the run fails.
     fn walk<R: Rng + ?Sized>(
         &self,
-        rep: &mut Replica<D>,
+        me: &mut Thread<D>,
         params: &Params,
         rng: &mut R,
         progress: &(dyn Fn(u64) + Sync),
     ) {
+        let tree = self.cluster.tree();
         loop {
-            if !self.sync(rep) {
+            if !self.sync(me) {
                 return;
             }
-            let mut w = Walker::born(rep.r_ext + params.birth_gap, rng);
-            rep.walk.reset();
+            // The walker holds nothing from the tree yet: announce the epoch.
+            self.epochs[me.index]
+                .0
+                .store(tree.epoch(), Ordering::Release);
+            let mut w = Walker::born(me.r_ext + params.birth_gap, rng);
+            me.walk.reset();
             let stick = loop {
-                if let Some(p) = w.advance(&mut rep.walk, &rep.cluster, rep.r_ext, params, rng) {
+                if let Some(p) = w.advance(&mut me.walk, self.cluster, me.r_ext, params, rng) {
                     break p;
                 }
-                if !self.sync(rep) {
+                if !self.sync(me) {
                     return;
                 }
             };
-            let q = match rep.cluster.tree().stored_position(&stick) {
-                Ok(q) => q,
-                Err(e) => return self.fail(&mut self.lock(), e.into()),
-            };
-            // A jump or step made on the replica can end inside a particle another thread
-            // stored meanwhile; once that particle is applied the next move sticks at once,
-            // overlapping it. So the sticking point is checked against the replica (private,
-            // no lock needed) and, under the lock, against the particles stored since.
+            // Particles published before this load are in the tree the pre-check reads; the
+            // ones after it are checked under the lock.
+            let seen = self.published.load(Ordering::Acquire);
+            // A jump or step can end inside a particle another thread stored during it; once
+            // that particle is seen the next move would stick at once, overlapping it.
             let mut overlap = false;
-            rep.cluster
-                .tree()
-                .for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
+            tree.for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
             let mut guard = self.lock();
             if guard.growth.n >= self.target
                 || self.stop.load(Ordering::Relaxed)
@@ -339,28 +399,33 @@ where
             {
                 return;
             }
-            self.take_pending(&guard, rep);
-            // Re-check under the lock (section 3.4) against the particles other
-            // threads stored since the walker's last move (now in `pending`, a handful at most).
+            // Re-check under the lock (section 3.4) against the particles other threads
+            // stored since the pre-check (a handful at most).
             let r_sq = OVERLAP_DISTANCE * OVERLAP_DISTANCE;
-            overlap |= rep.pending.iter().any(|x| dist_sq(&stick, x) <= r_sq);
+            overlap |= guard.points[seen - guard.base..]
+                .iter()
+                .any(|x| dist_sq(&stick, x) <= r_sq);
             if let Err(e) = guard.guard.record(overlap) {
                 return self.fail(&mut guard, e);
             }
             if overlap {
-                drop(guard);
-                if !self.insert_pending(rep) {
-                    return;
-                }
                 continue;
             }
+            let q = match tree.insert_shared(stick, self.readers_epoch()) {
+                Ok(q) => q,
+                Err(OrthtreeError::NeedsExclusive) => {
+                    // The walker is dropped; the next phase reserves more room.
+                    guard.needs_room = true;
+                    self.stop.store(true, Ordering::Relaxed);
+                    return;
+                }
+                Err(e) => return self.fail(&mut guard, e.into()),
+            };
             let log = &mut *guard;
             log.growth.account(q, self.final_target);
             log.points.push(q);
-            rep.pending.push(q);
-            rep.applied += 1;
-            self.applied[rep.index].store(rep.applied, Ordering::Relaxed);
-            self.published.store(rep.applied, Ordering::Release);
+            self.published
+                .store(log.base + log.points.len(), Ordering::Release);
             if log.growth.n % 1024 == 0 {
                 progress(log.growth.n);
             }
@@ -380,12 +445,9 @@ where
             drop(guard);
             // The stuck particle lowers the shared distance maps once, atomically; until it
             // has, another thread's walker may jump by a stale bound, which the re-check at
-            // its sticking catches like any move made before a particle was applied.
-            if let Err(e) = rep.cluster.update_maps(&q) {
+            // its sticking catches like any move made before a particle was stored.
+            if let Err(e) = self.cluster.update_maps(&q) {
                 return self.fail(&mut self.lock(), e);
-            }
-            if !self.insert_pending(rep) {
-                return;
             }
         }
     }

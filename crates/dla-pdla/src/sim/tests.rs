@@ -50,3 +50,36 @@ fn near_cache_is_used_only_where_the_tree_is_exact() {
     assert_eq!(cached_moves::<2>(0.8), 0);
     assert_eq!(cached_moves::<3>(0.8), 0);
 }
+
+/// A PDLA phase whose shared tree runs out of room (here a root reserved far too small) ends at
+/// a quiescent point and the next phase reserves more: the run completes with several phases
+/// and a valid cluster (every particle touching an earlier one, none overlapping).
+#[test]
+fn pdla_phases_that_run_out_of_room_continue_in_the_next() {
+    pdla::FIRST_RADIUS_IN_TESTS.set(0.0);
+    let params = Params {
+        particles: 3000,
+        threads: 2,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let mut sim = Simulation::<2>::new(params, 5).unwrap();
+    sim.run().unwrap();
+    pdla::FIRST_RADIUS_IN_TESTS.set(1.25);
+    assert!(sim.pdla_phases() >= 3, "{} phases", sim.pdla_phases());
+    let pos = sim.positions().unwrap();
+    assert_eq!(pos.len(), 3000);
+    assert_eq!(sim.tree().len(), 3000);
+    for (i, p) in pos.iter().enumerate() {
+        let mut close = 0;
+        sim.tree()
+            .for_each_within(p, OVERLAP_DISTANCE, |_| close += 1);
+        assert_eq!(close, 1, "particle {i} overlaps another");
+        if i > 0 {
+            let touches = pos[..i]
+                .iter()
+                .any(|q| spatial::orthtree::dist_sq(p, q).sqrt() <= 1.0 + 1e-6);
+            assert!(touches, "particle {i} touches no earlier particle");
+        }
+    }
+}

@@ -6,8 +6,13 @@
 //! grows, so a point's stored position does not depend on insertion order; every node lies on
 //! the path to at least one stored point.
 
-use super::pool::{self, LeafPool};
-use super::{CODE_SCALE, COORD_LIMIT_LEAVES, EMPTY, Leaf, Orthtree, OrthtreeError, decode};
+use super::arena::slow_growth;
+use super::pool::LeafPool;
+use super::{
+    CODE_SCALE, COORD_LIMIT_LEAVES, EMPTY, EPOCH_INSERTS, Leaf, Orthtree, OrthtreeError, Writer,
+    decode,
+};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 impl<const D: usize> Orthtree<D> {
     /// Leaf cell of `p` in leaf sides and the fixed-point offsets inside it, after checking the
@@ -58,29 +63,72 @@ impl<const D: usize> Orthtree<D> {
         let mut node = self.root;
         let mut level = self.root_level;
         loop {
-            let child = self.children[node as usize * Self::FANOUT + self.child_index(k, level)];
+            let child = self.child(node as usize * Self::FANOUT + self.child_index(k, level));
             if child == EMPTY {
                 return 0;
             }
             if level == 1 {
-                return self.leaves[child as usize].len;
+                return self.leaf(child).len;
             }
             node = child;
             level -= 1;
         }
     }
 
-    /// Appends an internal node with no children.
-    fn new_node(&mut self) -> u32 {
-        let n = self.node_count() as u32;
-        pool::reserve_slowly(&mut self.children, Self::FANOUT);
-        self.children
-            .resize(self.children.len() + Self::FANOUT, EMPTY);
-        n
+    /// The index-limit checks of an insert into the leaf of length `leaf_len`, before any
+    /// change. 128 nodes: the most one insert can add (root growth and a path down to a leaf).
+    fn check_limits(&self, w: &Writer, leaf_len: u32) -> Result<(), OrthtreeError> {
+        if w.nodes as u64 + 128 > self.index_limit {
+            return Err(OrthtreeError::CapacityExceeded("nodes"));
+        }
+        if w.leaves as u64 + 1 > self.index_limit {
+            return Err(OrthtreeError::CapacityExceeded("leaves"));
+        }
+        if leaf_len == u32::MAX
+            || w.pool.len as u64 + LeafPool::push_needs(leaf_len) > self.index_limit
+        {
+            return Err(OrthtreeError::CapacityExceeded("point slots"));
+        }
+        Ok(())
+    }
+
+    /// Whether the arenas hold what an insert into the leaf of length `leaf_len` may append:
+    /// a path of `root_level` nodes, one leaf, and a new block.
+    fn has_room(&self, w: &Writer, leaf_len: u32) -> bool {
+        (w.nodes + self.root_level as usize) * Self::FANOUT <= self.children.capacity()
+            && w.leaves < self.leaves.capacity()
+            && w.pool.len + LeafPool::push_needs(leaf_len) as usize <= self.slots.capacity()
+    }
+
+    /// Initialises internal node `w.nodes` with empty child slots (not yet linked).
+    fn new_node(&self, w: &mut Writer) -> u32 {
+        let n = w.nodes;
+        for i in 0..Self::FANOUT {
+            self.children
+                .init(n * Self::FANOUT + i, AtomicU32::new(EMPTY));
+        }
+        w.nodes += 1;
+        n as u32
+    }
+
+    /// Grows the arenas (exclusive access) so that the next insert fits.
+    fn reserve_for_insert(&mut self, leaf_len: u32) {
+        let fanout = Self::FANOUT;
+        let depth = self.root_level as usize + 64;
+        let w = Self::writer_mut(&mut self.shared);
+        let nodes = w.nodes * fanout;
+        self.children.set_capacity(
+            nodes,
+            slow_growth(self.children.capacity(), nodes + depth * fanout),
+        );
+        self.leaves
+            .set_capacity(w.leaves, slow_growth(self.leaves.capacity(), w.leaves + 1));
+        w.pool.reserve(&mut self.slots, leaf_len);
     }
 
     /// Doubles the root towards leaf cell `k` (the variable-precision paper builds its tree over a
     /// fixed domain; here the domain grows, the old root becoming a child of the new one).
+    /// Exclusive access, with room for one node reserved.
     fn grow_root(&mut self, k: &[i64; D]) {
         let side = 1i64 << self.root_level;
         let mut origin = self.root_origin;
@@ -99,11 +147,90 @@ impl<const D: usize> Orthtree<D> {
                 slot |= 1 << i;
             }
         }
-        let n = self.new_node();
-        self.children[n as usize * Self::FANOUT + slot] = self.root;
+        let mut w = self.writer();
+        let n = self.new_node(&mut w);
+        drop(w);
+        self.children
+            .get(n as usize * Self::FANOUT + slot)
+            .store(self.root, Ordering::Relaxed);
         self.root = n;
         self.root_level += 1;
         self.root_origin = origin;
+    }
+
+    /// Makes the root contain leaf cell `k` (exclusive access): creates it for the first point
+    /// `p`, or doubles it towards `k`.
+    fn cover(&mut self, p: &[f64; D], k: &[i64; D]) {
+        if self.root == EMPTY {
+            // Root of 2 x 2 leaf cells centred on the leaf-cell corner nearest to p.
+            for i in 0..D {
+                let frac = p[i] / self.leaf_side - k[i] as f64;
+                self.root_origin[i] = if frac < 0.5 { k[i] - 1 } else { k[i] };
+                self.anchor[i] = self.root_origin[i] + 1;
+            }
+            self.root_level = 1;
+            self.reserve_for_insert(0);
+            let mut w = self.writer();
+            let n = self.new_node(&mut w);
+            drop(w);
+            self.root = n;
+        }
+        while !self.root_contains(k) {
+            self.reserve_for_insert(0);
+            self.grow_root(k);
+        }
+    }
+
+    /// Stores the record `code` in leaf cell `k` (inside the root; limits and room checked):
+    /// appends it to the existing leaf, or builds the missing nodes and the leaf below the
+    /// first empty slot of the path and links them with one `Release` store, so a concurrent
+    /// reader sees either the tree before the insert or after it, and every node it reaches
+    /// holds a point. Old blocks are retired at epoch `retire` if given (readers may scan
+    /// them), else freed.
+    fn place(&self, w: &mut Writer, k: &[i64; D], code: [u32; D], retire: Option<u64>) {
+        let mut node = self.root;
+        let mut level = self.root_level;
+        loop {
+            let slot = node as usize * Self::FANOUT + self.child_index(k, level);
+            let child = self.children.get(slot).load(Ordering::Relaxed);
+            if child == EMPTY {
+                // Build the missing part of the path bottom-up, then link it.
+                let rec = w
+                    .pool
+                    .push(&self.slots, Leaf { start: 0, len: 0 }, code, retire);
+                let l = w.leaves;
+                self.leaves.init(l, AtomicU64::new(rec.pack()));
+                w.leaves += 1;
+                let mut below = l as u32;
+                for lv in 1..level {
+                    let n = self.new_node(w);
+                    self.children
+                        .get(n as usize * Self::FANOUT + self.child_index(k, lv))
+                        .store(below, Ordering::Relaxed);
+                    below = n;
+                }
+                self.children.get(slot).store(below, Ordering::Release);
+                return;
+            }
+            if level == 1 {
+                let record = self.leaves.get(child as usize);
+                let leaf = Leaf::unpack(record.load(Ordering::Relaxed));
+                let rec = w.pool.push(&self.slots, leaf, code, retire);
+                record.store(rec.pack(), Ordering::Release);
+                return;
+            }
+            node = child;
+            level -= 1;
+        }
+    }
+
+    /// The stored position of cell `k` and offsets `code`.
+    fn decoded(&self, k: &[i64; D], code: &[u32; D]) -> [f64; D] {
+        let mut stored = [0.0; D];
+        for i in 0..D {
+            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
+        }
+        stored
     }
 
     /// Inserts a particle centre (the variable-precision paper, section 3.3: the particle is stored
@@ -115,72 +242,124 @@ impl<const D: usize> Orthtree<D> {
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(&p)?;
         // Capacity checks before any change, so that an error leaves the tree as it was.
-        // 128 nodes: the most one insert can add (root growth and a path down to a leaf).
-        if self.node_count() as u64 + 128 > self.index_limit {
-            return Err(OrthtreeError::CapacityExceeded("nodes"));
-        }
-        if self.leaves.len() as u64 + 1 > self.index_limit {
-            return Err(OrthtreeError::CapacityExceeded("leaves"));
-        }
         let leaf_len = self.existing_leaf_len(&k);
-        if leaf_len == u32::MAX
-            || self.pool.slots.len() as u64 + LeafPool::<D>::push_needs(leaf_len) > self.index_limit
+        self.check_limits(&self.writer(), leaf_len)?;
+        self.cover(&p, &k);
+        self.reserve_for_insert(leaf_len);
         {
-            return Err(OrthtreeError::CapacityExceeded("point slots"));
+            let mut w = self.writer();
+            self.place(&mut w, &k, code, None);
         }
+        *self.shared.len.get_mut() += 1;
+        let w = Self::writer_mut(&mut self.shared);
+        if w.pool.wants_compaction() {
+            let leaves = self.leaves.prefix_mut(w.leaves);
+            w.pool.compact(&mut self.slots, leaves);
+        }
+        Ok(self.decoded(&k, &code))
+    }
 
+    /// Inserts `p` like [`insert`](Self::insert) while other threads query the tree (PDLA's
+    /// shared tree, the variable-precision paper, section 3.4). Inserts are serialised by the
+    /// tree's writer lock; a query running meanwhile sees the tree before or after the insert.
+    ///
+    /// Needs the root to contain `p` and the room reserved by
+    /// [`prepare_shared`](Self::prepare_shared); otherwise it fails with
+    /// [`OrthtreeError::NeedsExclusive`] and changes nothing (insert the point with
+    /// [`insert`](Self::insert) once the readers are gone).
+    ///
+    /// **Reclamation.** A leaf that outgrows its block moves to a larger one; the old block may
+    /// still be scanned by a reader, so it is retired, not reused. Every reader announces the
+    /// [`epoch`](Self::epoch) it read at a point where it holds nothing from the tree (a
+    /// walker's birth, say); `readers_epoch` is the smallest such announcement over the
+    /// readers (`u64::MAX` when none is reading), and blocks retired before it are reused.
+    pub fn insert_shared(
+        &self,
+        p: [f64; D],
+        readers_epoch: u64,
+    ) -> Result<[f64; D], OrthtreeError> {
+        let (k, code) = self.locate(&p)?;
+        if self.root == EMPTY || !self.root_contains(&k) {
+            return Err(OrthtreeError::NeedsExclusive);
+        }
+        let mut w = self.writer();
+        let leaf_len = self.existing_leaf_len(&k);
+        self.check_limits(&w, leaf_len)?;
+        if !self.has_room(&w, leaf_len) {
+            return Err(OrthtreeError::NeedsExclusive);
+        }
+        w.pool.reclaim(&self.slots, readers_epoch);
+        let epoch = self.shared.epoch.load(Ordering::Relaxed);
+        self.place(&mut w, &k, code, Some(epoch));
+        self.shared.len.fetch_add(1, Ordering::Relaxed);
+        w.since_epoch += 1;
+        if w.since_epoch >= EPOCH_INSERTS {
+            w.since_epoch = 0;
+            // Release: a reader that reads the new value sees every record stored before it.
+            self.shared.epoch.fetch_add(1, Ordering::AcqRel);
+        }
+        Ok(self.decoded(&k, &code))
+    }
+
+    /// The reclamation epoch a reader announces (see [`insert_shared`](Self::insert_shared)).
+    pub fn epoch(&self) -> u64 {
+        self.shared.epoch.load(Ordering::Acquire)
+    }
+
+    /// Prepares for [`insert_shared`](Self::insert_shared) of up to about `points` more points
+    /// within `radius` of the origin: grows the root to cover the cube of half side `radius`
+    /// and reserves room for the points at the tree's current nodes, leaves and slots per point
+    /// (plus a quarter and a floor for small trees). Reserved room that is never used costs
+    /// address space only: the pages are touched when used. Needs a non-empty tree.
+    pub fn prepare_shared(&mut self, points: usize, radius: f64) -> Result<(), OrthtreeError> {
         if self.root == EMPTY {
-            // Root of 2 x 2 leaf cells centred on the leaf-cell corner nearest to p.
-            for i in 0..D {
-                let frac = p[i] / self.leaf_side - k[i] as f64;
-                self.root_origin[i] = if frac < 0.5 { k[i] - 1 } else { k[i] };
-                self.anchor[i] = self.root_origin[i] + 1;
-            }
-            self.root_level = 1;
-            self.root = self.new_node();
+            return Err(OrthtreeError::NeedsExclusive);
         }
-        while !self.root_contains(&k) {
-            self.grow_root(&k);
+        for corner in [-radius, radius] {
+            let (k, _) = self.locate(&[corner; D])?;
+            self.cover(&[corner; D], &k);
         }
-
-        let mut node = self.root;
-        let mut level = self.root_level;
-        let leaf = loop {
-            let slot = node as usize * Self::FANOUT + self.child_index(&k, level);
-            let child = self.children[slot];
-            if level == 1 {
-                break if child == EMPTY {
-                    let l = self.leaves.len() as u32;
-                    pool::reserve_slowly(&mut self.leaves, 1);
-                    self.leaves.push(Leaf { start: 0, len: 0 });
-                    self.children[slot] = l;
-                    l
-                } else {
-                    child
-                };
-            }
-            node = if child == EMPTY {
-                let n = self.new_node();
-                self.children[slot] = n;
-                n
-            } else {
-                child
-            };
-            level -= 1;
+        let n = self.len().max(1);
+        let fanout = Self::FANOUT;
+        let levels = self.root_level as usize;
+        let w = Self::writer_mut(&mut self.shared);
+        // Per point now, at least what a small tree of one leaf per point would need.
+        let small = n < 4096;
+        let per = |used: usize, floor: f64| {
+            let ratio = used as f64 / n as f64;
+            let ratio = if small { ratio.max(floor) } else { ratio };
+            used + (ratio * points as f64 * 1.25) as usize + 4096
         };
+        let nodes = per(w.nodes, 1.0) + levels;
+        self.children.set_capacity(
+            w.nodes * fanout,
+            self.children.capacity().max(nodes * fanout),
+        );
+        let leaves = per(w.leaves, 1.0);
+        self.leaves
+            .set_capacity(w.leaves, self.leaves.capacity().max(leaves));
+        let slots = per(w.pool.len, 2.0);
+        self.slots
+            .set_capacity(w.pool.len, self.slots.capacity().max(slots));
+        w.pool.reclaim(&self.slots, u64::MAX);
+        Ok(())
+    }
 
-        let mut stored = [0.0; D];
-        for i in 0..D {
-            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
-        }
-        let mut rec = self.leaves[leaf as usize];
-        self.pool.push(&mut rec, code);
-        self.leaves[leaf as usize] = rec;
-        self.len += 1;
-        if self.pool.wants_compaction() {
-            self.pool.compact(&mut self.leaves);
-        }
-        Ok(stored)
+    /// Ends shared inserting (exclusive access): reuses every retired block and returns the
+    /// unused part of the reserved room, keeping the usual slack of about 1/8.
+    pub fn finish_shared(&mut self) {
+        let fanout = Self::FANOUT;
+        let w = Self::writer_mut(&mut self.shared);
+        w.pool.reclaim(&self.slots, u64::MAX);
+        let keep = |len: usize| len + (len / 8).max(64);
+        self.children.set_capacity(
+            w.nodes * fanout,
+            keep(w.nodes * fanout).min(self.children.capacity()),
+        );
+        self.leaves
+            .set_capacity(w.leaves, keep(w.leaves).min(self.leaves.capacity()));
+        self.slots
+            .set_capacity(w.pool.len, keep(w.pool.len).min(self.slots.capacity()));
     }
 
     /// The position [`insert`](Self::insert) would store for `p` (its fixed-point rounding),
@@ -188,10 +367,6 @@ impl<const D: usize> Orthtree<D> {
     /// paper, section 3.4). Fails as `insert` would on a non-finite or out-of-range coordinate.
     pub fn stored_position(&self, p: &[f64; D]) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(p)?;
-        let mut stored = [0.0; D];
-        for i in 0..D {
-            stored[i] = decode(k[i] as f64 * self.leaf_side, code[i], self.step);
-        }
-        Ok(stored)
+        Ok(self.decoded(&k, &code))
     }
 }

@@ -25,7 +25,7 @@ impl<const D: usize> Orthtree<D> {
             leaf: &[],
             leaf_origin: [0.0; D],
             pos: 0,
-            remaining: self.len,
+            remaining: self.len(),
         }
     }
 }
@@ -72,7 +72,7 @@ impl<const D: usize> Iterator for Points<'_, D> {
             }
             let ci = top.next;
             top.next += 1;
-            let child = tree.children[top.node as usize * Orthtree::<D>::FANOUT + ci];
+            let child = tree.child(top.node as usize * Orthtree::<D>::FANOUT + ci);
             if child == EMPTY {
                 continue;
             }
@@ -84,7 +84,7 @@ impl<const D: usize> Iterator for Points<'_, D> {
                 }
             }
             if top.level == 1 {
-                self.leaf = tree.pool.points(tree.leaves[child as usize]);
+                self.leaf = tree.leaf_points(child);
                 self.leaf_origin = origin.map(|o| o as f64 * tree.leaf_side);
                 self.pos = 0;
             } else {

@@ -133,6 +133,7 @@
 //! # Ok::<(), spatial::orthtree::OrthtreeError>(())
 //! ```
 
+mod arena;
 mod insert;
 mod iter;
 mod pool;
@@ -140,10 +141,13 @@ mod query;
 #[cfg(test)]
 mod tests;
 
+use arena::Arena;
+use pool::LeafPool;
 use std::fmt;
+use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard};
 
 pub use iter::Points;
-use pool::LeafPool;
 pub use query::{Neighbour, VpEstimate, dist_sq};
 
 /// The orthtree's default leaf side `s`, in particle diameters: the side of the leaf cells
@@ -220,6 +224,12 @@ pub enum OrthtreeError {
     /// [`Orthtree::set_index_limit`]) cannot number another node, leaf or point slot.
     #[error("orthtree capacity exceeded: no index left for more {0}")]
     CapacityExceeded(&'static str),
+    /// A shared insert ([`Orthtree::insert_shared`]) needs the root grown or more capacity
+    /// than [`Orthtree::prepare_shared`] reserved: both need exclusive access.
+    #[error(
+        "the point needs the orthtree's root or capacity grown, which a shared insert cannot do; insert it with exclusive access"
+    )]
+    NeedsExclusive,
 }
 
 /// A leaf's block in the point pool.
@@ -231,13 +241,58 @@ struct Leaf {
     len: u32,
 }
 
+impl Leaf {
+    /// The record as one word (stored in an `AtomicU64`, so a reader sees a block and its
+    /// length from the same update).
+    #[inline(always)]
+    fn pack(self) -> u64 {
+        u64::from(self.start) | u64::from(self.len) << 32
+    }
+
+    #[inline(always)]
+    fn unpack(word: u64) -> Self {
+        Leaf {
+            start: word as u32,
+            len: (word >> 32) as u32,
+        }
+    }
+}
+
+/// What only the tree's writer changes: the element counts of the arenas and the pool's
+/// allocator. Behind a mutex, so that a shared insert has the same exclusive view as an
+/// `&mut` one.
+#[derive(Debug, Clone)]
+struct Writer {
+    /// Internal nodes in use.
+    nodes: usize,
+    /// Leaf records in use.
+    leaves: usize,
+    /// The point pool's allocator.
+    pool: LeafPool,
+    /// Shared inserts since the epoch was last advanced.
+    since_epoch: u32,
+}
+
+/// State the writer changes and readers may look at, in its own allocation so that updating
+/// it never touches a cache line the queries read.
+#[derive(Debug)]
+struct Shared {
+    writer: Mutex<Writer>,
+    /// Number of stored points.
+    len: AtomicUsize,
+    /// Reclamation epoch of shared inserts (see [`Orthtree::insert_shared`]).
+    epoch: AtomicU64,
+}
+
+/// Shared inserts between two advances of the reclamation epoch.
+const EPOCH_INSERTS: u32 = 64;
+
 /// Quadtree (`D = 2`), octree (`D = 3`) or `2^D`-ary tree of points with exact nearest-distance
 /// and variable-precision distance queries (the variable-precision paper, sections 3.1 and 3.3,
 /// Listing 1).
 ///
 /// See the [module documentation](self) for the layout, the complexity and the error bound of
 /// [`vpdist`](Self::vpdist). `D` must be in `1..=8`.
-#[derive(Clone)]
 pub struct Orthtree<const D: usize> {
     /// Leaf side `s` (a power of two).
     leaf_side: f64,
@@ -253,14 +308,14 @@ pub struct Orthtree<const D: usize> {
     root_origin: [i64; D],
     /// Centre of the first root, in leaf sides: growth keeps the root centred on it.
     anchor: [i64; D],
-    /// `2^D` child slots per internal node.
-    children: Vec<u32>,
-    /// Leaf records.
-    leaves: Vec<Leaf>,
-    /// Point records of all leaves.
-    pool: LeafPool<D>,
-    /// Number of stored points.
-    len: usize,
+    /// `2^D` child slots per internal node (a node, a leaf, or `EMPTY`).
+    children: Arena<AtomicU32>,
+    /// Leaf records ([`Leaf::pack`]).
+    leaves: Arena<AtomicU64>,
+    /// Point records of all leaves (blocks carved by the writer's [`LeafPool`]).
+    slots: Arena<[u32; D]>,
+    /// Counts, allocator and epoch.
+    shared: Box<Shared>,
     /// Largest number of nodes, leaves or point slots ([`MAX_INDEX`] unless lowered by
     /// [`Orthtree::set_index_limit`]).
     index_limit: u64,
@@ -297,12 +352,38 @@ impl<const D: usize> fmt::Debug for Orthtree<D> {
         f.debug_struct("Orthtree")
             .field("dim", &D)
             .field("leaf_side", &self.leaf_side)
-            .field("len", &self.len)
+            .field("len", &self.len())
             .field("root_level", &self.root_level)
             .field("root_origin", &self.root_origin)
             .field("nodes", &self.node_count())
-            .field("leaves", &self.leaves.len())
+            .field("leaves", &self.leaf_count())
             .finish()
+    }
+}
+
+impl<const D: usize> Clone for Orthtree<D> {
+    fn clone(&self) -> Self {
+        let w = self.writer().clone();
+        Self {
+            leaf_side: self.leaf_side,
+            step: self.step,
+            sqrt_d_up: self.sqrt_d_up,
+            root: self.root,
+            root_level: self.root_level,
+            root_origin: self.root_origin,
+            anchor: self.anchor,
+            children: self
+                .children
+                .duplicate(w.nodes * Self::FANOUT, self.children.capacity()),
+            leaves: self.leaves.duplicate(w.leaves, self.leaves.capacity()),
+            slots: self.slots.duplicate(w.pool.len, self.slots.capacity()),
+            shared: Box::new(Shared {
+                writer: Mutex::new(w),
+                len: AtomicUsize::new(self.len()),
+                epoch: AtomicU64::new(self.shared.epoch.load(Ordering::Acquire)),
+            }),
+            index_limit: self.index_limit,
+        }
     }
 }
 
@@ -338,10 +419,19 @@ impl<const D: usize> Orthtree<D> {
             root_level: 1,
             root_origin: [0; D],
             anchor: [0; D],
-            children: Vec::new(),
-            leaves: Vec::new(),
-            pool: LeafPool::new(),
-            len: 0,
+            children: Arena::new(),
+            leaves: Arena::new(),
+            slots: Arena::new(),
+            shared: Box::new(Shared {
+                writer: Mutex::new(Writer {
+                    nodes: 0,
+                    leaves: 0,
+                    pool: LeafPool::new(),
+                    since_epoch: 0,
+                }),
+                len: AtomicUsize::new(0),
+                epoch: AtomicU64::new(1),
+            }),
             index_limit: MAX_INDEX,
         }
     }
@@ -359,12 +449,47 @@ impl<const D: usize> Orthtree<D> {
 
     /// Number of stored points.
     pub fn len(&self) -> usize {
-        self.len
+        self.shared.len.load(Ordering::Relaxed)
     }
 
     /// Whether no point is stored.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.len() == 0
+    }
+
+    /// The writer's state (locked: held only for an insert or to read counts).
+    fn writer(&self) -> MutexGuard<'_, Writer> {
+        self.shared
+            .writer
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// The writer's state with exclusive access to the tree (no lock taken).
+    fn writer_mut(shared: &mut Shared) -> &mut Writer {
+        shared
+            .writer
+            .get_mut()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    /// Child slot `i` (a reader's view: `Acquire`, so a node, leaf or point reached through
+    /// it is initialised).
+    #[inline(always)]
+    fn child(&self, i: usize) -> u32 {
+        self.children.get(i).load(Ordering::Acquire)
+    }
+
+    /// Leaf record `i` (`Acquire`, so the points of its block are written).
+    #[inline(always)]
+    fn leaf(&self, i: u32) -> Leaf {
+        Leaf::unpack(self.leaves.get(i as usize).load(Ordering::Acquire))
+    }
+
+    /// The stored point records of leaf `i`.
+    #[inline(always)]
+    fn leaf_points(&self, i: u32) -> &[[u32; D]] {
+        LeafPool::points(&self.slots, self.leaf(i))
     }
 
     /// Side of the leaf cells (the variable-precision paper, section 3.1: the last level of the
@@ -384,12 +509,12 @@ impl<const D: usize> Orthtree<D> {
 
     /// Number of internal nodes.
     pub fn node_count(&self) -> usize {
-        self.children.len() / Self::FANOUT
+        self.writer().nodes
     }
 
     /// Number of leaves (non-empty leaf cells).
     pub fn leaf_count(&self) -> usize {
-        self.leaves.len()
+        self.writer().leaves
     }
 
     /// Lowers the number of nodes, leaves and point slots the tree may use to `limit` (capped at
@@ -405,24 +530,26 @@ impl<const D: usize> Orthtree<D> {
     /// paper, section 3.3 reports memory per particle).
     pub fn memory_bytes(&self) -> usize {
         size_of::<Self>()
+            + size_of::<Shared>()
             + self.children.capacity() * size_of::<u32>()
-            + self.leaves.capacity() * size_of::<Leaf>()
-            + self.pool.slots.capacity() * size_of::<[u32; D]>()
+            + self.leaves.capacity() * size_of::<u64>()
+            + self.slots.capacity() * size_of::<[u32; D]>()
     }
 
     /// Shape and memory counts.
     pub fn stats(&self) -> OrthtreeStats {
+        let w = self.writer();
         OrthtreeStats {
-            points: self.len,
-            nodes: self.node_count(),
-            leaves: self.leaves.len(),
+            points: self.len(),
+            nodes: w.nodes,
+            leaves: w.leaves,
             depth: if self.root == EMPTY {
                 0
             } else {
                 self.root_level
             },
-            point_slots: self.pool.slots.len(),
-            free_slots: self.pool.free_slots(),
+            point_slots: w.pool.len,
+            free_slots: w.pool.free_slots(),
             memory_bytes: self.memory_bytes(),
         }
     }

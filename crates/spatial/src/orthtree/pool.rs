@@ -11,6 +11,9 @@
 //! free lists cost no memory either.
 
 use super::Leaf;
+use super::arena::{Arena, slow_growth};
+use std::collections::VecDeque;
+use std::sync::atomic::AtomicU64;
 
 /// Leaf sizes up to this many points get a block of exactly their size.
 const EXACT_CLASSES: u32 = 16;
@@ -39,42 +42,48 @@ pub(super) fn class_of(n: u32) -> (usize, u64) {
     }
 }
 
-/// Grows `v` so it can take `additional` more elements, by at most 1/8 of its capacity beyond
-/// what is needed (plus a small floor), instead of `Vec`'s doubling. This keeps the heap slack
-/// that [`memory_bytes`](super::Orthtree::memory_bytes) reports at about 12 % at any size.
-pub(super) fn reserve_slowly<T>(v: &mut Vec<T>, additional: usize) {
-    let need = v.len() + additional;
-    if need > v.capacity() {
-        let target = need.max(v.capacity() + (v.capacity() / 8).max(64));
-        v.reserve_exact(target - v.len());
-    }
+/// A block a shared insert replaced: readers may still be scanning it, so it waits here
+/// until every reader has announced an epoch after `epoch` (see
+/// [`Orthtree::insert_shared`](super::Orthtree::insert_shared)).
+#[derive(Debug, Clone, Copy)]
+struct Retired {
+    epoch: u64,
+    start: u32,
+    class: u8,
+    cap: u32,
 }
 
-/// The pool of fixed-point point records shared by all leaves.
-#[derive(Clone)]
-pub(super) struct LeafPool<const D: usize> {
-    /// Point records: per coordinate, the offset inside the leaf cell in units of
-    /// `leaf_side / 2^32`. Free blocks are also in here.
-    pub(super) slots: Vec<[u32; D]>,
+/// The allocator of the point pool: which slots are in use, the free lists, the retired
+/// blocks. The point records themselves live in the tree's slot arena.
+#[derive(Debug, Clone)]
+pub(super) struct LeafPool {
+    /// Slots in use at the front of the arena (blocks of leaves, free or retired).
+    pub(super) len: usize,
     /// Head of the free list of each size class (`NIL` when empty).
     free: [u32; NUM_CLASSES],
     /// Total slots currently on free lists.
     free_slots: usize,
+    /// Blocks replaced by shared inserts, oldest first.
+    retired: VecDeque<Retired>,
+    /// Slots of the retired blocks.
+    retired_slots: usize,
 }
 
-impl<const D: usize> LeafPool<D> {
+impl LeafPool {
     /// An empty pool.
     pub(super) fn new() -> Self {
         Self {
-            slots: Vec::new(),
+            len: 0,
             free: [NIL; NUM_CLASSES],
             free_slots: 0,
+            retired: VecDeque::new(),
+            retired_slots: 0,
         }
     }
 
-    /// Slots sitting on free lists (allocated, counted by `memory_bytes`, holding no point).
+    /// Slots on free lists or retired (allocated, counted by `memory_bytes`, holding no point).
     pub(super) fn free_slots(&self) -> usize {
-        self.free_slots
+        self.free_slots + self.retired_slots
     }
 
     /// Upper bound on the number of new slots a push into a leaf of length `len` may append to
@@ -89,88 +98,142 @@ impl<const D: usize> LeafPool<D> {
         }
     }
 
-    /// A block of `cap` slots of class `class`, from the free list or the end of the pool.
-    fn alloc(&mut self, class: usize, cap: u64) -> u32 {
+    /// Grows `slots` (exclusive access) so that a push into a leaf of length `leaf_len` fits.
+    pub(super) fn reserve<const D: usize>(&self, slots: &mut Arena<[u32; D]>, leaf_len: u32) {
+        let need = self.len + Self::push_needs(leaf_len) as usize;
+        slots.set_capacity(self.len, slow_growth(slots.capacity(), need));
+    }
+
+    /// A block of `cap` slots of class `class`, from the free list or the end of the pool
+    /// (whose capacity the caller has checked).
+    fn alloc<const D: usize>(&mut self, slots: &Arena<[u32; D]>, class: usize, cap: u64) -> u32 {
         let head = self.free[class];
         if head != NIL {
-            self.free[class] = self.slots[head as usize][0];
+            self.free[class] = slots.get(head as usize)[0];
             self.free_slots -= cap as usize;
             head
         } else {
-            let start = self.slots.len();
-            let cap = cap as usize;
-            reserve_slowly(&mut self.slots, cap);
-            self.slots.resize(start + cap, [0; D]);
+            let start = self.len;
+            for i in start..start + cap as usize {
+                slots.init(i, [0; D]);
+            }
+            self.len += cap as usize;
             start as u32
         }
     }
 
-    /// Puts the block at `start` (class `class`, `cap` slots) on its free list.
-    fn free(&mut self, start: u32, class: usize, cap: u64) {
-        self.slots[start as usize][0] = self.free[class];
+    /// Puts the block at `start` (class `class`) on its free list; no reader may be scanning it.
+    fn free<const D: usize>(
+        &mut self,
+        slots: &Arena<[u32; D]>,
+        start: u32,
+        class: usize,
+        cap: u64,
+    ) {
+        let mut link = [0; D];
+        link[0] = self.free[class];
+        slots.init(start as usize, link);
         self.free[class] = start;
         self.free_slots += cap as usize;
     }
 
-    /// Appends one point record to `leaf`, moving the leaf to a larger block if its block is
-    /// full. The caller has checked with [`push_needs`](Self::push_needs) that the pool indices
-    /// stay below `u32::MAX`.
-    pub(super) fn push(&mut self, leaf: &mut Leaf, code: [u32; D]) {
+    /// Appends one point record to the leaf `leaf` and returns its new record, moving the
+    /// points to a larger block if the block is full. The old block goes to its free list, or,
+    /// with `retire = Some(epoch)` (readers may be scanning it), to the retired blocks. The
+    /// caller has checked the slot capacity ([`push_needs`](Self::push_needs)). The new point
+    /// is written before the record that makes it visible is returned.
+    pub(super) fn push<const D: usize>(
+        &mut self,
+        slots: &Arena<[u32; D]>,
+        leaf: Leaf,
+        code: [u32; D],
+        retire: Option<u64>,
+    ) -> Leaf {
         let n = leaf.len;
+        let mut start = leaf.start;
         if n == 0 {
             let (class, cap) = class_of(1);
-            leaf.start = self.alloc(class, cap);
+            start = self.alloc(slots, class, cap);
         } else {
             let (old_class, old_cap) = class_of(n);
             if u64::from(n) == old_cap {
                 let (new_class, new_cap) = class_of(n + 1);
-                let new_start = self.alloc(new_class, new_cap);
-                let old = leaf.start as usize;
-                self.slots
-                    .copy_within(old..old + n as usize, new_start as usize);
-                self.free(leaf.start, old_class, old_cap);
-                leaf.start = new_start;
+                start = self.alloc(slots, new_class, new_cap);
+                for i in 0..n {
+                    slots.init((start + i) as usize, *slots.get((leaf.start + i) as usize));
+                }
+                match retire {
+                    None => self.free(slots, leaf.start, old_class, old_cap),
+                    Some(epoch) => {
+                        self.retired.push_back(Retired {
+                            epoch,
+                            start: leaf.start,
+                            class: old_class as u8,
+                            cap: old_cap as u32,
+                        });
+                        self.retired_slots += old_cap as usize;
+                    }
+                }
             }
         }
-        self.slots[(leaf.start + n) as usize] = code;
-        leaf.len = n + 1;
+        slots.init((start + n) as usize, code);
+        Leaf { start, len: n + 1 }
+    }
+
+    /// Moves the retired blocks of epochs before `safe` (every reader has announced `safe` or
+    /// later since) to the free lists.
+    pub(super) fn reclaim<const D: usize>(&mut self, slots: &Arena<[u32; D]>, safe: u64) {
+        while let Some(r) = self.retired.front().copied() {
+            if r.epoch >= safe {
+                break;
+            }
+            self.retired.pop_front();
+            self.retired_slots -= r.cap as usize;
+            self.free(slots, r.start, r.class as usize, u64::from(r.cap));
+        }
     }
 
     /// Whether enough slots sit on free lists to make [`compact`](Self::compact) worth it:
     /// more than 1/8 of the pool and more than 64 Ki slots.
     pub(super) fn wants_compaction(&self) -> bool {
-        self.free_slots > (self.slots.len() / 8).max(1 << 16)
+        self.free_slots > (self.len / 8).max(1 << 16)
     }
 
     /// Slides every leaf's block down over the free blocks, in place (blocks keep their order
-    /// and their class capacity), and empties the free lists. The pool's capacity is kept for
-    /// the blocks allocated next. O(slots + leaves log leaves), with a temporary index of 4
-    /// bytes per leaf.
-    pub(super) fn compact(&mut self, leaves: &mut [Leaf]) {
+    /// and their class capacity), and empties the free lists (exclusive access: no reader, no
+    /// retired block). O(slots + leaves log leaves), with a temporary index of 4 bytes per leaf.
+    pub(super) fn compact<const D: usize>(
+        &mut self,
+        slots: &mut Arena<[u32; D]>,
+        leaves: &mut [AtomicU64],
+    ) {
+        debug_assert!(self.retired.is_empty());
         let mut order: Vec<u32> = (0..leaves.len() as u32)
-            .filter(|&l| leaves[l as usize].len > 0)
+            .filter(|&l| Leaf::unpack(*leaves[l as usize].get_mut()).len > 0)
             .collect();
-        order.sort_unstable_by_key(|&l| leaves[l as usize].start);
+        order.sort_unstable_by_key(|&l| Leaf::unpack(*leaves[l as usize].get_mut()).start);
+        let pool = slots.prefix_mut(self.len);
         let mut cursor = 0usize;
         for l in order {
-            let leaf = &mut leaves[l as usize];
+            let rec = leaves[l as usize].get_mut();
+            let mut leaf = Leaf::unpack(*rec);
             let start = leaf.start as usize;
             debug_assert!(cursor <= start);
-            self.slots
-                .copy_within(start..start + leaf.len as usize, cursor);
+            pool.copy_within(start..start + leaf.len as usize, cursor);
             leaf.start = cursor as u32;
+            *rec = leaf.pack();
             cursor += class_of(leaf.len).1 as usize;
         }
-        self.slots.truncate(cursor);
+        self.len = cursor;
         self.free = [NIL; NUM_CLASSES];
         self.free_slots = 0;
     }
 
-    /// The point records of `leaf`.
-    #[inline]
-    pub(super) fn points(&self, leaf: Leaf) -> &[[u32; D]] {
-        let s = leaf.start as usize;
-        &self.slots[s..s + leaf.len as usize]
+    /// The point records of `leaf` (a published record: its block is not written while the
+    /// slice lives).
+    #[inline(always)]
+    pub(super) fn points<const D: usize>(slots: &Arena<[u32; D]>, leaf: Leaf) -> &[[u32; D]] {
+        slots.slice(leaf.start as usize, leaf.len as usize)
     }
 }
 
@@ -204,38 +267,64 @@ mod tests {
 
     #[test]
     fn pool_reuses_freed_blocks_and_keeps_contents() {
-        let mut pool = LeafPool::<2>::new();
+        let mut slots = Arena::<[u32; 2]>::new();
+        let mut pool = LeafPool::new();
         let mut a = Leaf { start: 0, len: 0 };
         let mut b = Leaf { start: 0, len: 0 };
         for i in 0..40u32 {
-            pool.push(&mut a, [i, 1000 + i]);
+            pool.reserve(&mut slots, a.len);
+            a = pool.push(&slots, a, [i, 1000 + i], None);
             if i % 3 == 0 {
-                pool.push(&mut b, [i, 7]);
+                pool.reserve(&mut slots, b.len);
+                b = pool.push(&slots, b, [i, 7], None);
             }
         }
-        let pa: Vec<_> = pool.points(a).to_vec();
+        let pa: Vec<_> = LeafPool::points(&slots, a).to_vec();
         assert_eq!(pa.len(), 40);
         for (i, p) in pa.iter().enumerate() {
             assert_eq!(*p, [i as u32, 1000 + i as u32]);
         }
-        let pb: Vec<_> = pool.points(b).to_vec();
+        let pb: Vec<_> = LeafPool::points(&slots, b).to_vec();
         assert_eq!(pb.len(), 14);
         for (k, p) in pb.iter().enumerate() {
             assert_eq!(*p, [3 * k as u32, 7]);
         }
         // Every block of a's and b's old classes was freed and partly reused by b.
         let used = (class_of(40).1 + class_of(14).1) as usize;
-        assert_eq!(pool.slots.len(), used + pool.free_slots());
-        let mut leaves = [a, b];
-        pool.compact(&mut leaves);
-        assert_eq!(pool.slots.len(), used);
+        assert_eq!(pool.len, used + pool.free_slots());
+        let mut leaves = [AtomicU64::new(a.pack()), AtomicU64::new(b.pack())];
+        pool.compact(&mut slots, &mut leaves);
+        let [a, b] = leaves.map(|l| Leaf::unpack(l.into_inner()));
+        assert_eq!(pool.len, used);
         assert_eq!(pool.free_slots(), 0);
-        assert_eq!(pool.points(leaves[0]), &pa[..]);
-        assert_eq!(pool.points(leaves[1]), &pb[..]);
+        assert_eq!(LeafPool::points(&slots, a), &pa[..]);
+        assert_eq!(LeafPool::points(&slots, b), &pb[..]);
         // Growing after compaction works.
-        pool.push(&mut leaves[1], [99, 99]);
-        assert_eq!(pool.points(leaves[1]).len(), 15);
-        assert_eq!(pool.points(leaves[1])[14], [99, 99]);
-        assert_eq!(pool.points(leaves[0]), &pa[..]);
+        pool.reserve(&mut slots, b.len);
+        let b = pool.push(&slots, b, [99, 99], None);
+        assert_eq!(LeafPool::points(&slots, b).len(), 15);
+        assert_eq!(LeafPool::points(&slots, b)[14], [99, 99]);
+        assert_eq!(LeafPool::points(&slots, a), &pa[..]);
+    }
+
+    #[test]
+    fn retired_blocks_wait_for_their_epoch() {
+        let mut slots = Arena::<[u32; 2]>::new();
+        let mut pool = LeafPool::new();
+        let mut a = Leaf { start: 0, len: 0 };
+        for i in 0..3u32 {
+            pool.reserve(&mut slots, a.len);
+            a = pool.push(&slots, a, [i, i], Some(u64::from(i) + 1));
+        }
+        // Blocks of 1 (epoch 2) and 2 (epoch 3) slots are retired, not free.
+        assert_eq!(pool.free_slots(), 3);
+        assert_eq!(pool.free[0], NIL);
+        pool.reclaim(&slots, 3);
+        assert_ne!(pool.free[0], NIL);
+        assert_eq!(pool.free[1], NIL);
+        pool.reclaim(&slots, u64::MAX);
+        assert_ne!(pool.free[1], NIL);
+        assert_eq!(pool.free_slots(), 3);
+        assert_eq!(LeafPool::points(&slots, a), &[[0, 0], [1, 1], [2, 2]]);
     }
 }

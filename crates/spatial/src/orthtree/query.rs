@@ -330,7 +330,7 @@ impl<const D: usize> Orthtree<D> {
             let mut node = self.root;
             let mut l = self.root_level;
             while l > level {
-                let child = self.children[node as usize * Self::FANOUT + self.child_index(&k, l)];
+                let child = self.child(node as usize * Self::FANOUT + self.child_index(&k, l));
                 if child == EMPTY {
                     continue 'cells;
                 }
@@ -428,10 +428,9 @@ impl<const D: usize> Orthtree<D> {
             slab[i] = [lo * lo, hi * hi];
         }
         let base = node as usize * Self::FANOUT;
-        let kids = &self.children[base..base + Self::FANOUT];
         for &m in &CHILD_ORDER[D][..Self::FANOUT] {
             let ci = home ^ m as usize;
-            let child = kids[ci];
+            let child = self.child(base + ci);
             if child == EMPTY {
                 continue;
             }
@@ -472,7 +471,7 @@ impl<const D: usize> Orthtree<D> {
             return;
         }
         let origin = c.map(|x| x - half);
-        let pts = self.pool.points(self.leaves[leaf as usize]);
+        let pts = self.leaf_points(leaf);
         let (best_sq, best_j) = nearest_in_leaf(&s.p, &origin, self.step, pts, s.best_sq);
         if best_j != usize::MAX {
             s.best_sq = best_sq;
@@ -502,7 +501,7 @@ impl<const D: usize> Orthtree<D> {
         let q = half * 0.5;
         let base = node as usize * Self::FANOUT;
         for ci in 0..Self::FANOUT {
-            let child = self.children[base + ci];
+            let child = self.child(base + ci);
             if child == EMPTY {
                 continue;
             }
@@ -539,7 +538,7 @@ impl<const D: usize> Orthtree<D> {
         f: &mut F,
     ) {
         let origin = c.map(|x| x - half);
-        for code in self.pool.points(self.leaves[leaf as usize]) {
+        for code in self.leaf_points(leaf) {
             let mut x = [0.0; D];
             let mut d2 = 0.0;
             for i in 0..D {
