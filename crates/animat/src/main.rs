@@ -9,6 +9,7 @@ use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
+use core_lattice::ensemble::{Curve, Ensemble, EnsembleArgs};
 use core_lattice::io::{RunClock, read_checkpoint, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -90,6 +91,9 @@ struct Cli {
 
     #[command(flatten)]
     log: LogArgs,
+
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
 }
 
 /// Builds validated parameters: defaults, then the config file, then the flags.
@@ -164,8 +168,38 @@ fn culprit(cli: &Cli, e: &ParamsError) -> String {
     }
 }
 
+/// What an ensemble (`--seeds`) averages over its members.
+const CURVES: &[Curve] = &[Curve {
+    file: "populations.csv",
+    x: "step",
+    ys: &["foxes", "rabbits"],
+    missing: None,
+    title: "Populations against steps",
+    log_x: false,
+    log_y: false,
+}];
+
 fn main() -> ExitCode {
-    core_lattice::cli::main_with("animat", |c: &Cli| c.log, params, run)
+    if let Some(code) = core_lattice::ensemble::merge_main("animat", CURVES) {
+        return code;
+    }
+    core_lattice::cli::main_with(
+        "animat",
+        |c: &Cli| c.log,
+        params,
+        |cli, params| match &cli.ensemble.seeds {
+            Some(seeds) => core_lattice::ensemble::run(&Ensemble {
+                program: "animat",
+                seeds: &seeds.0,
+                jobs: cli.ensemble.jobs,
+                member_threads: 1,
+                out: &cli.out,
+                curves: CURVES,
+                log: &cli.log,
+            }),
+            None => run(cli, params),
+        },
+    )
 }
 
 /// File name of checkpoints in the output directory.

@@ -21,8 +21,12 @@
 
 #[cfg(feature = "cli")]
 pub mod cli;
+#[cfg(feature = "cli")]
+pub mod ensemble;
 pub mod io;
 pub mod lattice;
+#[cfg(feature = "plot")]
+pub mod plot;
 pub mod rng;
 pub mod stats;
 #[cfg(feature = "test-support")]

@@ -177,3 +177,105 @@ pub fn send_sigterm(pid: u32) {
         panic!("SIGTERM is a Unix signal");
     }
 }
+
+/// `run.json` of the run in `dir`, as JSON.
+fn manifest(dir: &Path) -> serde_json::Value {
+    manifest_named(dir, "run.json")
+}
+
+/// The ensemble contract of a model binary (`--seeds`, see [`crate::ensemble`]), with the run
+/// flags `flags` (small and fast), checked in the working directory `dir`:
+///
+/// - a bad list, or `--seeds` with `--seed`, is a usage error (exit code 2);
+/// - of `--seeds 1..=3`, a member that cannot run (its directory is taken by a file) is
+///   reported by seed with exit code 1 while the others finish and are combined
+///   (`ensemble.json` with `results.state_hash` absent and a scalar with `n` = 2);
+/// - every member equals the plain run with its seed (same `state_hash`);
+/// - rerunning the command runs only the missing member and leaves the finished ones alone;
+/// - `--merge DIR` rebuilds the same combined results.
+pub fn ensemble_contract(binary: &Path, program: &str, dir: &Path, flags: &[&str], scalar: &str) {
+    let run = |args: &[&str]| {
+        Command::new(binary)
+            .args(args)
+            .args(flags)
+            .arg("-qq")
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .output()
+            .expect("the binary starts")
+    };
+    for bad in [
+        &["--seeds", "1,1", "--out", "bad"][..],
+        &["--seeds", "3..=1", "--out", "bad"],
+        &["--seeds", "1..=2", "--seed", "4", "--out", "bad"],
+    ] {
+        let o = run(bad);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{bad:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        assert!(!dir.join("bad").exists(), "{bad:?} created its --out");
+    }
+    let ens = dir.join("ens");
+    std::fs::create_dir_all(&ens).expect("creating the ensemble directory");
+    std::fs::write(ens.join("seed-0003"), b"in the way").expect("a blocking file");
+    let o = run(&["--seeds", "1..=3", "--out", "ens"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(&format!("{program}: run failed: "))
+            && err.contains("seed 3:")
+            && err.lines().count() == 1,
+        "{err}"
+    );
+    let doc = manifest_named(&ens, "ensemble.json");
+    assert_eq!(doc["members"], 2, "{doc}");
+    assert_eq!(doc["results"][scalar]["n"], 2, "{doc}");
+    assert!(doc["results"].get("state_hash").is_none());
+    for seed in [1u64, 2] {
+        let single = format!("single-{seed}");
+        let o = run(&["--seed", &seed.to_string(), "--out", &single]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert_eq!(
+            manifest(&dir.join(&single))["results"]["state_hash"],
+            manifest(&ens.join(format!("seed-{seed:04}")))["results"]["state_hash"],
+            "member {seed} differs from the plain run with its seed"
+        );
+    }
+    std::fs::remove_file(ens.join("seed-0003")).expect("removing the blocking file");
+    let before = std::fs::metadata(ens.join("seed-0001/run.json"))
+        .and_then(|m| m.modified())
+        .expect("mtime");
+    let o = run(&["--seeds", "1..=3", "--out", "ens"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let after = std::fs::metadata(ens.join("seed-0001/run.json"))
+        .and_then(|m| m.modified())
+        .expect("mtime");
+    assert_eq!(before, after, "a finished member was run again");
+    let doc = manifest_named(&ens, "ensemble.json");
+    assert_eq!(doc["members"], 3);
+    assert_eq!(doc["results"][scalar]["n"], 3);
+    let mean = doc["results"][scalar]["mean"].as_f64().expect("a mean");
+    assert!(mean.is_finite());
+    std::fs::remove_file(ens.join("ensemble.json")).expect("removing ensemble.json");
+    let o = Command::new(binary)
+        .args(["--merge", "ens"])
+        .current_dir(dir)
+        .output()
+        .expect("the binary starts");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        manifest_named(&ens, "ensemble.json")["results"],
+        doc["results"]
+    );
+    assert!(ens.join("ensemble.md").is_file());
+}
+
+/// A JSON file in `dir`.
+fn manifest_named(dir: &Path, name: &str) -> serde_json::Value {
+    let path = dir.join(name);
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_slice(&bytes).expect("JSON")
+}

@@ -22,7 +22,7 @@ use std::sync::Arc;
 /// In serial growth [`insert`](Self::insert) stores a particle in the tree and the maps and
 /// grows both as needed. In PDLA all threads share one cluster: between
 /// [`prepare_shared`](Self::prepare_shared) and [`finish_shared`](Self::finish_shared) a
-/// particle enters the tree through [`insert_shared`](Self::insert_shared) and lowers the maps
+/// particle enters the tree through [`Orthtree::insert_shared`] and lowers the maps
 /// through [`update_maps`](Self::update_maps), both while other threads query. A clone shares
 /// the maps, which then no longer grow.
 #[derive(Debug, Clone, Default)]

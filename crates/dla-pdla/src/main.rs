@@ -6,6 +6,7 @@
 use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
+use core_lattice::ensemble::{Curve, Ensemble, EnsembleArgs};
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
@@ -128,6 +129,9 @@ struct Cli {
 
     #[command(flatten)]
     log: LogArgs,
+
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
 }
 
 /// An on/off switch.
@@ -208,17 +212,40 @@ where
     Ok(sim)
 }
 
+/// What an ensemble (`--seeds`) averages over its members.
+const CURVES: &[Curve] = &[Curve {
+    file: "growth.csv",
+    x: "n",
+    ys: &["radius_of_gyration", "r_ext"],
+    missing: None,
+    title: "Radius of gyration and extent against N",
+    log_x: true,
+    log_y: true,
+}];
+
 fn main() -> ExitCode {
+    if let Some(code) = core_lattice::ensemble::merge_main("dla", CURVES) {
+        return code;
+    }
     core_lattice::cli::main_with(
         "dla",
         |c: &Cli| c.log,
         params,
         // The one run-time dimension dispatch: adding a dimension is one arm here (and its
         // `Space` implementation).
-        |cli, params: Params| match params.dim {
-            2 => run::<2>(cli, params),
-            3 => run::<3>(cli, params),
-            d => Err(ParamsError::Dim(d).into()),
+        |cli, params: Params| match (&cli.ensemble.seeds, params.dim) {
+            (Some(seeds), _) => core_lattice::ensemble::run(&Ensemble {
+                program: "dla",
+                seeds: &seeds.0,
+                jobs: cli.ensemble.jobs,
+                member_threads: params.threads,
+                out: &cli.out,
+                curves: CURVES,
+                log: &cli.log,
+            }),
+            (None, 2) => run::<2>(cli, params),
+            (None, 3) => run::<3>(cli, params),
+            (None, d) => Err(ParamsError::Dim(d).into()),
         },
     )
 }

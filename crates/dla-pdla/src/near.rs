@@ -21,8 +21,9 @@
 //!   of `p`; when that ball lies inside the cache's, the cache lists the same particles (same
 //!   inclusion test) and the earliest contact time is the same minimum.
 //! - **Growth.** Particles are only added. In serial DLA none is added while a walker moves;
-//!   in PDLA the particles another thread stored are added to the cache as they are applied
-//!   to the replica ([`NearCache::added`]), so the cache never misses one its tree has.
+//!   in PDLA the particles another thread stored are added to the cache before the walker's
+//!   next move ([`NearCache::added`]), so the cache misses at most what the tree gained during
+//!   one move, as the walk itself does (the re-check at sticking covers both).
 
 use spatial::orthtree::{Orthtree, dist_sq};
 

@@ -7,6 +7,7 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
+use core_lattice::ensemble::{Curve, Ensemble, EnsembleArgs};
 use core_lattice::io::RunClock;
 use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
@@ -134,6 +135,9 @@ struct Cli {
 
     #[command(flatten)]
     log: LogArgs,
+
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
 }
 
 /// Side lengths as given to `--size`.
@@ -280,8 +284,49 @@ fn resume(dir: &Path, params: Params, seed: u64) -> anyhow::Result<Simulation> {
     Simulation::restore(snapshot).map_err(|e| usage(format!("{}: {e}", at())))
 }
 
+/// What an ensemble (`--seeds`) averages over its members.
+const CURVES: &[Curve] = &[
+    Curve {
+        file: "sweeps.csv",
+        x: "sweep",
+        ys: &["clusters", "largest"],
+        missing: None,
+        title: "Clusters and largest cluster against sweeps",
+        log_x: true,
+        log_y: true,
+    },
+    Curve {
+        file: "sizes.csv",
+        x: "size",
+        ys: &["count"],
+        missing: Some(0.0),
+        title: "Cluster size distribution at the end",
+        log_x: true,
+        log_y: true,
+    },
+];
+
 fn main() -> ExitCode {
-    core_lattice::cli::main_with("dlca", |c: &Cli| c.log, params, run)
+    if let Some(code) = core_lattice::ensemble::merge_main("dlca", CURVES) {
+        return code;
+    }
+    core_lattice::cli::main_with(
+        "dlca",
+        |c: &Cli| c.log,
+        params,
+        |cli, params| match &cli.ensemble.seeds {
+            Some(seeds) => core_lattice::ensemble::run(&Ensemble {
+                program: "dlca",
+                seeds: &seeds.0,
+                jobs: cli.ensemble.jobs,
+                member_threads: 1,
+                out: &cli.out,
+                curves: CURVES,
+                log: &cli.log,
+            }),
+            None => run(cli, params),
+        },
+    )
 }
 
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {

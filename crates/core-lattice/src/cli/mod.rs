@@ -21,7 +21,7 @@ mod resume;
 
 pub use out_dir::{check_out_dir, prepare_out_dir};
 pub use progress::Progress;
-pub use resume::flag_differences;
+pub use resume::{flag_differences, labelled_differences};
 
 use std::process::ExitCode;
 

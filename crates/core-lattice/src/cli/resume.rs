@@ -14,6 +14,18 @@ pub fn flag_differences<T: Serialize>(
     given: &T,
     renames: &[(&str, Option<&str>)],
 ) -> Vec<String> {
+    labelled_differences(checkpointed, given, ("in the checkpoint", "given"), renames)
+}
+
+/// [`flag_differences`] with other words for the two sides: `labels = ("for seed 1", "for seed
+/// 2")` gives `--size 8 for seed 1, 16 for seed 2`.
+pub fn labelled_differences<T: Serialize>(
+    checkpointed: &T,
+    given: &T,
+    labels: (&str, &str),
+    renames: &[(&str, Option<&str>)],
+) -> Vec<String> {
+    let (la, lb) = labels;
     let (Ok(serde_json::Value::Object(old)), Ok(serde_json::Value::Object(new))) = (
         serde_json::to_value(checkpointed),
         serde_json::to_value(given),
@@ -26,11 +38,7 @@ pub fn flag_differences<T: Serialize>(
         return if a == b {
             Vec::new()
         } else {
-            vec![format!(
-                "{} in the checkpoint, {} given",
-                text(&a),
-                text(&b)
-            )]
+            vec![format!("{} {la}, {} {lb}", text(&a), text(&b))]
         };
     };
     let mut out = Vec::new();
@@ -42,11 +50,7 @@ pub fn flag_differences<T: Serialize>(
         };
         let b = new.get(field).cloned().unwrap_or(serde_json::Value::Null);
         if *a != b {
-            out.push(format!(
-                "{flag} {} in the checkpoint, {} given",
-                text(a),
-                text(&b)
-            ));
+            out.push(format!("{flag} {} {la}, {} {lb}", text(a), text(&b)));
         }
     }
     out

@@ -7,7 +7,7 @@
 //! |---|---|
 //! | `growth` | what a stored particle changes: count, `R_ext`, `R_g`, hash, samples |
 //! | `serial` | serial DLA: one walker at a time on one stream |
-//! | `pdla` | PDLA: threads, replicas, the shared log, the re-check |
+//! | `pdla` | PDLA: threads on one shared tree, the shared log, the re-check, phases |
 //! | `checkpoint` | the checkpoint format, writing and rebuilding a run from it |
 //!
 //! Invariant: `growth.n` particles are stored in `cluster`, in the order `growth` accounted

@@ -21,11 +21,12 @@
 //!   on the side of the new point along each axis where the point is outside, and on the side
 //!   that keeps the root centred on the first point along the other axes. Leaf cells never move,
 //!   so the stored (decoded) position of a point does not depend on insertion order or growth.
-//! - **Nodes.** One flat `Vec<u32>` with `2^D` child slots per internal node (16 bytes per node
+//! - **Nodes.** One flat array of `u32` with `2^D` child slots per internal node (16 bytes per node
 //!   in 2D, 32 in 3D): a child is a node index, or a leaf index for level-1 nodes, or `u32::MAX`
 //!   when empty. Nodes exist only on the paths to stored points, so every node holds at least one
 //!   point (the error bound below relies on this).
-//! - **Leaves.** `Vec<Leaf>`, 8 bytes each: the start and length of the leaf's block in the pool.
+//! - **Leaves.** One array of 8-byte records: the start and length of the leaf's block in the
+//!   pool, in one word.
 //! - **Points.** One pool of `[u32; D]` records: each coordinate is a fixed-point offset inside
 //!   the leaf cell, in units of `s / 2^32` (the variable-precision paper, section 3.3, stores
 //!   relative coordinates in one byte; that is far too coarse for contact within 1e-6, 32 bits
@@ -35,9 +36,9 @@
 //!   points inserted in random order), an insert compacts the pool in place: O(N) at that
 //!   insert, amortised O(leaf size) per insert. DLA growth, which keeps creating leaves at the
 //!   front, reuses the free blocks and practically never compacts.
-//! - **Growth of the vectors** is capped at 1/8 of their capacity, not doubled, so the heap slack
-//!   counted by [`Orthtree::memory_bytes`] stays near 12 %; this also bounds the latency of an
-//!   insert under a writer lock.
+//! - **Growth of the arrays** is capped at 1/8 of their capacity, not doubled, so the heap slack
+//!   counted by [`Orthtree::memory_bytes`] stays near 12 %. Large arrays grow by `realloc`,
+//!   which remaps pages instead of copying, so growing never holds two copies.
 //!
 //! Memory (2D): 8 bytes per point record plus the node and leaf records and the capped slack,
 //! about 12 bytes per point with the default leaf side (`examples/orthtree_memory.rs` measures
@@ -71,8 +72,27 @@
 //! | [`iter`](Orthtree::iter) | O(N + nodes) |
 //!
 //! Queries take `&self` and never allocate (except [`iter`](Orthtree::iter), which keeps an
-//! O(h) stack); inserts take `&mut self`. The type is `Send + Sync` with no interior mutability,
-//! so PDLA can share it behind a `RwLock` (many walkers querying, one inserting).
+//! O(h) stack); [`insert`](Orthtree::insert) takes `&mut self`.
+//!
+//! # One writer, many readers
+//!
+//! PDLA's walkers share one tree (the variable-precision paper, section 3.4) instead of a copy
+//! per thread: between [`prepare_shared`](Orthtree::prepare_shared) and
+//! [`finish_shared`](Orthtree::finish_shared), [`insert_shared`](Orthtree::insert_shared)
+//! stores a point through `&self` while other threads query, without a lock on the query side.
+//!
+//! - The arrays never move during sharing: `prepare_shared` reserves their room for the phase
+//!   (address space; pages are only touched as they are used) and grows the root over the
+//!   region the points will reach. A point that needs more is refused with
+//!   [`OrthtreeError::NeedsExclusive`] and nothing changes.
+//! - An insert builds the missing nodes, leaf and point below the first empty slot of its path,
+//!   then links them with one `Release` store; child slots and leaf records are atomics read
+//!   with `Acquire` (plain loads on x86), so a query sees the tree before or after an insert,
+//!   never a node without a point.
+//! - A leaf that outgrows its block moves to a larger one; the old block may still be scanned,
+//!   so it is *retired* with the current epoch and reused only once every reader has announced
+//!   a later [`epoch`](Orthtree::epoch) (epoch-based reclamation; a walker announces at birth).
+//! - Compaction never runs while shared.
 //!
 //! # Variable-precision distance and its error bound
 //!

@@ -1,0 +1,369 @@
+//! Ensembles (feature `cli`): one run per seed, combined into one result with error bars.
+//!
+//! `PROG --seeds 1..=80 [flags] --out DIR` runs each member as an ordinary run of the model's
+//! own binary, `PROG [flags] --seed S --out DIR/seed-NNNN -qq`, so a member has its own
+//! `run.json`, outputs and checkpoint and can be rerun or inspected alone. Members run as child
+//! processes, `--jobs` at a time: a member that fails or crashes cannot take the others down.
+//!
+//! - **Restartable.** Rerunning the same command skips members with a `run.json`, resumes those
+//!   with a `checkpoint.bin` (`--resume`), and runs the rest.
+//! - **Failures.** A failed member is reported with its seed and the last line it printed
+//!   (kept in `DIR/seed-NNNN/member.log`); the others go on; the exit code is 1 if any failed.
+//! - **Signals.** SIGINT or SIGTERM stop launching members and pass SIGTERM on to the running
+//!   ones (which checkpoint if they were asked to); the ensemble exits with code 130.
+//! - **Combined result** ([`merge`]): `DIR/ensemble.json`, `DIR/ensemble.md` and averaged
+//!   curves with error bands, rebuilt from whatever members exist by `PROG --merge DIR`.
+
+mod merge;
+mod seeds;
+
+pub use merge::{Curve, MergeReport, ScalarStats, merge};
+pub use seeds::{Seeds, parse_seeds};
+
+use crate::cli::{Interrupted, LogArgs};
+use anyhow::{Context, anyhow};
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode, Stdio};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Duration;
+
+/// The ensemble flags every model's command line flattens in.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct EnsembleArgs {
+    /// Run an ensemble: one run per seed, each in DIR/seed-NNNN/ (DIR = --out) with its own
+    /// run.json and outputs, combined into DIR/ensemble.json and ensemble.md (mean, standard
+    /// deviation and standard error of every result) and averaged curves. LIST: 1..=80, 1..81,
+    /// 3,5,9 or a mix. Rerunning the command skips finished members and resumes checkpointed
+    /// ones. `--merge DIR` alone rebuilds the combined result from the members in DIR.
+    #[arg(long, value_name = "LIST", value_parser = seeds::parse_seeds_arg, conflicts_with_all = ["seed", "resume"])]
+    pub seeds: Option<Seeds>,
+
+    /// With --seeds: members run at once (default: the cores divided by each member's threads).
+    #[arg(long, value_name = "J", requires = "seeds", value_parser = clap::value_parser!(u64).range(1..=4096))]
+    pub jobs: Option<u64>,
+}
+
+/// One ensemble to run.
+#[derive(Debug, Clone, Copy)]
+pub struct Ensemble<'a> {
+    /// The model binary's name (`dla`, `dlca`, `animat`), as in `run.json`'s `model`.
+    pub program: &'a str,
+    /// The members' seeds.
+    pub seeds: &'a [u64],
+    /// `--jobs`, if given.
+    pub jobs: Option<u64>,
+    /// Threads each member uses (`--threads` of the model, 1 if it has none).
+    pub member_threads: usize,
+    /// The ensemble's directory (`--out`).
+    pub out: &'a Path,
+    /// The curves to average.
+    pub curves: &'a [Curve],
+    /// The logging flags.
+    pub log: &'a LogArgs,
+}
+
+/// Subdirectory of member `seed`.
+pub fn member_dir(out: &Path, seed: u64) -> PathBuf {
+    out.join(format!("seed-{seed:04}"))
+}
+
+/// The log file of a member, in its directory.
+pub const MEMBER_LOG: &str = "member.log";
+
+/// Flags of the ensemble's command line that a member does not get (with a value).
+const DROPPED_WITH_VALUE: [&str; 5] = ["--seeds", "--jobs", "--out", "--seed", "--heartbeat"];
+/// Flags without a value that a member does not get (members run with `-qq`).
+const DROPPED_BARE: [&str; 2] = ["--quiet", "--verbose"];
+
+/// The member's flags: the ensemble's, less the ensemble and logging flags.
+fn member_args(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
+    let mut out = Vec::new();
+    let mut skip_value = false;
+    for a in args {
+        if skip_value {
+            skip_value = false;
+            continue;
+        }
+        let s = a.to_string_lossy();
+        if DROPPED_WITH_VALUE.contains(&s.as_ref()) {
+            skip_value = true;
+            continue;
+        }
+        let dropped_with_equals = DROPPED_WITH_VALUE
+            .iter()
+            .any(|f| s.starts_with(&format!("{f}=")));
+        let short_log =
+            s.len() > 1 && s.starts_with('-') && s[1..].chars().all(|c| c == 'q' || c == 'v');
+        if dropped_with_equals || short_log || DROPPED_BARE.contains(&s.as_ref()) {
+            continue;
+        }
+        out.push(a);
+    }
+    out
+}
+
+/// What a member needs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Todo {
+    /// Nothing: it has a `run.json`.
+    Finished,
+    /// `--resume` from its `checkpoint.bin`.
+    Resume,
+    /// A fresh run.
+    Run,
+}
+
+fn todo(dir: &Path) -> Todo {
+    if crate::io::RunManifest::read(dir.join("run.json")).is_ok() {
+        Todo::Finished
+    } else if dir.join("checkpoint.bin").is_file() {
+        Todo::Resume
+    } else {
+        Todo::Run
+    }
+}
+
+/// How a member ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum Ended {
+    Ok,
+    Interrupted,
+    Failed(String),
+}
+
+/// Runs the ensemble and writes its combined result; see the module documentation.
+pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
+    let exe = std::env::current_exe().context("locating the model's binary for the members")?;
+    let args = member_args(std::env::args_os().skip(1));
+    crate::cli::prepare_out_dir(e.out)
+        .with_context(|| format!("creating output directory {}", e.out.display()))?;
+    let stop = crate::cli::stop_on_signals().context("installing signal handlers")?;
+    let work: Vec<(u64, Todo)> = e
+        .seeds
+        .iter()
+        .map(|&s| (s, todo(&member_dir(e.out, s))))
+        .filter(|(_, t)| *t != Todo::Finished)
+        .collect();
+    let skipped = e.seeds.len() - work.len();
+    if skipped > 0 {
+        tracing::info!("{skipped} members finished already");
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let jobs = e
+        .jobs
+        .map_or((cores / e.member_threads.max(1)).max(1), |j| j as usize)
+        .min(work.len().max(1));
+    let progress = e.log.progress(
+        e.program,
+        work.len() as u64,
+        "members",
+        "{elapsed_precise} [{bar:40}] {pos}/{len} members (eta {eta})",
+    );
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    let ended: Mutex<Vec<(u64, Ended)>> = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            s.spawn(|| {
+                loop {
+                    if stop.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&(seed, todo)) = work.get(i) else {
+                        return;
+                    };
+                    let end = run_member(&exe, &args, e.out, seed, todo, &stop);
+                    ended
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .push((seed, end));
+                    let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    progress.set_position(n as u64);
+                }
+            });
+        }
+    });
+    progress.finish();
+    let mut ended = ended.into_inner().unwrap_or_else(|p| p.into_inner());
+    ended.sort_by_key(|(s, _)| *s);
+    let report = merge(e.out, e.program, e.curves);
+    let failed: Vec<String> = ended
+        .iter()
+        .filter_map(|(s, end)| match end {
+            Ended::Failed(why) => Some(format!("seed {s}: {why}")),
+            _ => None,
+        })
+        .collect();
+    let unfinished =
+        e.seeds.len() - skipped - ended.iter().filter(|(_, x)| *x == Ended::Ok).count();
+    if !e.log.is_quiet() {
+        if let Ok(r) = &report {
+            eprintln!(
+                "{}: ensemble of {} members in {}: {} finished, {} failed; {}",
+                e.program,
+                e.seeds.len(),
+                e.out.display(),
+                r.members,
+                failed.len(),
+                e.out.join("ensemble.json").display()
+            );
+        }
+    }
+    if stop.load(Ordering::Relaxed) {
+        return Err(Interrupted(format!(
+            "interrupted with {} of {} members unfinished; run the same command again to continue",
+            unfinished.saturating_sub(failed.len()),
+            e.seeds.len()
+        ))
+        .into());
+    }
+    if !failed.is_empty() {
+        return Err(anyhow!(
+            "{} of {} members failed ({}); the others are combined in {}",
+            failed.len(),
+            e.seeds.len(),
+            failed.join("; "),
+            e.out.join("ensemble.json").display()
+        ));
+    }
+    report.map(drop)
+}
+
+/// Runs one member to its end, passing SIGTERM on once `stop` is set.
+fn run_member(
+    exe: &Path,
+    args: &[OsString],
+    out: &Path,
+    seed: u64,
+    todo: Todo,
+    stop: &AtomicBool,
+) -> Ended {
+    let dir = member_dir(out, seed);
+    if let Err(e) = std::fs::create_dir_all(&dir) {
+        return Ended::Failed(format!("creating {}: {e}", dir.display()));
+    }
+    let log_path = dir.join(MEMBER_LOG);
+    let log = match std::fs::File::create(&log_path) {
+        Ok(f) => f,
+        Err(e) => return Ended::Failed(format!("creating {}: {e}", log_path.display())),
+    };
+    let mut cmd = Command::new(exe);
+    cmd.args(args)
+        .arg("--seed")
+        .arg(seed.to_string())
+        .arg("--out")
+        .arg(&dir)
+        .arg("-qq")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(log);
+    if todo == Todo::Resume {
+        cmd.arg("--resume").arg(&dir);
+    }
+    let mut child = match cmd.spawn() {
+        Ok(c) => c,
+        Err(e) => return Ended::Failed(format!("starting {}: {e}", exe.display())),
+    };
+    let mut signalled = false;
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(status)) => break status,
+            Ok(None) => {}
+            Err(e) => return Ended::Failed(format!("waiting for the member: {e}")),
+        }
+        if stop.load(Ordering::Relaxed) && !signalled {
+            signalled = true;
+            terminate(&child);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    if status.success() {
+        return Ended::Ok;
+    }
+    if status.code() == Some(i32::from(crate::cli::EXIT_INTERRUPTED)) || signalled {
+        return Ended::Interrupted;
+    }
+    let last = std::fs::read_to_string(&log_path)
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .rev()
+                .find(|l| !l.trim().is_empty())
+                .map(str::to_owned)
+        })
+        .unwrap_or_else(|| format!("exited with {status}"));
+    Ended::Failed(last)
+}
+
+/// Sends SIGTERM to a member (it checkpoints and stops if it checkpoints at all).
+#[cfg(unix)]
+fn terminate(child: &std::process::Child) {
+    use nix::sys::signal::{Signal, kill};
+    use nix::unistd::Pid;
+    if let Ok(pid) = i32::try_from(child.id()) {
+        let _ = kill(Pid::from_raw(pid), Signal::SIGTERM);
+    }
+}
+
+#[cfg(not(unix))]
+fn terminate(_child: &std::process::Child) {}
+
+/// Handles `PROG --merge DIR` (exactly those arguments) before the model parses its flags:
+/// rebuilds the combined result of the members in `DIR`. `None` for any other command line.
+pub fn merge_main(program: &str, curves: &[Curve]) -> Option<ExitCode> {
+    let args: Vec<OsString> = std::env::args_os().skip(1).collect();
+    let dir = match args.as_slice() {
+        [flag, dir] if flag == "--merge" => PathBuf::from(dir),
+        [flag] => PathBuf::from(flag.to_str()?.strip_prefix("--merge=")?),
+        _ => return None,
+    };
+    Some(match merge(&dir, program, curves) {
+        Ok(r) => {
+            eprintln!(
+                "{program}: combined {} members of {} into {}",
+                r.members,
+                dir.display(),
+                dir.join("ensemble.json").display()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("{program}: error: --merge {}: {e:#}", dir.display());
+            ExitCode::from(crate::cli::EXIT_USAGE)
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn os(v: &[&str]) -> Vec<OsString> {
+        v.iter().map(OsString::from).collect()
+    }
+
+    #[test]
+    fn members_get_the_run_flags_only() {
+        let got = member_args(os(&[
+            "--seeds",
+            "1..=4",
+            "--particles",
+            "100",
+            "--out",
+            "d",
+            "--jobs=2",
+            "-qq",
+            "-v",
+            "--heartbeat",
+            "5",
+            "--quiet",
+            "--seed=3",
+            "--threads",
+            "2",
+        ]));
+        assert_eq!(got, os(&["--particles", "100", "--threads", "2"]));
+    }
+}

@@ -1,0 +1,338 @@
+//! PNG charts with plotters (feature `plot`), drawn into a memory buffer and written with the
+//! project's atomic PNG writer: the figures of `cargo xtask` and of the models' ensembles.
+//! Text uses the DejaVu Sans font committed under `crates/core-lattice/assets/fonts/` and
+//! registered with plotters' `ab_glyph` backend, so no system font library is needed.
+
+use anyhow::{Context, Result, anyhow};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+/// The font file committed with the repository (Bitstream Vera licence, see
+/// `crates/core-lattice/assets/fonts/DejaVu-LICENSE.txt`).
+static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+            .map_err(|_| ())
+            .expect("the committed DejaVu Sans font parses");
+    });
+}
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Style {
+    /// A line through the points.
+    Line,
+    /// A dashed-looking thin line (fits, reference curves).
+    Thin,
+    /// Markers only.
+    Points,
+    /// Line and markers.
+    LinePoints,
+    /// Large hollow markers (to mark a special point, e.g. the default setting).
+    Highlight,
+}
+
+/// One data series.
+#[derive(Debug, Clone)]
+pub struct Series {
+    /// Legend entry.
+    pub name: String,
+    /// `(x, y)` points.
+    pub points: Vec<(f64, f64)>,
+    /// Drawing style.
+    pub style: Style,
+    /// Optional text drawn next to each point (same length as `points`).
+    pub labels: Option<Vec<String>>,
+    /// Optional error band `(x, low, high)`, shaded in the series' colour under it.
+    pub band: Option<Vec<(f64, f64, f64)>>,
+}
+
+impl Series {
+    /// A series from its name, points and style.
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>, style: Style) -> Self {
+        Series {
+            name: name.into(),
+            points,
+            style,
+            labels: None,
+            band: None,
+        }
+    }
+
+    /// The same series with an error band `(x, low, high)` (mean +- standard error, say).
+    pub fn with_band(mut self, band: Vec<(f64, f64, f64)>) -> Self {
+        self.band = Some(band);
+        self
+    }
+
+    /// The same series with a text label beside each point.
+    pub fn with_labels(mut self, labels: Vec<String>) -> Self {
+        assert_eq!(labels.len(), self.points.len(), "one label per point");
+        self.labels = Some(labels);
+        self
+    }
+}
+
+/// A chart: title, axis labels, log or linear axes, series.
+#[derive(Debug, Clone)]
+pub struct Chart {
+    /// Caption.
+    pub title: String,
+    /// x-axis label.
+    pub x_label: String,
+    /// y-axis label.
+    pub y_label: String,
+    /// Logarithmic x axis.
+    pub log_x: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The data.
+    pub series: Vec<Series>,
+}
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(120, 120, 120),
+    RGBColor(0, 0, 0),
+];
+
+const WIDTH: u32 = 960;
+const HEIGHT: u32 = 640;
+
+/// Axis range covering `values` (positive values only on a log axis), with a margin.
+fn range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        return None;
+    }
+    Some(if log {
+        let (a, b) = (lo.log10(), hi.log10());
+        let m = ((b - a) * 0.05).max(0.05);
+        (10f64.powf(a - m), 10f64.powf(b + m))
+    } else {
+        let m = ((hi - lo) * 0.05).max(hi.abs().max(1e-12) * 0.05);
+        (lo - m, hi + m)
+    })
+}
+
+/// A short tick label: `0.05`, `10`, `2.5e-6`.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e5).contains(&a) {
+        format!("{v:.1e}").replace(".0e", "e")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+macro_rules! draw_chart {
+    ($root:expr, $chart:expr, $xr:expr, $yr:expr) => {{
+        let spec: &Chart = $chart;
+        let mut ctx = ChartBuilder::on($root)
+            .caption(&spec.title, ("sans-serif", 24))
+            .margin(16)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d($xr, $yr)
+            .map_err(|e| anyhow!("{e}"))?;
+        ctx.configure_mesh()
+            .x_desc(&spec.x_label)
+            .y_desc(&spec.y_label)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .label_style(("sans-serif", 15))
+            .axis_desc_style(("sans-serif", 17))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        for (i, s) in spec.series.iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            let pts: Vec<(f64, f64)> = s
+                .points
+                .iter()
+                .copied()
+                .filter(|(x, y)| {
+                    x.is_finite()
+                        && y.is_finite()
+                        && (!spec.log_x || *x > 0.0)
+                        && (!spec.log_y || *y > 0.0)
+                })
+                .collect();
+            let legend_color = color;
+            if let Some(band) = &s.band {
+                let ok = |x: f64, y: f64| {
+                    x.is_finite()
+                        && y.is_finite()
+                        && (!spec.log_x || x > 0.0)
+                        && (!spec.log_y || y > 0.0)
+                };
+                let band: Vec<_> = band
+                    .iter()
+                    .copied()
+                    .filter(|&(x, lo, hi)| ok(x, lo) && ok(x, hi))
+                    .collect();
+                let outline: Vec<(f64, f64)> = band
+                    .iter()
+                    .map(|&(x, lo, _)| (x, lo))
+                    .chain(band.iter().rev().map(|&(x, _, hi)| (x, hi)))
+                    .collect();
+                if outline.len() >= 3 {
+                    ctx.draw_series(std::iter::once(Polygon::new(
+                        outline,
+                        color.mix(0.25).filled(),
+                    )))
+                    .map_err(|e| anyhow!("{e}"))?;
+                }
+            }
+            match s.style {
+                Style::Line | Style::Thin | Style::LinePoints => {
+                    let width = if s.style == Style::Thin { 1 } else { 2 };
+                    ctx.draw_series(LineSeries::new(pts.clone(), color.stroke_width(width)))
+                        .map_err(|e| anyhow!("{e}"))?
+                        .label(&s.name)
+                        .legend(move |(x, y)| {
+                            PathElement::new(
+                                vec![(x, y), (x + 20, y)],
+                                legend_color.stroke_width(2),
+                            )
+                        });
+                    if s.style == Style::LinePoints {
+                        ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                            .map_err(|e| anyhow!("{e}"))?;
+                    }
+                }
+                Style::Points => {
+                    ctx.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                        .map_err(|e| anyhow!("{e}"))?
+                        .label(&s.name)
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 4, legend_color.filled()));
+                }
+                Style::Highlight => {
+                    ctx.draw_series(
+                        pts.iter()
+                            .map(|&p| Circle::new(p, 9, color.stroke_width(3))),
+                    )
+                    .map_err(|e| anyhow!("{e}"))?
+                    .label(&s.name)
+                    .legend(move |(x, y)| {
+                        Circle::new((x + 10, y), 6, legend_color.stroke_width(2))
+                    });
+                }
+            }
+        }
+        for s in spec.series.iter() {
+            if let Some(labels) = &s.labels {
+                ctx.draw_series(
+                    s.points
+                        .iter()
+                        .zip(labels)
+                        .filter(|((x, y), _)| {
+                            x.is_finite()
+                                && y.is_finite()
+                                && (!spec.log_x || *x > 0.0)
+                                && (!spec.log_y || *y > 0.0)
+                        })
+                        .map(|(&p, l)| {
+                            EmptyElement::at(p)
+                                + Text::new(l.clone(), (6, -14), ("sans-serif", 12).into_font())
+                        }),
+                )
+                .map_err(|e| anyhow!("{e}"))?;
+            }
+        }
+        ctx.configure_series_labels()
+            .label_font(("sans-serif", 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+    }};
+}
+
+/// Draw `chart` to a PNG at `path` (written atomically).
+pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
+    register_font();
+    let all = || chart.series.iter().flat_map(|s| s.points.iter());
+    let bands = || chart.series.iter().flat_map(|s| s.band.iter().flatten());
+    let (x0, x1) = range(all().map(|p| p.0), chart.log_x)
+        .with_context(|| format!("no plottable x values for {}", path.display()))?;
+    let ys = all().map(|p| p.1).chain(bands().flat_map(|b| [b.1, b.2]));
+    let (y0, y1) = range(ys, chart.log_y)
+        .with_context(|| format!("no plottable y values for {}", path.display()))?;
+    let mut buf = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        match (chart.log_x, chart.log_y) {
+            (false, false) => draw_chart!(&root, chart, x0..x1, y0..y1),
+            (true, false) => draw_chart!(&root, chart, (x0..x1).log_scale(), y0..y1),
+            (false, true) => draw_chart!(&root, chart, x0..x1, (y0..y1).log_scale()),
+            (true, true) => {
+                draw_chart!(&root, chart, (x0..x1).log_scale(), (y0..y1).log_scale())
+            }
+        }
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    crate::io::write_png_rgb(path, WIDTH, HEIGHT, &buf)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_labels() {
+        assert_eq!(tick(10.0), "10");
+        assert_eq!(tick(0.05), "0.05");
+        assert_eq!(tick(9.99999999e-6), "1e-5");
+        assert_eq!(tick(2.5e-6), "2.5e-6");
+        assert_eq!(tick(1e6), "1e6");
+    }
+
+    #[test]
+    fn draws_every_axis_kind() {
+        let dir = tempfile::tempdir().unwrap();
+        for (log_x, log_y) in [(false, false), (true, false), (false, true), (true, true)] {
+            let chart = Chart {
+                title: "test ± μ".into(),
+                x_label: "N".into(),
+                y_label: "seconds".into(),
+                log_x,
+                log_y,
+                series: vec![
+                    Series::new(
+                        "a",
+                        vec![(1.0, 2.0), (10.0, 20.0), (100.0, 150.0)],
+                        Style::LinePoints,
+                    ),
+                    Series::new("b", vec![(2.0, 1.0), (20.0, 0.0)], Style::Points),
+                    Series::new("c", vec![(5.0, 5.0)], Style::Highlight),
+                    Series::new("d", vec![(1.0, 3.0), (100.0, 30.0)], Style::Line)
+                        .with_band(vec![(1.0, 2.5, 3.5), (100.0, 25.0, 35.0)]),
+                ],
+            };
+            let path = dir.path().join(format!("{log_x}{log_y}.png"));
+            write_png(&chart, &path).unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            assert_eq!(&bytes[1..4], b"PNG");
+            assert!(bytes.len() > 5_000, "a chart with text and lines");
+        }
+    }
+}

@@ -1,0 +1,16 @@
+//! `dlca --seeds`: members run, fail alone, restart, and combine (`ensemble.json`), and
+//! `--merge` rebuilds the combined result.
+
+use std::path::Path;
+
+#[test]
+fn ensembles_run_combine_restart_and_merge() {
+    let dir = tempfile::tempdir().unwrap();
+    core_lattice::testing::ensemble_contract(
+        Path::new(env!("CARGO_BIN_EXE_dlca")),
+        "dlca",
+        dir.path(),
+        &["--size", "32", "--fill", "0.1", "--target-clusters", "4"],
+        "sweeps",
+    );
+}
