@@ -147,7 +147,7 @@ fn bad_inputs_are_refused_before_any_work() {
         ),
         (
             with(&["--resume", "ck", "--step-min", "0.25"]),
-            "--step-min 0.5 in the checkpoint, 0.25 given",
+            "--step-min 0.1 in the checkpoint, 0.25 given",
         ),
         (
             vec!["--particles", "200", "--out", "out", "--resume", "ck"],

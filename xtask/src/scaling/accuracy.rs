@@ -236,9 +236,14 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     ]);
     for (i, (m, p)) in measured.iter().zip(&points).enumerate() {
         let (dm, dse) = mean_stderr(&m.d);
-        let note = match (i, is_default(&m.setting)) {
-            (0, _) => "reference (most exact)",
-            (_, true) => "default",
+        let paper = m.setting.precision == 2.0
+            && m.setting.step_min == 0.5
+            && m.setting.far_field == FarField::Return
+            && m.setting.distance_map;
+        let note = match (i, is_default(&m.setting), paper) {
+            (0, _, _) => "reference (most exact)",
+            (_, true, _) => "default",
+            (_, _, true) => "the paper's near-field step (the default before it was measured)",
             _ => "",
         };
         table.row(vec![
@@ -334,8 +339,12 @@ fn pareto_chart(
         Series::new("Pareto front", fp, Style::Line),
     ];
     if let Some(i) = default {
+        let d = Params::default();
         series.push(Series::new(
-            "default (precision 2, step 0.5, return)",
+            format!(
+                "default (precision {}, step {}, return)",
+                d.precision, d.step_min
+            ),
             vec![at(i)],
             Style::Highlight,
         ));

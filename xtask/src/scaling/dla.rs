@@ -62,12 +62,13 @@ pub fn fit_from(n: u64) -> u64 {
 pub fn run(ctx: &Ctx) -> Result<()> {
     let mut doc =
         ctx.doc("Sosa-Herrera & Rodriguez-Romo: off-lattice DLA and PDLA (Fig. 3, Table 2)");
-    doc.p(
+    doc.p(&format!(
         "Off-lattice DLA on the orthtree (`docs/dla.md`) with the default parameters \
-         (birth gap 5, exact far-field return, step 0.5, vpdist precision 2) unless a table \
-         says otherwise. The paper used a jump-and-kill far field and 64-bit integer \
-         coordinates; see `docs/dla.md` for what we changed and why.",
-    );
+         (birth gap 5, exact far-field return, step {}, vpdist precision 2) unless a table \
+         says otherwise. The paper used a jump-and-kill far field, a near-field step of 0.5 \
+         and 64-bit integer coordinates; see `docs/dla.md` for what we changed and why.",
+        dla_pdla::params::DEFAULT_STEP_MIN
+    ));
     fig3(ctx, &mut doc)?;
     table2(ctx, &mut doc)?;
     speedup(ctx, &mut doc)?;
