@@ -14,3 +14,65 @@ fn ensembles_run_combine_restart_and_merge() {
         "radius_of_gyration",
     );
 }
+
+/// `mpirun -np 3 dla --seeds ...` (feature `mpi`, Open MPI installed): rank 0 hands the members
+/// out, ranks 1 and 2 run them; the combined result and every member are those of a local
+/// ensemble, and a member that cannot run is reported by seed.
+#[cfg(feature = "mpi")]
+#[test]
+fn ensembles_over_mpi_ranks() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let dla = env!("CARGO_BIN_EXE_dla");
+    let run = |args: &[&str]| {
+        Command::new("mpirun")
+            .args(["--allow-run-as-root", "--oversubscribe", "-np", "3", dla])
+            .args(args)
+            .args(["--particles", "500", "--jobs", "1", "-qq"])
+            .current_dir(dir.path())
+            .output()
+            .expect("mpirun starts (Open MPI installed)")
+    };
+    std::fs::create_dir_all(dir.path().join("mpi")).unwrap();
+    std::fs::write(dir.path().join("mpi/seed-0004"), b"in the way").unwrap();
+    let o = run(&["--seeds", "1..=5", "--out", "mpi"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("seed 4:"), "{err}");
+    let o = Command::new(dla)
+        .args([
+            "--seeds",
+            "1..=5",
+            "--particles",
+            "500",
+            "--out",
+            "local",
+            "-qq",
+        ])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json = |p: &str| -> serde_json::Value {
+        serde_json::from_slice(&std::fs::read(dir.path().join(p)).unwrap()).unwrap()
+    };
+    for seed in [1, 2, 3, 5] {
+        let m = format!("seed-{seed:04}/run.json");
+        assert_eq!(
+            json(&format!("mpi/{m}"))["results"]["state_hash"],
+            json(&format!("local/{m}"))["results"]["state_hash"]
+        );
+    }
+    assert_eq!(json("mpi/ensemble.json")["members"], 4);
+    std::fs::remove_file(dir.path().join("mpi/seed-0004")).unwrap();
+    let o = run(&["--seeds", "1..=5", "--out", "mpi"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The physics is the same; the time and memory of the members are not.
+    for key in ["radius_of_gyration", "r_ext", "particles"] {
+        assert_eq!(
+            json("mpi/ensemble.json")["results"][key],
+            json("local/ensemble.json")["results"][key],
+            "{key}"
+        );
+    }
+    assert_eq!(json("mpi/ensemble.json")["members"], 5);
+}

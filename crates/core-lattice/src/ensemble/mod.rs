@@ -15,6 +15,8 @@
 //!   curves with error bands, rebuilt from whatever members exist by `PROG --merge DIR`.
 
 mod merge;
+#[cfg(feature = "mpi")]
+mod ranks;
 mod seeds;
 
 pub use merge::{Curve, MergeReport, ScalarStats, merge};
@@ -140,6 +142,26 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     crate::cli::prepare_out_dir(e.out)
         .with_context(|| format!("creating output directory {}", e.out.display()))?;
     let stop = crate::cli::stop_on_signals().context("installing signal handlers")?;
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let default_jobs = (cores / e.member_threads.max(1)).max(1);
+    // Under mpirun (feature `mpi`), rank 0 hands out the members and every other rank only
+    // runs them.
+    #[cfg(feature = "mpi")]
+    let universe = mpi::initialize();
+    #[cfg(feature = "mpi")]
+    let world = universe.as_ref().map(|u| u.world()).filter(|w| {
+        use mpi::traits::Communicator;
+        w.size() > 1
+    });
+    #[cfg(feature = "mpi")]
+    if let Some(w) = &world {
+        use mpi::traits::Communicator;
+        if w.rank() != 0 {
+            let jobs = e.jobs.map_or(default_jobs, |j| j as usize);
+            ranks::work(w, &exe, &args, e.out, jobs, &stop);
+            return Ok(());
+        }
+    }
     let work: Vec<(u64, Todo)> = e
         .seeds
         .iter()
@@ -150,10 +172,9 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     if skipped > 0 {
         tracing::info!("{skipped} members finished already");
     }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let jobs = e
         .jobs
-        .map_or((cores / e.member_threads.max(1)).max(1), |j| j as usize)
+        .map_or(default_jobs, |j| j as usize)
         .min(work.len().max(1));
     let progress = e.log.progress(
         e.program,
@@ -161,31 +182,21 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
         "members",
         "{elapsed_precise} [{bar:40}] {pos}/{len} members (eta {eta})",
     );
-    let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
     let ended: Mutex<Vec<(u64, Ended)>> = Mutex::new(Vec::new());
-    std::thread::scope(|s| {
-        for _ in 0..jobs {
-            s.spawn(|| {
-                loop {
-                    if stop.load(Ordering::Relaxed) {
-                        return;
-                    }
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(&(seed, todo)) = work.get(i) else {
-                        return;
-                    };
-                    let end = run_member(&exe, &args, e.out, seed, todo, &stop);
-                    ended
-                        .lock()
-                        .unwrap_or_else(|p| p.into_inner())
-                        .push((seed, end));
-                    let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-                    progress.set_position(n as u64);
-                }
-            });
+    #[cfg(feature = "mpi")]
+    let distributed = world;
+    #[cfg(not(feature = "mpi"))]
+    let distributed: Option<()> = None;
+    match distributed {
+        #[cfg(feature = "mpi")]
+        Some(world) => {
+            let done = ranks::dispatch(&world, e.out, &work, &stop, &progress);
+            *ended.lock().unwrap_or_else(|p| p.into_inner()) = done;
         }
-    });
+        #[cfg(not(feature = "mpi"))]
+        Some(()) => {}
+        None => run_local(&exe, &args, e.out, &work, jobs, &stop, &progress, &ended),
+    }
     progress.finish();
     let mut ended = ended.into_inner().unwrap_or_else(|p| p.into_inner());
     ended.sort_by_key(|(s, _)| *s);
@@ -286,7 +297,17 @@ fn run_member(
     if status.code() == Some(i32::from(crate::cli::EXIT_INTERRUPTED)) || signalled {
         return Ended::Interrupted;
     }
-    let last = std::fs::read_to_string(&log_path)
+    let last = last_line(&log_path);
+    Ended::Failed(if last.is_empty() {
+        format!("exited with {status}")
+    } else {
+        last
+    })
+}
+
+/// The last non-empty line of a member's log (empty if none or unreadable).
+fn last_line(log: &Path) -> String {
+    std::fs::read_to_string(log)
         .ok()
         .and_then(|s| {
             s.lines()
@@ -294,8 +315,45 @@ fn run_member(
                 .find(|l| !l.trim().is_empty())
                 .map(str::to_owned)
         })
-        .unwrap_or_else(|| format!("exited with {status}"));
-    Ended::Failed(last)
+        .unwrap_or_default()
+}
+
+/// Runs `work` on this machine, `jobs` members at a time, recording how each ended.
+#[allow(clippy::too_many_arguments)]
+fn run_local(
+    exe: &Path,
+    args: &[OsString],
+    out: &Path,
+    work: &[(u64, Todo)],
+    jobs: usize,
+    stop: &AtomicBool,
+    progress: &crate::cli::Progress,
+    ended: &Mutex<Vec<(u64, Ended)>>,
+) {
+    let next = AtomicUsize::new(0);
+    let done = AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            s.spawn(|| {
+                loop {
+                    if stop.load(Ordering::Relaxed) {
+                        return;
+                    }
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&(seed, todo)) = work.get(i) else {
+                        return;
+                    };
+                    let end = run_member(exe, args, out, seed, todo, stop);
+                    ended
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .push((seed, end));
+                    let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    progress.set_position(n as u64);
+                }
+            });
+        }
+    });
 }
 
 /// Sends SIGTERM to a member (it checkpoints and stops if it checkpoints at all).
