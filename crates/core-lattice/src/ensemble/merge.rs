@@ -46,19 +46,21 @@ pub struct ScalarStats {
 }
 
 impl ScalarStats {
-    /// The statistics of `values` (not empty).
+    /// The statistics of `values` (not empty), by Welford's update
+    /// ([`crate::stats::Welford`], as every mean and error in the workspace).
     pub fn of(values: &[f64]) -> Self {
+        let mut w = crate::stats::Welford::new();
+        values.iter().for_each(|&v| w.push(v));
         let n = values.len();
-        let mean = values.iter().sum::<f64>() / n as f64;
-        let var = if n > 1 {
-            values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64
+        let (std, stderr) = if n > 1 {
+            (w.std_dev(), w.std_error())
         } else {
-            0.0
+            (0.0, 0.0)
         };
         ScalarStats {
-            mean,
-            std: var.sqrt(),
-            stderr: (var / n as f64).sqrt(),
+            mean: w.mean(),
+            std,
+            stderr,
             n,
         }
     }
