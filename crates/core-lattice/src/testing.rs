@@ -184,26 +184,28 @@ fn manifest(dir: &Path) -> serde_json::Value {
 }
 
 /// The ensemble contract of a model binary (`--seeds`, see [`crate::ensemble`]), with the run
-/// flags `flags` (small and fast), checked in the working directory `dir`:
+/// flags `flags` (small and fast), checked in the working directory `dir`; `scalar` names a
+/// numeric result every member reports:
 ///
 /// - a bad list, or `--seeds` with `--seed`, is a usage error (exit code 2);
-/// - of `--seeds 1..=3`, a member that cannot run (its directory is taken by a file) is
-///   reported by seed with exit code 1 while the others finish and are combined
-///   (`ensemble.json` with `results.state_hash` absent and a scalar with `n` = 2);
-/// - every member equals the plain run with its seed (same `state_hash`);
-/// - rerunning the command runs only the missing member and leaves the finished ones alone;
-/// - `--merge DIR` rebuilds the same combined results.
+/// - an ensemble of 4 seeds killed (SIGKILL, with its members) after its second member and run
+///   again finishes only the missing members, and equals an uninterrupted ensemble;
+/// - every member equals the plain run with its seed (same `state_hash`), and every combined
+///   mean and standard error equals a direct computation from the members' `run.json`;
+/// - a member that cannot run is reported by seed with exit code 1 while the others finish and
+///   are combined;
+/// - `--merge` combines what is there, reporting a corrupt and a missing member.
 pub fn ensemble_contract(binary: &Path, program: &str, dir: &Path, flags: &[&str], scalar: &str) {
-    let run = |args: &[&str]| {
-        Command::new(binary)
-            .args(args)
+    let command = |args: &[&str]| {
+        let mut c = Command::new(binary);
+        c.args(args)
             .args(flags)
             .arg("-qq")
             .current_dir(dir)
-            .stdin(Stdio::null())
-            .output()
-            .expect("the binary starts")
+            .stdin(Stdio::null());
+        c
     };
+    let run = |args: &[&str]| command(args).output().expect("the binary starts");
     for bad in [
         &["--seeds", "1,1", "--out", "bad"][..],
         &["--seeds", "3..=1", "--out", "bad"],
@@ -218,23 +220,77 @@ pub fn ensemble_contract(binary: &Path, program: &str, dir: &Path, flags: &[&str
         );
         assert!(!dir.join("bad").exists(), "{bad:?} created its --out");
     }
+
+    // Killed midway, with its members (a crashed node), then run again.
     let ens = dir.join("ens");
-    std::fs::create_dir_all(&ens).expect("creating the ensemble directory");
-    std::fs::write(ens.join("seed-0003"), b"in the way").expect("a blocking file");
-    let o = run(&["--seeds", "1..=3", "--out", "ens"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.starts_with(&format!("{program}: run failed: "))
-            && err.contains("seed 3:")
-            && err.lines().count() == 1,
-        "{err}"
+    let mut cmd = command(&["--seeds", "1..=4", "--jobs", "1", "--out", "ens"]);
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
+    let (mut child, running) = spawn_until_written(&mut cmd, &ens.join("seed-0002/run.json"));
+    assert!(running, "the ensemble ended before it could be killed");
+    #[cfg(unix)]
+    {
+        use nix::sys::signal::{Signal, killpg};
+        let _ = killpg(
+            nix::unistd::Pid::from_raw(child.id() as i32),
+            Signal::SIGKILL,
+        );
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(!ens.join("ensemble.json").exists());
+    let mtime = |seed: u64| {
+        std::fs::metadata(ens.join(format!("seed-{seed:04}/run.json")))
+            .and_then(|m| m.modified())
+            .expect("a finished member")
+    };
+    let before = (mtime(1), mtime(2));
+    let o = run(&["--seeds", "1..=4", "--out", "ens"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        (mtime(1), mtime(2)),
+        before,
+        "a finished member was run again"
     );
+    let o = run(&["--seeds", "1..=4", "--out", "whole"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let doc = manifest_named(&ens, "ensemble.json");
-    assert_eq!(doc["members"], 2, "{doc}");
-    assert_eq!(doc["results"][scalar]["n"], 2, "{doc}");
-    assert!(doc["results"].get("state_hash").is_none());
-    for seed in [1u64, 2] {
+    let whole = manifest_named(&dir.join("whole"), "ensemble.json");
+    assert_eq!(doc["members"], 4);
+    let results = doc["results"].as_object().expect("results");
+    assert!(results.contains_key(scalar), "{doc}");
+    assert!(results.get("state_hash").is_none());
+    for (key, stats) in results {
+        // Times and memory are the machine's, not the model's.
+        if !key.contains("seconds") && !key.contains("bytes") {
+            assert_eq!(
+                *stats, whole["results"][key],
+                "{key}: resumed and whole ensembles differ"
+            );
+        }
+        // Against a direct computation from the members' run.json.
+        let values: Vec<f64> = (1..=4)
+            .filter_map(|s| {
+                let m = manifest(&ens.join(format!("seed-{s:04}")));
+                // Time and memory are top-level keys of run.json, the rest are results.
+                m["results"][key].as_f64().or_else(|| m[key].as_f64())
+            })
+            .collect();
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300);
+        assert_eq!(stats["n"].as_u64(), Some(values.len() as u64), "{key}");
+        assert!(
+            close(stats["mean"].as_f64().unwrap(), mean),
+            "{key}: {stats} against {mean}"
+        );
+        assert!(
+            close(stats["stderr"].as_f64().unwrap(), (var / n).sqrt()),
+            "{key}: {stats}"
+        );
+    }
+    for seed in 1u64..=4 {
         let single = format!("single-{seed}");
         let o = run(&["--seed", &seed.to_string(), "--out", &single]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -244,31 +300,46 @@ pub fn ensemble_contract(binary: &Path, program: &str, dir: &Path, flags: &[&str
             "member {seed} differs from the plain run with its seed"
         );
     }
-    std::fs::remove_file(ens.join("seed-0003")).expect("removing the blocking file");
-    let before = std::fs::metadata(ens.join("seed-0001/run.json"))
-        .and_then(|m| m.modified())
-        .expect("mtime");
-    let o = run(&["--seeds", "1..=3", "--out", "ens"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let after = std::fs::metadata(ens.join("seed-0001/run.json"))
-        .and_then(|m| m.modified())
-        .expect("mtime");
-    assert_eq!(before, after, "a finished member was run again");
-    let doc = manifest_named(&ens, "ensemble.json");
-    assert_eq!(doc["members"], 3);
-    assert_eq!(doc["results"][scalar]["n"], 3);
-    let mean = doc["results"][scalar]["mean"].as_f64().expect("a mean");
-    assert!(mean.is_finite());
-    std::fs::remove_file(ens.join("ensemble.json")).expect("removing ensemble.json");
+
+    // A member that cannot run.
+    let blocked = dir.join("blocked");
+    std::fs::create_dir_all(&blocked).expect("creating a directory");
+    std::fs::write(blocked.join("seed-0003"), b"in the way").expect("a blocking file");
+    let o = run(&["--seeds", "1..=4", "--out", "blocked"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(&format!("{program}: run failed: "))
+            && err.contains("seed 3:")
+            && err.lines().count() == 1,
+        "{err}"
+    );
+    let b = manifest_named(&blocked, "ensemble.json");
+    assert_eq!(b["members"], 3, "{b}");
+    assert_eq!(b["results"][scalar]["n"], 3, "{b}");
+
+    // --merge with a corrupt and a missing member.
+    std::fs::write(ens.join("seed-0004/run.json"), b"{\"model\": ").expect("corrupting");
+    std::fs::create_dir_all(ens.join("seed-0009")).expect("an unfinished member");
     let o = Command::new(binary)
         .args(["--merge", "ens"])
         .current_dir(dir)
         .output()
         .expect("the binary starts");
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert_eq!(
-        manifest_named(&ens, "ensemble.json")["results"],
-        doc["results"]
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("seed-0004") && err.contains("seed-0009"),
+        "{err}"
+    );
+    let m = manifest_named(&ens, "ensemble.json");
+    assert_eq!(m["members"], 3);
+    assert_eq!(m["unfinished"][0], "seed-0009");
+    assert!(
+        m["invalid"][0]
+            .as_str()
+            .is_some_and(|s| s.starts_with("seed-0004")),
+        "{m}"
     );
     assert!(ens.join("ensemble.md").is_file());
 }

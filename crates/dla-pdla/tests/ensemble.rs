@@ -35,13 +35,13 @@ fn ensembles_over_mpi_ranks() {
     };
     std::fs::create_dir_all(dir.path().join("mpi")).unwrap();
     std::fs::write(dir.path().join("mpi/seed-0004"), b"in the way").unwrap();
-    let o = run(&["--seeds", "1..=5", "--out", "mpi"]);
+    let o = run(&["--seeds", "1..=6", "--out", "mpi"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("seed 4:"), "{err}");
     let o = Command::new(dla)
         .args([
             "--seeds",
-            "1..=5",
+            "1..=6",
             "--particles",
             "500",
             "--out",
@@ -55,16 +55,16 @@ fn ensembles_over_mpi_ranks() {
     let json = |p: &str| -> serde_json::Value {
         serde_json::from_slice(&std::fs::read(dir.path().join(p)).unwrap()).unwrap()
     };
-    for seed in [1, 2, 3, 5] {
+    for seed in [1, 2, 3, 5, 6] {
         let m = format!("seed-{seed:04}/run.json");
         assert_eq!(
             json(&format!("mpi/{m}"))["results"]["state_hash"],
             json(&format!("local/{m}"))["results"]["state_hash"]
         );
     }
-    assert_eq!(json("mpi/ensemble.json")["members"], 4);
+    assert_eq!(json("mpi/ensemble.json")["members"], 5);
     std::fs::remove_file(dir.path().join("mpi/seed-0004")).unwrap();
-    let o = run(&["--seeds", "1..=5", "--out", "mpi"]);
+    let o = run(&["--seeds", "1..=6", "--out", "mpi"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     // The physics is the same; the time and memory of the members are not.
     for key in ["radius_of_gyration", "r_ext", "particles"] {
@@ -74,5 +74,5 @@ fn ensembles_over_mpi_ranks() {
             "{key}"
         );
     }
-    assert_eq!(json("mpi/ensemble.json")["members"], 5);
+    assert_eq!(json("mpi/ensemble.json")["members"], 6);
 }

@@ -73,6 +73,8 @@ pub struct MergeReport {
     pub members: usize,
     /// Member directories without one (unfinished or failed).
     pub unfinished: Vec<String>,
+    /// Members left out because their `run.json` cannot be read, with the reason.
+    pub invalid: Vec<String>,
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -90,6 +92,7 @@ struct Member {
 pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<MergeReport> {
     let mut members = Vec::new();
     let mut unfinished = Vec::new();
+    let mut invalid = Vec::new();
     let entries = std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))?;
     for entry in entries {
         let entry = entry.with_context(|| format!("reading {}", dir.display()))?;
@@ -102,8 +105,14 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
             unfinished.push(name);
             continue;
         }
-        let manifest =
-            RunManifest::read(&path).with_context(|| format!("reading {}", path.display()))?;
+        let manifest = match RunManifest::read(&path) {
+            Ok(m) => m,
+            Err(e) => {
+                // A truncated or foreign file: reported, and the other members combined.
+                invalid.push(format!("{name}: {}: {e}", path.display()));
+                continue;
+            }
+        };
         if manifest.model != program {
             bail!(
                 "{} is a {} run, not a {program} run",
@@ -122,6 +131,10 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
     }
     members.sort_by_key(|m| m.seed);
     unfinished.sort();
+    invalid.sort();
+    for why in &invalid {
+        tracing::warn!("member left out: {why}");
+    }
     let first = &members[0];
     for m in &members[1..] {
         let differ = crate::cli::labelled_differences(
@@ -207,6 +220,7 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
         "members": members.len(),
         "seeds": members.iter().map(|m| m.seed).collect::<Vec<_>>(),
         "unfinished": unfinished,
+        "invalid": invalid,
         "results": results,
         "per_member": per_member,
         "curves": curve_files,
@@ -220,22 +234,34 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
     let md_path = dir.join("ensemble.md");
     write_atomic(
         &md_path,
-        markdown(program, &members, &unfinished, &results, curves, &doc).as_bytes(),
+        markdown(
+            program,
+            &members,
+            &unfinished,
+            &invalid,
+            &results,
+            curves,
+            &doc,
+        )
+        .as_bytes(),
     )
     .with_context(|| format!("writing {}", md_path.display()))?;
     files.push(md_path);
     Ok(MergeReport {
         members: members.len(),
         unfinished,
+        invalid,
         files,
     })
 }
 
 /// `ensemble.md`: the parameters, the members, the results table, the curves.
+#[allow(clippy::too_many_arguments)]
 fn markdown(
     program: &str,
     members: &[Member],
     unfinished: &[String],
+    invalid: &[String],
     results: &BTreeMap<&str, ScalarStats>,
     curves: &[Curve],
     doc: &Value,
@@ -246,6 +272,9 @@ fn markdown(
     let _ = writeln!(s, "Seeds: {}.", seeds.join(", "));
     if !unfinished.is_empty() {
         let _ = writeln!(s, "Not finished (not included): {}.", unfinished.join(", "));
+    }
+    for why in invalid {
+        let _ = writeln!(s, "Left out, unreadable: {why}.");
     }
     let _ = writeln!(
         s,
@@ -497,9 +526,17 @@ mod tests {
         member(dir.path(), 1, "m", 1.0, "size,count\n1,4\n2,2\n");
         member(dir.path(), 2, "m", 3.0, "size,count\n1,2\n3,1\n");
         std::fs::create_dir_all(dir.path().join("seed-0003")).unwrap();
+        std::fs::create_dir_all(dir.path().join("seed-0004")).unwrap();
+        std::fs::write(
+            dir.path().join("seed-0004/run.json"),
+            b"{\"model\": \"m\", ",
+        )
+        .unwrap();
         let r = merge(dir.path(), "m", &[SIZES]).unwrap();
         assert_eq!(r.members, 2);
         assert_eq!(r.unfinished, vec!["seed-0003".to_string()]);
+        assert_eq!(r.invalid.len(), 1);
+        assert!(r.invalid[0].starts_with("seed-0004: "), "{:?}", r.invalid);
         let doc: Value =
             serde_json::from_slice(&std::fs::read(dir.path().join("ensemble.json")).unwrap())
                 .unwrap();

@@ -289,7 +289,7 @@ fn run_member(
             signalled = true;
             terminate(&child);
         }
-        std::thread::sleep(Duration::from_millis(50));
+        std::thread::sleep(Duration::from_millis(5));
     };
     if status.success() {
         return Ended::Ok;
@@ -380,11 +380,19 @@ pub fn merge_main(program: &str, curves: &[Curve]) -> Option<ExitCode> {
     };
     Some(match merge(&dir, program, curves) {
         Ok(r) => {
+            for why in &r.invalid {
+                eprintln!("{program}: warning: left out {why}");
+            }
             eprintln!(
-                "{program}: combined {} members of {} into {}",
+                "{program}: combined {} members of {} into {}{}",
                 r.members,
                 dir.display(),
-                dir.join("ensemble.json").display()
+                dir.join("ensemble.json").display(),
+                if r.unfinished.is_empty() {
+                    String::new()
+                } else {
+                    format!("; not finished: {}", r.unfinished.join(", "))
+                }
             );
             ExitCode::SUCCESS
         }
