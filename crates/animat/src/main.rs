@@ -9,7 +9,7 @@ use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
-use core_lattice::ensemble::{Curve, Ensemble, EnsembleArgs};
+use core_lattice::ensemble::{Curve, EnsembleArgs};
 use core_lattice::io::{RunClock, read_checkpoint, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -187,17 +187,10 @@ fn main() -> ExitCode {
         "animat",
         |c: &Cli| c.log,
         params,
-        |cli, params| match &cli.ensemble.seeds {
-            Some(seeds) => core_lattice::ensemble::run(&Ensemble {
-                program: "animat",
-                seeds: &seeds.0,
-                jobs: cli.ensemble.jobs,
-                member_threads: 1,
-                out: &cli.out,
-                curves: CURVES,
-                log: &cli.log,
-            }),
-            None => run(cli, params),
+        |cli, params| {
+            cli.ensemble
+                .run("animat", 1, &cli.out, CURVES, &cli.log)
+                .unwrap_or_else(|| run(cli, params))
         },
     )
 }

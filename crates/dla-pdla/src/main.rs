@@ -6,7 +6,7 @@
 use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
-use core_lattice::ensemble::{Curve, Ensemble, EnsembleArgs};
+use core_lattice::ensemble::{Curve, EnsembleArgs};
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
@@ -235,19 +235,15 @@ fn main() -> ExitCode {
         params,
         // The one run-time dimension dispatch: adding a dimension is one arm here (and its
         // `Space` implementation).
-        |cli, params: Params| match (&cli.ensemble.seeds, params.dim) {
-            (Some(seeds), _) => core_lattice::ensemble::run(&Ensemble {
-                program: "dla",
-                seeds: &seeds.0,
-                jobs: cli.ensemble.jobs,
-                member_threads: params.threads,
-                out: &cli.out,
-                curves: CURVES,
-                log: &cli.log,
-            }),
-            (None, 2) => run::<2>(cli, params),
-            (None, 3) => run::<3>(cli, params),
-            (None, d) => Err(ParamsError::Dim(d).into()),
+        |cli, params: Params| {
+            let ensemble = cli
+                .ensemble
+                .run("dla", params.threads, &cli.out, CURVES, &cli.log);
+            ensemble.unwrap_or_else(|| match params.dim {
+                2 => run::<2>(cli, params),
+                3 => run::<3>(cli, params),
+                d => Err(ParamsError::Dim(d).into()),
+            })
         },
     )
 }

@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
-use core_lattice::ensemble::{Curve, Ensemble, EnsembleArgs};
+use core_lattice::ensemble::{Curve, EnsembleArgs};
 use core_lattice::io::RunClock;
 use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
@@ -314,17 +314,10 @@ fn main() -> ExitCode {
         "dlca",
         |c: &Cli| c.log,
         params,
-        |cli, params| match &cli.ensemble.seeds {
-            Some(seeds) => core_lattice::ensemble::run(&Ensemble {
-                program: "dlca",
-                seeds: &seeds.0,
-                jobs: cli.ensemble.jobs,
-                member_threads: 1,
-                out: &cli.out,
-                curves: CURVES,
-                log: &cli.log,
-            }),
-            None => run(cli, params),
+        |cli, params| {
+            cli.ensemble
+                .run("dlca", 1, &cli.out, CURVES, &cli.log)
+                .unwrap_or_else(|| run(cli, params))
         },
     )
 }

@@ -47,6 +47,30 @@ pub struct EnsembleArgs {
     pub jobs: Option<u64>,
 }
 
+impl EnsembleArgs {
+    /// Runs the ensemble these flags ask for, if they ask for one (`--seeds`): the branch every
+    /// model binary takes before its own run. `member_threads` is each member's `--threads`.
+    pub fn run(
+        &self,
+        program: &str,
+        member_threads: usize,
+        out: &Path,
+        curves: &[Curve],
+        log: &LogArgs,
+    ) -> Option<anyhow::Result<()>> {
+        let seeds = self.seeds.as_ref()?;
+        Some(run(&Ensemble {
+            program,
+            seeds: &seeds.0,
+            jobs: self.jobs,
+            member_threads,
+            out,
+            curves,
+            log,
+        }))
+    }
+}
+
 /// One ensemble to run.
 #[derive(Debug, Clone, Copy)]
 pub struct Ensemble<'a> {
