@@ -133,6 +133,23 @@ pub fn kill_once_written(cmd: &mut Command, file: &Path) -> bool {
     running
 }
 
+/// Like [`kill_once_written`], but `cmd` runs in a process group of its own and the whole group
+/// is killed: a process and the children it started (an ensemble and its members), as a node
+/// that crashes. Returns whether the process was still running when killed.
+pub fn kill_group_once_written(cmd: &mut Command, file: &Path) -> bool {
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(cmd, 0);
+    let (mut child, running) = spawn_until_written(cmd, file);
+    #[cfg(unix)]
+    if let Ok(pid) = i32::try_from(child.id()) {
+        use nix::sys::signal::{Signal, killpg};
+        let _ = killpg(nix::unistd::Pid::from_raw(pid), Signal::SIGKILL);
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    running
+}
+
 /// Starts `cmd`, waits until `file` exists, then sends it SIGTERM (as a batch system's time
 /// limit does) and waits for it. Returns whether it was still running when signalled, and its
 /// exit code.
@@ -223,21 +240,11 @@ pub fn ensemble_contract(binary: &Path, program: &str, dir: &Path, flags: &[&str
 
     // Killed midway, with its members (a crashed node), then run again.
     let ens = dir.join("ens");
-    let mut cmd = command(&["--seeds", "1..=4", "--jobs", "1", "--out", "ens"]);
-    #[cfg(unix)]
-    std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
-    let (mut child, running) = spawn_until_written(&mut cmd, &ens.join("seed-0002/run.json"));
+    let running = kill_group_once_written(
+        &mut command(&["--seeds", "1..=4", "--jobs", "1", "--out", "ens"]),
+        &ens.join("seed-0002/run.json"),
+    );
     assert!(running, "the ensemble ended before it could be killed");
-    #[cfg(unix)]
-    {
-        use nix::sys::signal::{Signal, killpg};
-        let _ = killpg(
-            nix::unistd::Pid::from_raw(child.id() as i32),
-            Signal::SIGKILL,
-        );
-    }
-    let _ = child.kill();
-    let _ = child.wait();
     assert!(!ens.join("ensemble.json").exists());
     let mtime = |seed: u64| {
         std::fs::metadata(ens.join(format!("seed-{seed:04}/run.json")))

@@ -15,6 +15,59 @@ fn ensembles_run_combine_restart_and_merge() {
     );
 }
 
+/// Members that checkpoint: an ensemble killed (with its members) while the first member runs
+/// leaves that member with a checkpoint and no `run.json`; run again, the ensemble resumes it
+/// (`--resume`), and it ends as the plain run with its seed.
+#[test]
+fn checkpointed_members_are_resumed() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let dla = env!("CARGO_BIN_EXE_dla");
+    let flags = ["--particles", "20000", "--checkpoint-every", "500"];
+    let ens = dir.path().join("ens");
+    let mut cmd = Command::new(dla);
+    cmd.args(["--seeds", "1..=2", "--jobs", "1", "-qq", "--out"])
+        .arg(&ens)
+        .args(flags);
+    let running = core_lattice::testing::kill_group_once_written(
+        &mut cmd,
+        &ens.join("seed-0001/checkpoint.bin"),
+    );
+    assert!(running, "the ensemble ended before it could be killed");
+    assert!(
+        !ens.join("seed-0001/run.json").exists(),
+        "member 1 finished before the kill"
+    );
+    let o = Command::new(dla)
+        .args(["--seeds", "1..=2", "--out"])
+        .arg(&ens)
+        .args(flags)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("(0 already, 1 resumed from a checkpoint)"),
+        "{err}"
+    );
+    let o = Command::new(dla)
+        .args(["--seed", "1", "-qq", "--out"])
+        .arg(dir.path().join("plain"))
+        .args(flags)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let hash = |p: &std::path::Path| -> serde_json::Value {
+        let m: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(p.join("run.json")).unwrap()).unwrap();
+        m["results"]["state_hash"].clone()
+    };
+    assert_eq!(
+        hash(&ens.join("seed-0001")),
+        hash(&dir.path().join("plain"))
+    );
+}
+
 /// `mpirun -np 3 dla --seeds ...` (feature `mpi`, Open MPI installed): rank 0 hands the members
 /// out, ranks 1 and 2 run them; the combined result and every member are those of a local
 /// ensemble, and a member that cannot run is reported by seed.

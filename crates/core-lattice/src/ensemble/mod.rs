@@ -193,6 +193,7 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
         .filter(|(_, t)| *t != Todo::Finished)
         .collect();
     let skipped = e.seeds.len() - work.len();
+    let resumed = work.iter().filter(|(_, t)| *t == Todo::Resume).count();
     if skipped > 0 {
         tracing::info!("{skipped} members finished already");
     }
@@ -237,11 +238,13 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     if !e.log.is_quiet() {
         if let Ok(r) = &report {
             eprintln!(
-                "{}: ensemble of {} members in {}: {} finished, {} failed; {}",
+                "{}: ensemble of {} members in {}: {} finished ({} already, {} resumed from a checkpoint), {} failed; {}",
                 e.program,
                 e.seeds.len(),
                 e.out.display(),
                 r.members,
+                skipped,
+                resumed,
                 failed.len(),
                 e.out.join("ensemble.json").display()
             );
