@@ -57,7 +57,7 @@ fn checkpointed_members_are_resumed() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let hash = |p: &std::path::Path| -> serde_json::Value {
+    let hash = |p: &Path| -> serde_json::Value {
         let m: serde_json::Value =
             serde_json::from_slice(&std::fs::read(p.join("run.json")).unwrap()).unwrap();
         m["results"]["state_hash"].clone()
