@@ -98,6 +98,12 @@ pub const DLA_LEAF_SIDE: f64 = 8.0;
 /// branch stick sooner). `--step-min 0.5` is the paper's setting.
 pub const DEFAULT_STEP_MIN: f64 = 0.1;
 
+/// Smallest accepted near-field step: the contact tolerance. A walker at distance `r` from the
+/// origin moves only if its step exceeds the rounding of `r` (about `r * 1.1e-16`); 1e-6 is ten
+/// thousand times that at the radius of a 1e9-particle cluster, while `--step-min 1e-300` would
+/// leave a walker in place forever.
+pub const MIN_STEP_MIN: f64 = 1e-6;
+
 fn default_leaf_side() -> f64 {
     DLA_LEAF_SIDE
 }
@@ -136,6 +142,16 @@ fn dimension_list() -> String {
 /// [`OrthtreeError::CapacityExceeded`](spatial::orthtree::OrthtreeError::CapacityExceeded).
 pub const MAX_PARTICLES: u64 = 3_500_000_000;
 
+/// A value as a user would type it: `0.25`, `1000`, or `1e-300` for the very small and large.
+fn short(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-4..1e15).contains(&a) {
+        format!("{v:e}")
+    } else {
+        v.to_string()
+    }
+}
+
 /// A parameter outside its accepted range; the message names the value and the range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamsError {
@@ -154,7 +170,10 @@ pub enum ParamsError {
     #[error("--death-ratio {0} is outside the accepted range (1, 1e300]")]
     DeathRatio(f64),
     /// `step_min` not positive or too large.
-    #[error("--step-min {0} is outside the accepted range (0, 1e3]")]
+    #[error(
+        "--step-min {} is outside the accepted range [1e-6, 1e3] (a step below the contact tolerance of 1e-6 diameters is lost to rounding at the cluster's coordinates, so the walker would never move)",
+        short(*.0)
+    )]
     StepMin(f64),
     /// `precision` not > 1/2 (vpdist needs kappa > 1/2 to be useful).
     #[error("--precision {0} is outside the accepted range (0.5, inf] (inf = exact search)")]
@@ -187,7 +206,7 @@ impl Params {
         if !(self.death_ratio > 1.0 && self.death_ratio <= 1e300) {
             return Err(ParamsError::DeathRatio(self.death_ratio));
         }
-        if !(self.step_min > 0.0 && self.step_min <= 1e3) {
+        if !(MIN_STEP_MIN..=1e3).contains(&self.step_min) {
             return Err(ParamsError::StepMin(self.step_min));
         }
         if self.precision.is_nan() || self.precision <= 0.5 {
@@ -248,7 +267,7 @@ mod tests {
                     ..d()
                 },
                 "--step-min 0 ",
-                "(0, 1e3]",
+                "[1e-6, 1e3]",
             ),
             (
                 Params {
@@ -256,7 +275,15 @@ mod tests {
                     ..d()
                 },
                 "--step-min -1 ",
-                "(0, 1e3]",
+                "[1e-6, 1e3]",
+            ),
+            (
+                Params {
+                    step_min: 1e-300,
+                    ..d()
+                },
+                "--step-min 1e-300 ",
+                "[1e-6, 1e3] (a step below",
             ),
             (Params { threads: 0, ..d() }, "--threads 0 ", "1..=1024"),
             (

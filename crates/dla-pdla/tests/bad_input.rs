@@ -108,6 +108,7 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--dim", "1"]), "--dim 1"),
         (with(&["--step-min", "0"]), "--step-min 0"),
         (with(&["--step-min", "NaN"]), "--step-min NaN"),
+        (with(&["--step-min", "1e-300"]), "[1e-6, 1e3]"),
         (with(&["--precision", "0.5"]), "--precision 0.5"),
         (with(&["--birth-gap", "0.5"]), "--birth-gap 0.5"),
         (with(&["--death-ratio", "1"]), "--death-ratio 1"),
