@@ -2,7 +2,7 @@
 //! its peak RSS is its own, reported as JSON (seconds, peak RSS, per-item rates) and, with
 //! `--against`, as ratios to a saved baseline.
 
-use crate::report::{machine, utc_now};
+use crate::report::{build_id, machine, utc_now};
 use anyhow::{Context, Result, bail};
 use core_lattice::io::{RunManifest, write_atomic};
 use serde::{Deserialize, Serialize};
@@ -154,6 +154,9 @@ pub struct BenchReport {
     pub date: String,
     /// Where it ran.
     pub machine: String,
+    /// What ran: version and git commit.
+    #[serde(default)]
+    pub build: String,
     /// The measurements.
     pub workloads: Vec<Measurement>,
     /// Ratios to a baseline (`--against`), if one was given.
@@ -400,6 +403,7 @@ pub fn run(
     let mut report = BenchReport {
         date: utc_now(),
         machine: machine(),
+        build: build_id(),
         workloads,
         against: Vec::new(),
     };
@@ -519,6 +523,7 @@ mod tests {
         let r = BenchReport {
             date: "d".into(),
             machine: "m".into(),
+            build: "b".into(),
             workloads: vec![m("a", 1.0, 2, "h")],
             against: Vec::new(),
         };

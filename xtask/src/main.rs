@@ -37,7 +37,9 @@ enum Cmd {
         no_tests: bool,
     },
     /// Regenerate the papers' tables and figures from our own runs, with fitted exponents and
-    /// error bars beside the published values: markdown, CSV and PNG under --out.
+    /// error bars beside the published values: markdown, CSV and PNG under --out. Builds the
+    /// release binaries first; multi-seed experiments run them as ensembles (`--seeds`) whose
+    /// members stay in target/scaling-runs/.
     Scaling {
         /// Smaller sizes, under 3 minutes on 2 cores; every table says so. Default output
         /// directory: docs/results/quick/.
@@ -195,6 +197,10 @@ fn main() -> Result<()> {
                 .chain(std::env::args().skip(1))
                 .collect::<Vec<_>>()
                 .join(" ");
+            // The multi-seed experiments run the model binaries' own ensembles.
+            let root = workspace_root();
+            xtask::bench::build(&root, &cargo())?;
+            let target = xtask::bench::target_dir(&root);
             let start = Instant::now();
             let times = xtask::scaling::run(&Options {
                 scale,
@@ -202,6 +208,10 @@ fn main() -> Result<()> {
                 out: out.clone(),
                 seed,
                 command,
+                bin_dir: target.join("release"),
+                runs: target
+                    .join("scaling-runs")
+                    .join(scale.name().split(' ').next().unwrap_or("runs")),
             })?;
             eprintln!(
                 "==> {} experiment(s) in {:.1} s; reports in {}",

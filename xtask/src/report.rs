@@ -6,7 +6,7 @@ use core_lattice::Welford;
 use core_lattice::io::{CsvField, CsvWriter, write_atomic};
 use std::fmt::Write as _;
 use std::path::Path;
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::time::SystemTime;
 
 /// A table written both as markdown (for the report) and as CSV (the data behind it).
 #[derive(Debug, Clone, Default)]
@@ -126,44 +126,23 @@ pub fn std_dev(xs: &[f64]) -> f64 {
 
 /// Today's date and time in UTC, `YYYY-MM-DD HH:MM UTC`, from the system clock.
 pub fn utc_now() -> String {
-    let secs = SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map(|d| d.as_secs())
-        .unwrap_or(0);
-    let (days, rem) = (secs / 86_400, secs % 86_400);
-    let (y, m, d) = civil_from_days(days as i64);
-    format!(
-        "{y:04}-{m:02}-{d:02} {:02}:{:02} UTC",
-        rem / 3600,
-        (rem % 3600) / 60
-    )
+    core_lattice::io::provenance::utc_minutes(SystemTime::now())
 }
 
-/// Proleptic Gregorian date of a day count since 1970-01-01 (H. Hinnant's algorithm).
-fn civil_from_days(z: i64) -> (i64, u32, u32) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    (y, m, d)
+/// The build: `aggsim 0.1.0 at commit <hash>` (the commit when built from a git checkout).
+pub fn build_id() -> String {
+    match core_lattice::io::provenance::GIT_COMMIT {
+        Some(c) => format!("aggsim {} at commit {c}", env!("CARGO_PKG_VERSION")),
+        None => format!(
+            "aggsim {} (not built from a git checkout)",
+            env!("CARGO_PKG_VERSION")
+        ),
+    }
 }
 
 /// One line describing the machine: CPU model, logical cores, memory, kernel, rustc.
 pub fn machine() -> String {
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
-        .unwrap_or_else(|| "unknown CPU".to_string());
+    let cpu = core_lattice::io::provenance::cpu_model();
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);
@@ -248,13 +227,6 @@ mod tests {
         assert_eq!(pm(2.0, 0.0), "2.000");
         assert_eq!(sig(0.012345, 3), "0.0123");
         assert_eq!(sig(1.5e-7, 2), "1.5e-7");
-    }
-
-    #[test]
-    fn dates() {
-        assert_eq!(civil_from_days(0), (1970, 1, 1));
-        assert_eq!(civil_from_days(20_414), (2025, 11, 22));
-        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
     }
 
     #[test]

@@ -10,7 +10,7 @@ use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::ensemble::{Curve, EnsembleArgs};
-use core_lattice::io::{RunClock, read_checkpoint, write_checkpoint};
+use core_lattice::io::{Positions, RunClock, read_checkpoint, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -73,9 +73,11 @@ struct Cli {
     #[arg(long)]
     snapshot_every: Option<u64>,
 
-    /// Write positions.csv: every live animat at the end.
-    #[arg(long)]
-    positions: bool,
+    /// Write every live animat at the end (id, species, x, y, age, hunger): positions.csv
+    /// (`--positions` alone), positions.npy with one positions_<attribute>.npy per attribute
+    /// (NumPy), positions.vtk (ParaView), positions.xyz (extended XYZ: OVITO, VMD), or none.
+    #[arg(long, value_enum, value_name = "FORMAT", num_args = 0..=1, default_value_t = Positions::None, default_missing_value = "csv")]
+    positions: Positions,
 
     /// Save the run to OUT/checkpoint.bin every N steps and at the end (atomically), for
     /// --resume; SIGINT or SIGTERM then save it after the current step and stop (exit code
@@ -364,8 +366,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     }
     output::write_populations(&cli.out, &rows, cli.timing)?;
-    if cli.positions {
-        output::write_positions(&cli.out, &world)?;
+    if let Some(format) = cli.positions.format() {
+        output::write_positions(&cli.out, &world, format)?;
     }
     let m = output::write_manifest(&cli.out, &world, cli.seed, &clock)?;
     if !cli.log.is_quiet() {

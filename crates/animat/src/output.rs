@@ -10,7 +10,9 @@
 
 use crate::params::Species;
 use crate::world::World;
-use core_lattice::io::{CsvWriter, RunClock, RunManifest, write_png_rgb};
+use core_lattice::io::{
+    Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_png_rgb, write_points,
+};
 use std::path::Path;
 
 pub use core_lattice::io::OutputError;
@@ -61,26 +63,59 @@ pub fn write_populations(
     Ok(())
 }
 
-/// Writes `positions.csv`: every live animat at the end, in id order.
+/// Writes `positions.<format>` (see [`core_lattice::io::points`]): every live animat at the
+/// end, in id order, with its `id`, `species` (0 fox, 1 rabbit in `.npy` and VTK; the name in
+/// CSV and XYZ), `age` and `hunger`.
 ///
 /// # Errors
 /// [`OutputError`] if a file cannot be written.
-pub fn write_positions(dir: &Path, world: &World) -> Result<(), OutputError> {
-    let mut w = CsvWriter::create(
-        dir.join("positions.csv"),
-        &["id", "species", "x", "y", "age", "hunger"],
-    )?;
-    for a in world.animats() {
-        w.row(&[
-            &a.id,
-            &a.species.name(),
-            &a.pos[0],
-            &a.pos[1],
-            &a.age,
-            &a.hunger,
-        ])?;
-    }
-    w.finish()?;
+pub fn write_positions(dir: &Path, world: &World, format: PointFormat) -> Result<(), OutputError> {
+    const SPECIES: [&str; 2] = [Species::Fox.name(), Species::Rabbit.name()];
+    let attributes = [
+        Attribute {
+            name: "id",
+            labels: None,
+        },
+        Attribute {
+            name: "species",
+            labels: Some(&SPECIES),
+        },
+        Attribute {
+            name: "age",
+            labels: None,
+        },
+        Attribute {
+            name: "hunger",
+            labels: None,
+        },
+    ];
+    let title = format!(
+        "animats after {} steps: {} foxes, {} rabbits",
+        world.steps(),
+        world.foxes(),
+        world.rabbits()
+    );
+    let set = PointSet {
+        n: world.foxes() + world.rabbits(),
+        axes: &["x", "y"],
+        integer_coordinates: true,
+        attributes: &attributes,
+        index: None,
+        title: &title,
+    };
+    write_points(dir, "positions", format, &set, &mut |f| {
+        for a in world.animats() {
+            let species = match a.species {
+                Species::Fox => 0,
+                Species::Rabbit => 1,
+            };
+            f(
+                &[a.pos[0] as f64, a.pos[1] as f64],
+                &[a.id as i64, species, i64::from(a.age), i64::from(a.hunger)],
+            )?;
+        }
+        Ok(())
+    })?;
     Ok(())
 }
 

@@ -21,7 +21,7 @@ pub enum Species {
 
 impl Species {
     /// `fox` or `rabbit`.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             Species::Fox => "fox",
             Species::Rabbit => "rabbit",

@@ -286,3 +286,60 @@ fn a_quiet_run_without_a_terminal_sends_a_heartbeat_and_qq_silences_it() {
     assert!(o.status.success());
     assert_eq!(String::from_utf8_lossy(&o.stderr), "");
 }
+
+/// `run.json` records where the run came from; logs are plain text unless asked otherwise.
+#[test]
+fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    core_lattice::testing::provenance_and_color_contract(
+        Path::new(env!("CARGO_BIN_EXE_animat")),
+        dir.path(),
+        &["--steps", "5", "--seed", "2"],
+    );
+}
+
+/// `--positions npy|vtk|xyz` hold the same animats as `--positions` (CSV).
+#[test]
+fn positions_in_every_format_hold_the_same_animats() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = |format: Option<&str>| {
+        let out = tmp.path().join(format.unwrap_or("default"));
+        let mut args = vec!["--steps", "8", "--seed", "5", "-q", "--out", out.to_str().unwrap()];
+        args.push("--positions");
+        args.extend(format);
+        let o = animat(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let csv = std::fs::read_to_string(run(None).join("positions.csv")).unwrap();
+    assert_eq!(csv.lines().next(), Some("x,y,id,species,age,hunger"));
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert!(rows.len() > 100);
+
+    let npy = run(Some("npy"));
+    let mut r = core_lattice::io::NpyReader::open(npy.join("positions.npy")).unwrap();
+    assert_eq!((r.rows(), r.cols()), (rows.len() as u64, 2));
+    let species = std::fs::read(npy.join("positions_species.npy")).unwrap();
+    let mut p = [0.0; 2];
+    for (i, row) in rows.iter().enumerate() {
+        assert!(r.next_row(&mut p).unwrap());
+        assert_eq!([p[0].to_string(), p[1].to_string()], [row[0], row[1]]);
+        let s = i64::from_le_bytes(species[128 + 8 * i..136 + 8 * i].try_into().unwrap());
+        assert_eq!(["fox", "rabbit"][s as usize], row[3]);
+    }
+    for a in ["id", "age", "hunger"] {
+        assert!(npy.join(format!("positions_{a}.npy")).exists(), "{a}");
+    }
+
+    let xyz = std::fs::read_to_string(run(Some("xyz")).join("positions.xyz")).unwrap();
+    let first: Vec<&str> = xyz.lines().nth(2).unwrap().split(' ').collect();
+    assert_eq!(first[0], rows[0][3], "the species is the element column");
+    assert_eq!(&first[1..3], &rows[0][0..2]);
+
+    let vtk = std::fs::read(run(Some("vtk")).join("positions.vtk")).unwrap();
+    let has = |s: &str| vtk.windows(s.len()).any(|w| w == s.as_bytes());
+    assert!(has(&format!("POINTS {} double\n", rows.len())));
+    for a in ["id", "species", "age", "hunger"] {
+        assert!(has(&format!("SCALARS {a} int 1\n")), "{a}");
+    }
+}

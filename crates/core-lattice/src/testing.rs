@@ -357,3 +357,60 @@ fn manifest_named(dir: &Path, name: &str) -> serde_json::Value {
     let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_slice(&bytes).expect("JSON")
 }
+
+/// The provenance and log contract of a model binary run with `flags` (small and fast, without
+/// `--out`), checked in the working directory `dir`:
+///
+/// - `run.json` has a `provenance` with the date, version, this build's git commit, the command
+///   line as given, the host, the CPU and the threads;
+/// - with stderr redirected (not a terminal), `-v` logs carry no ANSI escape codes, and
+///   `--color always` puts them back.
+pub fn provenance_and_color_contract(binary: &Path, dir: &Path, flags: &[&str]) {
+    let run = |out: &str, extra: &[&str]| {
+        let o = Command::new(binary)
+            .args(flags)
+            .args(extra)
+            .args(["-v", "--out", out])
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .output()
+            .expect("the binary starts");
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let plain = run("plain", &[]);
+    assert!(plain.contains("INFO"), "no info log with -v: {plain}");
+    assert!(
+        !plain.contains('\u{1b}'),
+        "ANSI codes in a redirected log: {plain:?}"
+    );
+    let coloured = run("coloured", &["--color", "always"]);
+    assert!(coloured.contains("\u{1b}["), "--color always: {coloured:?}");
+
+    let m = manifest(&dir.join("plain"));
+    let p = &m["provenance"];
+    let date = p["date_utc"].as_str().expect("date_utc");
+    assert!(
+        date.len() == 20 && date.ends_with('Z') && date.starts_with("20"),
+        "{date}"
+    );
+    assert_eq!(p["version"], m["version"]);
+    assert_eq!(p["threads"], m["threads"]);
+    assert_eq!(
+        p["git_commit"].as_str(),
+        crate::io::provenance::GIT_COMMIT,
+        "the binary and this test were built from different commits"
+    );
+    let line: Vec<&str> = p["command_line"]
+        .as_array()
+        .expect("command_line")
+        .iter()
+        .filter_map(|a| a.as_str())
+        .collect();
+    assert!(line.len() == flags.len() + 4, "{line:?}");
+    assert!(line[1..].starts_with(flags), "{line:?}");
+    for key in ["host", "cpu"] {
+        assert!(!p[key].as_str().unwrap_or("").is_empty(), "{key}: {p}");
+    }
+    assert!(p["cpus"].as_u64().unwrap_or(0) >= 1, "{p}");
+}

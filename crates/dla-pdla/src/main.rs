@@ -99,8 +99,9 @@ struct Cli {
     fit_from: u64,
 
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
-    /// (N, D), NumPy's format) as the cluster grows, never held in memory; csv, bin and xyz are
-    /// made from it at the end (csv and xyz take about 50 bytes per particle on disk).
+    /// (N, D), NumPy's format) as the cluster grows, never held in memory; csv, bin, xyz
+    /// (extended XYZ: OVITO, VMD) and vtk (legacy VTK with the arrival index: ParaView) are made
+    /// from it at the end (csv and xyz take about 50 bytes per particle on disk).
     #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
     positions: PositionsFormat,
 
@@ -254,6 +255,13 @@ where
 {
     let clock = RunClock::start();
     let total = params.particles;
+    if cli.positions == PositionsFormat::Vtk && total > core_lattice::io::points::VTK_MAX_POINTS {
+        return Err(usage(format!(
+            "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {total}; \
+             use --positions npy",
+            core_lattice::io::points::VTK_MAX_POINTS
+        )));
+    }
     tracing::info!(?params, seed = cli.seed, "starting growth");
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
@@ -270,11 +278,7 @@ where
     if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {
         tracing::warn!(
             "--positions {} for {total} particles writes about {} GB of text; positions.npy holds them in {} GB",
-            if cli.positions == PositionsFormat::Csv {
-                "csv"
-            } else {
-                "xyz"
-            },
+            cli.positions.name(),
             total * 25 * D as u64 / 1_000_000_000,
             total * 8 * D as u64 / 1_000_000_000
         );

@@ -11,13 +11,15 @@
 //! | `positions.npy` | every position, arrival order, float64 `(N, D)` (NumPy `.npy`) |
 //! | `positions.csv` | `--positions csv`: `x,y` or `x,y,z`, arrival order |
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
-//! | `positions.xyz` | `--positions xyz`: XYZ point cloud, element `C` |
+//! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C` |
+//! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView) |
 //! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: projection on x, y) |
 
 use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
 use core_lattice::io::{
-    AtomicFile, CsvField, CsvWriter, NpyReader, RunClock, RunManifest, write_png_gray,
+    AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, RunClock, RunManifest, write_png_gray,
+    write_points,
 };
 use serde_json::json;
 use std::io::Write;
@@ -38,8 +40,24 @@ pub enum PositionsFormat {
     Csv,
     /// `positions.bin`.
     Bin,
-    /// `positions.xyz`.
+    /// `positions.xyz` (extended XYZ).
     Xyz,
+    /// `positions.vtk` (legacy VTK, the arrival index as a point scalar).
+    Vtk,
+}
+
+impl PositionsFormat {
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            PositionsFormat::None => "none",
+            PositionsFormat::Npy => "npy",
+            PositionsFormat::Csv => "csv",
+            PositionsFormat::Bin => "bin",
+            PositionsFormat::Xyz => "xyz",
+            PositionsFormat::Vtk => "vtk",
+        }
+    }
 }
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest; `png` is
@@ -65,31 +83,29 @@ where
     }
     match positions {
         PositionsFormat::None | PositionsFormat::Npy => {}
-        PositionsFormat::Csv => {
-            let mut w = CsvWriter::create(dir.join("positions.csv"), &Dim::<D>::AXES)?;
-            each_position(sim, dir, |_, p: &[f64; D]| {
-                let f: Vec<&dyn CsvField> = p.iter().map(|x| x as &dyn CsvField).collect();
-                w.row(&f)?;
-                Ok(())
-            })?;
-            w.finish()?;
-        }
         PositionsFormat::Bin => write_positions_bin(sim, dir)?,
-        PositionsFormat::Xyz => {
-            let mut f = AtomicFile::create(dir.join("positions.xyz"))?;
-            {
-                let mut b = std::io::BufWriter::new(&mut f);
-                writeln!(b, "{}", sim.particles())?;
-                writeln!(b, "DLA cluster, seed {}, arrival order", sim.seed())?;
-                each_position(sim, dir, |_, p: &[f64; D]| {
-                    // XYZ holds three coordinates: z = 0 in the plane.
-                    let z = p.get(2).copied().unwrap_or(0.0);
-                    writeln!(b, "C {} {} {}", p[0], p[1], z)?;
-                    Ok(())
-                })?;
-                b.flush()?;
-            }
-            f.commit()?;
+        PositionsFormat::Csv | PositionsFormat::Xyz | PositionsFormat::Vtk => {
+            let format = match positions {
+                PositionsFormat::Csv => PointFormat::Csv,
+                PositionsFormat::Xyz => PointFormat::Xyz,
+                _ => PointFormat::Vtk,
+            };
+            let title = format!(
+                "DLA cluster, {D}D, {} particles, seed {}, arrival order",
+                sim.particles(),
+                sim.seed()
+            );
+            let set = PointSet {
+                n: sim.particles(),
+                axes: &Dim::<D>::AXES,
+                integer_coordinates: false,
+                attributes: &[],
+                index: Some("arrival"),
+                title: &title,
+            };
+            write_points(dir, "positions", format, &set, &mut |f| {
+                each_position(sim, dir, |_, p: &[f64; D]| Ok(f(p, &[])?))
+            })?;
         }
     }
     if let Some(side) = png {

@@ -109,6 +109,10 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--step-min", "0"]), "--step-min 0"),
         (with(&["--step-min", "NaN"]), "--step-min NaN"),
         (with(&["--step-min", "1e-300"]), "[1e-6, 1e3]"),
+        (
+            with(&["--particles", "2000000000", "--positions", "vtk"]),
+            "--positions vtk holds at most",
+        ),
         (with(&["--precision", "0.5"]), "--precision 0.5"),
         (with(&["--birth-gap", "0.5"]), "--birth-gap 0.5"),
         (with(&["--death-ratio", "1"]), "--death-ratio 1"),

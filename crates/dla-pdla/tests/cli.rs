@@ -13,6 +13,7 @@ fn run_writes_every_output() {
         ("3", "csv", "positions.csv", "x,y,z"),
         ("2", "bin", "positions.bin", "DLAPOS01"),
         ("3", "xyz", "positions.xyz", "500"),
+        ("3", "vtk", "positions.vtk", "# vtk DataFile Version 3.0"),
     ] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("out");
@@ -271,5 +272,16 @@ fn a_failure_after_the_start_is_one_line_with_exit_code_1() {
     assert!(
         err.starts_with("dla: run failed: ") && err.contains("run.json"),
         "{err}"
+    );
+}
+
+/// `run.json` records where the run came from; logs are plain text unless asked otherwise.
+#[test]
+fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    core_lattice::testing::provenance_and_color_contract(
+        std::path::Path::new(env!("CARGO_BIN_EXE_dla")),
+        dir.path(),
+        &["--particles", "200", "--seed", "2"],
     );
 }

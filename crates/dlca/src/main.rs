@@ -8,7 +8,7 @@ use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::ensemble::{Curve, EnsembleArgs};
-use core_lattice::io::RunClock;
+use core_lattice::io::{Positions, RunClock};
 use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
 use std::sync::atomic::Ordering;
@@ -132,6 +132,12 @@ struct Cli {
     /// Write dlca.png: the final state, one colour per cluster (first two axes).
     #[arg(long)]
     png: bool,
+
+    /// Every particle's final site and cluster id: particles.csv (x1..xd,cluster), particles.npy
+    /// with particles_cluster.npy (NumPy), particles.vtk (ParaView, cluster as a point scalar),
+    /// particles.xyz (extended XYZ: OVITO, VMD), or none.
+    #[arg(long, value_enum, value_name = "FORMAT", default_value_t = Positions::Csv)]
+    positions: Positions,
 
     #[command(flatten)]
     log: LogArgs,
@@ -380,7 +386,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     }
     progress.finish();
-    let m = dlca::output::write_outputs(&sim, cli.seed, &clock, &cli.out, cli.png)?;
+    let m = dlca::output::write_outputs(
+        &sim,
+        cli.seed,
+        &clock,
+        &cli.out,
+        cli.png,
+        cli.positions.format(),
+    )?;
     if !cli.log.is_quiet() {
         eprintln!(
             "dlca: {} clusters (largest {}) after {} sweeps in {:.2} s with {}; outputs in {}",

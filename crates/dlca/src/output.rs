@@ -6,24 +6,28 @@
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results |
 //! | `sweeps.csv` | `sweep,clusters,largest` (and `seconds` with `--timing`), from sweep 0 |
 //! | `sizes.csv` | `size,count`: the final cluster size distribution |
-//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id |
+//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`core_lattice::io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
 //! | `dlca.png` | with `--png`: the final state, one colour per cluster |
 
 use crate::analysis::{ClusterMeasure, fractal_dimension, gyration, size_distribution};
 use crate::sim::Simulation;
-use core_lattice::io::{CsvField, CsvWriter, OutputError, RunClock, write_png_rgb};
+use core_lattice::io::{
+    Attribute, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_png_rgb, write_points,
+};
 use serde_json::json;
 use std::path::Path;
 
-/// Write every output of `sim` into `dir` (which must exist) and return the manifest written.
+/// Write every output of `sim` into `dir` (which must exist) and return the manifest written;
+/// the particles' sites and cluster ids go into `particles.<format>` if `positions` names one.
 pub fn write_outputs(
     sim: &Simulation,
     seed: u64,
     clock: &RunClock,
     dir: &Path,
     png: bool,
+    positions: Option<PointFormat>,
 ) -> Result<core_lattice::io::RunManifest, OutputError> {
     let params = sim.params();
     let dim = sim.lattice().dim();
@@ -51,28 +55,50 @@ pub fn write_outputs(
     }
     w.finish()?;
 
-    // particles.csv
-    let names: Vec<String> = (1..=dim)
-        .map(|a| format!("x{a}"))
-        .chain(["cluster".to_string()])
-        .collect();
-    let header: Vec<&str> = names.iter().map(String::as_str).collect();
-    let mut w = CsvWriter::create(dir.join("particles.csv"), &header)?;
-    let mut ids = sim.sets().live().to_vec();
-    ids.sort_unstable();
-    let mut row: Vec<u64> = vec![0; dim + 1];
-    for &id in &ids {
-        let mut sites = sim.sets().sites(id).to_vec();
-        sites.sort_unstable();
-        for k in sites {
-            let x = sim.lattice().decode(k)?;
-            row[..dim].copy_from_slice(&x);
-            row[dim] = u64::from(id);
-            let fields: Vec<&dyn CsvField> = row.iter().map(|v| v as &dyn CsvField).collect();
-            w.row(&fields)?;
-        }
+    // particles: every site of every cluster, clusters in id order, sites in index order.
+    if let Some(format) = positions {
+        let axes: Vec<String> = (1..=dim).map(|a| format!("x{a}")).collect();
+        let axes: Vec<&str> = axes.iter().map(String::as_str).collect();
+        let title = format!(
+            "DLCA lattice {}, seed {seed}, {} particles in {} clusters",
+            sim.lattice()
+                .sizes()
+                .iter()
+                .map(u64::to_string)
+                .collect::<Vec<_>>()
+                .join("x"),
+            sim.particles(),
+            sim.sets().live().len()
+        );
+        let set = PointSet {
+            n: sim.particles(),
+            axes: &axes,
+            integer_coordinates: true,
+            attributes: &[Attribute {
+                name: "cluster",
+                labels: None,
+            }],
+            index: None,
+            title: &title,
+        };
+        let mut ids = sim.sets().live().to_vec();
+        ids.sort_unstable();
+        write_points(dir, "particles", format, &set, &mut |f| {
+            let mut p = vec![0.0; dim];
+            for &id in &ids {
+                let mut sites = sim.sets().sites(id).to_vec();
+                sites.sort_unstable();
+                for k in sites {
+                    let x = sim.lattice().decode(k)?;
+                    for (c, v) in p.iter_mut().zip(x.iter()) {
+                        *c = *v as f64;
+                    }
+                    f(&p, &[i64::from(id)])?;
+                }
+            }
+            Ok(())
+        })?;
     }
-    w.finish()?;
 
     // histogram.csv
     if !params.histogram_sweeps.is_empty() {

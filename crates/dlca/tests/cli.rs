@@ -237,3 +237,86 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
         a["results"]["state_hash"]
     );
 }
+
+/// `run.json` records where the run came from; logs are plain text unless asked otherwise.
+#[test]
+fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
+    let dir = tempfile::tempdir().unwrap();
+    core_lattice::testing::provenance_and_color_contract(
+        Path::new(env!("CARGO_BIN_EXE_dlca")),
+        dir.path(),
+        &["--size", "32", "--fill", "0.05", "--seed", "2"],
+    );
+}
+
+/// `--positions npy|vtk|xyz|none` write the same particles and cluster ids as the default CSV.
+#[test]
+fn positions_in_every_format_hold_the_same_particles() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = |format: &str| {
+        let out = tmp.path().join(format);
+        let o = dlca(&[
+            "--size",
+            "24x20",
+            "--fill",
+            "0.1",
+            "--seed",
+            "6",
+            "--target-clusters",
+            "4",
+            "-q",
+            "--positions",
+            format,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let csv = std::fs::read_to_string(run("csv").join("particles.csv")).unwrap();
+    let rows: Vec<Vec<i64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(csv.lines().next(), Some("x1,x2,cluster"));
+    assert_eq!(rows.len(), 48);
+
+    let npy = run("npy");
+    let mut r = core_lattice::io::NpyReader::open(npy.join("particles.npy")).unwrap();
+    assert_eq!((r.rows(), r.cols()), (48, 2));
+    let ids = std::fs::read(npy.join("particles_cluster.npy")).unwrap();
+    let mut p = [0.0; 2];
+    for (i, row) in rows.iter().enumerate() {
+        assert!(r.next_row(&mut p).unwrap());
+        assert_eq!([p[0] as i64, p[1] as i64], [row[0], row[1]]);
+        let id = i64::from_le_bytes(ids[128 + 8 * i..136 + 8 * i].try_into().unwrap());
+        assert_eq!(id, row[2]);
+    }
+    assert!(!npy.join("particles.csv").exists());
+
+    let xyz = std::fs::read_to_string(run("xyz").join("particles.xyz")).unwrap();
+    let lines: Vec<&str> = xyz.lines().collect();
+    assert_eq!(lines[0], "48");
+    assert!(lines[1].starts_with("Properties=species:S:1:pos:R:3:cluster:I:1"));
+    assert_eq!(
+        lines[2],
+        format!("C {} {} 0 {}", rows[0][0], rows[0][1], rows[0][2])
+    );
+
+    let vtk = std::fs::read(run("vtk").join("particles.vtk")).unwrap();
+    assert!(vtk.starts_with(b"# vtk DataFile Version 3.0\n"));
+    let has = |s: &str| vtk.windows(s.len()).any(|w| w == s.as_bytes());
+    assert!(has("POINTS 48 double\n") && has("SCALARS cluster int 1\n"));
+
+    let none = run("none");
+    assert!(none.join("run.json").exists());
+    for f in [
+        "particles.csv",
+        "particles.npy",
+        "particles.vtk",
+        "particles.xyz",
+    ] {
+        assert!(!none.join(f).exists(), "{f}");
+    }
+}

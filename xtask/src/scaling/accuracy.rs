@@ -4,13 +4,13 @@
 //! distribution of `vpdist` errors against the exact nearest distance.
 
 use super::Ctx;
-use super::dla::{Grown, fit_from, grow};
+use super::dla::fit_from;
+use super::ensemble::columns;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;
 use core_lattice::rng::{stream, uniform01};
 use dla_pdla::{FarField, Params, Simulation};
-use rayon::prelude::*;
 
 /// One point of the sweep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,14 +106,25 @@ struct Measured {
     ln_prefactor: Vec<f64>,
 }
 
+/// What the sweep takes from one member of a setting's ensemble.
+struct Run {
+    /// Wall microseconds of the run per particle.
+    us_per_particle: f64,
+    /// Its fitted fractal dimension.
+    fractal_dimension: f64,
+    /// Its growth samples: N and R_g (`growth.csv`).
+    n: Vec<f64>,
+    radius_of_gyration: Vec<f64>,
+}
+
 /// Mean of `ln R_g - ln N / d_ref` over the samples used in the fit.
-fn ln_prefactor(g: &Grown, from: u64, d_ref: f64) -> f64 {
-    let v: Vec<f64> = g
-        .samples
-        .iter()
-        .filter(|s| s.n >= from)
-        .map(|s| s.radius_of_gyration.ln() - (s.n as f64).ln() / d_ref)
-        .collect();
+fn ln_prefactor(g: &Run, from: u64, d_ref: f64) -> f64 {
+    let v: Vec<f64> =
+        g.n.iter()
+            .zip(&g.radius_of_gyration)
+            .filter(|(n, _)| **n >= from as f64)
+            .map(|(n, rg)| rg.ln() - n.ln() / d_ref)
+            .collect();
     v.iter().sum::<f64>() / v.len() as f64
 }
 
@@ -127,40 +138,52 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         "Every setting grows {e} clusters of N = {n} particles in 2D (seeds {}..{}), the same \
          seeds for every setting. The reference is the most exact setting: exact nearest-\
          distance search (`--precision inf`), the shortest near-field step (`--step-min 0.05`) \
-         and the exact far-field return. Runs go two at a time, one per core, so every \
-         setting is timed under the same load.",
+         and the exact far-field return. Each setting is one ensemble of the `dla` binary \
+         (`dla --seeds ...`), its members two at a time, one per core, so every setting is \
+         timed under the same load; the time is the member's wall time per particle.",
         ctx.seed,
         ctx.seed + e - 1
     ));
     let settings = settings();
-    // Seed-major order: each setting's runs are spread over the whole sweep, so a change of
-    // machine load during the sweep does not bias one setting's time.
-    let jobs: Vec<(usize, u64)> = (0..e)
-        .flat_map(|s| (0..settings.len()).map(move |i| (i, s)))
-        .collect();
     ctx.log(&format!(
         "{} settings x {e} runs of N = {n}",
         settings.len()
     ));
-    let runs: Vec<_> = jobs
-        .par_iter()
-        .map(|&(i, s)| {
-            let st = settings[i];
-            let p = Params {
-                particles: n,
-                precision: st.precision,
-                step_min: st.step_min,
-                far_field: st.far_field,
-                distance_map: st.distance_map,
-                fit_from: from,
-                ..Params::default()
-            };
-            grow(&p, ctx.seed + s)
-        })
-        .collect();
-    let mut per: Vec<Vec<Grown>> = vec![Vec::new(); settings.len()];
-    for ((i, _), r) in jobs.iter().zip(runs) {
-        per[*i].push(r?);
+    // One ensemble of the `dla` binary per setting (members two at a time, one per core); the
+    // seeds are the same for every setting.
+    let mut per: Vec<Vec<Run>> = Vec::new();
+    for (i, st) in settings.iter().enumerate() {
+        let ens = ctx.ensemble(
+            "dla",
+            &format!("accuracy/setting-{i:02}"),
+            e,
+            &[
+                format!("--particles={n}"),
+                format!("--precision={}", st.precision),
+                format!("--step-min={}", st.step_min),
+                format!("--far-field={}", st.far_field.name()),
+                format!(
+                    "--distance-map={}",
+                    if st.distance_map { "on" } else { "off" }
+                ),
+                format!("--fit-from={from}"),
+            ],
+        )?;
+        let mut runs = Vec::new();
+        for m in &ens.members {
+            let growth = columns(
+                &ens.member_dir(m).join("growth.csv"),
+                &["n", "radius_of_gyration"],
+            )?;
+            let get = |k: &str| m.results.get(k).copied().unwrap_or(f64::NAN);
+            runs.push(Run {
+                us_per_particle: get("wall_seconds") / get("particles") * 1e6,
+                fractal_dimension: get("fractal_dimension"),
+                n: growth[0].clone(),
+                radius_of_gyration: growth[1].clone(),
+            });
+        }
+        per.push(runs);
     }
     let d_ref = mean_stderr(
         &per[0]
@@ -174,11 +197,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         .zip(&per)
         .map(|(s, gs)| Measured {
             setting: *s,
-            us_per_particle: mean_stderr(
-                &gs.iter()
-                    .map(|g| g.seconds / g.n as f64 * 1e6)
-                    .collect::<Vec<_>>(),
-            ),
+            us_per_particle: mean_stderr(&gs.iter().map(|g| g.us_per_particle).collect::<Vec<_>>()),
             d: gs.iter().map(|g| g.fractal_dimension).collect(),
             ln_prefactor: gs.iter().map(|g| ln_prefactor(g, from, d_ref)).collect(),
         })

@@ -6,11 +6,10 @@
 use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, mean_stderr, pm, sig};
-use anyhow::{Result, bail};
+use anyhow::{Context, Result, bail};
 use core_lattice::{Boundary, Fit};
 use dlca::record::SweepRecord;
 use dlca::{Init, Params, Search, Simulation};
-use rayon::prelude::*;
 
 const FILLS: [f64; 2] = [0.01, 0.05];
 
@@ -70,23 +69,28 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     let mut data = Table::new(&["fill", "seed", "sweep", "clusters", "largest"]);
     let mut series = Vec::new();
     for fill in FILLS {
-        let jobs: Vec<u64> = (0..seeds).map(|i| ctx.seed + i).collect();
-        let runs: Vec<_> = jobs
-            .par_iter()
-            .map(|&seed| -> Result<(u64, Vec<SweepRecord>)> {
-                let mut sim = Simulation::new(params(size, fill, Search::Lattice), seed)?;
-                sim.run();
-                Ok((sim.particles(), sim.records().sweeps().to_vec()))
-            })
-            .collect();
-        let mut to_target = Vec::new();
+        // The model's own ensemble: one `dlca` run per seed, in parallel on the cores.
+        let ens = ctx.ensemble(
+            "dlca",
+            &format!("dlca_fig5/fill-{fill}"),
+            seeds,
+            &[
+                format!("--size={}", size_name(size)),
+                "--boundary=periodic".into(),
+                format!("--fill={fill}"),
+                "--search=lattice".into(),
+                "--target-clusters=100".into(),
+            ],
+        )?;
+        let particles = ens.stat("particles")?.mean as u64;
+        let to_target = ens.stat("sweeps")?;
         let mut exponents = Vec::new();
-        let mut particles = 0;
-        for (i, r) in runs.into_iter().enumerate() {
-            let (n, sweeps) = r?;
-            particles = n;
+        for (i, m) in ens.members.iter().enumerate() {
+            let path = ens.member_dir(m).join("sweeps.csv");
+            let sweeps: Vec<SweepRecord> = csv::Reader::from_path(&path)
+                .and_then(|r| r.into_deserialize().collect())
+                .with_context(|| format!("reading {}", path.display()))?;
             let last = sweeps.last().expect("sweep 0 is always recorded").sweep;
-            to_target.push(last as f64);
             let marks = log_spaced(1, last.max(1), 200);
             let picked: Vec<&SweepRecord> = marks
                 .iter()
@@ -95,7 +99,7 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             for s in &picked {
                 data.row(vec![
                     fill.to_string(),
-                    jobs[i].to_string(),
+                    m.seed.to_string(),
                     s.sweep.to_string(),
                     s.clusters.to_string(),
                     s.largest.to_string(),
@@ -112,7 +116,7 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             }
             if i < 3 {
                 series.push(Series::new(
-                    format!("{} fill, seed {}", pct(fill), jobs[i]),
+                    format!("{} fill, seed {}", pct(fill), m.seed),
                     picked
                         .iter()
                         .map(|s| (s.sweep as f64, s.clusters as f64))
@@ -121,14 +125,13 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                 ));
             }
         }
-        let (m, se) = mean_stderr(&to_target);
         let (zm, zse) = mean_stderr(&exponents);
         table.row(vec![
             pct(fill),
             size_name(size),
             particles.to_string(),
-            seeds.to_string(),
-            pm(m, se),
+            to_target.n.to_string(),
+            pm(to_target.mean, to_target.stderr),
             pm(zm, zse),
             "plot only; the 5% system loses clusters faster".into(),
         ]);

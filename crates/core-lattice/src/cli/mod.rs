@@ -50,6 +50,33 @@ pub struct LogArgs {
     /// progress report on stderr every this many seconds; 0 never.
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = parse_heartbeat)]
     pub heartbeat: f64,
+
+    /// Colour in log messages: `auto` only when stderr is a terminal, so a redirected log stays
+    /// plain text.
+    #[arg(long, value_name = "WHEN", value_enum, default_value_t = Color::Auto)]
+    pub color: Color,
+}
+
+/// When log messages are coloured (`--color`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Color {
+    /// Only when stderr is a terminal.
+    Auto,
+    /// Always (ANSI escape codes even in a file).
+    Always,
+    /// Never.
+    Never,
+}
+
+impl Color {
+    /// Whether to write ANSI colour codes to stderr.
+    pub fn enabled(self) -> bool {
+        match self {
+            Color::Auto => std::io::IsTerminal::is_terminal(&std::io::stderr()),
+            Color::Always => true,
+            Color::Never => false,
+        }
+    }
 }
 
 impl Default for LogArgs {
@@ -58,6 +85,7 @@ impl Default for LogArgs {
             quiet: 0,
             verbose: 0,
             heartbeat: 60.0,
+            color: Color::Auto,
         }
     }
 }
@@ -144,7 +172,7 @@ pub fn main_with<C: clap::Parser, P>(
         Err(code) => return code,
     };
     let log = logging(&cli);
-    init_logging(log.quiet > 0, log.verbose);
+    init_logging(log.quiet > 0, log.verbose, log.color);
     let params = match params(&cli) {
         Ok(p) => p,
         Err(msg) => return usage_error(program, &msg),
@@ -213,8 +241,8 @@ pub fn usage_error(program: &str, msg: &str) -> ExitCode {
 }
 
 /// Log to stderr with `tracing`: warnings only when `quiet` or without `-v`, info with `-v`,
-/// debug with `-vv`; `RUST_LOG` overrides.
-pub fn init_logging(quiet: bool, verbose: u8) {
+/// debug with `-vv`; `RUST_LOG` overrides. Colour as `color` says.
+pub fn init_logging(quiet: bool, verbose: u8, color: Color) {
     let default = match (quiet, verbose) {
         (true, _) | (false, 0) => "warn",
         (false, 1) => "info",
@@ -225,8 +253,7 @@ pub fn init_logging(quiet: bool, verbose: u8) {
     let _ = tracing_subscriber::fmt()
         .with_env_filter(filter)
         .with_writer(std::io::stderr)
-        // Colour codes only on a terminal: a redirected log stays plain text.
-        .with_ansi(std::io::IsTerminal::is_terminal(&std::io::stderr()))
+        .with_ansi(color.enabled())
         .try_init();
 }
 

@@ -504,6 +504,7 @@ mod tests {
             wall_seconds: 1.0,
             cpu_seconds: None,
             peak_rss_bytes: None,
+            provenance: None,
             results,
         };
         m.write(&d).unwrap();

@@ -4,10 +4,13 @@
 //!
 //! Its top-level keys are exactly: `model`, `version`, `seed`, `threads`, `params` (the full
 //! validated parameters), `wall_seconds`, `cpu_seconds`, `peak_rss_bytes` (read from the
-//! operating system with `getrusage(2)`, not estimated) and `results` (a map each model fills).
-//! `cpu_seconds` and `peak_rss_bytes` are `null` on a platform that cannot report them.
+//! operating system with `getrusage(2)`, not estimated), `provenance` (date, version, git commit,
+//! command line, host, CPU: [`Provenance`]) and `results` (a map each model fills).
+//! `cpu_seconds` and `peak_rss_bytes` are `null` on a platform that cannot report them;
+//! `provenance` is absent only from files written before it existed.
 
 use super::atomic::write_atomic;
+use super::provenance::Provenance;
 use serde::{Deserialize, Serialize};
 use serde_json::{Map, Value};
 use std::io;
@@ -34,6 +37,9 @@ pub struct RunManifest {
     pub cpu_seconds: Option<f64>,
     /// Peak resident set size of the process, in bytes, as the operating system reports it.
     pub peak_rss_bytes: Option<u64>,
+    /// Where the run came from (absent from files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
     /// Headline results, filled by the model.
     pub results: Map<String, Value>,
 }
@@ -147,6 +153,7 @@ impl RunClock {
             wall_seconds: self.wall_seconds(),
             cpu_seconds: self.cpu_seconds(),
             peak_rss_bytes: usage.map(|u| u.peak_rss_bytes),
+            provenance: Some(Provenance::now(version, threads)),
             results: Map::new(),
         })
     }
@@ -191,6 +198,7 @@ mod tests {
                 "model",
                 "params",
                 "peak_rss_bytes",
+                "provenance",
                 "results",
                 "seed",
                 "threads",

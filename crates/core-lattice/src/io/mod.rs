@@ -9,6 +9,8 @@
 //! - [`image`]: grayscale and RGB PNG.
 //! - [`table`]: CSV with a header line.
 //! - [`hash`]: the stable 64-bit state hash models report as `state_hash`.
+//! - [`points`]: point sets (particles, animats) as CSV, `.npy`, legacy VTK or extended XYZ.
+//! - [`provenance`]: date, version, git commit, command line, host and CPU of a run.
 //! - [`npy`]: rows of `f64` streamed to a NumPy `.npy` file as a run goes (the exception to
 //!   atomic writes: an arrival log that a checkpoint refers to).
 
@@ -18,6 +20,8 @@ pub mod hash;
 pub mod image;
 pub mod manifest;
 pub mod npy;
+pub mod points;
+pub mod provenance;
 pub mod table;
 
 pub use atomic::{AtomicFile, remove_stale_temporaries, write_atomic};
@@ -26,6 +30,8 @@ pub use hash::StateHasher;
 pub use image::{write_png_gray, write_png_rgb};
 pub use manifest::{ProcessUsage, RunClock, RunManifest};
 pub use npy::{NpyError, NpyReader, NpyWriter};
+pub use points::{Attribute, PointFormat, PointSet, Positions, write_points};
+pub use provenance::Provenance;
 pub use table::{CsvField, CsvWriter};
 
 /// Why a model's output could not be written (every model's `output::write_outputs`); each

@@ -55,7 +55,17 @@ fn format_error(path: &Path, why: impl Into<String>) -> NpyError {
 
 /// The [`HEADER_BYTES`] bytes of a `(rows, cols)` array of `<f8`.
 fn header(rows: u64, cols: usize) -> Vec<u8> {
-    let text = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': ({rows}, {cols}), }}");
+    header_bytes("<f8", rows, Some(cols))
+}
+
+/// The [`HEADER_BYTES`] bytes of a C-order array of NumPy type `descr` (`<f8`, `<i8`) with
+/// shape `(rows, cols)`, or `(rows,)` without `cols`.
+pub(crate) fn header_bytes(descr: &str, rows: u64, cols: Option<usize>) -> Vec<u8> {
+    let shape = match cols {
+        Some(c) => format!("({rows}, {c})"),
+        None => format!("({rows},)"),
+    };
+    let text = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
     let mut h = Vec::with_capacity(HEADER_BYTES as usize);
     h.extend_from_slice(MAGIC);
     h.extend_from_slice(&[1, 0]);

@@ -1,0 +1,502 @@
+//! Point sets (particles, animats) in the formats that field tools read, chosen by every model's
+//! `--positions`:
+//!
+//! | format | files | read by |
+//! |---|---|---|
+//! | `csv` | `STEM.csv`: the coordinates, then one column per attribute | pandas, R, spreadsheets |
+//! | `npy` | `STEM.npy`: float64 `(N, D)`; `STEM_<attribute>.npy`: int64 `(N,)` each | `numpy.load` (memory-mapped) |
+//! | `vtk` | `STEM.vtk`: legacy VTK, binary `POLYDATA`, one vertex per point, the attributes as point scalars | ParaView, VisIt |
+//! | `xyz` | `STEM.xyz`: extended XYZ (count, a `Properties=` comment line, one line per point) | OVITO, VMD, ASE |
+//!
+//! Points come from a visitor the writer may call more than once (VTK stores each attribute in
+//! its own section after all coordinates), so a caller that streams its points from disk never
+//! holds them in memory. Every file is written atomically.
+
+use super::atomic::AtomicFile;
+use super::{CsvField, CsvWriter, OutputError};
+use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+/// A positions file format (`--positions`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum PointFormat {
+    /// CSV with a header line.
+    Csv,
+    /// NumPy `.npy`: coordinates float64 `(N, D)`, each attribute int64 `(N,)` in its own file.
+    Npy,
+    /// Legacy VTK (binary `POLYDATA` with vertices and point scalars) for ParaView and VisIt.
+    Vtk,
+    /// Extended XYZ for OVITO, VMD and ASE.
+    Xyz,
+}
+
+impl PointFormat {
+    /// The file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            PointFormat::Csv => "csv",
+            PointFormat::Npy => "npy",
+            PointFormat::Vtk => "vtk",
+            PointFormat::Xyz => "xyz",
+        }
+    }
+}
+
+/// `--positions` of the lattice and animat models: a [`PointFormat`] or no file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "lowercase")]
+pub enum Positions {
+    /// No positions file.
+    None,
+    /// CSV with a header line.
+    Csv,
+    /// NumPy `.npy`: coordinates float64 `(N, D)`, each attribute int64 `(N,)` in its own file.
+    Npy,
+    /// Legacy VTK (binary `POLYDATA` with vertices and point scalars) for ParaView and VisIt.
+    Vtk,
+    /// Extended XYZ for OVITO, VMD and ASE.
+    Xyz,
+}
+
+impl Positions {
+    /// The format to write, if any.
+    pub fn format(self) -> Option<PointFormat> {
+        match self {
+            Positions::None => None,
+            Positions::Csv => Some(PointFormat::Csv),
+            Positions::Npy => Some(PointFormat::Npy),
+            Positions::Vtk => Some(PointFormat::Vtk),
+            Positions::Xyz => Some(PointFormat::Xyz),
+        }
+    }
+}
+
+/// The most points legacy VTK holds: its cell list counts `2 N` 32-bit integers.
+pub const VTK_MAX_POINTS: u64 = (i32::MAX / 2) as u64;
+
+/// An integer attribute of every point (a cluster id, a species).
+#[derive(Debug, Clone, Copy)]
+pub struct Attribute<'a> {
+    /// Its name: a CSV column, a VTK scalar, the suffix of its `.npy` file.
+    pub name: &'a str,
+    /// Names of the values `0, 1, ...`, written instead of the numbers in CSV and XYZ (a
+    /// species); `None` writes the numbers.
+    pub labels: Option<&'a [&'a str]>,
+}
+
+/// What a point set holds, apart from the points themselves.
+#[derive(Debug, Clone, Copy)]
+pub struct PointSet<'a> {
+    /// Number of points the visitor yields.
+    pub n: u64,
+    /// Names of the coordinates (`x`, `y`, `z` or `x1`, ... `xd`); their number is the dimension.
+    pub axes: &'a [&'a str],
+    /// Whether the coordinates are integers (lattice sites): CSV and XYZ write them without a
+    /// fractional part.
+    pub integer_coordinates: bool,
+    /// The explicit attributes, in the order the visitor yields them.
+    pub attributes: &'a [Attribute<'a>],
+    /// A name for the point's index (its order: `arrival` for DLA), written as a VTK scalar;
+    /// the other formats keep it as the row order.
+    pub index: Option<&'a str>,
+    /// One line describing the set (VTK title, XYZ comment).
+    pub title: &'a str,
+}
+
+/// A function that calls its argument with each point in order: coordinates, then attributes.
+pub type Visitor<'v> =
+    dyn FnMut(&mut dyn FnMut(&[f64], &[i64]) -> io::Result<()>) -> Result<(), OutputError> + 'v;
+
+/// Writes `set` as `dir/STEM.<extension>` (and, for `npy`, one file per attribute); returns the
+/// paths written. `visit` yields the points and may be called several times.
+pub fn write_points(
+    dir: &Path,
+    stem: &str,
+    format: PointFormat,
+    set: &PointSet<'_>,
+    visit: &mut Visitor<'_>,
+) -> Result<Vec<std::path::PathBuf>, OutputError> {
+    let path = dir.join(format!("{stem}.{}", format.extension()));
+    let mut written = vec![path.clone()];
+    let checked = |count: u64| -> Result<(), OutputError> {
+        if count == set.n {
+            Ok(())
+        } else {
+            Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!(
+                    "{}: {count} points visited, {} announced",
+                    path.display(),
+                    set.n
+                ),
+            )
+            .into())
+        }
+    };
+    match format {
+        PointFormat::Csv => {
+            let header: Vec<&str> = set
+                .axes
+                .iter()
+                .copied()
+                .chain(set.attributes.iter().map(|a| a.name))
+                .collect();
+            let mut w = CsvWriter::create(&path, &header)?;
+            let mut count = 0u64;
+            let mut ints = Vec::new();
+            visit(&mut |p, attrs| {
+                count += 1;
+                let mut fields: Vec<&dyn CsvField> = Vec::with_capacity(header.len());
+                if set.integer_coordinates {
+                    ints.clear();
+                    ints.extend(p.iter().map(|&x| x as i64));
+                    fields.extend(ints.iter().map(|x| x as &dyn CsvField));
+                } else {
+                    fields.extend(p.iter().map(|x| x as &dyn CsvField));
+                }
+                let labels: Vec<Option<&str>> = set
+                    .attributes
+                    .iter()
+                    .zip(attrs)
+                    .map(|(a, v)| label(a, *v))
+                    .collect();
+                for (l, v) in labels.iter().zip(attrs) {
+                    fields.push(match l {
+                        Some(l) => l as &dyn CsvField,
+                        None => v as &dyn CsvField,
+                    });
+                }
+                w.row(&fields)
+            })?;
+            checked(count)?;
+            w.finish()?;
+        }
+        PointFormat::Npy => {
+            let dim = set.axes.len();
+            let mut coords = NpyFile::create(&path, "<f8", set.n, Some(dim))?;
+            let mut attrs: Vec<NpyFile> = Vec::new();
+            for a in set.attributes {
+                let p = dir.join(format!("{stem}_{}.npy", a.name));
+                attrs.push(NpyFile::create(&p, "<i8", set.n, None)?);
+                written.push(p);
+            }
+            let mut count = 0u64;
+            visit(&mut |p, values| {
+                count += 1;
+                for x in p {
+                    coords.out.write_all(&x.to_le_bytes())?;
+                }
+                for (f, v) in attrs.iter_mut().zip(values) {
+                    f.out.write_all(&v.to_le_bytes())?;
+                }
+                Ok(())
+            })?;
+            checked(count)?;
+            coords.commit()?;
+            for f in attrs {
+                f.commit()?;
+            }
+        }
+        PointFormat::Vtk => write_vtk(&path, set, visit)?,
+        PointFormat::Xyz => {
+            let mut f = AtomicFile::create(&path)?;
+            let mut count = 0u64;
+            {
+                let mut b = BufWriter::new(&mut f);
+                writeln!(b, "{}", set.n)?;
+                // The leading `species` column (the particle type of OVITO and ASE) holds a
+                // labelled attribute named `species` if there is one, else `C`.
+                let species = set
+                    .attributes
+                    .iter()
+                    .position(|a| a.name == "species" && a.labels.is_some());
+                let mut props = String::from("species:S:1:pos:R:3");
+                for (k, a) in set.attributes.iter().enumerate() {
+                    if Some(k) != species {
+                        let kind = if a.labels.is_some() { "S" } else { "I" };
+                        props.push_str(&format!(":{}:{kind}:1", a.name));
+                    }
+                }
+                writeln!(
+                    b,
+                    "Properties={props} Comment=\"{}\"",
+                    set.title.replace('"', "'")
+                )?;
+                visit(&mut |p, values| {
+                    count += 1;
+                    // XYZ holds three coordinates: 0 for the axes a plane lacks.
+                    let c = |i: usize| p.get(i).copied().unwrap_or(0.0);
+                    let element = species
+                        .and_then(|k| label(&set.attributes[k], values[k]))
+                        .unwrap_or("C");
+                    if set.integer_coordinates {
+                        write!(
+                            b,
+                            "{element} {} {} {}",
+                            c(0) as i64,
+                            c(1) as i64,
+                            c(2) as i64
+                        )?;
+                    } else {
+                        write!(b, "{element} {} {} {}", c(0), c(1), c(2))?;
+                    }
+                    for (k, (a, v)) in set.attributes.iter().zip(values).enumerate() {
+                        if Some(k) == species {
+                            continue;
+                        }
+                        match label(a, *v) {
+                            Some(l) => write!(b, " {l}")?,
+                            None => write!(b, " {v}")?,
+                        }
+                    }
+                    writeln!(b)
+                })?;
+                b.flush()?;
+            }
+            checked(count)?;
+            f.commit()?;
+        }
+    }
+    Ok(written)
+}
+
+fn label<'a>(a: &Attribute<'a>, v: i64) -> Option<&'a str> {
+    a.labels
+        .and_then(|l| usize::try_from(v).ok().and_then(|i| l.get(i).copied()))
+}
+
+/// An `.npy` file of `n` rows written front to back.
+struct NpyFile {
+    out: BufWriter<AtomicFile>,
+}
+
+impl NpyFile {
+    fn create(path: &Path, descr: &str, n: u64, cols: Option<usize>) -> io::Result<Self> {
+        let mut out = BufWriter::new(AtomicFile::create(path)?);
+        out.write_all(&super::npy::header_bytes(descr, n, cols))?;
+        Ok(NpyFile { out })
+    }
+
+    fn commit(self) -> io::Result<()> {
+        self.out
+            .into_inner()
+            .map_err(|e| io::Error::other(e.to_string()))?
+            .commit()
+    }
+}
+
+/// Legacy VTK 3.0, binary (big-endian): `POINTS` (float64, z = 0 in the plane; only the first
+/// three axes of a higher-dimensional set), one `VERTICES` cell per point so that every viewer
+/// draws them, and the index and the attributes as `POINT_DATA` scalars.
+fn write_vtk(path: &Path, set: &PointSet<'_>, visit: &mut Visitor<'_>) -> Result<(), OutputError> {
+    let n = set.n;
+    // VTK's legacy cells and scalars are 32-bit.
+    let n32 = i32::try_from(n)
+        .ok()
+        .filter(|_| n <= VTK_MAX_POINTS)
+        .ok_or_else(|| {
+            io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("{n} points are too many for legacy VTK's 32-bit cells; use npy"),
+            )
+        })?;
+    let mut f = AtomicFile::create(path)?;
+    {
+        let mut b = BufWriter::new(&mut f);
+        let title: String = set.title.chars().filter(|c| *c != '\n').take(255).collect();
+        write!(
+            b,
+            "# vtk DataFile Version 3.0\n{title}\nBINARY\nDATASET POLYDATA\nPOINTS {n} double\n"
+        )?;
+        let mut count = 0u64;
+        visit(&mut |p, _| {
+            count += 1;
+            for i in 0..3 {
+                b.write_all(&p.get(i).copied().unwrap_or(0.0).to_be_bytes())?;
+            }
+            Ok(())
+        })?;
+        if count != n {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("{}: {count} points visited, {n} announced", path.display()),
+            )
+            .into());
+        }
+        write!(b, "\nVERTICES {n} {}\n", 2 * n)?;
+        for i in 0..n32 {
+            b.write_all(&1i32.to_be_bytes())?;
+            b.write_all(&i.to_be_bytes())?;
+        }
+        write!(b, "\nPOINT_DATA {n}\n")?;
+        if let Some(name) = set.index {
+            write!(b, "SCALARS {name} int 1\nLOOKUP_TABLE default\n")?;
+            for i in 0..n32 {
+                b.write_all(&i.to_be_bytes())?;
+            }
+            writeln!(b)?;
+        }
+        for (k, a) in set.attributes.iter().enumerate() {
+            write!(b, "SCALARS {} int 1\nLOOKUP_TABLE default\n", a.name)?;
+            visit(&mut |_, values| {
+                let v = values.get(k).copied().unwrap_or(0);
+                let v = i32::try_from(v).map_err(|_| {
+                    io::Error::new(
+                        io::ErrorKind::InvalidData,
+                        format!("{} = {v} does not fit VTK's 32-bit scalars", a.name),
+                    )
+                })?;
+                b.write_all(&v.to_be_bytes())
+            })?;
+            writeln!(b)?;
+        }
+        b.flush()?;
+    }
+    f.commit()?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const POINTS: [([f64; 2], [i64; 2]); 3] = [
+        ([0.0, 1.5], [0, 7]),
+        ([2.0, -1.0], [1, 7]),
+        ([3.25, 4.0], [0, 9]),
+    ];
+    const SPECIES: [&str; 2] = ["rabbit", "fox"];
+    const ATTRS: [Attribute<'static>; 2] = [
+        Attribute {
+            name: "species",
+            labels: Some(&SPECIES),
+        },
+        Attribute {
+            name: "cluster",
+            labels: None,
+        },
+    ];
+
+    fn set() -> PointSet<'static> {
+        PointSet {
+            n: 3,
+            axes: &["x", "y"],
+            integer_coordinates: false,
+            attributes: &ATTRS,
+            index: Some("arrival"),
+            title: "three points",
+        }
+    }
+
+    fn write(format: PointFormat, dir: &Path) -> Vec<std::path::PathBuf> {
+        write_points(dir, "positions", format, &set(), &mut |f| {
+            for (p, a) in &POINTS {
+                f(p, a)?;
+            }
+            Ok(())
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn csv_and_xyz_write_labels_and_numbers() {
+        let dir = tempfile::tempdir().unwrap();
+        write(PointFormat::Csv, dir.path());
+        let csv = std::fs::read_to_string(dir.path().join("positions.csv")).unwrap();
+        assert_eq!(
+            csv,
+            "x,y,species,cluster\n0.0,1.5,rabbit,7\n2.0,-1.0,fox,7\n3.25,4.0,rabbit,9\n"
+        );
+        write(PointFormat::Xyz, dir.path());
+        let xyz = std::fs::read_to_string(dir.path().join("positions.xyz")).unwrap();
+        let lines: Vec<&str> = xyz.lines().collect();
+        assert_eq!(lines[0], "3");
+        assert!(lines[1].starts_with("Properties=species:S:1:pos:R:3:cluster:I:1 "));
+        assert_eq!(lines[3], "fox 2 -1 0 7");
+        assert_eq!(lines.len(), 5);
+    }
+
+    #[test]
+    fn npy_files_read_back() {
+        let dir = tempfile::tempdir().unwrap();
+        let files = write(PointFormat::Npy, dir.path());
+        assert_eq!(files.len(), 3);
+        let mut r = super::super::NpyReader::open(dir.path().join("positions.npy")).unwrap();
+        assert_eq!((r.rows(), r.cols()), (3, 2));
+        let mut row = [0.0; 2];
+        for (p, _) in &POINTS {
+            assert!(r.next_row(&mut row).unwrap());
+            assert_eq!(&row, p);
+        }
+        let bytes = std::fs::read(dir.path().join("positions_cluster.npy")).unwrap();
+        let header = String::from_utf8_lossy(&bytes[..128]);
+        assert!(
+            header.contains("'descr': '<i8'") && header.contains("'shape': (3,)"),
+            "{header}"
+        );
+        let values: Vec<i64> = bytes[128..]
+            .chunks(8)
+            .map(|c| i64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(values, [7, 7, 9]);
+    }
+
+    #[test]
+    fn vtk_has_points_vertices_and_scalars() {
+        let dir = tempfile::tempdir().unwrap();
+        write(PointFormat::Vtk, dir.path());
+        let bytes = std::fs::read(dir.path().join("positions.vtk")).unwrap();
+        let head =
+            "# vtk DataFile Version 3.0\nthree points\nBINARY\nDATASET POLYDATA\nPOINTS 3 double\n";
+        assert!(bytes.starts_with(head.as_bytes()));
+        let at = head.len();
+        let xyz: Vec<f64> = bytes[at..at + 72]
+            .chunks(8)
+            .map(|c| f64::from_be_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(xyz, [0.0, 1.5, 0.0, 2.0, -1.0, 0.0, 3.25, 4.0, 0.0]);
+        let rest = &bytes[at + 72..];
+        let find = |s: &str| {
+            rest.windows(s.len())
+                .position(|w| w == s.as_bytes())
+                .unwrap_or_else(|| panic!("{s:?} missing"))
+        };
+        let v = find("VERTICES 3 6\n") + "VERTICES 3 6\n".len();
+        assert_eq!(&rest[v..v + 8], &[0, 0, 0, 1, 0, 0, 0, 0]);
+        find("POINT_DATA 3\n");
+        let c = find("SCALARS cluster int 1\nLOOKUP_TABLE default\n")
+            + "SCALARS cluster int 1\nLOOKUP_TABLE default\n".len();
+        let ids: Vec<i32> = rest[c..c + 12]
+            .chunks(4)
+            .map(|b| i32::from_be_bytes(b.try_into().unwrap()))
+            .collect();
+        assert_eq!(ids, [7, 7, 9]);
+        find("SCALARS arrival int 1\n");
+        find("SCALARS species int 1\n");
+    }
+
+    #[test]
+    fn a_visitor_that_disagrees_with_the_count_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        for format in [
+            PointFormat::Csv,
+            PointFormat::Npy,
+            PointFormat::Vtk,
+            PointFormat::Xyz,
+        ] {
+            let r = write_points(dir.path(), "short", format, &set(), &mut |f| {
+                f(&[0.0, 0.0], &[0, 0])?;
+                Ok(())
+            });
+            assert!(r.is_err(), "{format:?}");
+            assert!(
+                !dir.path()
+                    .join(format!("short.{}", format.extension()))
+                    .exists()
+            );
+        }
+    }
+}
