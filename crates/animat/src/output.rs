@@ -119,12 +119,15 @@ pub fn write_positions(dir: &Path, world: &World, format: PointFormat) -> Result
     Ok(())
 }
 
-/// Largest side of a snapshot in pixels.
+/// Largest side of a snapshot in cells (one pixel each, or a block of pixels when zoomed).
 pub const SNAPSHOT_MAX_SIDE: i64 = 1024;
+/// Smallest side of a snapshot in pixels: a smaller world is zoomed by an integer factor.
+pub const SNAPSHOT_MIN_SIDE: i64 = 512;
 
 /// Writes a PNG of the world: foxes red, rabbits green, on black. The frame is the bounding
 /// box of the live animats plus a margin, one pixel per cell, scaled down by an integer factor
-/// when it would exceed [`SNAPSHOT_MAX_SIDE`]; y points up.
+/// when it would exceed [`SNAPSHOT_MAX_SIDE`], or zoomed (a square of pixels per cell) to at
+/// least [`SNAPSHOT_MIN_SIDE`]; y points up.
 ///
 /// # Errors
 /// [`OutputError`] if the PNG cannot be encoded or written.
@@ -143,19 +146,26 @@ pub fn write_snapshot(path: &Path, world: &World) -> Result<(), OutputError> {
     let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
     let span = (x1.saturating_add(margin) - x0 + 1).max(y1.saturating_add(margin) - y0 + 1);
     let factor = (span + SNAPSHOT_MAX_SIDE - 1) / SNAPSHOT_MAX_SIDE;
-    let side = (span + factor - 1) / factor;
+    let cells = (span + factor - 1) / factor;
+    // A small world is drawn with `zoom` x `zoom` pixels per cell, so the picture is readable.
+    let zoom = ((SNAPSHOT_MIN_SIDE + cells - 1) / cells).max(1);
+    let side = cells * zoom;
     let mut pixels = vec![0u8; (side * side * 3) as usize];
     for a in world.animats() {
-        let px = (a.pos[0] - x0) / factor;
-        let py = side - 1 - (a.pos[1] - y0) / factor;
-        let at = ((py * side + px) * 3) as usize;
+        let cx = (a.pos[0] - x0) / factor;
+        let cy = cells - 1 - (a.pos[1] - y0) / factor;
         let c: [u8; 3] = match a.species {
             Species::Fox => [255, 60, 40],
             Species::Rabbit => [80, 220, 80],
         };
-        // A fox drawn over a rabbit in a shared scaled pixel stays visible.
-        if a.species == Species::Fox || pixels[at] != 255 {
-            pixels[at..at + 3].copy_from_slice(&c);
+        for py in cy * zoom..(cy + 1) * zoom {
+            for px in cx * zoom..(cx + 1) * zoom {
+                let at = ((py * side + px) * 3) as usize;
+                // A fox drawn over a rabbit in a shared scaled pixel stays visible.
+                if a.species == Species::Fox || pixels[at] != 255 {
+                    pixels[at..at + 3].copy_from_slice(&c);
+                }
+            }
         }
     }
     write_png_rgb(path, side as u32, side as u32, &pixels)?;

@@ -304,7 +304,15 @@ fn positions_in_every_format_hold_the_same_animats() {
     let tmp = tempfile::tempdir().unwrap();
     let run = |format: Option<&str>| {
         let out = tmp.path().join(format.unwrap_or("default"));
-        let mut args = vec!["--steps", "8", "--seed", "5", "-q", "--out", out.to_str().unwrap()];
+        let mut args = vec![
+            "--steps",
+            "8",
+            "--seed",
+            "5",
+            "-q",
+            "--out",
+            out.to_str().unwrap(),
+        ];
         args.push("--positions");
         args.extend(format);
         let o = animat(&args);
@@ -313,7 +321,11 @@ fn positions_in_every_format_hold_the_same_animats() {
     };
     let csv = std::fs::read_to_string(run(None).join("positions.csv")).unwrap();
     assert_eq!(csv.lines().next(), Some("x,y,id,species,age,hunger"));
-    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
     assert!(rows.len() > 100);
 
     let npy = run(Some("npy"));

@@ -49,6 +49,8 @@ pub struct Series {
     pub labels: Option<Vec<String>>,
     /// Optional error band `(x, low, high)`, shaded in the series' colour under it.
     pub band: Option<Vec<(f64, f64, f64)>>,
+    /// Optional symmetric error bars on y, one per point (a standard error, say).
+    pub y_errors: Option<Vec<f64>>,
 }
 
 impl Series {
@@ -60,7 +62,15 @@ impl Series {
             style,
             labels: None,
             band: None,
+            y_errors: None,
         }
+    }
+
+    /// The same series with an error bar of half-length `errors[i]` on point `i`.
+    pub fn with_y_errors(mut self, errors: Vec<f64>) -> Self {
+        assert_eq!(errors.len(), self.points.len(), "one error per point");
+        self.y_errors = Some(errors);
+        self
     }
 
     /// The same series with an error band `(x, low, high)` (mean +- standard error, say).
@@ -142,7 +152,7 @@ fn tick(v: f64) -> String {
 }
 
 macro_rules! draw_chart {
-    ($root:expr, $chart:expr, $xr:expr, $yr:expr) => {{
+    ($root:expr, $chart:expr, $xr:expr, $yr:expr, $corner:expr) => {{
         let spec: &Chart = $chart;
         let mut ctx = ChartBuilder::on($root)
             .caption(&spec.title, ("sans-serif", 24))
@@ -198,6 +208,42 @@ macro_rules! draw_chart {
                     )))
                     .map_err(|e| anyhow!("{e}"))?;
                 }
+            }
+            if let Some(errors) = &s.y_errors {
+                let ok = |x: f64, y: f64| {
+                    x.is_finite()
+                        && y.is_finite()
+                        && (!spec.log_x || x > 0.0)
+                        && (!spec.log_y || y > 0.0)
+                };
+                let bars: Vec<((f64, f64), (f64, f64))> = s
+                    .points
+                    .iter()
+                    .zip(errors)
+                    .filter(|((x, y), e)| ok(*x, *y) && e.is_finite() && **e > 0.0)
+                    .map(|(&(x, y), &e)| {
+                        // On a log axis a bar reaching zero or below is cut at a tenth of y.
+                        let lo = if spec.log_y && y - e <= 0.0 {
+                            y / 10.0
+                        } else {
+                            y - e
+                        };
+                        ((x, lo), (x, y + e))
+                    })
+                    .collect();
+                ctx.draw_series(
+                    bars.iter()
+                        .map(|&(a, b)| PathElement::new(vec![a, b], color.stroke_width(1))),
+                )
+                .map_err(|e| anyhow!("{e}"))?;
+                // Caps: short horizontal ticks in pixels at both ends.
+                ctx.draw_series(bars.iter().flat_map(|&(a, b)| {
+                    [a, b].map(|p| {
+                        EmptyElement::at(p)
+                            + PathElement::new(vec![(-4, 0), (4, 0)], color.stroke_width(1))
+                    })
+                }))
+                .map_err(|e| anyhow!("{e}"))?;
             }
             match s.style {
                 Style::Line | Style::Thin | Style::LinePoints => {
@@ -259,10 +305,76 @@ macro_rules! draw_chart {
             .label_font(("sans-serif", 15))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperLeft)
+            .position($corner)
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
     }};
+}
+
+/// The corner of the plot where the legend covers the least data: the share of the plot a
+/// legend of this chart's entries takes is estimated from their number and length, and the
+/// points (and the lines between them, sampled) that fall under it are counted in each corner.
+fn legend_corner(chart: &Chart, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> SeriesLabelPosition {
+    let unit = |v: f64, lo: f64, hi: f64, log: bool| {
+        if log {
+            (v.log10() - lo.log10()) / (hi.log10() - lo.log10())
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    // Plot area in pixels: the chart less its margins, caption and label areas.
+    let (plot_w, plot_h) = (f64::from(WIDTH) - 112.0, f64::from(HEIGHT) - 130.0);
+    let longest = chart
+        .series
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0);
+    let w = ((longest as f64 * 8.0 + 50.0) / plot_w).min(1.0);
+    let h = ((chart.series.len() as f64 * 21.0 + 12.0) / plot_h).min(1.0);
+    let mut samples: Vec<(f64, f64)> = Vec::new();
+    for s in &chart.series {
+        let pts: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .filter(|(x, y)| {
+                x.is_finite()
+                    && y.is_finite()
+                    && (!chart.log_x || *x > 0.0)
+                    && (!chart.log_y || *y > 0.0)
+            })
+            .map(|&(x, y)| (unit(x, x0, x1, chart.log_x), unit(y, y0, y1, chart.log_y)))
+            .collect();
+        samples.extend(&pts);
+        if matches!(s.style, Style::Line | Style::Thin | Style::LinePoints) {
+            for pair in pts.windows(2) {
+                let ((ax, ay), (bx, by)) = (pair[0], pair[1]);
+                samples.extend((1..8).map(|k| {
+                    let t = f64::from(k) / 8.0;
+                    (ax + t * (bx - ax), ay + t * (by - ay))
+                }));
+            }
+        }
+    }
+    let covered = |left: bool, top: bool| {
+        samples
+            .iter()
+            .filter(|&&(x, y)| {
+                let in_x = if left { x <= w } else { x >= 1.0 - w };
+                let in_y = if top { y >= 1.0 - h } else { y <= h };
+                in_x && in_y
+            })
+            .count()
+    };
+    [
+        (SeriesLabelPosition::UpperLeft, true, true),
+        (SeriesLabelPosition::UpperRight, false, true),
+        (SeriesLabelPosition::LowerRight, false, false),
+        (SeriesLabelPosition::LowerLeft, true, false),
+    ]
+    .into_iter()
+    .min_by_key(|&(_, left, top)| covered(left, top))
+    .map_or(SeriesLabelPosition::UpperLeft, |(p, _, _)| p)
 }
 
 /// Draw `chart` to a PNG at `path` (written atomically).
@@ -272,19 +384,37 @@ pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
     let bands = || chart.series.iter().flat_map(|s| s.band.iter().flatten());
     let (x0, x1) = range(all().map(|p| p.0), chart.log_x)
         .with_context(|| format!("no plottable x values for {}", path.display()))?;
-    let ys = all().map(|p| p.1).chain(bands().flat_map(|b| [b.1, b.2]));
+    let bars = || {
+        chart.series.iter().flat_map(|s| {
+            s.points
+                .iter()
+                .zip(s.y_errors.iter().flatten())
+                .flat_map(|(p, e)| [p.1 - e, p.1 + e])
+        })
+    };
+    let ys = all()
+        .map(|p| p.1)
+        .chain(bands().flat_map(|b| [b.1, b.2]))
+        .chain(bars());
     let (y0, y1) = range(ys, chart.log_y)
         .with_context(|| format!("no plottable y values for {}", path.display()))?;
+    let corner = legend_corner(chart, (x0, x1), (y0, y1));
     let mut buf = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
         match (chart.log_x, chart.log_y) {
-            (false, false) => draw_chart!(&root, chart, x0..x1, y0..y1),
-            (true, false) => draw_chart!(&root, chart, (x0..x1).log_scale(), y0..y1),
-            (false, true) => draw_chart!(&root, chart, x0..x1, (y0..y1).log_scale()),
+            (false, false) => draw_chart!(&root, chart, x0..x1, y0..y1, corner),
+            (true, false) => draw_chart!(&root, chart, (x0..x1).log_scale(), y0..y1, corner),
+            (false, true) => draw_chart!(&root, chart, x0..x1, (y0..y1).log_scale(), corner),
             (true, true) => {
-                draw_chart!(&root, chart, (x0..x1).log_scale(), (y0..y1).log_scale())
+                draw_chart!(
+                    &root,
+                    chart,
+                    (x0..x1).log_scale(),
+                    (y0..y1).log_scale(),
+                    corner
+                )
             }
         }
         root.present().map_err(|e| anyhow!("{e}"))?;
@@ -307,6 +437,31 @@ mod tests {
     }
 
     #[test]
+    fn the_legend_goes_where_it_covers_least_data() {
+        let line = |pts: Vec<(f64, f64)>| Chart {
+            title: String::new(),
+            x_label: String::new(),
+            y_label: String::new(),
+            log_x: false,
+            log_y: false,
+            series: vec![Series::new("a long legend entry", pts, Style::Line)],
+        };
+        let corner = |c: &Chart| legend_corner(c, (0.0, 1.0), (0.0, 1.0));
+        // Falling from the upper left: the upper right is free.
+        let falling = line(vec![(0.0, 1.0), (1.0, 0.0)]);
+        assert!(matches!(corner(&falling), SeriesLabelPosition::UpperRight));
+        // Rising from the lower left: the upper left is free.
+        let rising = line(vec![(0.0, 0.0), (1.0, 1.0)]);
+        assert!(matches!(corner(&rising), SeriesLabelPosition::UpperLeft));
+        // Along the top edge: a lower corner.
+        let top = line(vec![(0.0, 0.98), (0.5, 0.97), (1.0, 0.98)]);
+        assert!(matches!(
+            corner(&top),
+            SeriesLabelPosition::LowerLeft | SeriesLabelPosition::LowerRight
+        ));
+    }
+
+    #[test]
     fn draws_every_axis_kind() {
         let dir = tempfile::tempdir().unwrap();
         for (log_x, log_y) in [(false, false), (true, false), (false, true), (true, true)] {
@@ -326,6 +481,8 @@ mod tests {
                     Series::new("c", vec![(5.0, 5.0)], Style::Highlight),
                     Series::new("d", vec![(1.0, 3.0), (100.0, 30.0)], Style::Line)
                         .with_band(vec![(1.0, 2.5, 3.5), (100.0, 25.0, 35.0)]),
+                    Series::new("e", vec![(3.0, 4.0), (30.0, 40.0)], Style::Points)
+                        .with_y_errors(vec![1.0, 50.0]),
                 ],
             };
             let path = dir.path().join(format!("{log_x}{log_y}.png"));

@@ -315,6 +315,12 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         &format!("2D DLA, N = {n}: cost against error of D"),
         "|D - D_ref|",
         &points.iter().map(|p| (p.0, p.1)).collect::<Vec<_>>(),
+        // The reference's own error is zero by definition.
+        &points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| if i == 0 { 0.0 } else { p.4 })
+            .collect::<Vec<_>>(),
         &short,
         default,
         "accuracy_pareto.png",
@@ -324,6 +330,12 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         &format!("2D DLA, N = {n}: cost against error of the R_g prefactor"),
         "|relative error of the R_g prefactor|",
         &points.iter().map(|p| (p.0, p.2)).collect::<Vec<_>>(),
+        // The reference's own error is zero by definition.
+        &points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| if i == 0 { 0.0 } else { p.6 })
+            .collect::<Vec<_>>(),
         &short,
         default,
         "accuracy_pareto_prefactor.png",
@@ -339,11 +351,13 @@ pub fn run(ctx: &Ctx) -> Result<()> {
 
 /// Cost against error for every setting, the Pareto front as a line, the default and the
 /// reference marked (the reference's zero error is drawn at 1e-4 on the log axis).
+#[allow(clippy::too_many_arguments)]
 fn pareto_chart(
     ctx: &Ctx,
     title: &str,
     y_label: &str,
     pts: &[(f64, f64)],
+    errors: &[f64],
     labels: &[String],
     default: Option<usize>,
     file: &str,
@@ -353,8 +367,13 @@ fn pareto_chart(
     let mut fp: Vec<(f64, f64)> = pareto(pts).into_iter().map(at).collect();
     fp.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut series = vec![
-        Series::new("settings", (0..pts.len()).map(at).collect(), Style::Points)
-            .with_labels(labels.to_vec()),
+        Series::new(
+            "settings (± standard error)",
+            (0..pts.len()).map(at).collect(),
+            Style::Points,
+        )
+        .with_labels(labels.to_vec())
+        .with_y_errors(errors.to_vec()),
         Series::new("Pareto front", fp, Style::Line),
     ];
     if let Some(i) = default {

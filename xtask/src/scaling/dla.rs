@@ -146,6 +146,14 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
                 Style::Line,
             ));
         }
+        // The paper's fitted cost per particle (its Fig. 3, 2008 hardware) as T = a N, without
+        // its intercept, which was fitted over 1e6-1e9 particles.
+        let a = if d == 2 { 3e-5 } else { 1e-4 };
+        series.push(Series::new(
+            format!("{d}D paper: {} us per particle (2008 hardware)", a * 1e6),
+            vec![(100.0, a * 100.0), (n as f64, a * n as f64)],
+            Style::Thin,
+        ));
     }
     ctx.table(doc, &table, "dla_fig3_summary.csv")?;
     data.write_csv(&ctx.path("dla_fig3.csv"))?;
@@ -164,7 +172,9 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
         "One cluster per row, timed as it grows (about 1000 log-spaced samples); the linear fit \
          uses every sample, as the paper fitted T against N. The standard error of a comes from \
          the fit; the samples of one run are correlated, so it understates the run-to-run \
-         spread. Data: [`dla_fig3.csv`](dla_fig3.csv).",
+         spread. The thin lines are the paper's fitted cost per particle (30 and 100 \
+         microseconds, on 2008 hardware) drawn through the origin. Data: \
+         [`dla_fig3.csv`](dla_fig3.csv).",
     );
     doc.image("run time against N", "dla_fig3.png");
     Ok(())

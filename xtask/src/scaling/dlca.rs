@@ -3,6 +3,7 @@
 //! of candidate clusters examined per move (Figs. 4, 7, 8), and the log-log gradient of the sweep
 //! cost against N for each strategy.
 
+use super::ensemble::columns;
 use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, mean_stderr, pm, sig};
@@ -80,12 +81,13 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                 format!("--fill={fill}"),
                 "--search=lattice".into(),
                 "--target-clusters=100".into(),
+                "--positions=none".into(),
             ],
         )?;
         let particles = ens.stat("particles")?.mean as u64;
         let to_target = ens.stat("sweeps")?;
         let mut exponents = Vec::new();
-        for (i, m) in ens.members.iter().enumerate() {
+        for m in &ens.members {
             let path = ens.member_dir(m).join("sweeps.csv");
             let sweeps: Vec<SweepRecord> = csv::Reader::from_path(&path)
                 .and_then(|r| r.into_deserialize().collect())
@@ -114,17 +116,34 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             if let Ok(f) = Fit::log_log(&x, &y) {
                 exponents.push(-f.slope);
             }
-            if i < 3 {
-                series.push(Series::new(
-                    format!("{} fill, seed {}", pct(fill), m.seed),
-                    picked
-                        .iter()
-                        .map(|s| (s.sweep as f64, s.clusters as f64))
-                        .collect(),
-                    Style::Line,
-                ));
-            }
         }
+        // The ensemble's mean cluster count (over the sweeps every member reached) with its
+        // standard error as a band.
+        let mean = columns(
+            &ens.dir.join("ensemble_sweeps.csv"),
+            &["sweep", "clusters_mean", "clusters_stderr"],
+        )?;
+        let keep: Vec<usize> = log_spaced(1, mean[0].len().max(2) as u64 - 1, 200)
+            .into_iter()
+            .map(|k| k as usize)
+            .filter(|&k| k < mean[0].len())
+            .collect();
+        series.push(
+            Series::new(
+                format!(
+                    "{} fill, mean of {} runs ± standard error",
+                    pct(fill),
+                    ens.members.len()
+                ),
+                keep.iter().map(|&k| (mean[0][k], mean[1][k])).collect(),
+                Style::Line,
+            )
+            .with_band(
+                keep.iter()
+                    .map(|&k| (mean[0][k], mean[1][k] - mean[2][k], mean[1][k] + mean[2][k]))
+                    .collect(),
+            ),
+        );
         let (zm, zse) = mean_stderr(&exponents);
         table.row(vec![
             pct(fill),
@@ -151,8 +170,10 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     )?;
     doc.p(
         "Each run stops at 100 clusters. z is the log-log slope of clusters against sweeps from \
-         sweep 10 on, per run, then averaged (± standard error over runs). Per-sweep data at \
-         about 200 log-spaced sweeps per run: [`dlca_fig5.csv`](dlca_fig5.csv).",
+         sweep 10 on, per run, then averaged (± standard error over runs). The plot shows the \
+         mean cluster count over the runs, up to the sweep every run reached, with its \
+         standard error as a band. Per-sweep data at about 200 log-spaced sweeps per run: \
+         [`dlca_fig5.csv`](dlca_fig5.csv).",
     );
     doc.image("clusters against sweeps", "dlca_fig5.png");
     Ok(())
