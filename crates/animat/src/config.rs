@@ -49,6 +49,18 @@ pub fn parse_config(text: &str, path: &str) -> Result<Params, ConfigError> {
     })
 }
 
+/// `params` as a config file that [`parse_config`] reads back to the same parameters, with a
+/// header saying what it is.
+///
+/// # Errors
+/// A parameter TOML cannot represent (none of the current ones).
+pub fn to_toml(params: &Params) -> Result<String, toml::ser::Error> {
+    Ok(format!(
+        "# animat model parameters (read with --config; --steps and --seed are flags)\n{}",
+        toml::to_string(params)?
+    ))
+}
+
 /// Reads and parses a config file (not validated: call [`Params::validate`]).
 ///
 /// # Errors

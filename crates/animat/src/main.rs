@@ -32,13 +32,19 @@ struct Cli {
     seed: u64,
 
     /// Output directory (created if missing; nothing is written on bad input).
-    #[arg(long)]
-    out: PathBuf,
+    #[arg(long, required_unless_present = "dump_config")]
+    out: Option<PathBuf>,
 
     /// TOML file with any model parameters (see data/animat-default.toml); unknown keys are
-    /// errors.
+    /// errors. A run saves its parameters as OUT/config.toml, so `--config OUT/config.toml`
+    /// with the same --steps and --seed repeats it.
     #[arg(long)]
     config: Option<PathBuf>,
+
+    /// Print the effective model parameters (defaults, then --config, then flags) as a config
+    /// file and exit without running.
+    #[arg(long)]
+    dump_config: bool,
 
     /// Foxes at the start.
     #[arg(long)]
@@ -98,6 +104,15 @@ struct Cli {
     ensemble: EnsembleArgs,
 }
 
+impl Cli {
+    /// The output directory (clap requires it unless `--dump-config`, which never gets here).
+    fn out(&self) -> &Path {
+        self.out
+            .as_deref()
+            .expect("clap requires --out unless --dump-config")
+    }
+}
+
 /// Builds validated parameters: defaults, then the config file, then the flags.
 fn params(cli: &Cli) -> Result<Params, String> {
     let mut p = match &cli.config {
@@ -140,7 +155,9 @@ fn params(cli: &Cli) -> Result<Params, String> {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
     p.validate().map_err(|e| culprit(cli, &e))?;
-    core_lattice::cli::check_out_dir(&cli.out)?;
+    if let Some(out) = &cli.out {
+        core_lattice::cli::check_out_dir(out)?;
+    }
     Ok(p)
 }
 
@@ -190,8 +207,12 @@ fn main() -> ExitCode {
         |c: &Cli| c.log,
         params,
         |cli, params| {
+            if cli.dump_config {
+                print!("{}", animat::config::to_toml(&params)?);
+                return Ok(());
+            }
             cli.ensemble
-                .run("animat", 1, &cli.out, CURVES, &cli.log)
+                .run("animat", 1, cli.out(), CURVES, &cli.log)
                 .unwrap_or_else(|| run(cli, params))
         },
     )
@@ -273,8 +294,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     };
     world.set_timing(cli.timing);
-    core_lattice::cli::prepare_out_dir(&cli.out)
-        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    core_lattice::cli::prepare_out_dir(cli.out())
+        .with_context(|| format!("creating output directory {}", cli.out().display()))?;
+    // The effective parameters, so that `--config OUT/config.toml` repeats the run.
+    core_lattice::io::write_atomic(
+        cli.out().join("config.toml"),
+        animat::config::to_toml(world.params())?.as_bytes(),
+    )
+    .with_context(|| format!("writing {}/config.toml", cli.out().display()))?;
     tracing::info!(
         foxes = world.foxes(),
         rabbits = world.rabbits(),
@@ -286,12 +313,12 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             world: world.snapshot(),
             rows: rows.to_vec(),
         };
-        write_checkpoint(cli.out.join(CHECKPOINT), CHECKPOINT_MODEL, &saved)
+        write_checkpoint(cli.out().join(CHECKPOINT), CHECKPOINT_MODEL, &saved)
             .context("writing a checkpoint")?;
         Ok(())
     };
     let snapshot = |w: &World| -> anyhow::Result<()> {
-        let path = cli.out.join(format!("snapshot_{:06}.png", w.steps()));
+        let path = cli.out().join(format!("snapshot_{:06}.png", w.steps()));
         output::write_snapshot(&path, w)?;
         Ok(())
     };
@@ -319,8 +346,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             return Err(Interrupted(format!(
                 "interrupted after step {}; checkpoint in {}: continue with --resume {}",
                 world.steps(),
-                cli.out.display(),
-                cli.out.display()
+                cli.out().display(),
+                cli.out().display()
             ))
             .into());
         }
@@ -365,11 +392,11 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             snapshot(&world)?;
         }
     }
-    output::write_populations(&cli.out, &rows, cli.timing)?;
+    output::write_populations(cli.out(), &rows, cli.timing)?;
     if let Some(format) = cli.positions.format() {
-        output::write_positions(&cli.out, &world, format)?;
+        output::write_positions(cli.out(), &world, format)?;
     }
-    let m = output::write_manifest(&cli.out, &world, cli.seed, &clock)?;
+    let m = output::write_manifest(cli.out(), &world, cli.seed, &clock)?;
     if !cli.log.is_quiet() {
         eprintln!(
             "animat: {} foxes, {} rabbits after {} steps in {:.2} s (state {}); outputs in {}",
@@ -378,7 +405,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             world.steps(),
             m.wall_seconds,
             world.state_hash(),
-            cli.out.display()
+            cli.out().display()
         );
     }
     Ok(())

@@ -355,3 +355,43 @@ fn positions_in_every_format_hold_the_same_animats() {
         assert!(has(&format!("SCALARS {a} int 1\n")), "{a}");
     }
 }
+
+/// A run saves its parameters as `config.toml`; `--dump-config` prints the same without `--out`;
+/// `--config OUT/config.toml` with the same steps and seed repeats the run.
+#[test]
+fn config_files_repeat_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let a = tmp.path().join("a");
+    let b = tmp.path().join("b");
+    let flags = ["--steps", "6", "--seed", "3", "--vision", "25", "-q"];
+    let o = animat(&[&flags[..], &["--out", a.to_str().unwrap()]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let saved = std::fs::read_to_string(a.join("config.toml")).unwrap();
+    assert!(saved.contains("vision = 25"), "{saved}");
+    let dump = animat(&["--vision", "25", "--dump-config"]);
+    assert!(
+        dump.status.success(),
+        "{}",
+        String::from_utf8_lossy(&dump.stderr)
+    );
+    assert_eq!(String::from_utf8_lossy(&dump.stdout), saved);
+    let config = a.join("config.toml");
+    let o = animat(&[
+        "--steps",
+        "6",
+        "--seed",
+        "3",
+        "-q",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        b.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let hash = |d: &Path| {
+        let j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("run.json")).unwrap()).unwrap();
+        j["results"]["state_hash"].clone()
+    };
+    assert_eq!(hash(&a), hash(&b));
+}

@@ -414,3 +414,59 @@ pub fn provenance_and_color_contract(binary: &Path, dir: &Path, flags: &[&str]) 
     }
     assert!(p["cpus"].as_u64().unwrap_or(0) >= 1, "{p}");
 }
+
+/// The config-file contract of a binary with [`crate::cli::ConfigArgs`], run with `flags`
+/// (small and fast, without `--out`) in the working directory `dir`:
+///
+/// - a run saves its effective configuration as `OUT/config.toml`, and `--dump-config` with the
+///   same flags prints exactly that file, without running and without `--out`;
+/// - `--config OUT/config.toml` repeats the run (same `state_hash`);
+/// - a flag on the command line overrides the file.
+pub fn config_contract(binary: &Path, dir: &Path, flags: &[&str]) {
+    let run = |args: &[&str]| {
+        let o = Command::new(binary)
+            .args(args)
+            .arg("-qq")
+            .current_dir(dir)
+            .stdin(Stdio::null())
+            .output()
+            .expect("the binary starts");
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    };
+    fn with<'a>(flags: &[&'a str], extra: &[&'a str]) -> Vec<&'a str> {
+        flags.iter().chain(extra).copied().collect()
+    }
+    run(&with(flags, &["--out", "a"]));
+    let saved = std::fs::read_to_string(dir.join("a/config.toml")).expect("config.toml");
+    let dumped = run(&with(flags, &["--dump-config"]));
+    assert_eq!(
+        dumped, saved,
+        "--dump-config differs from the saved config.toml"
+    );
+    assert!(!dir.join("b").exists());
+    run(&["--config", "a/config.toml", "--out", "b"]);
+    let hash = |d: &str| manifest(&dir.join(d))["results"]["state_hash"].clone();
+    assert_eq!(
+        hash("a"),
+        hash("b"),
+        "--config OUT/config.toml did not repeat the run"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("b/config.toml")).unwrap(),
+        saved,
+        "the repeated run's configuration differs"
+    );
+    run(&["--config", "a/config.toml", "--seed", "98765", "--out", "c"]);
+    assert_ne!(
+        hash("a"),
+        hash("c"),
+        "--seed on the command line did not override the file"
+    );
+    let c = std::fs::read_to_string(dir.join("c/config.toml")).unwrap();
+    assert!(c.contains("seed = 98765"), "{c}");
+}

@@ -5,7 +5,7 @@
 
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
+use core_lattice::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::ensemble::{Curve, EnsembleArgs};
 use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
@@ -131,6 +131,9 @@ struct Cli {
     png_size: Option<u32>,
 
     #[command(flatten)]
+    config: ConfigArgs,
+
+    #[command(flatten)]
     log: LogArgs,
 
     #[command(flatten)]
@@ -230,7 +233,7 @@ fn main() -> ExitCode {
     if let Some(code) = core_lattice::ensemble::merge_main("dla", CURVES) {
         return code;
     }
-    core_lattice::cli::main_with(
+    core_lattice::cli::main_with_config(
         "dla",
         |c: &Cli| c.log,
         params,
@@ -273,6 +276,9 @@ where
     };
     core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    // The effective flags, so that `--config OUT/config.toml` repeats the run.
+    core_lattice::cli::config::save(&cli.out)
+        .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
     let positions =
         cli.png || cli.positions != PositionsFormat::None || cli.checkpoint_every.is_some();
     if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {

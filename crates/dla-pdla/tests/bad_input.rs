@@ -27,6 +27,9 @@ fn run_ok(dir: &Path, args: &[&str]) {
 /// another model's, without its positions log, with another run's log.
 fn fixtures(dir: &Path) {
     std::fs::write(dir.join("file"), b"not a directory").unwrap();
+    // Config files: an unknown key on line 2, malformed TOML on line 1.
+    std::fs::write(dir.join("unknown.toml"), b"seed = 3\nwalkers = 3\n").unwrap();
+    std::fs::write(dir.join("broken.toml"), b"seed = [\n").unwrap();
     std::fs::create_dir(dir.join("empty")).unwrap();
     run_ok(
         dir,
@@ -105,6 +108,18 @@ fn bad_inputs_are_refused_before_any_work() {
         (vec!["--particles", "abc", "--out", "out"], "abc"),
         (vec!["--particles", "-5", "--out", "out"], "-5"),
         (with(&["--dim", "4"]), "--dim 4"),
+        (
+            with(&["--config", "missing.toml"]),
+            "--config missing.toml: cannot read it",
+        ),
+        (
+            with(&["--config", "unknown.toml"]),
+            "line 2: unknown key `walkers`",
+        ),
+        (
+            with(&["--config", "broken.toml"]),
+            "--config broken.toml, line",
+        ),
         (with(&["--dim", "1"]), "--dim 1"),
         (with(&["--step-min", "0"]), "--step-min 0"),
         (with(&["--step-min", "NaN"]), "--step-min NaN"),

@@ -250,8 +250,8 @@ fn outputs_are_created_with_the_umask_0644_and_0755_under_022() {
         files += 1;
     }
     assert_eq!(
-        files, 6,
-        "run.json, growth.csv, positions.npy, positions.csv, dla.png, checkpoint.bin"
+        files, 7,
+        "run.json, config.toml, growth.csv, positions.npy, positions.csv, dla.png, checkpoint.bin"
     );
 }
 
@@ -283,5 +283,16 @@ fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
         std::path::Path::new(env!("CARGO_BIN_EXE_dla")),
         dir.path(),
         &["--particles", "200", "--seed", "2"],
+    );
+}
+
+/// `--config` files: the saved configuration repeats the run, flags override it.
+#[test]
+fn config_files_repeat_runs_and_flags_override_them() {
+    let dir = tempfile::tempdir().unwrap();
+    core_lattice::testing::config_contract(
+        std::path::Path::new(env!("CARGO_BIN_EXE_dla")),
+        dir.path(),
+        &["--particles", "300", "--seed", "4", "--step-min", "0.2"],
     );
 }

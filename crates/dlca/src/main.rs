@@ -6,7 +6,7 @@
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use core_lattice::Boundary;
-use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
+use core_lattice::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::ensemble::{Curve, EnsembleArgs};
 use core_lattice::io::{Positions, RunClock};
 use core_lattice::io::{read_checkpoint, write_checkpoint};
@@ -138,6 +138,9 @@ struct Cli {
     /// particles.xyz (extended XYZ: OVITO, VMD), or none.
     #[arg(long, value_enum, value_name = "FORMAT", default_value_t = Positions::Csv)]
     positions: Positions,
+
+    #[command(flatten)]
+    config: ConfigArgs,
 
     #[command(flatten)]
     log: LogArgs,
@@ -316,7 +319,7 @@ fn main() -> ExitCode {
     if let Some(code) = core_lattice::ensemble::merge_main("dlca", CURVES) {
         return code;
     }
-    core_lattice::cli::main_with(
+    core_lattice::cli::main_with_config(
         "dlca",
         |c: &Cli| c.log,
         params,
@@ -340,6 +343,9 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     // Created before the run so a long run cannot end with nowhere to write.
     core_lattice::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    // The effective flags, so that `--config OUT/config.toml` repeats the run.
+    core_lattice::cli::config::save(&cli.out)
+        .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
     tracing::info!("{}", sim.strategy_reason());
     let initial = sim.clusters();
     let progress = cli.log.progress(

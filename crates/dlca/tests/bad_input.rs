@@ -12,6 +12,9 @@ const DLCA: &str = env!("CARGO_BIN_EXE_dlca");
 /// 1) in `ck/`, and broken copies: truncated, one byte flipped, another model's.
 fn fixtures(dir: &Path) {
     std::fs::write(dir.join("file"), b"not a directory").unwrap();
+    // Config files: an unknown key on line 2, malformed TOML on line 1.
+    std::fs::write(dir.join("unknown.toml"), b"seed = 3\nwalkers = 3\n").unwrap();
+    std::fs::write(dir.join("broken.toml"), b"seed = [\n").unwrap();
     std::fs::create_dir(dir.join("empty")).unwrap();
     let o = Command::new(DLCA)
         .args(["--size", "32", "--fill", "0.1", "--target-clusters", "1"])
@@ -39,6 +42,18 @@ fn bad_inputs_are_refused_before_any_work() {
         (vec!["--fill", "0.1", "--out", "out"], "--size is required"),
         (vec!["--size", "32", "--fill", "0.1"], "--out"),
         (with(&["--dim", "0"]), "--dim 0"),
+        (
+            with(&["--config", "missing.toml"]),
+            "--config missing.toml: cannot read it",
+        ),
+        (
+            with(&["--config", "unknown.toml"]),
+            "line 2: unknown key `walkers`",
+        ),
+        (
+            with(&["--config", "broken.toml"]),
+            "--config broken.toml, line",
+        ),
         (with(&["--dim", "6"]), "--dim 6"),
         (
             vec!["--size", "0", "--fill", "0.1", "--out", "out"],

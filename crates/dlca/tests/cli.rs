@@ -320,3 +320,14 @@ fn positions_in_every_format_hold_the_same_particles() {
         assert!(!none.join(f).exists(), "{f}");
     }
 }
+
+/// `--config` files: the saved configuration repeats the run, flags override it.
+#[test]
+fn config_files_repeat_runs_and_flags_override_them() {
+    let dir = tempfile::tempdir().unwrap();
+    core_lattice::testing::config_contract(
+        Path::new(env!("CARGO_BIN_EXE_dlca")),
+        dir.path(),
+        &["--size", "32x16", "--fill", "0.05", "--seed", "4", "--png"],
+    );
+}

@@ -15,10 +15,12 @@
 //!   there is no bar (a redirected log, or `--quiet`), so a long run is told from a hang;
 //!   `-qq` silences it ([`LogArgs`], [`Progress`]).
 
+pub mod config;
 mod out_dir;
 mod progress;
 mod resume;
 
+pub use config::ConfigArgs;
 pub use out_dir::{check_out_dir, prepare_out_dir};
 pub use progress::Progress;
 pub use resume::{flag_differences, labelled_differences};
@@ -167,7 +169,34 @@ pub fn main_with<C: clap::Parser, P>(
     params: impl FnOnce(&C) -> Result<P, String>,
     run: impl FnOnce(&C, P) -> anyhow::Result<()>,
 ) -> ExitCode {
-    let cli: C = match parse_or_exit(program) {
+    main_parsed(program, parse_or_exit(program), logging, params, run)
+}
+
+/// [`main_with`] for a binary whose flags include [`ConfigArgs`]: `--config FILE` stands for
+/// the flags in the file and `--dump-config` prints the effective ones ([`config`]).
+pub fn main_with_config<C: clap::Parser, P>(
+    program: &str,
+    logging: impl FnOnce(&C) -> LogArgs,
+    params: impl FnOnce(&C) -> Result<P, String>,
+    run: impl FnOnce(&C, P) -> anyhow::Result<()>,
+) -> ExitCode {
+    main_parsed(
+        program,
+        config::parse_with_config(program),
+        logging,
+        params,
+        run,
+    )
+}
+
+fn main_parsed<C, P>(
+    program: &str,
+    parsed: Result<C, ExitCode>,
+    logging: impl FnOnce(&C) -> LogArgs,
+    params: impl FnOnce(&C) -> Result<P, String>,
+    run: impl FnOnce(&C, P) -> anyhow::Result<()>,
+) -> ExitCode {
+    let cli: C = match parsed {
         Ok(cli) => cli,
         Err(code) => return code,
     };
@@ -216,21 +245,25 @@ pub fn error_line(e: &anyhow::Error) -> String {
 /// `Err(ExitCode::SUCCESS)`; any parse error prints clap's message folded onto one line,
 /// prefixed by `program`, and returns `Err` with exit code 2.
 pub fn parse_or_exit<C: clap::Parser>(program: &str) -> Result<C, ExitCode> {
-    C::try_parse().map_err(|e| {
-        use clap::error::ErrorKind;
-        if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
-            let _ = e.print();
-            return ExitCode::SUCCESS;
-        }
-        // clap's message up to its blank line, folded onto one line.
-        let text = e.to_string();
-        let message: Vec<&str> = text
-            .lines()
-            .take_while(|l| !l.trim().is_empty())
-            .map(str::trim)
-            .collect();
-        usage_error(program, message.join(" ").trim_start_matches("error: "))
-    })
+    C::try_parse().map_err(|e| clap_error(program, e))
+}
+
+/// A clap error as [`parse_or_exit`] reports it: help and version print and give
+/// `ExitCode::SUCCESS`; anything else is one line, prefixed by `program`, with exit code 2.
+pub fn clap_error(program: &str, e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    // clap's message up to its blank line, folded onto one line.
+    let text = e.to_string();
+    let message: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.trim().is_empty())
+        .map(str::trim)
+        .collect();
+    usage_error(program, message.join(" ").trim_start_matches("error: "))
 }
 
 /// Print `program: error: msg` on one line and return exit code 2 (bad input).
