@@ -24,3 +24,29 @@ pub fn workspace_root() -> PathBuf {
 pub fn cargo() -> String {
     std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string())
 }
+
+/// For the integration tests: the model binaries (`dla`, `dlca`, `animat`) of the calling test's
+/// build profile, built if missing or stale (a no-op after `cargo test --workspace`, which builds
+/// them for the models' own tests). Returns their directory, `target/<profile>`.
+///
+/// # Panics
+/// If the test's own path is not `target/<profile>/deps/<test>` or cargo fails.
+pub fn model_binaries_for_tests() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test's path");
+    let profile_dir = exe
+        .parent()
+        .and_then(std::path::Path::parent)
+        .expect("target/<profile>/deps/<test>")
+        .to_path_buf();
+    let mut cmd = std::process::Command::new(cargo());
+    cmd.args([
+        "build", "-p", "dla-pdla", "-p", "dlca", "-p", "animat", "--bins",
+    ])
+    .current_dir(workspace_root());
+    if profile_dir.file_name().is_some_and(|n| n == "release") {
+        cmd.arg("--release");
+    }
+    let status = cmd.status().expect("starting cargo build");
+    assert!(status.success(), "building the model binaries failed");
+    profile_dir
+}

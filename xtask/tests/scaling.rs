@@ -4,7 +4,6 @@
 use core_lattice::Fit;
 use core_lattice::rng::{stream, uniform01};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use xtask::scaling::{Experiment, Options, Scale, run};
 
 fn read(dir: &Path, file: &str) -> String {
@@ -52,26 +51,6 @@ fn check_png(dir: &Path, file: &str) {
     );
 }
 
-/// The model binaries of this test's build profile (the multi-seed experiments run them as
-/// ensembles), built if missing or stale: a no-op after `cargo test --workspace`, which builds
-/// them for the models' own tests.
-fn model_bins() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    // target/<profile>/deps/<test binary>
-    let profile_dir = exe.parent().and_then(Path::parent).unwrap().to_path_buf();
-    let mut cmd = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
-    cmd.args([
-        "build", "-p", "dla-pdla", "-p", "dlca", "-p", "animat", "--bins",
-    ])
-    .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."));
-    if profile_dir.file_name().is_some_and(|n| n == "release") {
-        cmd.arg("--release");
-    }
-    let status = cmd.status().expect("starting cargo build");
-    assert!(status.success(), "building the model binaries failed");
-    profile_dir
-}
-
 #[test]
 fn tiny_run_produces_every_table_csv_and_plot() {
     let dir = tempfile::tempdir().unwrap();
@@ -82,7 +61,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         out: dir.path().to_path_buf(),
         seed: 1,
         command: "cargo xtask scaling --scale tiny".into(),
-        bin_dir: model_bins(),
+        bin_dir: xtask::model_binaries_for_tests(),
         runs: runs.path().to_path_buf(),
     })
     .unwrap();
