@@ -23,7 +23,7 @@ use std::sync::atomic::Ordering;
 #[command(name = "animat", version, allow_negative_numbers = true)]
 struct Cli {
     /// Steps to run.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = animat::params::DEFAULT_STEPS)]
     steps: u64,
 
     /// Seed of every random stream of the run: same seed and parameters, same run.

@@ -289,6 +289,9 @@ pub enum ParamsError {
     },
 }
 
+/// Steps a run takes unless told otherwise (`--steps`).
+pub const DEFAULT_STEPS: u64 = 1000;
+
 /// Largest vision, crowding radius, start radius and grid-box side accepted: squared radii stay
 /// far inside `u64` and coordinates far inside `i64`.
 pub const MAX_RADIUS: i64 = 1 << 30;

@@ -116,7 +116,7 @@ struct Cli {
         long,
         requires = "histogram",
         value_delimiter = ',',
-        default_value = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000"
+        default_value = dlca::params::DEFAULT_HISTOGRAM_SWEEPS
     )]
     histogram_sweeps: Vec<u64>,
 

@@ -13,6 +13,10 @@ pub const MAX_MODEL_DIM: usize = 5;
 /// Default memory budget for the occupancy lattice: 4 GiB.
 pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
+/// Default sweeps at which `--histogram` records (`--histogram-sweeps`): about three per
+/// decade up to 10^4, as in Figs. 4, 7, 8 of Hawick, James & Scogings 2006.
+pub const DEFAULT_HISTOGRAM_SWEEPS: &str = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000";
+
 /// How many particles to place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

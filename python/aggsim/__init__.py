@@ -1,0 +1,50 @@
+"""aggsim: aggregation and artificial life at native speed, results as NumPy arrays.
+
+Three models, each as a function that runs to the end and returns a result object, and two
+of them also as objects to step forward and look at between steps:
+
+- :func:`dla`: off-lattice diffusion-limited aggregation (DLA), or parallel DLA (PDLA) with
+  ``threads`` > 1, in 2D and 3D (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance
+  search for random fractal cluster simulations").
+- :func:`dlca`, :class:`DlcaLattice`: diffusion-limited cluster-cluster aggregation on
+  lattices of 1 to 5 dimensions (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial
+  Simulation Performance Optimisation").
+- :func:`animat`, :class:`AnimatWorld`: foxes and rabbits running prioritised rule lists
+  (Hawick, James & Scogings 2006, section II.B).
+
+Parameters are the command-line flags of the ``dla``, ``dlca`` and ``animat`` binaries with
+dashes as underscores, with their defaults (:func:`defaults`), validated by the same code:
+a bad value raises ``ValueError`` with the binary's message. Runs release the GIL, stop on
+Ctrl-C with ``KeyboardInterrupt`` and show progress with ``progress=True``. The same seed and
+parameters give the binary's ``state_hash``. See docs/python.md in the repository.
+"""
+
+from ._aggsim import (
+    FOX,
+    RABBIT,
+    AnimatResult,
+    AnimatWorld,
+    DlaResult,
+    DlcaLattice,
+    DlcaResult,
+    __version__,
+    animat,
+    defaults,
+    dla,
+    dlca,
+)
+
+__all__ = [
+    "FOX",
+    "RABBIT",
+    "AnimatResult",
+    "AnimatWorld",
+    "DlaResult",
+    "DlcaLattice",
+    "DlcaResult",
+    "__version__",
+    "animat",
+    "defaults",
+    "dla",
+    "dlca",
+]
