@@ -19,6 +19,10 @@ Ctrl-C with ``KeyboardInterrupt`` and show progress with ``progress=True``. The 
 parameters give the binary's ``state_hash``. See docs/python.md in the repository.
 """
 
+import functools as _functools
+import inspect as _inspect
+
+from . import _aggsim
 from ._aggsim import (
     FOX,
     RABBIT,
@@ -28,11 +32,42 @@ from ._aggsim import (
     DlcaLattice,
     DlcaResult,
     __version__,
-    animat,
     defaults,
-    dla,
-    dlca,
 )
+
+
+def _signature(obj, model):
+    """``obj``'s signature with the defaults the compiled module shows as ``...`` filled in
+    from the library (``defaults(model)``), so that ``help()`` shows the values."""
+    values = defaults(model)
+    sig = _inspect.signature(obj)
+    params = [
+        p.replace(default=values[p.name])
+        if p.default is Ellipsis and p.name in values
+        else p
+        for p in sig.parameters.values()
+    ]
+    return sig.replace(parameters=params)
+
+
+def _shown_with_defaults(fn, model):
+    """``fn`` (compiled) behind a Python function of the same name, doc and arguments, whose
+    signature shows the real defaults."""
+
+    @_functools.wraps(fn)
+    def call(*args, **kwargs):
+        return fn(*args, **kwargs)
+
+    call.__signature__ = _signature(fn, model)
+    return call
+
+
+dla = _shown_with_defaults(_aggsim.dla, "dla")
+dlca = _shown_with_defaults(_aggsim.dlca, "dlca")
+animat = _shown_with_defaults(_aggsim.animat, "animat")
+for _cls, _model in ((DlcaLattice, "dlca"), (AnimatWorld, "animat")):
+    _cls.__signature__ = _signature(_cls, _model)
+del _cls, _model
 
 __all__ = [
     "FOX",

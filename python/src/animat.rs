@@ -394,9 +394,6 @@ impl AnimatWorld {
         })
     }
 
-    /// step(n=1, progress=None)
-    /// --
-    ///
     /// Run up to ``n`` steps (fewer once every animat has died) and return how many ran. In a
     /// step every animat alive at its start, in a fresh random order, runs the first rule of
     /// its species' list whose condition holds. ``progress`` as in :func:`aggsim.animat`.
@@ -408,9 +405,6 @@ impl AnimatWorld {
         self.lock()?.steps(py, n, &progress)
     }
 
-    /// result()
-    /// --
-    ///
     /// The state now as an :class:`AnimatResult`, with ``run.json``'s results (times since
     /// the world was made).
     fn result(&self, py: Python<'_>) -> PyResult<Py<AnimatResult>> {

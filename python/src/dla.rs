@@ -97,7 +97,7 @@ impl DlaResult {
 /// seed : int
 ///     Seed of every random stream (default 1).
 /// threads : int
-///     Walkers moving at once (PDLA); 1 (default) is DLA and deterministic.
+///     Walkers moving at once (PDLA; default 1, which is DLA and deterministic).
 /// birth_gap : float
 ///     R_b - R_ext in diameters, >= 1 (default 5).
 /// far_field : str

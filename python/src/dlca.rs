@@ -426,9 +426,6 @@ impl DlcaLattice {
         })
     }
 
-    /// step(n=1, progress=None)
-    /// --
-    ///
     /// Run up to ``n`` sweeps (fewer once the run is done: at most ``target_clusters``
     /// clusters left, or ``max_sweeps`` reached) and return how many ran. Each sweep moves
     /// every cluster once, in a fresh random order. ``progress`` as in :func:`aggsim.dlca`,
@@ -440,9 +437,6 @@ impl DlcaLattice {
         self.lock()?.sweeps(py, n, &progress)
     }
 
-    /// run(progress=None)
-    /// --
-    ///
     /// Sweep until the run is done, as the binary does, and return the sweeps made.
     /// ``progress`` counts merges. Ctrl-C stops after the current sweep.
     #[pyo3(signature = (progress = None))]
@@ -451,9 +445,6 @@ impl DlcaLattice {
         self.lock()?.until_done(py, &progress)
     }
 
-    /// result()
-    /// --
-    ///
     /// The state now as a :class:`DlcaResult`, with ``run.json``'s results (times since the
     /// lattice was made).
     fn result(&self, py: Python<'_>) -> PyResult<Py<DlcaResult>> {

@@ -18,9 +18,6 @@ mod run;
 
 use pyo3::prelude::*;
 
-/// defaults(model)
-/// --
-///
 /// The defaults of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``) as a dict: the binaries'
 /// defaults, taken from the libraries, keyed by the keyword arguments' names.
 #[pyfunction]
