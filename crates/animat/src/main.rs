@@ -4,7 +4,6 @@
 //! outputs. Built with the `cli` feature (on by default).
 
 use animat::output::{self, PopulationRow};
-use animat::params::MAX_RADIUS;
 use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
@@ -24,7 +23,7 @@ use std::sync::atomic::Ordering;
 #[command(name = "animat", version, allow_negative_numbers = true)]
 struct Cli {
     /// Steps to run.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = animat::params::DEFAULT_STEPS)]
     steps: u64,
 
     /// Seed of every random stream of the run: same seed and parameters, same run.
@@ -129,19 +128,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         p.start_radius = v;
     }
     if let Some(d) = cli.density {
-        if !(d > 0.0 && d <= 0.5) {
-            return Err(format!(
-                "--density {d} is outside the accepted range (0, 0.5]"
-            ));
-        }
-        let animats = p.foxes.saturating_add(p.rabbits);
-        p.start_radius = Params::radius_for_density(animats, d);
-        if p.start_radius > MAX_RADIUS {
-            return Err(format!(
-                "--density {d:e} spreads {animats} animats over a start disc of radius {:.3e} cells, above the largest accepted {MAX_RADIUS}; raise --density",
-                (animats as f64 / (std::f64::consts::PI * d)).sqrt()
-            ));
-        }
+        p.set_density(d)?;
     }
     if let Some(v) = cli.vision {
         p.vision = v;
@@ -164,7 +151,6 @@ fn params(cli: &Cli) -> Result<Params, String> {
 /// The message of a parameter error, naming where the value came from: a flag
 /// (`--vision 0 is outside ...`) or the config file.
 fn culprit(cli: &Cli, e: &ParamsError) -> String {
-    let text = e.to_string();
     let by_flag = |name: &str| match name {
         "foxes" => cli.foxes.is_some(),
         "rabbits" => cli.rabbits.is_some(),
@@ -173,18 +159,7 @@ fn culprit(cli: &Cli, e: &ParamsError) -> String {
         "grid_box" => cli.grid_box.is_some(),
         _ => false,
     };
-    match e {
-        ParamsError::Range { name, .. } if by_flag(name) => text.replacen(
-            &format!("{name} = "),
-            &format!("--{} ", name.replace('_', "-")),
-            1,
-        ),
-        ParamsError::StartTooDense { .. } if cli.config.is_none() => text,
-        _ => match &cli.config {
-            Some(path) => format!("config {}: {text}", path.display()),
-            None => text,
-        },
-    }
+    animat::params::error_message(e, by_flag, cli.config.as_deref())
 }
 
 /// What an ensemble (`--seeds`) averages over its members.
@@ -283,13 +258,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         None => {
             // Every error of the set-up is a parameter the run cannot take.
             let world = World::new(params, cli.seed).map_err(|e| usage(e.to_string()))?;
-            let start = PopulationRow {
-                step: 0,
-                foxes: world.foxes(),
-                rabbits: world.rabbits(),
-                search_seconds: 0.0,
-                distance_evals: 0,
-            };
+            let start = PopulationRow::of(&world, Default::default());
             (world, vec![start])
         }
     };
@@ -356,13 +325,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             break;
         }
         let s = world.step();
-        rows.push(PopulationRow {
-            step: world.steps(),
-            foxes: world.foxes(),
-            rabbits: world.rabbits(),
-            search_seconds: s.search_seconds,
-            distance_evals: s.distance_evals,
-        });
+        rows.push(PopulationRow::of(&world, s));
         if let Some(k) = cli.snapshot_every {
             if world.steps() % k == 0 {
                 snapshot(&world)?;

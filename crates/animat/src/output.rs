@@ -9,7 +9,7 @@
 //! | `positions.csv` | with `--positions`: `id,species,x,y,age,hunger` of every live animat at the end |
 
 use crate::params::Species;
-use crate::world::World;
+use crate::world::{StepStats, World};
 use core_lattice::io::{
     Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_png_rgb, write_points,
 };
@@ -30,6 +30,20 @@ pub struct PopulationRow {
     pub search_seconds: f64,
     /// Distance evaluations during the step.
     pub distance_evals: u64,
+}
+
+impl PopulationRow {
+    /// The row of `world` as it is now, before any step or after one whose counters are
+    /// `stats` (zero at the start).
+    pub fn of(world: &World, stats: StepStats) -> Self {
+        PopulationRow {
+            step: world.steps(),
+            foxes: world.foxes(),
+            rabbits: world.rabbits(),
+            search_seconds: stats.search_seconds,
+            distance_evals: stats.distance_evals,
+        }
+    }
 }
 
 /// Writes `populations.csv`; `timing` adds the search columns.
@@ -182,6 +196,19 @@ pub fn write_manifest(
     seed: u64,
     clock: &RunClock,
 ) -> Result<RunManifest, OutputError> {
+    let m = manifest(world, seed, clock)?;
+    m.write(dir)?;
+    Ok(m)
+}
+
+/// The run's manifest, `run.json` as [`write_manifest`] writes it: parameters, seed, the
+/// measurements of `clock` taken now, and the headline results (`steps`, `foxes`, `rabbits`,
+/// `state_hash`, `distance_evaluations`, `grid_box`, `queries`). The one place these results
+/// are assembled, for the `animat` binary and the Python bindings.
+///
+/// # Errors
+/// [`OutputError`] if the parameters cannot be serialised.
+pub fn manifest(world: &World, seed: u64, clock: &RunClock) -> Result<RunManifest, OutputError> {
     let mut m = clock.finish("animat", env!("CARGO_PKG_VERSION"), seed, 1, world.params())?;
     let q = world.queries();
     m.set_result("steps", world.steps())
@@ -194,6 +221,5 @@ pub fn write_manifest(
             "queries",
             serde_json::json!({"adjacent": q.adjacent, "nearest": q.nearest, "count": q.count}),
         );
-    m.write(dir)?;
     Ok(m)
 }

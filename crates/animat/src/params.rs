@@ -289,6 +289,9 @@ pub enum ParamsError {
     },
 }
 
+/// Steps a run takes unless told otherwise (`--steps`).
+pub const DEFAULT_STEPS: u64 = 1000;
+
 /// Largest vision, crowding radius, start radius and grid-box side accepted: squared radii stay
 /// far inside `u64` and coordinates far inside `i64`.
 pub const MAX_RADIUS: i64 = 1 << 30;
@@ -516,6 +519,60 @@ impl Params {
             .sqrt()
             .ceil() as i64
     }
+
+    /// `--density`: sets `start_radius` so that the start population (`foxes + rabbits`, as
+    /// set now) has `density` animats per cell.
+    ///
+    /// # Errors
+    /// A density outside (0, 0.5], or one so low that the radius exceeds [`MAX_RADIUS`]; the
+    /// message is the `animat` binary's.
+    pub fn set_density(&mut self, density: f64) -> Result<(), String> {
+        let d = density;
+        if !(d > 0.0 && d <= 0.5) {
+            return Err(format!(
+                "--density {d} is outside the accepted range (0, 0.5]"
+            ));
+        }
+        let animats = self.foxes.saturating_add(self.rabbits);
+        self.start_radius = Params::radius_for_density(animats, d);
+        if self.start_radius > MAX_RADIUS {
+            return Err(format!(
+                "--density {d:e} spreads {animats} animats over a start disc of radius {:.3e} cells, above the largest accepted {MAX_RADIUS}; raise --density",
+                (animats as f64 / (std::f64::consts::PI * d)).sqrt()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The parameters the `animat` command line sets with a flag of their own (`--foxes`,
+/// `--rabbits`, `--start-radius`, `--vision`, `--grid-box`); the others come from a config
+/// file.
+pub const FLAGS: [&str; 5] = ["foxes", "rabbits", "start_radius", "vision", "grid_box"];
+
+/// The message of a parameter error, naming where the value came from: a flag
+/// (`--vision 0 is outside ...`) when `by_flag(name)` says the value was given as one (see
+/// [`FLAGS`]; `start_radius` also by `--density`), else the config file `config` if any
+/// (`config FILE: vision = 0 is outside ...`). The `animat` binary and the Python bindings
+/// word their errors with this.
+pub fn error_message(
+    e: &ParamsError,
+    by_flag: impl Fn(&str) -> bool,
+    config: Option<&std::path::Path>,
+) -> String {
+    let text = e.to_string();
+    match e {
+        ParamsError::Range { name, .. } if by_flag(name) => text.replacen(
+            &format!("{name} = "),
+            &format!("--{} ", name.replace('_', "-")),
+            1,
+        ),
+        ParamsError::StartTooDense { .. } if config.is_none() => text,
+        _ => match config {
+            Some(path) => format!("config {}: {text}", path.display()),
+            None => text,
+        },
+    }
 }
 
 #[cfg(test)]
@@ -604,6 +661,33 @@ mod tests {
             p.validate(),
             Err(ParamsError::StartTooDense { .. })
         ));
+    }
+
+    #[test]
+    fn density_and_messages_name_the_flag_or_file() {
+        let mut p = Params::default();
+        p.set_density(0.1).unwrap();
+        assert_eq!(p.start_radius, Params::radius_for_density(2300, 0.1));
+        assert_eq!(
+            p.set_density(0.6).unwrap_err(),
+            "--density 0.6 is outside the accepted range (0, 0.5]"
+        );
+        assert!(
+            p.set_density(1e-30)
+                .unwrap_err()
+                .contains("raise --density")
+        );
+        let e = Params {
+            vision: 0,
+            ..Params::default()
+        }
+        .validate()
+        .unwrap_err();
+        let flag = |n: &str| FLAGS.contains(&n);
+        assert!(error_message(&e, flag, None).starts_with("--vision 0 is outside"));
+        assert!(error_message(&e, |_| false, None).starts_with("vision = 0 is outside"));
+        let file = std::path::Path::new("a.toml");
+        assert!(error_message(&e, |_| false, Some(file)).starts_with("config a.toml: vision = 0"));
     }
 
     #[test]

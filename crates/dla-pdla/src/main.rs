@@ -165,20 +165,9 @@ fn params(cli: &Cli) -> Result<Params, String> {
         distance_map: cli.distance_map == Toggle::On,
         near_cache: cli.near_cache == Toggle::On,
     };
-    p.validate().map_err(|e| e.to_string())?;
-    // Flags that would be silently ignored are refused instead.
-    if cli.death_ratio.is_some() && p.far_field != FarField::Jump {
-        return Err(
-            "--death-ratio is used by --far-field jump only (the default `return` has no death radius)"
-                .into(),
-        );
-    }
-    if p.serial_until > 0 && p.threads == 1 {
-        return Err(format!(
-            "--serial-until {} is used with --threads > 1 only (one thread is serial throughout)",
-            p.serial_until
-        ));
-    }
+    // Flags that would be silently ignored are refused too.
+    p.validate_given(cli.death_ratio.is_some())
+        .map_err(|e| e.to_string())?;
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }

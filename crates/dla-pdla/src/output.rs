@@ -112,6 +112,22 @@ where
         write_picture(sim, dir, &dir.join("dla.png"), side)?;
     }
 
+    let m = manifest(sim, clock)?;
+    m.write(dir)?;
+    Ok(m)
+}
+
+/// The run's manifest, `run.json` as [`write_outputs`] writes it: parameters, seed, the
+/// measurements of `clock` taken now, and every result (`particles`, `radius_of_gyration`,
+/// `r_ext`, `state_hash`, the fractal dimension or `fit_error`, the PDLA and memory figures).
+/// The one place these results are assembled, for the `dla` binary and the Python bindings.
+pub fn manifest<const D: usize>(
+    sim: &Simulation<D>,
+    clock: &RunClock,
+) -> Result<RunManifest, OutputError>
+where
+    Dim<D>: Space<D>,
+{
     let fit = sim.fractal_dimension();
     let params = sim.params();
     let mut m = clock.finish(
@@ -154,7 +170,6 @@ where
                 .set_result("fit_error", e.to_string());
         }
     }
-    m.write(dir)?;
     Ok(m)
 }
 

@@ -189,6 +189,14 @@ pub enum ParamsError {
     /// `threads` is 0 or absurd.
     #[error("--threads {0} is outside the accepted range 1..=1024")]
     Threads(usize),
+    /// A death ratio given for the `return` far field, which has no death radius.
+    #[error(
+        "--death-ratio is used by --far-field jump only (the default `return` has no death radius)"
+    )]
+    DeathRatioUnused,
+    /// `serial_until` given with one thread, which is serial throughout.
+    #[error("--serial-until {0} is used with --threads > 1 only (one thread is serial throughout)")]
+    SerialUntilUnused(u64),
 }
 
 impl Params {
@@ -221,6 +229,21 @@ impl Params {
         let l = self.leaf_side;
         if !((1.0..=64.0).contains(&l) && l.log2().fract() == 0.0) {
             return Err(ParamsError::LeafSide(l));
+        }
+        Ok(())
+    }
+
+    /// [`validate`](Self::validate), then refuse what a front end was given but the run would
+    /// silently ignore: a death ratio (`death_ratio_given`) without `--far-field jump`, and
+    /// `serial_until` with one thread. The `dla` binary and the Python bindings check their
+    /// parameters with this.
+    pub fn validate_given(&self, death_ratio_given: bool) -> Result<(), ParamsError> {
+        self.validate()?;
+        if death_ratio_given && self.far_field != FarField::Jump {
+            return Err(ParamsError::DeathRatioUnused);
+        }
+        if self.serial_until > 0 && self.threads == 1 {
+            return Err(ParamsError::SerialUntilUnused(self.serial_until));
         }
         Ok(())
     }
@@ -333,5 +356,39 @@ mod tests {
         for &dim in DIMENSIONS {
             assert!(Params { dim, ..d() }.validate().is_ok());
         }
+    }
+
+    #[test]
+    fn flags_the_run_would_ignore_are_refused() {
+        let d = Params::default;
+        assert_eq!(d().validate_given(false), Ok(()));
+        assert_eq!(d().validate_given(true), Err(ParamsError::DeathRatioUnused));
+        let jump = Params {
+            far_field: FarField::Jump,
+            ..d()
+        };
+        assert_eq!(jump.validate_given(true), Ok(()));
+        let serial = Params {
+            serial_until: 100,
+            ..d()
+        };
+        let e = serial.validate_given(false).unwrap_err().to_string();
+        assert!(
+            e.starts_with("--serial-until 100 is used with --threads > 1"),
+            "{e}"
+        );
+        assert_eq!(
+            Params {
+                threads: 2,
+                ..serial
+            }
+            .validate_given(false),
+            Ok(())
+        );
+        // Range errors come first, as from `validate`.
+        assert_eq!(
+            Params { threads: 0, ..d() }.validate_given(true),
+            Err(ParamsError::Threads(0))
+        );
     }
 }

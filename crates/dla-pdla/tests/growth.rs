@@ -544,3 +544,66 @@ fn a_tree_out_of_indices_stops_the_run_with_a_typed_error() {
         );
     }
 }
+
+/// `run_until` stops where it is told (here from the progress report, as a front end's
+/// Ctrl-C would) and a later call continues: stopped twice and continued, one thread ends as
+/// the uninterrupted run, with the same samples and positions; two threads stop at a
+/// quiescent point and end as a valid cluster of the target size.
+#[test]
+fn run_until_stops_and_continues_to_the_uninterrupted_run() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let whole = grow::<2>(5000, 3, 1);
+    let mut sim = Simulation::<2>::new(
+        Params {
+            particles: 5000,
+            keep_positions: true,
+            ..Params::default()
+        },
+        3,
+    )
+    .unwrap();
+    for at in [1024, 3072] {
+        let stop = AtomicBool::new(false);
+        let done = sim
+            .run_until(&stop, &|n| {
+                if n >= at {
+                    stop.store(true, Ordering::Relaxed);
+                }
+            })
+            .unwrap();
+        assert!(!done);
+        // Stopped right after the particle whose report set the flag.
+        assert_eq!(sim.particles(), at);
+    }
+    assert!(sim.run_until(&AtomicBool::new(false), &|_| {}).unwrap());
+    assert_eq!(sim.state_hash(), whole.state_hash());
+    let n = |s: &Simulation<2>| s.samples().iter().map(|s| s.n).collect::<Vec<_>>();
+    assert_eq!(n(&sim), n(&whole));
+    assert_eq!(
+        sim.into_positions().unwrap(),
+        whole.into_positions().unwrap()
+    );
+
+    let mut pdla = Simulation::<2>::new(
+        Params {
+            particles: 3000,
+            threads: 2,
+            keep_positions: true,
+            ..Params::default()
+        },
+        5,
+    )
+    .unwrap();
+    let stop = AtomicBool::new(false);
+    let done = pdla
+        .run_until(&stop, &|n| {
+            if n >= 1000 {
+                stop.store(true, Ordering::Relaxed);
+            }
+        })
+        .unwrap();
+    assert!(!done && pdla.particles() < 3000);
+    assert!(pdla.run_until(&AtomicBool::new(false), &|_| {}).unwrap());
+    assert_eq!(pdla.particles(), 3000);
+    assert_valid_cluster(pdla.tree(), pdla.positions().unwrap());
+}

@@ -5,12 +5,12 @@
 
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
-use core_lattice::Boundary;
 use core_lattice::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::ensemble::{Curve, EnsembleArgs};
 use core_lattice::io::{Positions, RunClock};
 use core_lattice::io::{read_checkpoint, write_checkpoint};
-use dlca::{Init, Params, Search, Simulation, Snapshot};
+use dlca::params::flags;
+use dlca::{Params, Search, Simulation, Snapshot};
 use std::sync::atomic::Ordering;
 
 /// File name of checkpoints in the output directory.
@@ -99,7 +99,7 @@ struct Cli {
 
     /// Memory the occupancy lattice (`--search lattice`) may take, in bytes; suffixes K, M, G
     /// (powers of 1024) are accepted.
-    #[arg(long, default_value = "4G", value_parser = parse_bytes)]
+    #[arg(long, default_value = "4G", value_parser = flags::parse_bytes)]
     max_memory: u64,
 
     /// Record the wall time of every sweep (a `seconds` column in sweeps.csv).
@@ -116,7 +116,7 @@ struct Cli {
         long,
         requires = "histogram",
         value_delimiter = ',',
-        default_value = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000"
+        default_value = dlca::params::DEFAULT_HISTOGRAM_SWEEPS
     )]
     histogram_sweeps: Vec<u64>,
 
@@ -154,84 +154,21 @@ struct Cli {
 struct Sizes(Vec<u64>);
 
 fn parse_size(s: &str) -> Result<Sizes, String> {
-    s.split('x')
-        .map(|p| {
-            p.trim()
-                .parse::<u64>()
-                .map_err(|_| format!("'{s}' is not a size like 1024 or 1024x512"))
-        })
-        .collect::<Result<_, _>>()
-        .map(Sizes)
-}
-
-fn parse_bytes(s: &str) -> Result<u64, String> {
-    let (digits, mult) = match s.trim().chars().last() {
-        Some('K' | 'k') => (&s[..s.len() - 1], 1u64 << 10),
-        Some('M' | 'm') => (&s[..s.len() - 1], 1 << 20),
-        Some('G' | 'g') => (&s[..s.len() - 1], 1 << 30),
-        Some('T' | 't') => (&s[..s.len() - 1], 1 << 40),
-        _ => (s, 1),
-    };
-    digits
-        .trim()
-        .parse::<u64>()
-        .ok()
-        .and_then(|v| v.checked_mul(mult))
-        .ok_or_else(|| format!("'{s}' is not a byte count like 4G or 500M"))
+    flags::parse_size(s).map(Sizes)
 }
 
 /// Turn the flags into validated parameters.
 fn params(cli: &Cli) -> Result<Params, String> {
-    if cli.dim == 0 || cli.dim > dlca::params::MAX_MODEL_DIM {
-        return Err(format!(
-            "--dim {} is outside the accepted range 1..={}",
-            cli.dim,
-            dlca::params::MAX_MODEL_DIM
-        ));
-    }
     let given = cli
         .size
         .as_ref()
         .map(|s| s.0.as_slice())
         .unwrap_or_default();
-    let size = match given {
-        [] => return Err("--size is required (for example --size 1024 or --size 1024x512)".into()),
-        [l] => vec![*l; cli.dim],
-        many if many.len() == cli.dim => many.to_vec(),
-        many => {
-            return Err(format!(
-                "--size has {} axes but --dim is {}; give one length or {} lengths",
-                many.len(),
-                cli.dim,
-                cli.dim
-            ));
-        }
-    };
-    let names: Vec<&str> = cli.boundary.split(',').map(str::trim).collect();
-    let boundary: Vec<Boundary> = match names.as_slice() {
-        [one] => vec![parse_boundary(one)?; cli.dim],
-        many if many.len() == cli.dim => many
-            .iter()
-            .map(|b| parse_boundary(b))
-            .collect::<Result<_, _>>()?,
-        many => {
-            return Err(format!(
-                "--boundary has {} entries but --dim is {}; give one or {}",
-                many.len(),
-                cli.dim,
-                cli.dim
-            ));
-        }
-    };
-    let init = match (cli.fill, cli.particles) {
-        (Some(f), None) => Init::Fill(f),
-        (None, Some(n)) => Init::Particles(n),
-        _ => return Err("give exactly one of --fill and --particles".into()),
-    };
+    let (size, boundary) = flags::axes(cli.dim, given, &cli.boundary)?;
     let p = Params {
         size,
         boundary,
-        init,
+        init: flags::init(cli.fill, cli.particles)?,
         temperature: cli.temperature,
         gravity: cli.gravity,
         mobility_exponent: cli.mobility_exponent,
@@ -252,11 +189,6 @@ fn params(cli: &Cli) -> Result<Params, String> {
     p.validate().map_err(|e| e.to_string())?;
     core_lattice::cli::check_out_dir(&cli.out)?;
     Ok(p)
-}
-
-fn parse_boundary(s: &str) -> Result<Boundary, String> {
-    s.parse::<Boundary>()
-        .map_err(|e| format!("--boundary: {e}"))
 }
 
 /// The run saved in `DIR/checkpoint.bin`, if it is one these flags continue (only

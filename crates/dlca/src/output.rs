@@ -17,6 +17,7 @@ use core_lattice::io::{
     Attribute, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_png_rgb, write_points,
 };
 use serde_json::json;
+use spatial::lattice::ItemId;
 use std::path::Path;
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest written;
@@ -81,22 +82,16 @@ pub fn write_outputs(
             index: None,
             title: &title,
         };
-        let mut ids = sim.sets().live().to_vec();
-        ids.sort_unstable();
         write_points(dir, "particles", format, &set, &mut |f| {
             let mut p = vec![0.0; dim];
-            for &id in &ids {
-                let mut sites = sim.sets().sites(id).to_vec();
-                sites.sort_unstable();
-                for k in sites {
-                    let x = sim.lattice().decode(k)?;
-                    for (c, v) in p.iter_mut().zip(x.iter()) {
-                        *c = *v as f64;
-                    }
-                    f(&p, &[i64::from(id)])?;
+            each_particle(sim, |id, k| -> Result<(), OutputError> {
+                let x = sim.lattice().decode(k)?;
+                for (c, v) in p.iter_mut().zip(x.iter()) {
+                    *c = *v as f64;
                 }
-            }
-            Ok(())
+                f(&p, &[i64::from(id)])?;
+                Ok(())
+            })
         })?;
     }
 
@@ -112,13 +107,37 @@ pub fn write_outputs(
         w.finish()?;
     }
 
-    // clusters.csv and the fit
+    // clusters.csv
+    let measures = params.gyration.then(|| gyration(sim));
+    if let Some(measures) = &measures {
+        write_clusters(dir, measures)?;
+    }
+
+    if png {
+        write_picture(sim, &dir.join("dlca.png"))?;
+    }
+
+    let m = manifest(sim, seed, clock, measures.as_deref())?;
+    m.write(dir)?;
+    Ok(m)
+}
+
+/// The run's manifest, `run.json` as [`write_outputs`] writes it: parameters, seed, the
+/// measurements of `clock` taken now, and every result (`clusters`, `sweeps`, `state_hash`,
+/// the search used, and with `--gyration` the fractal dimension or `fit_error`). `measures` are
+/// the final clusters' [`gyration`] measures when the parameters ask for them. The one place
+/// these results are assembled, for the `dlca` binary and the Python bindings.
+pub fn manifest(
+    sim: &Simulation,
+    seed: u64,
+    clock: &RunClock,
+    measures: Option<&[ClusterMeasure]>,
+) -> Result<core_lattice::io::RunManifest, OutputError> {
+    let params = sim.params();
     let mut fit_results = serde_json::Map::new();
-    if params.gyration {
-        let measures = gyration(sim);
-        write_clusters(dir, &measures)?;
+    if let Some(measures) = measures {
         let wrapping = measures.iter().filter(|c| c.wraps).count();
-        match fractal_dimension(&measures, params.fit_min_size) {
+        match fractal_dimension(measures, params.fit_min_size) {
             Ok(fit) => {
                 fit_results.insert("fractal_dimension".into(), json!(fit.slope));
                 fit_results.insert("fractal_dimension_stderr".into(), json!(fit.slope_stderr));
@@ -133,10 +152,6 @@ pub fn write_outputs(
             }
         }
         fit_results.insert("wrapping_clusters".into(), json!(wrapping));
-    }
-
-    if png {
-        write_picture(sim, &dir.join("dlca.png"))?;
     }
 
     let mut m = clock.finish("dlca", env!("CARGO_PKG_VERSION"), seed, 1, params)?;
@@ -160,8 +175,31 @@ pub fn write_outputs(
     for (k, v) in fit_results {
         m.results.insert(k, v);
     }
-    m.write(dir)?;
     Ok(m)
+}
+
+/// Calls `f(cluster id, site k-index)` for every particle in the order of `particles.csv`:
+/// clusters in increasing id, each cluster's sites in increasing k-index.
+///
+/// # Errors
+/// The first error of `f`.
+pub fn each_particle<E>(
+    sim: &Simulation,
+    mut f: impl FnMut(ItemId, u64) -> Result<(), E>,
+) -> Result<(), E> {
+    let sets = sim.sets();
+    let mut ids = sets.live().to_vec();
+    ids.sort_unstable();
+    let mut sites = Vec::new();
+    for id in ids {
+        sites.clear();
+        sites.extend_from_slice(sets.sites(id));
+        sites.sort_unstable();
+        for &k in &sites {
+            f(id, k)?;
+        }
+    }
+    Ok(())
 }
 
 fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputError> {

@@ -13,6 +13,10 @@ pub const MAX_MODEL_DIM: usize = 5;
 /// Default memory budget for the occupancy lattice: 4 GiB.
 pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
+/// Default sweeps at which `--histogram` records (`--histogram-sweeps`): about three per
+/// decade up to 10^4, as in Figs. 4, 7, 8 of Hawick, James & Scogings 2006.
+pub const DEFAULT_HISTOGRAM_SWEEPS: &str = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000";
+
 /// How many particles to place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -285,6 +289,101 @@ impl Params {
     }
 }
 
+/// The command line's spellings of the parameters, parsed and checked with the `dlca`
+/// binary's messages; any front end (the binary, the Python bindings) builds its [`Params`]
+/// with these.
+pub mod flags {
+    use super::{Init, MAX_MODEL_DIM};
+    use core_lattice::Boundary;
+
+    /// `--size`: one length for every axis (`1024`) or one per axis (`1024x512`).
+    pub fn parse_size(s: &str) -> Result<Vec<u64>, String> {
+        s.split('x')
+            .map(|p| {
+                p.trim()
+                    .parse::<u64>()
+                    .map_err(|_| format!("'{s}' is not a size like 1024 or 1024x512"))
+            })
+            .collect()
+    }
+
+    /// `--max-memory`: a byte count, with an optional suffix K, M, G or T (powers of 1024).
+    pub fn parse_bytes(s: &str) -> Result<u64, String> {
+        let (digits, mult) = match s.trim().chars().last() {
+            Some('K' | 'k') => (&s[..s.len() - 1], 1u64 << 10),
+            Some('M' | 'm') => (&s[..s.len() - 1], 1 << 20),
+            Some('G' | 'g') => (&s[..s.len() - 1], 1 << 30),
+            Some('T' | 't') => (&s[..s.len() - 1], 1 << 40),
+            _ => (s, 1),
+        };
+        digits
+            .trim()
+            .parse::<u64>()
+            .ok()
+            .and_then(|v| v.checked_mul(mult))
+            .ok_or_else(|| format!("'{s}' is not a byte count like 4G or 500M"))
+    }
+
+    /// The axes of `--dim`, `--size` (the lengths given: one for every axis, or one per axis)
+    /// and `--boundary` (`periodic` or `wall` for every axis, or one per axis separated by
+    /// commas): the side lengths and boundaries of [`Params`](super::Params).
+    pub fn axes(
+        dim: usize,
+        size: &[u64],
+        boundary: &str,
+    ) -> Result<(Vec<u64>, Vec<Boundary>), String> {
+        if dim == 0 || dim > MAX_MODEL_DIM {
+            return Err(format!(
+                "--dim {dim} is outside the accepted range 1..={MAX_MODEL_DIM}"
+            ));
+        }
+        let size = match size {
+            [] => {
+                return Err(
+                    "--size is required (for example --size 1024 or --size 1024x512)".into(),
+                );
+            }
+            [l] => vec![*l; dim],
+            many if many.len() == dim => many.to_vec(),
+            many => {
+                return Err(format!(
+                    "--size has {} axes but --dim is {dim}; give one length or {dim} lengths",
+                    many.len()
+                ));
+            }
+        };
+        let names: Vec<&str> = boundary.split(',').map(str::trim).collect();
+        let boundary: Vec<Boundary> = match names.as_slice() {
+            [one] => vec![parse_boundary(one)?; dim],
+            many if many.len() == dim => many
+                .iter()
+                .map(|b| parse_boundary(b))
+                .collect::<Result<_, _>>()?,
+            many => {
+                return Err(format!(
+                    "--boundary has {} entries but --dim is {dim}; give one or {dim}",
+                    many.len()
+                ));
+            }
+        };
+        Ok((size, boundary))
+    }
+
+    fn parse_boundary(s: &str) -> Result<Boundary, String> {
+        s.parse::<Boundary>()
+            .map_err(|e| format!("--boundary: {e}"))
+    }
+
+    /// The particles of `--fill` or `--particles`, exactly one of which must be given.
+    pub fn init(fill: Option<f64>, particles: Option<u64>) -> Result<Init, String> {
+        match (fill, particles) {
+            (Some(f), None) => Ok(Init::Fill(f)),
+            (None, Some(n)) => Ok(Init::Particles(n)),
+            _ => Err("give exactly one of --fill and --particles".into()),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -378,6 +477,54 @@ mod tests {
             }),
             Err(ParamError::TooLarge { .. })
         ));
+    }
+
+    #[test]
+    fn flags_parse_and_name_what_is_wrong() {
+        use flags::*;
+        assert_eq!(parse_size("1024x512"), Ok(vec![1024, 512]));
+        assert_eq!(parse_size("64"), Ok(vec![64]));
+        assert!(
+            parse_size("64xx")
+                .unwrap_err()
+                .contains("'64xx' is not a size")
+        );
+        assert_eq!(parse_bytes("4G"), Ok(4 << 30));
+        assert_eq!(parse_bytes("500"), Ok(500));
+        assert!(
+            parse_bytes("lots")
+                .unwrap_err()
+                .contains("is not a byte count")
+        );
+        assert_eq!(
+            axes(2, &[64], "periodic,wall"),
+            Ok((vec![64, 64], vec![Boundary::Periodic, Boundary::Wall]))
+        );
+        assert_eq!(
+            axes(3, &[64, 32], "periodic").unwrap_err(),
+            "--size has 2 axes but --dim is 3; give one length or 3 lengths"
+        );
+        assert_eq!(
+            axes(6, &[64], "periodic").unwrap_err(),
+            "--dim 6 is outside the accepted range 1..=5"
+        );
+        assert!(
+            axes(2, &[], "periodic")
+                .unwrap_err()
+                .starts_with("--size is required")
+        );
+        assert!(
+            axes(2, &[8], "sticky")
+                .unwrap_err()
+                .starts_with("--boundary: ")
+        );
+        assert_eq!(
+            axes(2, &[8], "wall,wall,wall").unwrap_err(),
+            "--boundary has 3 entries but --dim is 2; give one or 2"
+        );
+        assert_eq!(init(Some(0.1), None), Ok(Init::Fill(0.1)));
+        assert_eq!(init(None, Some(7)), Ok(Init::Particles(7)));
+        assert!(init(Some(0.1), Some(7)).is_err() && init(None, None).is_err());
     }
 
     #[test]

@@ -86,18 +86,37 @@ where
     /// Grow the cluster to `params.particles`, calling `progress(n)` about every 1024
     /// particles.
     pub fn run_with(&mut self, progress: &(dyn Fn(u64) + Sync)) -> Result<(), SimError> {
+        self.run_until(&AtomicBool::new(false), progress)
+            .map(|_| ())
+    }
+
+    /// Grow the cluster towards `params.particles`, calling `progress(n)` about every 1024
+    /// particles, and return early once `stop` is set (by another thread or from `progress`):
+    /// serially after the particle being grown, in PDLA at the phase's next quiescent point.
+    /// Returns whether the target was reached. The run stays valid either way, and a later
+    /// call continues it: with one thread, a run stopped and continued any number of times
+    /// ends as an uninterrupted one (the same `state_hash`). For front ends that must stay
+    /// responsive (the Python bindings stop on Ctrl-C this way).
+    pub fn run_until(
+        &mut self,
+        stop: &AtomicBool,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<bool, SimError> {
         let target = self.params.particles;
         while self.growth.n < self.serial_to() {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(false);
+            }
             self.add_one()?;
             if self.growth.n % 1024 == 0 {
                 progress(self.growth.n);
             }
         }
         if self.growth.n < target {
-            self.grow_parallel(target, &AtomicBool::new(false), progress)?;
+            self.grow_parallel(target, stop, progress)?;
         }
         progress(self.growth.n);
-        Ok(())
+        Ok(self.growth.n == target)
     }
 
     /// The size up to which the run grows with one walker: the target with one thread,
@@ -391,6 +410,12 @@ impl<const D: usize> Simulation<D> {
     /// Positions in arrival order, if `params.keep_positions`.
     pub fn positions(&self) -> Option<&[[f64; D]]> {
         self.growth.positions.as_deref()
+    }
+
+    /// The positions in arrival order, if `params.keep_positions`, moved out of the finished
+    /// run without a copy (the Python bindings hand them to NumPy this way).
+    pub fn into_positions(self) -> Option<Vec<[f64; D]>> {
+        self.growth.positions
     }
 
     /// The spatial structure holding the cluster.

@@ -1,0 +1,317 @@
+"""Type stubs of aggsim (the compiled module aggsim._aggsim). Defaults shown as ``...`` are
+the binaries' defaults, taken from the libraries: ``aggsim.defaults(model)`` lists them."""
+
+from os import PathLike
+from typing import Any, Callable, Dict, List, Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+FOX: int
+"""Species code of foxes in ``species`` arrays (0)."""
+RABBIT: int
+"""Species code of rabbits in ``species`` arrays (1)."""
+
+Progress = Union[None, bool, Callable[[int, int], Any]]
+"""``True``: progress on ``sys.stderr``; a callable: called as ``progress(done, total)``."""
+
+def defaults(model: Literal["dla", "dlca", "animat"]) -> Dict[str, Any]:
+    """The defaults of ``model``'s keyword arguments: the binary's, from the library."""
+
+class DlaResult:
+    """A grown DLA/PDLA cluster: :func:`dla`'s result."""
+
+    positions: npt.NDArray[np.float64]
+    """float64 (N, D): centres in arrival order, seed particle first."""
+    growth: Dict[str, npt.NDArray[Any]]
+    """``N`` (uint64), ``R_g``, ``R_ext``, ``seconds`` (float64) per growth sample."""
+    state_hash: str
+    particles: int
+    radius_of_gyration: float
+    r_ext: float
+    fractal_dimension: Optional[float]
+    fractal_dimension_stderr: Optional[float]
+    fit_points: int
+    """Samples in the fit (absent when ``fit_error`` is set)."""
+    fit_error: str
+    """Why no fractal dimension was fitted (present only then)."""
+    discarded_walkers: int
+    pdla_parallel_seconds: float
+    pdla_lock_wait_seconds: float
+    pdla_phases: int
+    tree_memory_bytes: int
+    tree_point_slots: int
+    distance_map_bytes: int
+    bytes_per_particle: Optional[float]
+    model: str
+    version: str
+    seed: int
+    threads: int
+    wall_seconds: float
+    cpu_seconds: Optional[float]
+    peak_rss_bytes: Optional[int]
+    params: Dict[str, Any]
+    run_json: Dict[str, Any]
+
+def dla(
+    dim: int = ...,
+    particles: int = ...,
+    seed: int = 1,
+    threads: int = ...,
+    *,
+    birth_gap: float = ...,
+    far_field: Literal["return", "jump"] = ...,
+    death_ratio: Optional[float] = None,
+    step_min: float = ...,
+    precision: float = ...,
+    leaf_side: float = ...,
+    distance_map: bool = ...,
+    near_cache: bool = ...,
+    serial_until: int = ...,
+    fit_from: int = ...,
+    progress: Progress = None,
+) -> DlaResult:
+    """Grow an off-lattice DLA cluster (PDLA with ``threads`` > 1); see ``help(aggsim.dla)``."""
+
+class DlcaResult:
+    """The final state of a DLCA run: :func:`dlca`'s result."""
+
+    positions: npt.NDArray[np.int64]
+    """int64 (N, D): lattice sites, clusters by increasing id."""
+    labels: npt.NDArray[np.int64]
+    """int64 (N,): cluster id of each particle."""
+    per_sweep: Dict[str, npt.NDArray[Any]]
+    """``sweep``, ``clusters``, ``largest`` (uint64), ``seconds`` with ``timing``."""
+    sizes: Dict[str, npt.NDArray[np.uint64]]
+    """``size``, ``count``: the final size distribution."""
+    gyration: Optional[Dict[str, npt.NDArray[Any]]]
+    histogram: Optional[Dict[str, npt.NDArray[np.uint64]]]
+    state_hash: str
+    particles: int
+    clusters: int
+    largest_cluster: int
+    sweeps: int
+    strategy: str
+    strategy_requested: str
+    strategy_reason: str
+    moves: int
+    mean_candidates_examined: float
+    search_events: List[Dict[str, Any]]
+    fractal_dimension: Optional[float]
+    """With ``gyration=True`` only."""
+    fractal_dimension_stderr: Optional[float]
+    fit_clusters: int
+    fit_r2: float
+    fit_error: str
+    wrapping_clusters: int
+    model: str
+    version: str
+    seed: int
+    threads: int
+    wall_seconds: float
+    cpu_seconds: Optional[float]
+    peak_rss_bytes: Optional[int]
+    params: Dict[str, Any]
+    run_json: Dict[str, Any]
+
+Size = Union[int, str, Sequence[int]]
+Boundary = Union[str, Sequence[str]]
+
+class DlcaLattice:
+    """A DLCA lattice to sweep forward and look at between sweeps."""
+
+    def __init__(
+        self,
+        size: Size,
+        fill: Optional[float] = None,
+        particles: Optional[int] = None,
+        *,
+        dim: Optional[int] = None,
+        seed: int = 1,
+        boundary: Optional[Boundary] = None,
+        temperature: float = ...,
+        gravity: float = ...,
+        mobility_exponent: float = ...,
+        target_clusters: int = ...,
+        max_sweeps: Optional[int] = None,
+        search: Literal["auto", "all-pairs", "grid", "lattice"] = ...,
+        grid_box: Optional[int] = None,
+        max_memory: Union[None, int, str] = None,
+        timing: bool = False,
+        histogram: bool = False,
+        histogram_sweeps: Optional[Sequence[int]] = None,
+        gyration: bool = False,
+        fit_min_size: int = ...,
+    ) -> None: ...
+    def step(self, n: int = 1, progress: Progress = None) -> int:
+        """Run up to ``n`` sweeps (fewer once done); return how many ran."""
+    def run(self, progress: Progress = None) -> int:
+        """Sweep until done; return how many sweeps ran."""
+    def result(self) -> DlcaResult:
+        """The state now, as :func:`dlca` returns it."""
+    @property
+    def done(self) -> bool: ...
+    @property
+    def sweeps(self) -> int: ...
+    @property
+    def clusters(self) -> int: ...
+    @property
+    def largest(self) -> int: ...
+    @property
+    def particles(self) -> int: ...
+    @property
+    def size(self) -> Tuple[int, ...]: ...
+    @property
+    def strategy(self) -> str: ...
+    @property
+    def state_hash(self) -> str: ...
+    @property
+    def params(self) -> Dict[str, Any]: ...
+    @property
+    def positions(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def labels(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def per_sweep(self) -> Dict[str, npt.NDArray[Any]]: ...
+    @property
+    def sizes(self) -> Dict[str, npt.NDArray[np.uint64]]: ...
+
+def dlca(
+    size: Size,
+    fill: Optional[float] = None,
+    particles: Optional[int] = None,
+    *,
+    dim: Optional[int] = None,
+    seed: int = 1,
+    boundary: Optional[Boundary] = None,
+    temperature: float = ...,
+    gravity: float = ...,
+    mobility_exponent: float = ...,
+    target_clusters: int = ...,
+    max_sweeps: Optional[int] = None,
+    search: Literal["auto", "all-pairs", "grid", "lattice"] = ...,
+    grid_box: Optional[int] = None,
+    max_memory: Union[None, int, str] = None,
+    timing: bool = False,
+    histogram: bool = False,
+    histogram_sweeps: Optional[Sequence[int]] = None,
+    gyration: bool = False,
+    fit_min_size: int = ...,
+    progress: Progress = None,
+) -> DlcaResult:
+    """Run DLCA to the end; see ``help(aggsim.dlca)``."""
+
+class AnimatResult:
+    """The populations and final animats of an animat run: :func:`animat`'s result."""
+
+    populations: Dict[str, npt.NDArray[Any]]
+    """``step``, ``foxes``, ``rabbits`` (uint64); with ``timing`` also ``search_seconds``,
+    ``distance_evaluations``."""
+    positions: npt.NDArray[np.int64]
+    """int64 (M, 2): cells of the live animats, by increasing id."""
+    species: npt.NDArray[np.uint8]
+    """uint8 (M,): :data:`FOX` or :data:`RABBIT`."""
+    ids: npt.NDArray[np.uint64]
+    ages: npt.NDArray[np.uint32]
+    hunger: npt.NDArray[np.uint32]
+    state_hash: str
+    steps: int
+    foxes: int
+    rabbits: int
+    distance_evaluations: int
+    grid_box: str
+    queries: Dict[str, int]
+    model: str
+    version: str
+    seed: int
+    threads: int
+    wall_seconds: float
+    cpu_seconds: Optional[float]
+    peak_rss_bytes: Optional[int]
+    params: Dict[str, Any]
+    run_json: Dict[str, Any]
+
+GridBox = Union[int, Literal["vision", "none"]]
+
+class AnimatWorld:
+    """An animat world to step forward and look at between steps."""
+
+    def __init__(
+        self,
+        seed: int = 1,
+        *,
+        config: Union[None, str, PathLike[str]] = None,
+        foxes: Optional[int] = None,
+        rabbits: Optional[int] = None,
+        start_radius: Optional[int] = None,
+        density: Optional[float] = None,
+        vision: Optional[int] = None,
+        grid_box: Optional[GridBox] = None,
+        hungry_at: Optional[int] = None,
+        starve: Optional[int] = None,
+        fox_max_age: Optional[int] = None,
+        rabbit_max_age: Optional[int] = None,
+        fox_breed_p: Optional[float] = None,
+        rabbit_breed_p: Optional[float] = None,
+        prey_needed: Optional[int] = None,
+        crowd_max: Optional[int] = None,
+        crowd_radius: Optional[int] = None,
+        fox_rules: Optional[Sequence[str]] = None,
+        rabbit_rules: Optional[Sequence[str]] = None,
+        timing: bool = False,
+    ) -> None: ...
+    def step(self, n: int = 1, progress: Progress = None) -> int:
+        """Run up to ``n`` steps (fewer once every animat has died); return how many ran."""
+    def result(self) -> AnimatResult:
+        """The state now, as :func:`animat` returns it."""
+    @property
+    def steps(self) -> int: ...
+    @property
+    def foxes(self) -> int: ...
+    @property
+    def rabbits(self) -> int: ...
+    @property
+    def state_hash(self) -> str: ...
+    @property
+    def params(self) -> Dict[str, Any]: ...
+    @property
+    def positions(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def species(self) -> npt.NDArray[np.uint8]: ...
+    @property
+    def ids(self) -> npt.NDArray[np.uint64]: ...
+    @property
+    def ages(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def hunger(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def populations(self) -> Dict[str, npt.NDArray[Any]]: ...
+
+def animat(
+    steps: int = ...,
+    seed: int = 1,
+    *,
+    config: Union[None, str, PathLike[str]] = None,
+    foxes: Optional[int] = None,
+    rabbits: Optional[int] = None,
+    start_radius: Optional[int] = None,
+    density: Optional[float] = None,
+    vision: Optional[int] = None,
+    grid_box: Optional[GridBox] = None,
+    hungry_at: Optional[int] = None,
+    starve: Optional[int] = None,
+    fox_max_age: Optional[int] = None,
+    rabbit_max_age: Optional[int] = None,
+    fox_breed_p: Optional[float] = None,
+    rabbit_breed_p: Optional[float] = None,
+    prey_needed: Optional[int] = None,
+    crowd_max: Optional[int] = None,
+    crowd_radius: Optional[int] = None,
+    fox_rules: Optional[Sequence[str]] = None,
+    rabbit_rules: Optional[Sequence[str]] = None,
+    timing: bool = False,
+    progress: Progress = None,
+) -> AnimatResult:
+    """Run the animat model; see ``help(aggsim.animat)``."""

@@ -1,0 +1,657 @@
+//! `aggsim.animat` and `aggsim.AnimatWorld`: the foxes-and-rabbits animat model over the
+//! `animat` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
+//! Performance Optimisation", section II.B).
+
+use crate::convert::{Columns, count, run_error, set_manifest, value_error};
+use crate::run::{Progress, interruptible};
+use ::animat::output::PopulationRow;
+use ::animat::params::{DEFAULT_STEPS, FLAGS, error_message};
+use ::animat::{GridBox, Params, World, WorldError};
+use core_lattice::io::RunClock;
+use numpy::IntoPyArray;
+use numpy::ndarray::Array2;
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::sync::{Mutex, MutexGuard, TryLockError};
+
+/// A `u32` parameter (set in config files, not by a flag of its own): out of range is the
+/// library's wording of a range error.
+fn u32_arg(name: &str, v: i64) -> PyResult<u32> {
+    u32::try_from(v).map_err(|_| {
+        value_error(format!(
+            "{name} = {v} is outside the accepted range 0..={}",
+            u32::MAX
+        ))
+    })
+}
+
+/// `--grid-box`: an int side, `"vision"` or `"none"`.
+fn grid_box(arg: &Bound<'_, PyAny>) -> PyResult<GridBox> {
+    if let Ok(s) = arg.cast::<PyString>() {
+        return s
+            .to_str()?
+            .parse::<GridBox>()
+            .map_err(|e| value_error(format!("--grid-box: {e}")));
+    }
+    Ok(GridBox::Side(arg.extract()?))
+}
+
+/// The model's keyword arguments; `None` keeps the config file's value or the default.
+#[derive(Default)]
+struct Args<'a, 'py> {
+    config: Option<PathBuf>,
+    foxes: Option<i64>,
+    rabbits: Option<i64>,
+    start_radius: Option<i64>,
+    density: Option<f64>,
+    vision: Option<i64>,
+    grid_box: Option<&'a Bound<'py, PyAny>>,
+    hungry_at: Option<i64>,
+    starve: Option<i64>,
+    fox_max_age: Option<i64>,
+    rabbit_max_age: Option<i64>,
+    fox_breed_p: Option<f64>,
+    rabbit_breed_p: Option<f64>,
+    prey_needed: Option<i64>,
+    crowd_max: Option<i64>,
+    crowd_radius: Option<i64>,
+    fox_rules: Option<Vec<String>>,
+    rabbit_rules: Option<Vec<String>>,
+}
+
+impl Args<'_, '_> {
+    /// Defaults, then the config file, then the arguments (as the binary: defaults, config,
+    /// flags), validated; errors name the flag or the config file as the binary's do.
+    fn params(&self) -> PyResult<Params> {
+        let mut p = match &self.config {
+            Some(path) => ::animat::config::read_config(path).map_err(value_error)?,
+            None => Params::default(),
+        };
+        if let Some(v) = self.foxes {
+            p.foxes = count("--foxes", v)?;
+        }
+        if let Some(v) = self.rabbits {
+            p.rabbits = count("--rabbits", v)?;
+        }
+        if self.start_radius.is_some() && self.density.is_some() {
+            return Err(value_error(
+                "--start-radius cannot be used with --density (it sets the start radius)",
+            ));
+        }
+        if let Some(v) = self.start_radius {
+            p.start_radius = v;
+        }
+        if let Some(d) = self.density {
+            p.set_density(d).map_err(value_error)?;
+        }
+        if let Some(v) = self.vision {
+            p.vision = v;
+        }
+        if let Some(g) = self.grid_box {
+            p.grid_box = grid_box(g)?;
+        }
+        let u32s = [
+            ("hungry_at", self.hungry_at, &mut p.hungry_at),
+            ("starve", self.starve, &mut p.starve),
+            ("fox_max_age", self.fox_max_age, &mut p.fox_max_age),
+            ("rabbit_max_age", self.rabbit_max_age, &mut p.rabbit_max_age),
+            ("prey_needed", self.prey_needed, &mut p.prey_needed),
+            ("crowd_max", self.crowd_max, &mut p.crowd_max),
+        ];
+        for (name, given, field) in u32s {
+            if let Some(v) = given {
+                *field = u32_arg(name, v)?;
+            }
+        }
+        if let Some(v) = self.fox_breed_p {
+            p.fox_breed_p = v;
+        }
+        if let Some(v) = self.rabbit_breed_p {
+            p.rabbit_breed_p = v;
+        }
+        if let Some(v) = self.crowd_radius {
+            p.crowd_radius = v;
+        }
+        if let Some(v) = &self.fox_rules {
+            p.fox_rules = v.clone();
+        }
+        if let Some(v) = &self.rabbit_rules {
+            p.rabbit_rules = v.clone();
+        }
+        p.validate().map_err(|e| self.message(&e))?;
+        Ok(p)
+    }
+
+    /// The binary's wording of a parameter error: the flag if the value was given as one.
+    fn message(&self, e: &::animat::ParamsError) -> PyErr {
+        let by_flag = |name: &str| {
+            FLAGS.contains(&name)
+                && match name {
+                    "foxes" => self.foxes.is_some(),
+                    "rabbits" => self.rabbits.is_some(),
+                    "start_radius" => self.start_radius.is_some() || self.density.is_some(),
+                    "vision" => self.vision.is_some(),
+                    "grid_box" => self.grid_box.is_some(),
+                    _ => false,
+                }
+        };
+        value_error(error_message(e, by_flag, self.config.as_deref()))
+    }
+}
+
+/// A world, the population rows so far and the clock (`run.json`'s times count from the
+/// world's creation).
+struct Run {
+    world: World,
+    rows: Vec<PopulationRow>,
+    clock: RunClock,
+    /// Whether the rows record the search's seconds and work (`timing`).
+    timing: bool,
+}
+
+impl Run {
+    fn new(py: Python<'_>, args: &Args<'_, '_>, seed: u64, timing: bool) -> PyResult<Self> {
+        let clock = RunClock::start();
+        let params = args.params()?;
+        // Placing a large population takes a while: without the GIL.
+        let world = py.detach(|| World::new(params, seed));
+        let mut world = world.map_err(|e| match e {
+            WorldError::Params(e) => args.message(&e),
+            other => value_error(other),
+        })?;
+        world.set_timing(timing);
+        let rows = vec![PopulationRow::of(&world, Default::default())];
+        Ok(Run {
+            world,
+            rows,
+            clock,
+            timing,
+        })
+    }
+
+    /// Up to `n` steps, fewer once every animat has died (as the binary); returns the steps
+    /// made.
+    fn steps(&mut self, py: Python<'_>, n: u64, progress: &Progress) -> PyResult<u64> {
+        let (world, rows) = (&mut self.world, &mut self.rows);
+        interruptible(py, progress, n, |shared| {
+            let mut k = 0;
+            while k < n && !shared.stop.load(Ordering::Relaxed) {
+                if world.foxes() + world.rabbits() == 0 {
+                    break;
+                }
+                let s = world.step();
+                rows.push(PopulationRow::of(world, s));
+                k += 1;
+                shared.done.store(k, Ordering::Relaxed);
+            }
+            k
+        })
+    }
+
+    /// The live animats' columns: positions (int64, (M, 2)), species codes, ids, ages,
+    /// hunger.
+    fn animats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let w = &self.world;
+        let n = (w.foxes() + w.rabbits()) as usize;
+        let mut pos = Vec::with_capacity(2 * n);
+        let (mut species, mut ids, mut ages, mut hunger) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for a in w.animats() {
+            pos.extend_from_slice(&a.pos);
+            species.push(a.species.code() as u8);
+            ids.push(a.id);
+            ages.push(a.age);
+            hunger.push(a.hunger);
+        }
+        let pos = Array2::from_shape_vec((ids.len(), 2), pos).map_err(run_error)?;
+        let d = Columns::default()
+            .add(py, "species", species)
+            .add(py, "ids", ids)
+            .add(py, "ages", ages)
+            .add(py, "hunger", hunger)
+            .into_dict(py)?;
+        d.set_item("positions", pos.into_pyarray(py))?;
+        Ok(d)
+    }
+
+    fn populations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let r = &self.rows;
+        let mut c = Columns::default()
+            .add(py, "step", r.iter().map(|x| x.step).collect())
+            .add(py, "foxes", r.iter().map(|x| x.foxes).collect())
+            .add(py, "rabbits", r.iter().map(|x| x.rabbits).collect());
+        if self.timing {
+            c = c
+                .add(
+                    py,
+                    "search_seconds",
+                    r.iter().map(|x| x.search_seconds).collect(),
+                )
+                .add(
+                    py,
+                    "distance_evaluations",
+                    r.iter().map(|x| x.distance_evals).collect(),
+                );
+        }
+        c.into_dict(py)
+    }
+
+    fn result(&self, py: Python<'_>) -> PyResult<Py<AnimatResult>> {
+        let w = &self.world;
+        let m = ::animat::output::manifest(w, w.seed(), &self.clock).map_err(run_error)?;
+        let out = Bound::new(py, AnimatResult {})?;
+        set_manifest(out.as_any(), &m)?;
+        for (k, v) in self.animats(py)?.iter() {
+            out.setattr(k.cast::<PyString>()?, v)?;
+        }
+        out.setattr("populations", self.populations(py)?)?;
+        Ok(out.unbind())
+    }
+}
+
+/// The result of :func:`aggsim.animat` (or :meth:`AnimatWorld.result`): populations per step,
+/// the final animats and every result of the ``animat`` binary's ``run.json``.
+///
+/// Attributes
+/// ----------
+/// populations : dict[str, numpy.ndarray]
+///     The binary's ``populations.csv`` from step 0: ``step``, ``foxes``, ``rabbits``
+///     (uint64), and with ``timing=True`` ``search_seconds`` and ``distance_evaluations``.
+/// positions : numpy.ndarray
+///     int64, shape (M, 2): the cell of every live animat at the end, by increasing id.
+/// species : numpy.ndarray
+///     uint8, shape (M,): :data:`aggsim.FOX` (0) or :data:`aggsim.RABBIT` (1).
+/// ids, ages, hunger : numpy.ndarray
+///     uint64, uint32, uint32, shape (M,): id, steps lived, and (foxes) steps since the last
+///     meal, as the binary's ``positions.csv``.
+/// state_hash : str
+///     16 hex digits over every live animat: the binary's for the same seed and parameters.
+/// steps, foxes, rabbits, distance_evaluations, grid_box, queries
+///     The results of ``run.json``.
+/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, params, run_json
+///     The rest of ``run.json``, and the whole of it as a dict.
+#[pyclass(dict, module = "aggsim")]
+pub struct AnimatResult {}
+
+#[pymethods]
+impl AnimatResult {
+    fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
+        let s: u64 = slf.getattr("steps")?.extract()?;
+        let f: u64 = slf.getattr("foxes")?.extract()?;
+        let r: u64 = slf.getattr("rabbits")?.extract()?;
+        let hash: String = slf.getattr("state_hash")?.extract()?;
+        Ok(format!(
+            "<aggsim.AnimatResult: {f} foxes, {r} rabbits after {s} steps, state_hash {hash}>"
+        ))
+    }
+}
+
+/// An animat world to step forward and look at between steps.
+///
+/// Takes the model parameters of :func:`aggsim.animat` (all but ``steps`` and
+/// ``progress``), places the start population and waits: :meth:`step` runs steps, the
+/// properties show the state, :meth:`result` gives what :func:`aggsim.animat` returns.
+/// Stepping one step at a time gives the very run ``animat`` makes (the same ``state_hash``).
+/// Ctrl-C during :meth:`step` stops after the current step with ``KeyboardInterrupt`` and
+/// leaves the world valid. One thread at a time may use a world (another gets
+/// ``RuntimeError`` while it runs).
+#[pyclass(module = "aggsim")]
+pub struct AnimatWorld {
+    run: Mutex<Run>,
+}
+
+impl AnimatWorld {
+    fn lock(&self) -> PyResult<MutexGuard<'_, Run>> {
+        match self.run.try_lock() {
+            Ok(g) => Ok(g),
+            Err(TryLockError::Poisoned(e)) => Ok(e.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(PyRuntimeError::new_err(
+                "the world is running in another thread",
+            )),
+        }
+    }
+}
+
+#[pymethods]
+impl AnimatWorld {
+    #[new]
+    #[pyo3(signature = (
+        seed = 1,
+        *,
+        config = None,
+        foxes = None,
+        rabbits = None,
+        start_radius = None,
+        density = None,
+        vision = None,
+        grid_box = None,
+        hungry_at = None,
+        starve = None,
+        fox_max_age = None,
+        rabbit_max_age = None,
+        fox_breed_p = None,
+        rabbit_breed_p = None,
+        prey_needed = None,
+        crowd_max = None,
+        crowd_radius = None,
+        fox_rules = None,
+        rabbit_rules = None,
+        timing = false,
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        seed: u64,
+        config: Option<PathBuf>,
+        foxes: Option<i64>,
+        rabbits: Option<i64>,
+        start_radius: Option<i64>,
+        density: Option<f64>,
+        vision: Option<i64>,
+        grid_box: Option<&Bound<'_, PyAny>>,
+        hungry_at: Option<i64>,
+        starve: Option<i64>,
+        fox_max_age: Option<i64>,
+        rabbit_max_age: Option<i64>,
+        fox_breed_p: Option<f64>,
+        rabbit_breed_p: Option<f64>,
+        prey_needed: Option<i64>,
+        crowd_max: Option<i64>,
+        crowd_radius: Option<i64>,
+        fox_rules: Option<Vec<String>>,
+        rabbit_rules: Option<Vec<String>>,
+        timing: bool,
+    ) -> PyResult<Self> {
+        let args = Args {
+            config,
+            foxes,
+            rabbits,
+            start_radius,
+            density,
+            vision,
+            grid_box,
+            hungry_at,
+            starve,
+            fox_max_age,
+            rabbit_max_age,
+            fox_breed_p,
+            rabbit_breed_p,
+            prey_needed,
+            crowd_max,
+            crowd_radius,
+            fox_rules,
+            rabbit_rules,
+        };
+        Ok(AnimatWorld {
+            run: Mutex::new(Run::new(py, &args, seed, timing)?),
+        })
+    }
+
+    /// Run up to ``n`` steps (fewer once every animat has died) and return how many ran. In a
+    /// step every animat alive at its start, in a fresh random order, runs the first rule of
+    /// its species' list whose condition holds. ``progress`` as in :func:`aggsim.animat`.
+    /// Ctrl-C stops after the current step (``KeyboardInterrupt``).
+    #[pyo3(signature = (n = 1, progress = None))]
+    fn step(&self, py: Python<'_>, n: i64, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
+        let n = count("n", n)?;
+        let progress = Progress::from_arg(progress, "animat", "steps")?;
+        self.lock()?.steps(py, n, &progress)
+    }
+
+    /// The state now as an :class:`AnimatResult`, with ``run.json``'s results (times since
+    /// the world was made).
+    fn result(&self, py: Python<'_>) -> PyResult<Py<AnimatResult>> {
+        self.lock()?.result(py)
+    }
+
+    /// Steps made.
+    #[getter]
+    fn steps(&self) -> PyResult<u64> {
+        Ok(self.lock()?.world.steps())
+    }
+
+    /// Live foxes.
+    #[getter]
+    fn foxes(&self) -> PyResult<u64> {
+        Ok(self.lock()?.world.foxes())
+    }
+
+    /// Live rabbits.
+    #[getter]
+    fn rabbits(&self) -> PyResult<u64> {
+        Ok(self.lock()?.world.rabbits())
+    }
+
+    /// Hash of every live animat (the binary's ``state_hash``).
+    #[getter]
+    fn state_hash(&self) -> PyResult<String> {
+        Ok(self.lock()?.world.state_hash())
+    }
+
+    /// The validated parameters, as ``run.json`` records them.
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let v = serde_json::to_value(self.lock()?.world.params()).map_err(run_error)?;
+        crate::convert::json(py, &v)
+    }
+
+    /// int64 array (M, 2): the cell of every live animat, by increasing id.
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "positions")
+    }
+
+    /// uint8 array (M,): ``FOX`` (0) or ``RABBIT`` (1) for every live animat.
+    #[getter]
+    fn species<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "species")
+    }
+
+    /// uint64 array (M,): every live animat's id.
+    #[getter]
+    fn ids<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "ids")
+    }
+
+    /// uint32 array (M,): steps lived.
+    #[getter]
+    fn ages<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "ages")
+    }
+
+    /// uint32 array (M,): steps since the last meal (0 for rabbits).
+    #[getter]
+    fn hunger<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "hunger")
+    }
+
+    /// Foxes and rabbits after every step so far (dict of arrays, as
+    /// :attr:`AnimatResult.populations`).
+    #[getter]
+    fn populations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.lock()?.populations(py)
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let r = self.lock()?;
+        Ok(format!(
+            "<aggsim.AnimatWorld: {} foxes, {} rabbits after {} steps>",
+            r.world.foxes(),
+            r.world.rabbits(),
+            r.world.steps()
+        ))
+    }
+}
+
+impl AnimatWorld {
+    fn column<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+        self.lock()?
+            .animats(py)?
+            .get_item(name)?
+            .ok_or_else(|| run_error(format!("no column {name}")))
+    }
+}
+
+/// Run the predator-prey animat model and return an :class:`AnimatResult`.
+///
+/// The model and every parameter are those of the ``animat`` binary (``animat --help`` and
+/// its config file, data/animat-default.toml), keyword names being its flags and config keys;
+/// a parameter left None takes the config file's value (``config``) or the default, from the
+/// library (see :func:`aggsim.defaults`). Foxes and rabbits live one per cell on the unbounded
+/// integer plane; every step each runs the first rule of its species' priority list whose
+/// condition holds (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
+/// Performance Optimisation", section II.B). The run is a pure function of (parameters, seed):
+/// its ``state_hash`` is the binary's.
+///
+/// Parameters
+/// ----------
+/// steps : int
+///     Steps to run (default 1000); the run ends early when every animat has died.
+/// seed : int
+///     Seed of every random stream (default 1).
+/// config : str or path or None
+///     A TOML file of model parameters, read as the binary's ``--config``; the arguments
+///     below override it.
+/// foxes, rabbits : int
+///     Start populations (default 300 and 2000).
+/// start_radius : int
+///     Radius of the start disc around the origin, in cells (default 60).
+/// density : float
+///     Start density in animats per cell, in (0, 0.5]: sets ``start_radius`` instead.
+/// vision : int
+///     Vision radius in cells, >= 1 (default 60, the paper's).
+/// grid_box : int or str
+///     Grid-box side, ``"vision"`` (default) or ``"none"`` (exhaustive search): speed only.
+/// hungry_at, starve, fox_max_age, rabbit_max_age : int
+///     A fox is hungry at this hunger and starves above ``starve``; each species dies older
+///     than its maximum age.
+/// fox_breed_p, rabbit_breed_p : float
+///     Probabilities that a breed rule whose condition holds produces an animat.
+/// prey_needed : int
+///     Rabbits within vision a fox needs to breed.
+/// crowd_max, crowd_radius : int
+///     More than ``crowd_max`` animats within ``crowd_radius`` forbid breeding.
+/// fox_rules, rabbit_rules : list of str
+///     Rule lists in priority order (fox: eat, breed, hunt, seek_mate, wander; rabbit: flee,
+///     breed, herd, wander).
+/// timing : bool
+///     Record the perception queries' seconds and distance evaluations per step (default
+///     False).
+/// progress : bool or callable
+///     True prints progress (steps) to ``sys.stderr``; a callable is called as
+///     ``progress(done, total)`` about twice a second (default None: quiet).
+///
+/// ``aggsim.defaults("animat")`` lists every default.
+///
+/// Returns
+/// -------
+/// AnimatResult
+///
+/// Raises
+/// ------
+/// ValueError
+///     A parameter outside its accepted range, with the binary's message.
+/// KeyboardInterrupt
+///     Ctrl-C: the run stops after the current step (use :class:`AnimatWorld` to keep the
+///     state).
+///
+/// The run releases the GIL: other Python threads run meanwhile.
+#[pyfunction]
+#[pyo3(signature = (
+    steps = DEFAULT_STEPS as i64,
+    seed = 1,
+    *,
+    config = None,
+    foxes = None,
+    rabbits = None,
+    start_radius = None,
+    density = None,
+    vision = None,
+    grid_box = None,
+    hungry_at = None,
+    starve = None,
+    fox_max_age = None,
+    rabbit_max_age = None,
+    fox_breed_p = None,
+    rabbit_breed_p = None,
+    prey_needed = None,
+    crowd_max = None,
+    crowd_radius = None,
+    fox_rules = None,
+    rabbit_rules = None,
+    timing = false,
+    progress = None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn animat(
+    py: Python<'_>,
+    steps: i64,
+    seed: u64,
+    config: Option<PathBuf>,
+    foxes: Option<i64>,
+    rabbits: Option<i64>,
+    start_radius: Option<i64>,
+    density: Option<f64>,
+    vision: Option<i64>,
+    grid_box: Option<&Bound<'_, PyAny>>,
+    hungry_at: Option<i64>,
+    starve: Option<i64>,
+    fox_max_age: Option<i64>,
+    rabbit_max_age: Option<i64>,
+    fox_breed_p: Option<f64>,
+    rabbit_breed_p: Option<f64>,
+    prey_needed: Option<i64>,
+    crowd_max: Option<i64>,
+    crowd_radius: Option<i64>,
+    fox_rules: Option<Vec<String>>,
+    rabbit_rules: Option<Vec<String>>,
+    timing: bool,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Py<AnimatResult>> {
+    let steps = count("--steps", steps)?;
+    let progress = Progress::from_arg(progress, "animat", "steps")?;
+    let world = AnimatWorld::new(
+        py,
+        seed,
+        config,
+        foxes,
+        rabbits,
+        start_radius,
+        density,
+        vision,
+        grid_box,
+        hungry_at,
+        starve,
+        fox_max_age,
+        rabbit_max_age,
+        fox_breed_p,
+        rabbit_breed_p,
+        prey_needed,
+        crowd_max,
+        crowd_radius,
+        fox_rules,
+        rabbit_rules,
+        timing,
+    )?;
+    let mut run = world.lock()?;
+    run.steps(py, steps, &progress)?;
+    run.result(py)
+}
+
+/// The `animat` binary's defaults, from the library.
+pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    let mut v = serde_json::to_value(Params::default()).map_err(run_error)?;
+    if let Some(o) = v.as_object_mut() {
+        o.insert("steps".into(), DEFAULT_STEPS.into());
+        o.insert("seed".into(), 1.into());
+        o.insert("timing".into(), false.into());
+    }
+    crate::convert::json(py, &v)
+}

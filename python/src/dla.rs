@@ -1,0 +1,268 @@
+//! `aggsim.dla`: off-lattice DLA and PDLA over the `dla_pdla` library (Sosa-Herrera &
+//! Rodriguez-Romo, "Variable precision distance search for random fractal cluster
+//! simulations").
+
+use crate::convert::{Columns, count, run_error, set_manifest, value_error};
+use crate::run::{Progress, interruptible};
+use core_lattice::io::RunClock;
+use dla_pdla::{Dim, FarField, Params, SimError, Simulation, Space};
+use numpy::IntoPyArray;
+use numpy::ndarray::Array2;
+use pyo3::prelude::*;
+use std::sync::atomic::Ordering;
+
+/// The library's defaults, which are the `dla` binary's.
+fn defaults() -> Params {
+    Params::default()
+}
+
+/// Particles of `aggsim.dla` when none are given (the binary requires `--particles`): a
+/// cluster of a second or so, large enough for a fractal-dimension fit.
+const PARTICLES: u64 = 100_000;
+
+/// `--far-field` by its name.
+fn far_field(name: &str) -> PyResult<FarField> {
+    [FarField::Return, FarField::Jump]
+        .into_iter()
+        .find(|f| f.name() == name)
+        .ok_or_else(|| {
+            value_error(format!(
+                "invalid value '{name}' for '--far-field': possible values are return, jump"
+            ))
+        })
+}
+
+/// The result of :func:`aggsim.dla`: the cluster, its growth and every result of the ``dla``
+/// binary's ``run.json``.
+///
+/// Attributes
+/// ----------
+/// positions : numpy.ndarray
+///     float64, shape (N, D): every particle's centre in arrival order (the seed particle
+///     first, at the origin); diameters are 1.
+/// growth : dict[str, numpy.ndarray]
+///     The growth samples (200 log-spaced sizes per decade and the final size), as the
+///     binary's ``growth.csv``: ``N`` (uint64, particles), ``R_g`` (radius of gyration),
+///     ``R_ext`` (largest centre distance from the origin), ``seconds`` (wall time since the
+///     start of growth).
+/// state_hash : str
+///     16 hex digits, a hash of the positions in arrival order: the binary's for the same
+///     seed and parameters (with one thread).
+/// particles, radius_of_gyration, r_ext, fractal_dimension, fractal_dimension_stderr,
+/// fit_points, fit_error, discarded_walkers, pdla_parallel_seconds, pdla_lock_wait_seconds,
+/// pdla_phases, tree_memory_bytes, tree_point_slots, distance_map_bytes, bytes_per_particle
+///     The results of ``run.json`` (``fit_error`` only when no fit was possible, and then
+///     ``fractal_dimension`` is None).
+/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes
+///     The other scalars of ``run.json`` (CPU seconds and peak memory are the whole Python
+///     process's).
+/// params : dict
+///     The validated parameters, as ``run.json`` records them.
+/// run_json : dict
+///     The whole manifest, as the binary would write it to ``run.json``.
+#[pyclass(dict, module = "aggsim")]
+pub struct DlaResult {}
+
+#[pymethods]
+impl DlaResult {
+    fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
+        let n: u64 = slf.getattr("particles")?.extract()?;
+        let dim: usize = slf.getattr("params")?.get_item("dim")?.extract()?;
+        let rg: f64 = slf.getattr("radius_of_gyration")?.extract()?;
+        let hash: String = slf.getattr("state_hash")?.extract()?;
+        Ok(format!(
+            "<aggsim.DlaResult: {n} particles in {dim}D, R_g {rg:.2}, state_hash {hash}>"
+        ))
+    }
+}
+
+/// Grow an off-lattice DLA cluster (PDLA with ``threads`` > 1) and return it as a
+/// :class:`DlaResult`.
+///
+/// The model and every parameter are those of the ``dla`` binary (``dla --help``), keyword
+/// names being its flags with dashes as underscores; the defaults are its defaults, from the
+/// library (see :func:`aggsim.defaults`). A seed particle sits at the origin; walkers
+/// (balls of diameter 1) are born on the sphere of radius R_b = R_ext + birth_gap, jump by the
+/// variable-precision distance to the cluster when far from it (Sosa-Herrera &
+/// Rodriguez-Romo, "Variable precision distance search for random fractal cluster
+/// simulations"), take steps of step_min near it, and stick at exact contact. With one thread
+/// the run is a pure function of (parameters, seed) and its ``state_hash`` is the binary's.
+///
+/// Parameters
+/// ----------
+/// dim : int
+///     Space dimension, 2 or 3 (default 2).
+/// particles : int
+///     Particles in the final cluster, seed particle included (default 100000).
+/// seed : int
+///     Seed of every random stream (default 1).
+/// threads : int
+///     Walkers moving at once (PDLA; default 1, which is DLA and deterministic).
+/// birth_gap : float
+///     R_b - R_ext in diameters, >= 1 (default 5).
+/// far_field : str
+///     ``"return"`` (default): a walker outside the birth sphere returns to it exactly where
+///     Brownian motion would first hit it; ``"jump"``: the paper's jump with relaunch beyond
+///     the death radius.
+/// death_ratio : float or None
+///     R_d / R_b for ``far_field="jump"`` (> 1; default None: 100). Refused with
+///     ``"return"``, as by the binary.
+/// step_min : float
+///     Near-field step in diameters, in [1e-6, 1e3] (default 0.1; the paper's 0.5 biases
+///     the R_g prefactor about 5 % low).
+/// precision : float
+///     kappa of the variable-precision distance, > 0.5 (default 2; ``math.inf`` is the
+///     exact search).
+/// leaf_side : float
+///     Side of the orthtree's leaves, a power of two in [1, 64] (default 8): speed and memory
+///     only.
+/// distance_map : bool
+///     The coarse distance maps in front of the orthtree (default True, the binary's
+///     ``--distance-map on``): speed only, but another trajectory.
+/// near_cache : bool
+///     Each walker's exact near cache (default True): speed only, same trajectory.
+/// serial_until : int
+///     With threads > 1: grow with one walker up to this many particles (default 0).
+/// fit_from : int
+///     Smallest N of the fractal-dimension fit log N = D log R_g + c (default 1000).
+/// progress : bool or callable
+///     True prints progress to ``sys.stderr``; a callable is called as
+///     ``progress(done, total)`` about twice a second (default None: quiet).
+///
+/// Returns
+/// -------
+/// DlaResult
+///
+/// Raises
+/// ------
+/// ValueError
+///     A parameter outside its accepted range, with the binary's message.
+/// KeyboardInterrupt
+///     Ctrl-C (SIGINT): the run stops within a particle (PDLA: at the phase's next quiescent
+///     point) and nothing is returned.
+///
+/// The run releases the GIL: other Python threads run meanwhile.
+#[pyfunction]
+#[pyo3(signature = (
+    dim = defaults().dim,
+    particles = PARTICLES as i64,
+    seed = 1,
+    threads = defaults().threads as i64,
+    *,
+    birth_gap = defaults().birth_gap,
+    far_field = defaults().far_field.name(),
+    death_ratio = None,
+    step_min = defaults().step_min,
+    precision = defaults().precision,
+    leaf_side = defaults().leaf_side,
+    distance_map = defaults().distance_map,
+    near_cache = defaults().near_cache,
+    serial_until = defaults().serial_until as i64,
+    fit_from = defaults().fit_from as i64,
+    progress = None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn dla(
+    py: Python<'_>,
+    dim: usize,
+    particles: i64,
+    seed: u64,
+    threads: i64,
+    birth_gap: f64,
+    far_field: &str,
+    death_ratio: Option<f64>,
+    step_min: f64,
+    precision: f64,
+    leaf_side: f64,
+    distance_map: bool,
+    near_cache: bool,
+    serial_until: i64,
+    fit_from: i64,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Py<DlaResult>> {
+    let clock = RunClock::start();
+    let params = Params {
+        dim,
+        particles: count("--particles", particles)?,
+        birth_gap,
+        far_field: self::far_field(far_field)?,
+        death_ratio: death_ratio.unwrap_or(defaults().death_ratio),
+        step_min,
+        precision,
+        threads: count("--threads", threads)? as usize,
+        serial_until: count("--serial-until", serial_until)?,
+        fit_from: count("--fit-from", fit_from)?,
+        // The positions are returned.
+        keep_positions: true,
+        leaf_side,
+        distance_map,
+        near_cache,
+    };
+    params
+        .validate_given(death_ratio.is_some())
+        .map_err(value_error)?;
+    let progress = Progress::from_arg(progress, "dla", "particles")?;
+    // The one run-time dimension dispatch, as in the binary.
+    match params.dim {
+        2 => grow::<2>(py, params, seed, &progress, &clock),
+        3 => grow::<3>(py, params, seed, &progress, &clock),
+        d => Err(value_error(dla_pdla::ParamsError::Dim(d))),
+    }
+}
+
+fn grow<const D: usize>(
+    py: Python<'_>,
+    params: Params,
+    seed: u64,
+    progress: &Progress,
+    clock: &RunClock,
+) -> PyResult<Py<DlaResult>>
+where
+    Dim<D>: Space<D>,
+{
+    let total = params.particles;
+    let mut sim = Simulation::<D>::new(params, seed).map_err(|e| match e {
+        SimError::Params(e) => value_error(e),
+        other => run_error(other),
+    })?;
+    let reached = interruptible(py, progress, total, |shared| {
+        sim.run_until(&shared.stop, &|n| shared.done.store(n, Ordering::Relaxed))
+    })?
+    .map_err(run_error)?;
+    if !reached {
+        return Err(run_error("stopped before the target size"));
+    }
+    let m = dla_pdla::output::manifest(&sim, clock).map_err(run_error)?;
+    let samples = sim.samples();
+    let growth = Columns::default()
+        .add(py, "N", samples.iter().map(|s| s.n).collect())
+        .add(
+            py,
+            "R_g",
+            samples.iter().map(|s| s.radius_of_gyration).collect(),
+        )
+        .add(py, "R_ext", samples.iter().map(|s| s.r_ext).collect())
+        .add(py, "seconds", samples.iter().map(|s| s.seconds).collect())
+        .into_dict(py)?;
+    let positions = sim
+        .into_positions()
+        .ok_or_else(|| run_error("the positions were not kept"))?;
+    // `Vec<[f64; D]>` becomes an (N, D) array and NumPy takes it over: no copy.
+    let positions = Array2::from(positions).into_pyarray(py);
+    let out = Bound::new(py, DlaResult {})?;
+    set_manifest(out.as_any(), &m)?;
+    out.setattr("positions", positions)?;
+    out.setattr("growth", growth)?;
+    Ok(out.unbind())
+}
+
+/// The `dla` binary's defaults, from the library.
+pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    let mut v = serde_json::to_value(defaults()).map_err(run_error)?;
+    if let Some(o) = v.as_object_mut() {
+        o.remove("keep_positions");
+        o.insert("particles".into(), PARTICLES.into());
+        o.insert("seed".into(), 1.into());
+    }
+    crate::convert::json(py, &v)
+}

@@ -1,0 +1,725 @@
+//! `aggsim.dlca` and `aggsim.DlcaLattice`: diffusion-limited cluster-cluster aggregation over
+//! the `dlca` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
+//! Performance Optimisation").
+
+use crate::convert::{Columns, count, run_error, set_manifest, value_error};
+use crate::run::{Progress, interruptible};
+use ::dlca::analysis::{gyration, size_distribution};
+use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, flags};
+use ::dlca::{Params, Search, Simulation};
+use core_lattice::io::RunClock;
+use numpy::IntoPyArray;
+use numpy::ndarray::{Array1, Array2};
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString, PyTuple};
+use std::sync::atomic::Ordering;
+use std::sync::{Mutex, MutexGuard, TryLockError};
+
+/// The library's defaults, which are the `dlca` binary's.
+fn defaults() -> Params {
+    Params::default()
+}
+
+/// `--size`: an int (every axis), a sequence of ints (one per axis) or a string as the binary
+/// takes it (`"1024x512"`).
+fn sizes(arg: &Bound<'_, PyAny>) -> PyResult<Vec<u64>> {
+    if let Ok(s) = arg.cast::<PyString>() {
+        return flags::parse_size(s.to_str()?).map_err(value_error);
+    }
+    let given: Vec<i64> = match arg.extract::<i64>() {
+        Ok(v) => vec![v],
+        Err(_) => arg.extract()?,
+    };
+    given.into_iter().map(|v| count("--size", v)).collect()
+}
+
+/// `--boundary`: `"periodic"`, `"wall"`, one per axis separated by commas, or a sequence of
+/// them.
+fn boundary(arg: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Ok(s) = arg.cast::<PyString>() {
+        return Ok(s.to_str()?.to_string());
+    }
+    let names: Vec<String> = arg.extract()?;
+    Ok(names.join(","))
+}
+
+/// `--max-memory`: bytes, or a string as the binary takes it (`"4G"`).
+fn bytes(arg: &Bound<'_, PyAny>) -> PyResult<u64> {
+    if let Ok(s) = arg.cast::<PyString>() {
+        return flags::parse_bytes(s.to_str()?).map_err(value_error);
+    }
+    count("--max-memory", arg.extract()?)
+}
+
+/// `--search` by its name.
+fn search(name: &str) -> PyResult<Search> {
+    let all = [
+        Search::Auto,
+        Search::AllPairs,
+        Search::Grid,
+        Search::Lattice,
+    ];
+    all.into_iter().find(|s| s.name() == name).ok_or_else(|| {
+        value_error(format!(
+            "invalid value '{name}' for '--search': possible values are auto, all-pairs, grid, lattice"
+        ))
+    })
+}
+
+/// The parameters of the keyword arguments, checked as the binary checks its flags.
+#[allow(clippy::too_many_arguments)]
+fn params(
+    size: &Bound<'_, PyAny>,
+    fill: Option<f64>,
+    particles: Option<i64>,
+    dim: Option<usize>,
+    boundary: &Bound<'_, PyAny>,
+    temperature: f64,
+    gravity: f64,
+    mobility_exponent: f64,
+    target_clusters: i64,
+    max_sweeps: Option<i64>,
+    search: &str,
+    grid_box: Option<i64>,
+    max_memory: &Bound<'_, PyAny>,
+    timing: bool,
+    histogram: bool,
+    histogram_sweeps: Option<Vec<i64>>,
+    gyration: bool,
+    fit_min_size: i64,
+) -> PyResult<Params> {
+    let given = sizes(size)?;
+    // A sequence of lengths gives the dimension; one length takes the binary's default, 2.
+    let dim = dim.unwrap_or(if given.len() > 1 { given.len() } else { 2 });
+    let (size, boundary) =
+        flags::axes(dim, &given, &self::boundary(boundary)?).map_err(value_error)?;
+    let particles = particles.map(|n| count("--particles", n)).transpose()?;
+    let histogram_sweeps = match (histogram, histogram_sweeps) {
+        (false, Some(_)) => {
+            return Err(value_error(
+                "--histogram-sweeps is used with --histogram only",
+            ));
+        }
+        (false, None) => Vec::new(),
+        (true, Some(v)) => v
+            .into_iter()
+            .map(|s| count("--histogram-sweeps", s))
+            .collect::<PyResult<_>>()?,
+        (true, None) => DEFAULT_HISTOGRAM_SWEEPS
+            .split(',')
+            .map(|s| s.parse().map_err(run_error))
+            .collect::<PyResult<_>>()?,
+    };
+    let p = Params {
+        size,
+        boundary,
+        init: flags::init(fill, particles).map_err(value_error)?,
+        temperature,
+        gravity,
+        mobility_exponent,
+        target_clusters: count("--target-clusters", target_clusters)?,
+        max_sweeps: max_sweeps.map(|n| count("--max-sweeps", n)).transpose()?,
+        search: self::search(search)?,
+        grid_box: grid_box.map(|n| count("--grid-box", n)).transpose()?,
+        max_memory: bytes(max_memory)?,
+        timing,
+        histogram_sweeps,
+        gyration,
+        fit_min_size: count("--fit-min-size", fit_min_size)?,
+    };
+    p.validate().map_err(value_error)?;
+    Ok(p)
+}
+
+/// A run and its clock (`run.json`'s times count from the lattice's creation).
+struct Run {
+    sim: Simulation,
+    clock: RunClock,
+}
+
+impl Run {
+    fn new(py: Python<'_>, params: Params, seed: u64) -> PyResult<Self> {
+        let clock = RunClock::start();
+        // Placing a large lattice takes a while: without the GIL.
+        let sim = py
+            .detach(|| Simulation::new(params, seed))
+            .map_err(value_error)?;
+        Ok(Run { sim, clock })
+    }
+
+    /// Up to `n` sweeps, fewer once the run is done; returns the sweeps made.
+    fn sweeps(&mut self, py: Python<'_>, n: u64, progress: &Progress) -> PyResult<u64> {
+        let sim = &mut self.sim;
+        interruptible(py, progress, n, |shared| {
+            let mut k = 0;
+            while k < n && !sim.is_done() && !shared.stop.load(Ordering::Relaxed) {
+                sim.sweep();
+                k += 1;
+                shared.done.store(k, Ordering::Relaxed);
+            }
+            k
+        })
+    }
+
+    /// Sweeps until the run is done (as the binary); returns the sweeps made. Progress counts
+    /// merges, as the binary's.
+    fn until_done(&mut self, py: Python<'_>, progress: &Progress) -> PyResult<u64> {
+        let sim = &mut self.sim;
+        let target = sim.params().target_clusters;
+        let initial = sim.clusters();
+        let merges = |sim: &Simulation| initial - sim.clusters().max(target).min(initial);
+        interruptible(py, progress, initial.saturating_sub(target), |shared| {
+            let mut k = 0;
+            shared.done.store(0, Ordering::Relaxed);
+            while !sim.is_done() && !shared.stop.load(Ordering::Relaxed) {
+                sim.sweep();
+                k += 1;
+                shared.done.store(merges(sim), Ordering::Relaxed);
+            }
+            k
+        })
+    }
+
+    /// Every particle's site (int64, (N, D)) and cluster id (int64, (N,)), in the order of
+    /// the binary's `particles.csv`.
+    fn particles<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let sim = &self.sim;
+        let l = sim.lattice();
+        let d = l.dim();
+        let n = sim.particles() as usize;
+        let mut x = Vec::with_capacity(n * d);
+        let mut labels = Vec::with_capacity(n);
+        ::dlca::output::each_particle(sim, |id, k| -> Result<(), ()> {
+            x.extend((0..d).map(|a| l.coord(k, a) as i64));
+            labels.push(i64::from(id));
+            Ok(())
+        })
+        .map_err(|()| run_error("reading the particles"))?;
+        let x = Array2::from_shape_vec((labels.len(), d), x).map_err(run_error)?;
+        Ok((
+            x.into_pyarray(py).into_any(),
+            Array1::from(labels).into_pyarray(py).into_any(),
+        ))
+    }
+
+    fn per_sweep<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let r = self.sim.records().sweeps();
+        let mut c = Columns::default()
+            .add(py, "sweep", r.iter().map(|s| s.sweep).collect())
+            .add(py, "clusters", r.iter().map(|s| s.clusters).collect())
+            .add(py, "largest", r.iter().map(|s| s.largest).collect());
+        if self.sim.params().timing {
+            c = c.add(
+                py,
+                "seconds",
+                r.iter().map(|s| s.seconds.unwrap_or(0.0)).collect(),
+            );
+        }
+        c.into_dict(py)
+    }
+
+    fn sizes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let h = size_distribution(&self.sim);
+        Columns::default()
+            .add(py, "size", h.iter().map(|(s, _)| s).collect())
+            .add(py, "count", h.iter().map(|(_, c)| c).collect())
+            .into_dict(py)
+    }
+
+    fn result(&self, py: Python<'_>) -> PyResult<Py<DlcaResult>> {
+        let sim = &self.sim;
+        let measures = sim.params().gyration.then(|| gyration(sim));
+        let m = ::dlca::output::manifest(sim, sim.seed(), &self.clock, measures.as_deref())
+            .map_err(run_error)?;
+        let out = Bound::new(py, DlcaResult {})?;
+        set_manifest(out.as_any(), &m)?;
+        let (x, labels) = self.particles(py)?;
+        out.setattr("positions", x)?;
+        out.setattr("labels", labels)?;
+        out.setattr("per_sweep", self.per_sweep(py)?)?;
+        out.setattr("sizes", self.sizes(py)?)?;
+        let g = match &measures {
+            Some(ms) => Columns::default()
+                .add(py, "cluster", ms.iter().map(|c| i64::from(c.id)).collect())
+                .add(py, "size", ms.iter().map(|c| c.size).collect())
+                .add(
+                    py,
+                    "radius_of_gyration",
+                    ms.iter().map(|c| c.radius_of_gyration).collect(),
+                )
+                .add(py, "wraps", ms.iter().map(|c| c.wraps).collect())
+                .into_dict(py)?
+                .into_any(),
+            None => py.None().into_bound(py),
+        };
+        out.setattr("gyration", g)?;
+        let hist = if sim.params().histogram_sweeps.is_empty() {
+            py.None().into_bound(py)
+        } else {
+            let (mut s, mut c, mut k) = (Vec::new(), Vec::new(), Vec::new());
+            for (sweep, h) in sim.records().histograms() {
+                for (candidates, moves) in h.iter() {
+                    s.push(*sweep);
+                    c.push(candidates);
+                    k.push(moves);
+                }
+            }
+            Columns::default()
+                .add(py, "sweep", s)
+                .add(py, "candidates", c)
+                .add(py, "moves", k)
+                .into_dict(py)?
+                .into_any()
+        };
+        out.setattr("histogram", hist)?;
+        Ok(out.unbind())
+    }
+}
+
+/// The result of :func:`aggsim.dlca` (or :meth:`DlcaLattice.result`): the final state, its
+/// history and every result of the ``dlca`` binary's ``run.json``.
+///
+/// Attributes
+/// ----------
+/// positions : numpy.ndarray
+///     int64, shape (N, D): every particle's lattice site, in the order of the binary's
+///     ``particles.csv`` (clusters by increasing id, each cluster's sites by increasing
+///     k-index).
+/// labels : numpy.ndarray
+///     int64, shape (N,): each particle's cluster id.
+/// per_sweep : dict[str, numpy.ndarray]
+///     The binary's ``sweeps.csv`` from sweep 0: ``sweep``, ``clusters``, ``largest``
+///     (uint64), and ``seconds`` (float64) with ``timing=True``.
+/// sizes : dict[str, numpy.ndarray]
+///     The final size distribution (``sizes.csv``): ``size``, ``count`` (uint64).
+/// gyration : dict[str, numpy.ndarray] or None
+///     With ``gyration=True``, ``clusters.csv``: ``cluster``, ``size``,
+///     ``radius_of_gyration``, ``wraps``.
+/// histogram : dict[str, numpy.ndarray] or None
+///     With ``histogram=True``, ``histogram.csv``: ``sweep``, ``candidates``, ``moves``.
+/// state_hash : str
+///     16 hex digits over every particle's site and cluster id: the binary's for the same
+///     seed and parameters.
+/// particles, clusters, largest_cluster, sweeps, strategy, strategy_requested,
+/// strategy_reason, moves, mean_candidates_examined, search_events
+///     The results of ``run.json``; with ``gyration=True`` also ``fractal_dimension``,
+///     ``fractal_dimension_stderr``, ``fit_clusters``, ``fit_r2`` (or ``fit_error``) and
+///     ``wrapping_clusters``.
+/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, params, run_json
+///     The rest of ``run.json``, and the whole of it as a dict.
+#[pyclass(dict, module = "aggsim")]
+pub struct DlcaResult {}
+
+#[pymethods]
+impl DlcaResult {
+    fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
+        let c: u64 = slf.getattr("clusters")?.extract()?;
+        let s: u64 = slf.getattr("sweeps")?.extract()?;
+        let n: u64 = slf.getattr("particles")?.extract()?;
+        let hash: String = slf.getattr("state_hash")?.extract()?;
+        Ok(format!(
+            "<aggsim.DlcaResult: {n} particles in {c} clusters after {s} sweeps, state_hash {hash}>"
+        ))
+    }
+}
+
+/// A DLCA lattice to step forward and look at between sweeps (Hawick, James & Scogings
+/// 2006, "Grid-Boxing for Spatial Simulation Performance Optimisation").
+///
+/// Takes the parameters of :func:`aggsim.dlca`, places the particles (face-adjacent ones form
+/// the initial clusters) and waits: :meth:`step` runs sweeps, :meth:`run` runs to the end, the
+/// properties show the state, :meth:`result` gives what :func:`aggsim.dlca` returns. Sweeping
+/// step by step gives the very run ``dlca`` makes (the same ``state_hash``). Ctrl-C during
+/// :meth:`step` or :meth:`run` stops after the current sweep with ``KeyboardInterrupt`` and
+/// leaves the lattice valid, to continue or inspect. One thread at a time may use a lattice
+/// (another gets ``RuntimeError`` while it runs).
+#[pyclass(module = "aggsim")]
+pub struct DlcaLattice {
+    run: Mutex<Run>,
+}
+
+impl DlcaLattice {
+    fn lock(&self) -> PyResult<MutexGuard<'_, Run>> {
+        match self.run.try_lock() {
+            Ok(g) => Ok(g),
+            Err(TryLockError::Poisoned(e)) => Ok(e.into_inner()),
+            Err(TryLockError::WouldBlock) => Err(PyRuntimeError::new_err(
+                "the lattice is running in another thread",
+            )),
+        }
+    }
+}
+
+#[pymethods]
+impl DlcaLattice {
+    #[new]
+    #[pyo3(signature = (
+        size,
+        fill = None,
+        particles = None,
+        *,
+        dim = None,
+        seed = 1,
+        boundary = None,
+        temperature = defaults().temperature,
+        gravity = defaults().gravity,
+        mobility_exponent = defaults().mobility_exponent,
+        target_clusters = defaults().target_clusters as i64,
+        max_sweeps = None,
+        search = defaults().search.name(),
+        grid_box = None,
+        max_memory = None,
+        timing = false,
+        histogram = false,
+        histogram_sweeps = None,
+        gyration = false,
+        fit_min_size = defaults().fit_min_size as i64,
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        size: &Bound<'_, PyAny>,
+        fill: Option<f64>,
+        particles: Option<i64>,
+        dim: Option<usize>,
+        seed: u64,
+        boundary: Option<&Bound<'_, PyAny>>,
+        temperature: f64,
+        gravity: f64,
+        mobility_exponent: f64,
+        target_clusters: i64,
+        max_sweeps: Option<i64>,
+        search: &str,
+        grid_box: Option<i64>,
+        max_memory: Option<&Bound<'_, PyAny>>,
+        timing: bool,
+        histogram: bool,
+        histogram_sweeps: Option<Vec<i64>>,
+        gyration: bool,
+        fit_min_size: i64,
+    ) -> PyResult<Self> {
+        let periodic = PyString::new(py, &defaults().boundary[0].to_string());
+        let memory = defaults().max_memory.into_pyobject(py)?.into_any();
+        let p = params(
+            size,
+            fill,
+            particles,
+            dim,
+            boundary.unwrap_or(periodic.as_any()),
+            temperature,
+            gravity,
+            mobility_exponent,
+            target_clusters,
+            max_sweeps,
+            search,
+            grid_box,
+            max_memory.unwrap_or(&memory),
+            timing,
+            histogram,
+            histogram_sweeps,
+            gyration,
+            fit_min_size,
+        )?;
+        Ok(DlcaLattice {
+            run: Mutex::new(Run::new(py, p, seed)?),
+        })
+    }
+
+    /// Run up to ``n`` sweeps (fewer once the run is done: at most ``target_clusters``
+    /// clusters left, or ``max_sweeps`` reached) and return how many ran. Each sweep moves
+    /// every cluster once, in a fresh random order. ``progress`` as in :func:`aggsim.dlca`,
+    /// counting sweeps. Ctrl-C stops after the current sweep (``KeyboardInterrupt``).
+    #[pyo3(signature = (n = 1, progress = None))]
+    fn step(&self, py: Python<'_>, n: i64, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
+        let n = count("n", n)?;
+        let progress = Progress::from_arg(progress, "dlca", "sweeps")?;
+        self.lock()?.sweeps(py, n, &progress)
+    }
+
+    /// Sweep until the run is done, as the binary does, and return the sweeps made.
+    /// ``progress`` counts merges. Ctrl-C stops after the current sweep.
+    #[pyo3(signature = (progress = None))]
+    fn run(&self, py: Python<'_>, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
+        let progress = Progress::from_arg(progress, "dlca", "merges")?;
+        self.lock()?.until_done(py, &progress)
+    }
+
+    /// The state now as a :class:`DlcaResult`, with ``run.json``'s results (times since the
+    /// lattice was made).
+    fn result(&self, py: Python<'_>) -> PyResult<Py<DlcaResult>> {
+        self.lock()?.result(py)
+    }
+
+    /// Whether the run is done: at most ``target_clusters`` clusters, or ``max_sweeps``
+    /// sweeps made.
+    #[getter]
+    fn done(&self) -> PyResult<bool> {
+        Ok(self.lock()?.sim.is_done())
+    }
+
+    /// Sweeps made.
+    #[getter]
+    fn sweeps(&self) -> PyResult<u64> {
+        Ok(self.lock()?.sim.sweeps())
+    }
+
+    /// Clusters now.
+    #[getter]
+    fn clusters(&self) -> PyResult<u64> {
+        Ok(self.lock()?.sim.clusters())
+    }
+
+    /// Size of the largest cluster.
+    #[getter]
+    fn largest(&self) -> PyResult<u64> {
+        Ok(self.lock()?.sim.largest())
+    }
+
+    /// Particles on the lattice.
+    #[getter]
+    fn particles(&self) -> PyResult<u64> {
+        Ok(self.lock()?.sim.particles())
+    }
+
+    /// The lattice's side lengths.
+    #[getter]
+    fn size<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyTuple>> {
+        PyTuple::new(py, self.lock()?.sim.lattice().sizes())
+    }
+
+    /// The contact search in use now (``auto`` resolves to one of the others).
+    #[getter]
+    fn strategy(&self) -> PyResult<&'static str> {
+        Ok(self.lock()?.sim.strategy().name())
+    }
+
+    /// Hash of every particle's site and cluster id (the binary's ``state_hash``).
+    #[getter]
+    fn state_hash(&self) -> PyResult<String> {
+        Ok(self.lock()?.sim.state_hash())
+    }
+
+    /// The validated parameters, as ``run.json`` records them.
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let v = serde_json::to_value(self.lock()?.sim.params()).map_err(run_error)?;
+        crate::convert::json(py, &v)
+    }
+
+    /// int64 array (N, D): every particle's site, clusters by increasing id (made on each
+    /// access).
+    #[getter]
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(self.lock()?.particles(py)?.0)
+    }
+
+    /// int64 array (N,): each particle's cluster id, in the order of :attr:`positions`.
+    #[getter]
+    fn labels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        Ok(self.lock()?.particles(py)?.1)
+    }
+
+    /// Clusters and largest cluster after every sweep so far (dict of arrays, as
+    /// :attr:`DlcaResult.per_sweep`).
+    #[getter]
+    fn per_sweep<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.lock()?.per_sweep(py)
+    }
+
+    /// The size distribution now (dict of arrays ``size``, ``count``).
+    #[getter]
+    fn sizes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        self.lock()?.sizes(py)
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let r = self.lock()?;
+        let s = &r.sim;
+        Ok(format!(
+            "<aggsim.DlcaLattice {:?}: {} particles in {} clusters after {} sweeps>",
+            s.lattice().sizes(),
+            s.particles(),
+            s.clusters(),
+            s.sweeps()
+        ))
+    }
+}
+
+/// Run diffusion-limited cluster-cluster aggregation to the end and return a
+/// :class:`DlcaResult`.
+///
+/// The model and every parameter are those of the ``dlca`` binary (``dlca --help``), keyword
+/// names being its flags with dashes as underscores and its defaults (from the library; see
+/// :func:`aggsim.defaults`). Particles on distinct random sites of a periodic or walled
+/// lattice form clusters (face-adjacent particles); each sweep moves every cluster one site in
+/// a random direction, in a fresh random order, and merges it with every cluster it then
+/// touches (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation Performance
+/// Optimisation"). The run is a pure function of (parameters, seed): its ``state_hash`` is the
+/// binary's.
+///
+/// Parameters
+/// ----------
+/// size : int, sequence of int or str
+///     Side lengths: one for every axis, one per axis, or ``"1024x512"`` (required).
+/// fill : float
+///     Fraction of sites holding a particle at the start, in (0, 1). Give exactly one of
+///     ``fill`` and ``particles``.
+/// particles : int
+///     Number of particles at the start, 1 to the number of sites.
+/// dim : int or None
+///     Lattice dimension, 1 to 5 (default: the number of lengths in ``size``, or 2 for one
+///     length, as the binary).
+/// seed : int
+///     Seed of every random stream (default 1).
+/// boundary : str or sequence of str
+///     ``"periodic"`` (default) or ``"wall"`` for every axis, or one per axis
+///     (``"periodic,wall"`` or ``["periodic", "wall"]``).
+/// temperature : float
+///     Move probability of a cluster per sweep, in (0, 1] (default 1).
+/// gravity : float
+///     g in [0, 1): moves down the last axis have weight 1+g, up 1-g (default 0).
+/// mobility_exponent : float
+///     gamma >= 0: a cluster of s particles moves with probability temperature * s^-gamma
+///     (default 0).
+/// target_clusters : int
+///     Stop when at most this many clusters remain, >= 1 (default 100).
+/// max_sweeps : int or None
+///     Stop after this many sweeps at the latest (default None: no limit).
+/// search : str
+///     Contact search, ``"auto"`` (default), ``"all-pairs"``, ``"grid"`` or ``"lattice"``:
+///     all give the same trajectory.
+/// grid_box : int or None
+///     Initial grid-box side for ``search="grid"``, a power of two (default: chosen).
+/// max_memory : int or str
+///     Memory the occupancy lattice may take, bytes or ``"4G"`` (default 4 GiB).
+/// timing : bool
+///     Record each sweep's wall time (``per_sweep["seconds"]``; default False).
+/// histogram : bool
+///     Record histograms of candidates examined per move (default False).
+/// histogram_sweeps : list of int or None
+///     The sweeps ``histogram`` records (default 1, 2, 5, ... 10000).
+/// gyration : bool
+///     Measure every final cluster's radius of gyration and fit the fractal dimension
+///     (default False).
+/// fit_min_size : int
+///     Smallest cluster size in that fit, >= 2 (default 10).
+/// progress : bool or callable
+///     True prints progress (merges) to ``sys.stderr``; a callable is called as
+///     ``progress(done, total)`` about twice a second (default None: quiet).
+///
+/// Returns
+/// -------
+/// DlcaResult
+///
+/// Raises
+/// ------
+/// ValueError
+///     A parameter outside its accepted range, with the binary's message.
+/// KeyboardInterrupt
+///     Ctrl-C: the run stops after the current sweep (use :class:`DlcaLattice` to keep the
+///     state).
+///
+/// The run releases the GIL: other Python threads run meanwhile.
+#[pyfunction]
+#[pyo3(signature = (
+    size,
+    fill = None,
+    particles = None,
+    *,
+    dim = None,
+    seed = 1,
+    boundary = None,
+    temperature = defaults().temperature,
+    gravity = defaults().gravity,
+    mobility_exponent = defaults().mobility_exponent,
+    target_clusters = defaults().target_clusters as i64,
+    max_sweeps = None,
+    search = defaults().search.name(),
+    grid_box = None,
+    max_memory = None,
+    timing = false,
+    histogram = false,
+    histogram_sweeps = None,
+    gyration = false,
+    fit_min_size = defaults().fit_min_size as i64,
+    progress = None,
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn dlca(
+    py: Python<'_>,
+    size: &Bound<'_, PyAny>,
+    fill: Option<f64>,
+    particles: Option<i64>,
+    dim: Option<usize>,
+    seed: u64,
+    boundary: Option<&Bound<'_, PyAny>>,
+    temperature: f64,
+    gravity: f64,
+    mobility_exponent: f64,
+    target_clusters: i64,
+    max_sweeps: Option<i64>,
+    search: &str,
+    grid_box: Option<i64>,
+    max_memory: Option<&Bound<'_, PyAny>>,
+    timing: bool,
+    histogram: bool,
+    histogram_sweeps: Option<Vec<i64>>,
+    gyration: bool,
+    fit_min_size: i64,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Py<DlcaResult>> {
+    let progress = Progress::from_arg(progress, "dlca", "merges")?;
+    let lattice = DlcaLattice::new(
+        py,
+        size,
+        fill,
+        particles,
+        dim,
+        seed,
+        boundary,
+        temperature,
+        gravity,
+        mobility_exponent,
+        target_clusters,
+        max_sweeps,
+        search,
+        grid_box,
+        max_memory,
+        timing,
+        histogram,
+        histogram_sweeps,
+        gyration,
+        fit_min_size,
+    )?;
+    let mut run = lattice.lock()?;
+    run.until_done(py, &progress)?;
+    run.result(py)
+}
+
+/// The `dlca` binary's defaults, from the library (`size` and `fill`/`particles` have none on
+/// the command line).
+pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    let p = defaults();
+    let v = serde_json::json!({
+        "seed": 1,
+        "boundary": p.boundary[0].to_string(),
+        "temperature": p.temperature,
+        "gravity": p.gravity,
+        "mobility_exponent": p.mobility_exponent,
+        "target_clusters": p.target_clusters,
+        "max_sweeps": p.max_sweeps,
+        "search": p.search.name(),
+        "grid_box": p.grid_box,
+        "max_memory": p.max_memory,
+        "timing": p.timing,
+        "histogram": false,
+        "histogram_sweeps": DEFAULT_HISTOGRAM_SWEEPS
+            .split(',')
+            .filter_map(|s| s.parse::<u64>().ok())
+            .collect::<Vec<_>>(),
+        "gyration": p.gyration,
+        "fit_min_size": p.fit_min_size,
+    });
+    crate::convert::json(py, &v)
+}

@@ -1,0 +1,51 @@
+//! `aggsim._aggsim`, the compiled part of the Python package `aggsim`: the three models of the
+//! workspace (`dla_pdla`, `dlca`, `animat`) called from Python, results as NumPy arrays. The
+//! parameters are built and validated by the same library code as the binaries', and the
+//! results assembled by the functions that write the binaries' `run.json`, so a run from Python
+//! equals the binary's for the same seed (the same `state_hash`). See `docs/python.md`.
+//!
+//! | module | owns |
+//! |---|---|
+//! | `run` | running on a worker thread without the GIL: Ctrl-C, progress |
+//! | `convert` | `run.json` onto result attributes, count arguments, columns as arrays |
+//! | `dla`, `dlca`, `animat` | one model each: its function, result class and step-wise class |
+
+mod animat;
+mod convert;
+mod dla;
+mod dlca;
+mod run;
+
+use pyo3::prelude::*;
+
+/// The defaults of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``) as a dict: the binaries'
+/// defaults, taken from the libraries, keyed by the keyword arguments' names.
+#[pyfunction]
+fn defaults<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
+    match model {
+        "dla" => dla::defaults_dict(py),
+        "dlca" => dlca::defaults_dict(py),
+        "animat" => animat::defaults_dict(py),
+        other => Err(convert::value_error(format!(
+            "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
+        ))),
+    }
+}
+
+/// The aggsim models (DLA/PDLA, DLCA, animats) at native speed, results as NumPy arrays.
+#[pymodule]
+fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(dla::dla, m)?)?;
+    m.add_function(wrap_pyfunction!(dlca::dlca, m)?)?;
+    m.add_function(wrap_pyfunction!(animat::animat, m)?)?;
+    m.add_function(wrap_pyfunction!(defaults, m)?)?;
+    m.add_class::<dla::DlaResult>()?;
+    m.add_class::<dlca::DlcaResult>()?;
+    m.add_class::<dlca::DlcaLattice>()?;
+    m.add_class::<animat::AnimatResult>()?;
+    m.add_class::<animat::AnimatWorld>()?;
+    m.add("FOX", ::animat::Species::Fox.code() as u8)?;
+    m.add("RABBIT", ::animat::Species::Rabbit.code() as u8)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

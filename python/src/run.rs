@@ -1,0 +1,183 @@
+//! Running a model from Python: the work runs on a worker thread without the GIL while the
+//! calling thread waits, checks for signals (Ctrl-C) every [`POLL`] and reports progress. On a
+//! signal the worker is told to stop at its next consistent point (a stop flag the model
+//! polls), joined, and the signal's exception (`KeyboardInterrupt`) raised.
+
+use pyo3::exceptions::PyRuntimeError;
+use pyo3::prelude::*;
+use pyo3::types::PyAny;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+/// How often the calling thread wakes to check for signals: Ctrl-C is seen within this.
+const POLL: Duration = Duration::from_millis(50);
+
+/// How often progress is reported (and once at the end).
+const REPORT_EVERY: Duration = Duration::from_millis(500);
+
+/// Stack of the worker thread: that of a main thread, which the binaries run on.
+const WORKER_STACK: usize = 8 << 20;
+
+/// What the worker shares with the waiting thread.
+pub struct Shared {
+    /// Set when the run must stop at its next consistent point.
+    pub stop: AtomicBool,
+    /// Work done so far (particles, merges, steps), for progress reports.
+    pub done: AtomicU64,
+}
+
+/// Where progress goes: nowhere, a line on `sys.stderr`, or a callable.
+pub enum Progress {
+    /// No reports.
+    Off,
+    /// `PROGRAM: done/total UNIT (p%), s elapsed, eta s` on `sys.stderr`, rewritten in place.
+    Stderr {
+        /// The model's name.
+        label: &'static str,
+        /// What is counted.
+        unit: &'static str,
+    },
+    /// `callback(done, total)`.
+    Callback(Py<PyAny>),
+}
+
+impl Progress {
+    /// From the `progress` argument: `False`/`None` off, `True` on `sys.stderr`, a callable is
+    /// called with `(done, total)`.
+    pub fn from_arg(
+        arg: Option<&Bound<'_, PyAny>>,
+        label: &'static str,
+        unit: &'static str,
+    ) -> PyResult<Self> {
+        let Some(arg) = arg else {
+            return Ok(Progress::Off);
+        };
+        if arg.is_none() {
+            return Ok(Progress::Off);
+        }
+        if arg.is_callable() {
+            return Ok(Progress::Callback(arg.clone().unbind()));
+        }
+        Ok(if arg.is_truthy()? {
+            Progress::Stderr { label, unit }
+        } else {
+            Progress::Off
+        })
+    }
+
+    fn report(
+        &self,
+        py: Python<'_>,
+        done: u64,
+        total: u64,
+        started: Instant,
+        last: bool,
+    ) -> PyResult<()> {
+        match self {
+            Progress::Off => Ok(()),
+            Progress::Callback(f) => f.call1(py, (done, total)).map(|_| ()),
+            Progress::Stderr { label, unit } => {
+                let secs = started.elapsed().as_secs_f64();
+                let frac = if total == 0 {
+                    1.0
+                } else {
+                    done as f64 / total as f64
+                };
+                let eta = if frac > 0.0 && !last {
+                    format!(", eta {:.1} s", secs * (1.0 - frac) / frac)
+                } else {
+                    String::new()
+                };
+                let line = format!(
+                    "\r{label}: {done}/{total} {unit} ({:.0}%), {secs:.1} s{eta}{}",
+                    100.0 * frac,
+                    if last { "\n" } else { "" }
+                );
+                let stderr = py.import("sys")?.getattr("stderr")?;
+                stderr.call_method1("write", (line,))?;
+                stderr.call_method0("flush")?;
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Runs `work` on a worker thread with the GIL released and returns its result. The calling
+/// thread checks for signals every [`POLL`]: on one (Ctrl-C raises `KeyboardInterrupt` in the
+/// main thread) it sets `Shared::stop`, waits for `work` to return at its next consistent point
+/// and raises the signal's exception. An exception of the progress callback stops the run the
+/// same way. `total` is the amount of work for progress reports, `work` stores what it has done
+/// in `Shared::done`.
+pub fn interruptible<T: Send>(
+    py: Python<'_>,
+    progress: &Progress,
+    total: u64,
+    work: impl FnOnce(&Shared) -> T + Send,
+) -> PyResult<T> {
+    let shared = Shared {
+        stop: AtomicBool::new(false),
+        done: AtomicU64::new(0),
+    };
+    let finished = (Mutex::new(false), Condvar::new());
+    let started = Instant::now();
+    std::thread::scope(|s| {
+        let worker = std::thread::Builder::new()
+            .name("aggsim".into())
+            .stack_size(WORKER_STACK)
+            .spawn_scoped(s, || {
+                let out = work(&shared);
+                *finished.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+                finished.1.notify_all();
+                out
+            })
+            .map_err(|e| PyRuntimeError::new_err(format!("starting the run's thread: {e}")))?;
+        let mut failure: Option<PyErr> = None;
+        let mut reported = Instant::now();
+        loop {
+            // Wait for the worker, at most POLL, without the GIL.
+            let done = py.detach(|| {
+                let guard = finished.0.lock().unwrap_or_else(|e| e.into_inner());
+                let (guard, _) = finished
+                    .1
+                    .wait_timeout_while(guard, POLL, |f| !*f)
+                    .unwrap_or_else(|e| e.into_inner());
+                *guard
+            });
+            if done {
+                break;
+            }
+            if failure.is_none() {
+                let mut check = py.check_signals();
+                if check.is_ok() && reported.elapsed() >= REPORT_EVERY {
+                    reported = Instant::now();
+                    let n = shared.done.load(Ordering::Relaxed);
+                    check = progress.report(py, n, total, started, false);
+                }
+                if let Err(e) = check {
+                    shared.stop.store(true, Ordering::Relaxed);
+                    failure = Some(e);
+                }
+            }
+        }
+        let out = match worker.join() {
+            Ok(out) => out,
+            Err(panic) => std::panic::resume_unwind(panic),
+        };
+        match failure {
+            Some(e) => {
+                if let Progress::Stderr { .. } = progress {
+                    // End the progress line before the traceback.
+                    let stderr = py.import("sys")?.getattr("stderr")?;
+                    stderr.call_method1("write", ("\n",))?;
+                }
+                Err(e)
+            }
+            None => {
+                let n = shared.done.load(Ordering::Relaxed);
+                progress.report(py, n, total, started, true)?;
+                Ok(out)
+            }
+        }
+    })
+}
