@@ -141,9 +141,9 @@ fn tiny_run_produces_every_table_csv_and_plot() {
     assert!(acc.contains("reference (most exact)") && acc.contains("| default |"));
 
     // Strategies gave identical trajectories (the harness refuses otherwise) and the table
-    // says so; every strategy row of Fig. 6 is present.
+    // says so; every strategy row of Fig. 6 is present (four strategies, two fills).
     let fig6 = read(d, "dlca_fig6_summary.csv");
-    assert_eq!(fig6.lines().filter(|l| l.contains(",yes,")).count(), 6);
+    assert_eq!(fig6.lines().filter(|l| l.contains(",yes,")).count(), 8);
     // Table 2 has the four (d, P) rows.
     assert_eq!(read(d, "dla_table2.csv").lines().count(), 5);
 }

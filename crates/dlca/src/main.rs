@@ -92,8 +92,9 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Search::Auto)]
     search: Search,
 
-    /// Initial grid-box side for `--search grid`, a power of two (default: from the cluster
-    /// spacing and the largest initial cluster). It doubles as clusters grow.
+    /// Initial grid-box side for `--search grid` or `grid-doubling`, a power of two (default:
+    /// `grid` takes the side of least predicted cost and re-tunes it as clusters grow;
+    /// `grid-doubling` starts from the cluster spacing and doubles with the largest cluster).
     #[arg(long)]
     grid_box: Option<u64>,
 

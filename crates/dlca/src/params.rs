@@ -37,9 +37,13 @@ pub enum Search {
     Auto,
     /// The all-pairs baseline of Hawick, James & Scogings 2006.
     AllPairs,
-    /// Grid boxes (Hawick, James & Scogings 2006), doubling with the largest cluster, falling
-    /// back to all-pairs once `3A >= L` on some axis.
+    /// Grid boxes (Hawick, James & Scogings 2006) with a halo per cluster: small boxes, each
+    /// cluster listed in every box its bounding region grown by one site overlaps, the box side
+    /// re-tuned at run time by a cost model.
     Grid,
+    /// The paper's grid boxes (Hawick, James & Scogings 2006), doubling with the largest
+    /// cluster, falling back to all-pairs once `3A >= L` on some axis (the Fig. 6 rule).
+    GridDoubling,
     /// Occupancy lattice: a cluster id per site.
     Lattice,
 }
@@ -51,6 +55,7 @@ impl Search {
             Search::Auto => "auto",
             Search::AllPairs => "all-pairs",
             Search::Grid => "grid",
+            Search::GridDoubling => "grid-doubling",
             Search::Lattice => "lattice",
         }
     }
@@ -79,8 +84,9 @@ pub struct Params {
     pub max_sweeps: Option<u64>,
     /// Contact search strategy (`--search`).
     pub search: Search,
-    /// Initial grid-box side for the `grid` strategy, a power of two (`--grid-box`); by default
-    /// chosen from the cluster spacing and the largest initial cluster.
+    /// Initial grid-box side for the grid strategies, a power of two (`--grid-box`); by default
+    /// `grid` takes the side of least predicted cost and `grid-doubling` the cluster spacing
+    /// (raised to the largest initial cluster).
     pub grid_box: Option<u64>,
     /// Memory the occupancy lattice may take, in bytes (`--max-memory`).
     pub max_memory: u64,
@@ -189,7 +195,7 @@ pub enum ParamError {
         shortest: u64,
     },
     /// A grid box given to a strategy that has none.
-    #[error("--grid-box is used by --search grid and auto only, not {0}")]
+    #[error("--grid-box is used by --search grid, grid-doubling and auto only, not {0}")]
     GridBoxUnused(&'static str),
     /// Too small a smallest size for the fractal-dimension fit.
     #[error(

@@ -52,7 +52,12 @@ fn records(sim: &Simulation) -> Vec<(u64, u64, u64)> {
 #[test]
 fn restored_runs_end_where_uninterrupted_runs_end() {
     for (i, params) in configs().into_iter().enumerate() {
-        for search in [Search::Lattice, Search::Grid, Search::AllPairs] {
+        for search in [
+            Search::Lattice,
+            Search::Grid,
+            Search::GridDoubling,
+            Search::AllPairs,
+        ] {
             let p = Params {
                 search,
                 ..params.clone()

@@ -85,7 +85,7 @@ fn writes_every_output() {
 #[test]
 fn strategies_agree_through_the_cli() {
     let tmp = tempfile::tempdir().unwrap();
-    let hashes: Vec<String> = ["all-pairs", "grid", "lattice"]
+    let hashes: Vec<String> = ["all-pairs", "grid", "grid-doubling", "lattice"]
         .iter()
         .map(|s| {
             let out = tmp.path().join(s);

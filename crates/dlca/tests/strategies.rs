@@ -85,15 +85,24 @@ fn every_strategy_gives_the_same_trajectory() {
             let reference = run(params, seed, Search::AllPairs, None, true);
             let mut others = vec![
                 ("grid", run(params, seed, Search::Grid, None, false)),
+                (
+                    "grid-doubling",
+                    run(params, seed, Search::GridDoubling, None, false),
+                ),
                 ("lattice", run(params, seed, Search::Lattice, None, true)),
                 ("auto", run(params, seed, Search::Auto, None, false)),
             ];
             // A given box must split the lattice (3A < the shortest side); the grid's own
             // choice (None above) may still start in the all-pairs fallback.
             let shortest = params.size.iter().copied().min().unwrap();
-            for (name, a) in [("grid A=1", 1), ("grid A=2", 2)] {
+            for (name, search, a) in [
+                ("grid A=1", Search::Grid, 1),
+                ("grid A=2", Search::Grid, 2),
+                ("grid-doubling A=1", Search::GridDoubling, 1),
+                ("grid-doubling A=2", Search::GridDoubling, 2),
+            ] {
                 if 3 * a < shortest {
-                    others.push((name, run(params, seed, Search::Grid, Some(a), false)));
+                    others.push((name, run(params, seed, search, Some(a), false)));
                 }
             }
             for (name, o) in &others {
@@ -118,7 +127,7 @@ fn every_strategy_gives_the_same_trajectory() {
             }
         }
     }
-    // The grid's doubling and its fall-back to all-pairs were exercised, and most runs
+    // The doubling grid's doubling and its fall-back to all-pairs were exercised, and most runs
     // actually aggregated to their target.
     assert!(doublings > 5, "only {doublings} grid doublings");
     assert!(fallbacks > 5, "only {fallbacks} fall-backs to all-pairs");
@@ -139,7 +148,7 @@ fn invariants_hold_with_gravity_walls_and_dense_fill() {
         max_sweeps: Some(300),
         ..Params::default()
     };
-    for search in [Search::Lattice, Search::Grid] {
+    for search in [Search::Lattice, Search::Grid, Search::GridDoubling] {
         let mut sim = Simulation::new(
             Params {
                 search,

@@ -205,9 +205,9 @@ impl Simulation {
         for id in dead {
             sets.remove(id);
         }
-        // The grid resumes with the box side it had (the parameters stay as given).
+        // A grid resumes with the box side it had (the parameters stay as given).
         let grid_box = match s.strategy {
-            Search::Grid => s.grid_side,
+            Search::Grid | Search::GridDoubling => s.grid_side,
             _ => s.params.grid_box,
         };
         let mut sim = Simulation::assemble(

@@ -3,21 +3,24 @@
 //!
 //! - all-pairs and, in 4 and 5 dimensions, the occupancy lattice: a `spatial` contact search
 //!   over the clusters as k-index arrays ([`indexed`]);
-//! - grid boxes, which also track bounding boxes to double the box side ([`grid`]);
+//! - grid boxes with a halo per cluster and a box side tuned at run time ([`halo`]);
+//! - the paper's grid boxes, which track bounding boxes to double the box side ([`doubling`]);
 //! - the occupancy lattice with rigid clusters in 1 to 3 dimensions ([`rigid`]).
 //!
 //! Invariant: every store gives the same trajectory (bit-identical state hashes); the
-//! simulation never asks which one is installed. The grid may hand its clusters over to
+//! simulation never asks which one is installed. The doubling grid may hand its clusters over to
 //! all-pairs during a merge ([`Merged::to_all_pairs`]); [`Engine`] makes the switch.
 
 mod arrays;
-mod grid;
+mod doubling;
+mod halo;
 mod indexed;
 mod rigid;
 mod strategy;
 
 pub(crate) use arrays::ClusterArrays;
-pub(crate) use grid::GridStore;
+pub(crate) use doubling::DoublingGrid;
+pub(crate) use halo::HaloGrid;
 pub(crate) use indexed::Indexed;
 pub(crate) use rigid::RigidClusters;
 pub(crate) use strategy::{ClusterStore, Merged};
@@ -32,8 +35,10 @@ use spatial::lattice::{AllPairs, ItemId, Occupancy, SiteSets};
 pub(crate) enum Engine {
     /// All-pairs.
     AllPairs(Indexed<AllPairs>),
-    /// Grid boxes.
-    Grid(Box<GridStore>),
+    /// Grid boxes with a halo per cluster.
+    Grid(Box<HaloGrid>),
+    /// The paper's grid boxes, doubling with the largest cluster.
+    GridDoubling(Box<DoublingGrid>),
     /// The `lattice` strategy where rigid clusters do not pay (4 and 5 dimensions).
     Occupancy(Indexed<Occupancy>),
     /// The `lattice` strategy with rigid clusters.
@@ -46,6 +51,7 @@ macro_rules! each {
         match $self {
             Engine::AllPairs($s) => $e,
             Engine::Grid($s) => $e,
+            Engine::GridDoubling($s) => $e,
             Engine::Occupancy($s) => $e,
             Engine::Rigid($s) => $e,
         }

@@ -1,5 +1,5 @@
-//! The grid strategy: grid boxes over the k-index arrays, with a bounding box per cluster to
-//! decide when to double the box side (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial
+//! The `grid-doubling` strategy, the paper's own rule: grid boxes over the k-index arrays, with a
+//! bounding box per cluster to decide when to double the box side (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial
 //! Simulation Performance Optimisation": doubling in section II.A, `3A < L` in section V).
 //!
 //! Invariants: the box side is a power of two at least the largest extent of any cluster as of
@@ -25,12 +25,12 @@ struct BBox {
 
 /// Grid boxes over the clusters, doubling with the largest cluster.
 #[derive(Debug, Clone)]
-pub(crate) struct GridStore {
+pub(crate) struct DoublingGrid {
     inner: Indexed<LatticeGridBoxes>,
     bbox: Vec<BBox>,
 }
 
-impl GridStore {
+impl DoublingGrid {
     /// Grid boxes over `arrays`, of side `requested` (a power of two, raised to the largest
     /// cluster's extent) or, by default, about the spacing of the clusters: in the dilute regime
     /// that keeps each halo to a few clusters (section V). Gives the arrays back, with a note,
@@ -67,7 +67,7 @@ impl GridStore {
         }
         grid.set_side(side, sets).expect("power of two");
         notes.push(format!("grid box side {side}"));
-        Ok(GridStore {
+        Ok(DoublingGrid {
             inner: Indexed::registered(arrays, grid),
             bbox,
         })
@@ -145,9 +145,9 @@ fn extent(dim: usize, b: &BBox) -> u64 {
         .unwrap_or(1)
 }
 
-impl ClusterStore for GridStore {
+impl ClusterStore for DoublingGrid {
     fn kind(&self) -> Search {
-        Search::Grid
+        Search::GridDoubling
     }
 
     fn grid_side(&self) -> Option<u64> {
