@@ -122,7 +122,7 @@ struct Cli {
     resume: Option<PathBuf>,
 
     /// Write dla.png: the cluster shaded by arrival order, or, when a pixel spans more than a
-    /// diameter, the number of particles per pixel on a log scale (3D: projected on x, y).
+    /// diameter, the number of particles per pixel on a log scale (3D: shaded spheres seen from +z, nearer brighter; the density is projected on x, y).
     #[arg(long)]
     png: bool,
 

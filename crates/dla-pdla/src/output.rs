@@ -13,7 +13,7 @@
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
 //! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C` |
 //! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView) |
-//! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: projection on x, y) |
+//! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: shaded spheres seen from +z with a depth buffer; the density image projects on x, y) |
 
 use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
@@ -251,6 +251,54 @@ pub const PNG_MAX_SIDE: u32 = 4096;
 /// dark (first) to white (last) by arrival order; when a pixel spans more than a diameter (a
 /// large cluster), each pixel shows how many particles it holds, log-scaled from dark (one) to
 /// white (the most), which shows the structure where dots would merge into a blot.
+/// A 3D cluster seen from +z: each particle a shaded sphere at its true size, the nearest
+/// surface at each pixel kept (a depth buffer), brighter where nearer the viewer and where the
+/// sphere faces the viewer, so the branches in front stand out from those behind.
+fn depth_shaded<const D: usize>(
+    sim: &Simulation<D>,
+    dir: &Path,
+    extent: f64,
+    scale: f64,
+    side: u32,
+) -> Result<Vec<u8>, OutputError> {
+    let s = side as usize;
+    let mut depth = vec![f64::NEG_INFINITY; s * s];
+    let mut px = vec![0u8; s * s];
+    let rad = 0.5 * scale;
+    each_position(sim, dir, |_, p: &[f64; D]| {
+        let (cx, cy) = ((p[0] + extent) * scale, (extent - p[1]) * scale);
+        let (x0, x1) = (
+            (cx - rad).floor().max(0.0) as u32,
+            ((cx + rad).ceil() as u32).min(side - 1),
+        );
+        let (y0, y1) = (
+            (cy - rad).floor().max(0.0) as u32,
+            ((cy + rad).ceil() as u32).min(side - 1),
+        );
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
+                let r2 = (dx * dx + dy * dy) / (rad * rad);
+                if r2 > 1.0 && !(x1 == x0 && y1 == y0) {
+                    continue;
+                }
+                // The sphere's surface height above its centre, in diameters, and its normal's
+                // component towards the viewer.
+                let facing = (1.0 - r2.min(1.0)).sqrt();
+                let z = p[2] + 0.5 * facing;
+                let at = y as usize * s + x as usize;
+                if z > depth[at] {
+                    depth[at] = z;
+                    let near = ((z + extent) / (2.0 * extent)).clamp(0.0, 1.0);
+                    px[at] = (40.0 + 215.0 * (0.3 + 0.7 * near) * (0.35 + 0.65 * facing)) as u8;
+                }
+            }
+        }
+        Ok(())
+    })?;
+    Ok(px)
+}
+
 fn write_picture<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
@@ -261,7 +309,9 @@ fn write_picture<const D: usize>(
     let extent = sim.r_ext() + 1.0;
     let scale = f64::from(side) / (2.0 * extent);
     let s = side as usize;
-    let px = if scale >= 1.0 {
+    let px = if scale >= 1.0 && D == 3 {
+        depth_shaded(sim, dir, extent, scale, side)?
+    } else if scale >= 1.0 {
         let mut px = vec![0u8; s * s];
         let n = sim.particles().max(2) as f64;
         let rad = 0.5 * scale;
