@@ -121,8 +121,9 @@ struct Cli {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
 
-    /// Write dla.png: the cluster shaded by arrival order, or, when a pixel spans more than a
-    /// diameter, the number of particles per pixel on a log scale (3D: shaded spheres seen from +z, nearer brighter; the density is projected on x, y).
+    /// Write dla.png: the cluster shaded by arrival order (3D: shaded spheres seen from +z,
+    /// nearer brighter), or, when a pixel spans more than a diameter, the number of particles
+    /// per pixel on a log scale (projected on x, y).
     #[arg(long)]
     png: bool,
 
