@@ -9,7 +9,7 @@
 //! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`core_lattice::io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
-//! | `dlca.png` | with `--png`: the final state, one colour per cluster |
+//! | `dlca.png` | with `--png`: the final state, one colour per cluster, a square of pixels per site on lattices under 512 sites wide |
 
 use crate::analysis::{ClusterMeasure, fractal_dimension, gyration, size_distribution};
 use crate::sim::Simulation;
@@ -228,7 +228,10 @@ fn write_picture(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
     let l = sim.lattice();
     let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
     let factor = w0.max(h0).div_ceil(8192).max(1);
-    let (w, h) = (w0.div_ceil(factor), h0.div_ceil(factor));
+    let (cw, ch) = (w0.div_ceil(factor), h0.div_ceil(factor));
+    // A small lattice is drawn with `zoom` x `zoom` pixels per site, at least 512 pixels wide.
+    let zoom = 512u64.div_ceil(cw.max(ch)).max(1);
+    let (w, h) = (cw * zoom, ch * zoom);
     let mut pixels = vec![0u8; (w * h * 3) as usize];
     for &id in sim.sets().live() {
         let c = colour(id);
@@ -240,8 +243,13 @@ fn write_picture(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
                 0
             };
             // Row 0 at the top: flip y so the last axis points up, as gravity pulls down.
-            let at = (((h - 1 - y) * w + x) * 3) as usize;
-            pixels[at..at + 3].copy_from_slice(&c);
+            let top = (ch - 1 - y) * zoom;
+            for py in top..top + zoom {
+                for px in x * zoom..(x + 1) * zoom {
+                    let at = ((py * w + px) * 3) as usize;
+                    pixels[at..at + 3].copy_from_slice(&c);
+                }
+            }
         }
     }
     write_png_rgb(path, w as u32, h as u32, &pixels)?;

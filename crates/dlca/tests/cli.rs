@@ -75,11 +75,11 @@ fn writes_every_output() {
             .unwrap()
             .starts_with("cluster,size,radius_of_gyration,wraps\n")
     );
-    assert!(
-        std::fs::read(out.join("dlca.png"))
-            .unwrap()
-            .starts_with(b"\x89PNG")
-    );
+    let png = std::fs::read(out.join("dlca.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
+    // 64x48 sites drawn 8x8 pixels each, so a small lattice is legible.
+    let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
+    assert_eq!((side(16), side(20)), (512, 384));
 }
 
 #[test]
