@@ -16,6 +16,9 @@ const POLL: Duration = Duration::from_millis(50);
 /// How often progress is reported (and once at the end).
 const REPORT_EVERY: Duration = Duration::from_millis(500);
 
+/// How often progress goes to `sys.stderr` when it is neither a terminal nor Jupyter.
+const LOG_EVERY: Duration = Duration::from_secs(10);
+
 /// Stack of the worker thread: that of a main thread, which the binaries run on.
 const WORKER_STACK: usize = 8 << 20;
 
@@ -31,12 +34,17 @@ pub struct Shared {
 pub enum Progress {
     /// No reports.
     Off,
-    /// `PROGRAM: done/total UNIT (p%), s elapsed, eta s` on `sys.stderr`, rewritten in place.
+    /// `PROGRAM: done/total UNIT (p%), s elapsed, eta s` on `sys.stderr`: rewritten in place
+    /// on a terminal or in Jupyter, else a line every [`LOG_EVERY`] (a log file stays short).
     Stderr {
         /// The model's name.
         label: &'static str,
         /// What is counted.
         unit: &'static str,
+        /// Whether the line is rewritten in place (`\r`).
+        in_place: bool,
+        /// Reports so far, for the lines of a log.
+        reports: std::cell::Cell<u64>,
     },
     /// `callback(done, total)`.
     Callback(Py<PyAny>),
@@ -60,7 +68,15 @@ impl Progress {
             return Ok(Progress::Callback(arg.clone().unbind()));
         }
         Ok(if arg.is_truthy()? {
-            Progress::Stderr { label, unit }
+            let stderr = arg.py().import("sys")?.getattr("stderr")?;
+            let tty = stderr.call_method0("isatty")?.is_truthy()?;
+            let module: String = stderr.get_type().getattr("__module__")?.extract()?;
+            Progress::Stderr {
+                label,
+                unit,
+                in_place: tty || module.starts_with("ipykernel"),
+                reports: std::cell::Cell::new(0),
+            }
         } else {
             Progress::Off
         })
@@ -77,7 +93,17 @@ impl Progress {
         match self {
             Progress::Off => Ok(()),
             Progress::Callback(f) => f.call1(py, (done, total)).map(|_| ()),
-            Progress::Stderr { label, unit } => {
+            Progress::Stderr {
+                label,
+                unit,
+                in_place,
+                reports,
+            } => {
+                reports.set(reports.get() + 1);
+                let every = (LOG_EVERY.as_millis() / REPORT_EVERY.as_millis()) as u64;
+                if !*in_place && !last && reports.get() % every != 0 {
+                    return Ok(());
+                }
                 let secs = started.elapsed().as_secs_f64();
                 let frac = if total == 0 {
                     1.0
@@ -90,9 +116,10 @@ impl Progress {
                     String::new()
                 };
                 let line = format!(
-                    "\r{label}: {done}/{total} {unit} ({:.0}%), {secs:.1} s{eta}{}",
+                    "{}{label}: {done}/{total} {unit} ({:.0}%), {secs:.1} s{eta}{}",
+                    if *in_place { "\r" } else { "" },
                     100.0 * frac,
-                    if last { "\n" } else { "" }
+                    if last || !*in_place { "\n" } else { "" }
                 );
                 let stderr = py.import("sys")?.getattr("stderr")?;
                 stderr.call_method1("write", (line,))?;
@@ -166,7 +193,7 @@ pub fn interruptible<T: Send>(
         };
         match failure {
             Some(e) => {
-                if let Progress::Stderr { .. } = progress {
+                if let Progress::Stderr { in_place: true, .. } = progress {
                     // End the progress line before the traceback.
                     let stderr = py.import("sys")?.getattr("stderr")?;
                     stderr.call_method1("write", ("\n",))?;
