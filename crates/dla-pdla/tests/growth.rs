@@ -607,3 +607,33 @@ fn run_until_stops_and_continues_to_the_uninterrupted_run() {
     assert_eq!(pdla.particles(), 3000);
     assert_valid_cluster(pdla.tree(), pdla.positions().unwrap());
 }
+
+/// PDLA towards a very large target reserves the tree's room phase by phase, not for the whole
+/// target at once from a tree of one particle (which asked for 30 GB at 1e8 and aborted).
+#[test]
+fn pdla_towards_a_huge_target_starts_without_reserving_it_all() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let mut pdla = Simulation::<2>::new(
+        Params {
+            particles: 100_000_000,
+            threads: 2,
+            ..Params::default()
+        },
+        7,
+    )
+    .unwrap();
+    let stop = AtomicBool::new(false);
+    let done = pdla
+        .run_until(&stop, &|n| {
+            if n >= 2000 {
+                stop.store(true, Ordering::Relaxed);
+            }
+        })
+        .unwrap();
+    assert!(!done && pdla.particles() >= 2000);
+    assert!(
+        pdla.tree().memory_bytes() < 1 << 30,
+        "{} bytes",
+        pdla.tree().memory_bytes()
+    );
+}

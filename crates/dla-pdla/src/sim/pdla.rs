@@ -102,7 +102,11 @@ where
     let mut radius = Dim::<D>::expected_r_ext(params.particles) * first_radius();
     while growth.n < target && !halt.load(Ordering::Relaxed) {
         radius = radius.max(growth.r_ext * 1.5) + params.birth_gap;
-        let points = (target - growth.n) as usize;
+        // A phase reserves room for at most 16 times the cluster it starts from: the room per
+        // point is estimated from the tree so far, which says little while it is small (a
+        // first phase reserving for 1e8 particles from a seed asked for 30 GB). A phase that
+        // fills its room ends, and the next one reserves again from a larger tree.
+        let points = ((target - growth.n) as usize).min((growth.n as usize).max(1 << 16) * 16);
         cluster.prepare_shared(points, radius)?;
         let round = *rounds;
         *rounds += 1;
