@@ -169,6 +169,7 @@ const CURVES: &[Curve] = &[Curve {
     ys: &["foxes", "rabbits"],
     missing: None,
     title: "Populations against steps",
+    axes: ("step", "animats"),
     log_x: false,
     log_y: false,
 }];

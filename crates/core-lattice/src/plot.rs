@@ -161,7 +161,12 @@ macro_rules! draw_chart {
             .y_label_area_size(80)
             .build_cartesian_2d($xr, $yr)
             .map_err(|e| anyhow!("{e}"))?;
+        // At most about 10 labels per axis and 4 light lines between them, so a log axis
+        // spanning less than a decade does not label (and grid) every minor tick.
         ctx.configure_mesh()
+            .x_labels(10)
+            .y_labels(8)
+            .max_light_lines(4)
             .x_desc(&spec.x_label)
             .y_desc(&spec.y_label)
             .x_label_formatter(&|v| tick(*v))

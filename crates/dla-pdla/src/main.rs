@@ -215,6 +215,7 @@ const CURVES: &[Curve] = &[Curve {
     ys: &["radius_of_gyration", "r_ext"],
     missing: None,
     title: "Radius of gyration and extent against N",
+    axes: ("particles N", "R_g and R_ext (particle diameters)"),
     log_x: true,
     log_y: true,
 }];

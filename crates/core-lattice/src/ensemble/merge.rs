@@ -25,6 +25,8 @@ pub struct Curve {
     pub missing: Option<f64>,
     /// Chart title.
     pub title: &'static str,
+    /// Axis labels of the chart, with units (`particles N`, `R_g, R_ext (diameters)`).
+    pub axes: (&'static str, &'static str),
     /// Logarithmic axes.
     pub log_x: bool,
     /// Logarithmic y axis.
@@ -435,8 +437,8 @@ fn average_curve(dir: &Path, members: &[Member], c: &Curve) -> anyhow::Result<Op
                 "{} ({} members, mean +- standard error)",
                 c.title, with_file
             ),
-            x_label: c.x.into(),
-            y_label: c.ys.join(", "),
+            x_label: c.axes.0.into(),
+            y_label: c.axes.1.into(),
             log_x: c.log_x,
             log_y: c.log_y,
             series: c
@@ -517,6 +519,7 @@ mod tests {
         ys: &["count"],
         missing: Some(0.0),
         title: "sizes",
+        axes: ("size", "clusters"),
         log_x: false,
         log_y: false,
     };
