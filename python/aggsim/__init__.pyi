@@ -52,6 +52,8 @@ class DlaResult:
     wall_seconds: float
     cpu_seconds: Optional[float]
     peak_rss_bytes: Optional[int]
+    #: run.json's provenance: date_utc, version, git_commit, command_line, host, cpu, threads, cpus.
+    provenance: Dict[str, Any]
     params: Dict[str, Any]
     run_json: Dict[str, Any]
 
@@ -113,6 +115,8 @@ class DlcaResult:
     wall_seconds: float
     cpu_seconds: Optional[float]
     peak_rss_bytes: Optional[int]
+    #: run.json's provenance: date_utc, version, git_commit, command_line, host, cpu, threads, cpus.
+    provenance: Dict[str, Any]
     params: Dict[str, Any]
     run_json: Dict[str, Any]
 
@@ -230,6 +234,8 @@ class AnimatResult:
     wall_seconds: float
     cpu_seconds: Optional[float]
     peak_rss_bytes: Optional[int]
+    #: run.json's provenance: date_utc, version, git_commit, command_line, host, cpu, threads, cpus.
+    provenance: Dict[str, Any]
     params: Dict[str, Any]
     run_json: Dict[str, Any]
 

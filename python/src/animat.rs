@@ -275,7 +275,7 @@ impl Run {
 ///     16 hex digits over every live animat: the binary's for the same seed and parameters.
 /// steps, foxes, rabbits, distance_evaluations, grid_box, queries
 ///     The results of ``run.json``.
-/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, params, run_json
+/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, provenance, params, run_json
 ///     The rest of ``run.json``, and the whole of it as a dict.
 #[pyclass(dict, module = "aggsim")]
 pub struct AnimatResult {}

@@ -53,7 +53,7 @@ fn far_field(name: &str) -> PyResult<FarField> {
 /// pdla_phases, tree_memory_bytes, tree_point_slots, distance_map_bytes, bytes_per_particle
 ///     The results of ``run.json`` (``fit_error`` only when no fit was possible, and then
 ///     ``fractal_dimension`` is None).
-/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes
+/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, provenance
 ///     The other scalars of ``run.json`` (CPU seconds and peak memory are the whole Python
 ///     process's).
 /// params : dict

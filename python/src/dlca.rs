@@ -306,7 +306,7 @@ impl Run {
 ///     The results of ``run.json``; with ``gyration=True`` also ``fractal_dimension``,
 ///     ``fractal_dimension_stderr``, ``fit_clusters``, ``fit_r2`` (or ``fit_error``) and
 ///     ``wrapping_clusters``.
-/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, params, run_json
+/// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, provenance, params, run_json
 ///     The rest of ``run.json``, and the whole of it as a dict.
 #[pyclass(dict, module = "aggsim")]
 pub struct DlcaResult {}
