@@ -319,7 +319,13 @@ macro_rules! draw_chart {
 /// The corner of the plot where the legend covers the least data: the share of the plot a
 /// legend of this chart's entries takes is estimated from their number and length, and the
 /// points (and the lines between them, sampled) that fall under it are counted in each corner.
-fn legend_corner(chart: &Chart, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> SeriesLabelPosition {
+/// Returns the corner, how many samples it still covers, and the share of the plot's height
+/// the legend takes.
+fn legend_corner(
+    chart: &Chart,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> (SeriesLabelPosition, usize, f64) {
     let unit = |v: f64, lo: f64, hi: f64, log: bool| {
         if log {
             (v.log10() - lo.log10()) / (hi.log10() - lo.log10())
@@ -378,8 +384,20 @@ fn legend_corner(chart: &Chart, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> S
         (SeriesLabelPosition::LowerLeft, true, false),
     ]
     .into_iter()
-    .min_by_key(|&(_, left, top)| covered(left, top))
-    .map_or(SeriesLabelPosition::UpperLeft, |(p, _, _)| p)
+    .map(|(p, left, top)| (p, covered(left, top), h))
+    .min_by_key(|&(_, c, _)| c)
+    .unwrap_or((SeriesLabelPosition::UpperLeft, 0, h))
+}
+
+/// The y range with room above the data for a legend taking `h` of the height.
+fn headroom((y0, y1): (f64, f64), h: f64, log: bool) -> (f64, f64) {
+    let grow = 1.0 / (1.0 - h - 0.03).max(0.2);
+    if log {
+        let (a, b) = (y0.log10(), y1.log10());
+        (y0, 10f64.powf(a + (b - a) * grow))
+    } else {
+        (y0, y0 + (y1 - y0) * grow)
+    }
 }
 
 /// Draw `chart` to a PNG at `path` (written atomically).
@@ -403,7 +421,14 @@ pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
         .chain(bars());
     let (y0, y1) = range(ys, chart.log_y)
         .with_context(|| format!("no plottable y values for {}", path.display()))?;
-    let corner = legend_corner(chart, (x0, x1), (y0, y1));
+    // Where every corner holds data, the y axis gets room above the data for the legend.
+    let (corner, covered, h) = legend_corner(chart, (x0, x1), (y0, y1));
+    let (corner, (y0, y1)) = if covered > 0 {
+        let (y0, y1) = headroom((y0, y1), h, chart.log_y);
+        (legend_corner(chart, (x0, x1), (y0, y1)).0, (y0, y1))
+    } else {
+        (corner, (y0, y1))
+    };
     let mut buf = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
@@ -451,7 +476,7 @@ mod tests {
             log_y: false,
             series: vec![Series::new("a long legend entry", pts, Style::Line)],
         };
-        let corner = |c: &Chart| legend_corner(c, (0.0, 1.0), (0.0, 1.0));
+        let corner = |c: &Chart| legend_corner(c, (0.0, 1.0), (0.0, 1.0)).0;
         // Falling from the upper left: the upper right is free.
         let falling = line(vec![(0.0, 1.0), (1.0, 0.0)]);
         assert!(matches!(corner(&falling), SeriesLabelPosition::UpperRight));
@@ -464,6 +489,13 @@ mod tests {
             corner(&top),
             SeriesLabelPosition::LowerLeft | SeriesLabelPosition::LowerRight
         ));
+        // Through every corner: none is free until the y axis gets headroom.
+        let zigzag = line(vec![(0.0, 0.0), (0.0, 1.0), (1.0, 0.0), (1.0, 1.0)]);
+        let (_, covered, h) = legend_corner(&zigzag, (0.0, 1.0), (0.0, 1.0));
+        assert!(covered > 0);
+        let roomy = headroom((0.0, 1.0), h, false);
+        let (_, covered, _) = legend_corner(&zigzag, (0.0, 1.0), roomy);
+        assert_eq!(covered, 0, "{roomy:?}");
     }
 
     #[test]
