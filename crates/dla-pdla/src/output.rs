@@ -251,6 +251,17 @@ pub const PNG_MAX_SIDE: u32 = 4096;
 /// dark (first) to white (last) by arrival order; when a pixel spans more than a diameter (a
 /// large cluster), each pixel shows how many particles it holds, log-scaled from dark (one) to
 /// white (the most), which shows the structure where dots would merge into a blot.
+/// The pixel ranges `(x0, x1, y0, y1)`, inclusive, that a disc of radius `rad` pixels centred
+/// at `(cx, cy)` can touch in a `side` x `side` picture.
+fn disc_bounds(cx: f64, cy: f64, rad: f64, side: u32) -> (u32, u32, u32, u32) {
+    (
+        (cx - rad).floor().max(0.0) as u32,
+        ((cx + rad).ceil() as u32).min(side - 1),
+        (cy - rad).floor().max(0.0) as u32,
+        ((cy + rad).ceil() as u32).min(side - 1),
+    )
+}
+
 /// A 3D cluster seen from +z: each particle a shaded sphere at its true size, the nearest
 /// surface at each pixel kept (a depth buffer), brighter where nearer the viewer and where the
 /// sphere faces the viewer, so the branches in front stand out from those behind.
@@ -267,14 +278,7 @@ fn depth_shaded<const D: usize>(
     let rad = 0.5 * scale;
     each_position(sim, dir, |_, p: &[f64; D]| {
         let (cx, cy) = ((p[0] + extent) * scale, (extent - p[1]) * scale);
-        let (x0, x1) = (
-            (cx - rad).floor().max(0.0) as u32,
-            ((cx + rad).ceil() as u32).min(side - 1),
-        );
-        let (y0, y1) = (
-            (cy - rad).floor().max(0.0) as u32,
-            ((cy + rad).ceil() as u32).min(side - 1),
-        );
+        let (x0, x1, y0, y1) = disc_bounds(cx, cy, rad, side);
         for y in y0..=y1 {
             for x in x0..=x1 {
                 let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
@@ -319,14 +323,7 @@ fn write_picture<const D: usize>(
             let shade = (55.0 + 200.0 * i as f64 / (n - 1.0)) as u8;
             let cx = (p[0] + extent) * scale;
             let cy = (extent - p[1]) * scale;
-            let (x0, x1) = (
-                (cx - rad).floor().max(0.0) as u32,
-                ((cx + rad).ceil() as u32).min(side - 1),
-            );
-            let (y0, y1) = (
-                (cy - rad).floor().max(0.0) as u32,
-                ((cy + rad).ceil() as u32).min(side - 1),
-            );
+            let (x0, x1, y0, y1) = disc_bounds(cx, cy, rad, side);
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
