@@ -111,14 +111,16 @@ fn touches(lattice: &Lattice, a_coords: &[[u64; MAX_DIM]], b: &[u64]) -> bool {
 
 /// A generation-stamped set of small integers: `insert` is O(1), clearing is O(1) amortised.
 /// Used to report each candidate item and each halo box once.
+/// Public for the other contact indexes built on this module's types (dlca's halo grid).
 #[derive(Debug, Clone, Default)]
-struct StampSet {
+pub struct StampSet {
     stamps: Vec<u32>,
     generation: u32,
 }
 
 impl StampSet {
-    fn clear(&mut self) {
+    /// Empties the set.
+    pub fn clear(&mut self) {
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             self.stamps.iter_mut().for_each(|s| *s = 0);
@@ -128,7 +130,7 @@ impl StampSet {
 
     /// Insert `i`; true if it was not yet in the set.
     #[inline]
-    fn insert(&mut self, i: usize) -> bool {
+    pub fn insert(&mut self, i: usize) -> bool {
         if i >= self.stamps.len() {
             self.stamps.resize((i + 1).max(2 * self.stamps.len()), 0);
         }

@@ -4,10 +4,10 @@
 //! Invariant: box `b` lists cluster `c` exactly once if the halo of `c` (its bounding region
 //! grown by one site) overlaps `b`, and not at all otherwise.
 
-use super::StampSet;
 use super::region::{Region, Span};
 use core_lattice::{Lattice, MAX_DIM};
 use spatial::lattice::ItemId;
+use spatial::lattice::StampSet;
 
 /// The boxes a span of coordinates overlaps along one axis: `first, first + 1, ...` (`n` of
 /// them), modulo the number of boxes on the axis.

@@ -49,37 +49,6 @@ const BOX_ALLOWANCE: u64 = 1 << 16;
 /// Position of a cluster id in the live list, or this for a retired id.
 const DEAD: u32 = u32::MAX;
 
-/// A generation-stamped set of small integers, to report each candidate once.
-#[derive(Debug, Clone, Default)]
-pub(super) struct StampSet {
-    stamps: Vec<u32>,
-    generation: u32,
-}
-
-impl StampSet {
-    fn clear(&mut self) {
-        self.generation = self.generation.wrapping_add(1);
-        if self.generation == 0 {
-            self.stamps.iter_mut().for_each(|s| *s = 0);
-            self.generation = 1;
-        }
-    }
-
-    /// Insert `i`; true if it was not yet in the set.
-    #[inline]
-    fn insert(&mut self, i: usize) -> bool {
-        if i >= self.stamps.len() {
-            self.stamps.resize((i + 1).max(2 * self.stamps.len()), 0);
-        }
-        if self.stamps[i] == self.generation {
-            false
-        } else {
-            self.stamps[i] = self.generation;
-            true
-        }
-    }
-}
-
 /// The clusters as rigid shapes, listed in grid boxes by their halos.
 #[derive(Debug)]
 pub(crate) struct HaloGrid {
