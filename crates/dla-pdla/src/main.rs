@@ -86,6 +86,12 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Toggle::On)]
     near_cache: Toggle,
 
+    /// The variable-precision paper's walk, to reproduce its numbers: --far-field jump
+    /// --death-ratio 100 --step-min 0.5 --precision 2 --distance-map off (the step of 0.5
+    /// biases the R_g prefactor about 5 % low against the default; docs/dla.md, "Accuracy").
+    #[arg(long, conflicts_with_all = ["far_field", "death_ratio", "step_min", "precision", "distance_map"])]
+    paper_settings: bool,
+
     /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
     #[arg(long, default_value_t = 1)]
     threads: usize,
@@ -165,6 +171,11 @@ fn params(cli: &Cli) -> Result<Params, String> {
         leaf_side: cli.leaf_side,
         distance_map: cli.distance_map == Toggle::On,
         near_cache: cli.near_cache == Toggle::On,
+    };
+    let p = if cli.paper_settings {
+        p.paper_settings()
+    } else {
+        p
     };
     // Flags that would be silently ignored are refused too.
     p.validate_given(cli.death_ratio.is_some())

@@ -122,6 +122,10 @@ fn bad_inputs_are_refused_before_any_work() {
         ),
         (with(&["--dim", "1"]), "--dim 1"),
         (with(&["--step-min", "0"]), "--step-min 0"),
+        (
+            with(&["--paper-settings", "--step-min", "0.1"]),
+            "'--paper-settings' cannot be used with '--step-min",
+        ),
         (with(&["--step-min", "NaN"]), "--step-min NaN"),
         (with(&["--step-min", "1e-300"]), "[1e-6, 1e3]"),
         (

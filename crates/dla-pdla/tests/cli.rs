@@ -296,3 +296,29 @@ fn config_files_repeat_runs_and_flags_override_them() {
         &["--particles", "300", "--seed", "4", "--step-min", "0.2"],
     );
 }
+
+#[test]
+fn paper_settings_run_the_papers_walk() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let st = dla()
+        .args(["--particles", "300", "--paper-settings", "-q", "--out"])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let p = &m["params"];
+    assert_eq!(p["far_field"], "jump");
+    assert_eq!(p["death_ratio"], 100.0);
+    assert_eq!(p["step_min"], 0.5);
+    assert_eq!(p["precision"], 2.0);
+    assert_eq!(p["distance_map"], false);
+    // The saved configuration repeats the preset, not its expansion.
+    let config = std::fs::read_to_string(out.join("config.toml")).unwrap();
+    assert!(
+        config.lines().any(|l| l == "paper-settings = true"),
+        "{config}"
+    );
+}
