@@ -71,6 +71,7 @@ def dla(
     leaf_side: float = ...,
     distance_map: bool = ...,
     near_cache: bool = ...,
+    paper_settings: bool = False,
     serial_until: int = ...,
     fit_from: int = ...,
     progress: Progress = None,

@@ -121,6 +121,10 @@ impl DlaResult {
 ///     ``--distance-map on``): speed only, but another trajectory.
 /// near_cache : bool
 ///     Each walker's exact near cache (default True): speed only, same trajectory.
+/// paper_settings : bool
+///     The variable-precision paper's walk (the binary's ``--paper-settings``):
+///     ``far_field="jump"``, ``death_ratio=100``, ``step_min=0.5``, ``precision=2``,
+///     ``distance_map=False`` (default False). Those five must then stay at their defaults.
 /// serial_until : int
 ///     With threads > 1: grow with one walker up to this many particles (default 0).
 /// fit_from : int
@@ -157,6 +161,7 @@ impl DlaResult {
     leaf_side = defaults().leaf_side,
     distance_map = defaults().distance_map,
     near_cache = defaults().near_cache,
+    paper_settings = false,
     serial_until = defaults().serial_until as i64,
     fit_from = defaults().fit_from as i64,
     progress = None,
@@ -176,6 +181,7 @@ pub fn dla(
     leaf_side: f64,
     distance_map: bool,
     near_cache: bool,
+    paper_settings: bool,
     serial_until: i64,
     fit_from: i64,
     progress: Option<&Bound<'_, PyAny>>,
@@ -197,6 +203,23 @@ pub fn dla(
         leaf_side,
         distance_map,
         near_cache,
+    };
+    let params = if paper_settings {
+        let d = defaults();
+        if params.far_field != d.far_field
+            || death_ratio.is_some()
+            || params.step_min != d.step_min
+            || params.precision != d.precision
+            || params.distance_map != d.distance_map
+        {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "paper_settings=True sets far_field, death_ratio, step_min, precision and \
+                 distance_map; leave them at their defaults",
+            ));
+        }
+        params.paper_settings()
+    } else {
+        params
     };
     params
         .validate_given(death_ratio.is_some())

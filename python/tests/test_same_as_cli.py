@@ -53,6 +53,10 @@ def same_results(result, run_json, ignore=()):
              "--birth-gap", 2.5],
             dict(particles=800, distance_map=False, near_cache=False, birth_gap=2.5),
         ),
+        (
+            ["--particles", 900, "--paper-settings"],
+            dict(particles=900, paper_settings=True),
+        ),
     ],
 )
 def test_dla_equals_the_binary(cli, flags, kwargs):
