@@ -57,8 +57,10 @@ struct Cli {
     #[arg(long, conflicts_with = "density")]
     start_radius: Option<i64>,
 
+    // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
+    // clap would read `-inf` as an unknown short flag.
     /// Start density in animats per cell, in (0, 0.5]: sets the start radius.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     density: Option<f64>,
 
     /// Vision radius in cells (>= 1).
