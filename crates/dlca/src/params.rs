@@ -337,21 +337,7 @@ pub mod flags {
     }
 
     /// `--max-memory`: a byte count, with an optional suffix K, M, G or T (powers of 1024).
-    pub fn parse_bytes(s: &str) -> Result<u64, String> {
-        let (digits, mult) = match s.trim().chars().last() {
-            Some('K' | 'k') => (&s[..s.len() - 1], 1u64 << 10),
-            Some('M' | 'm') => (&s[..s.len() - 1], 1 << 20),
-            Some('G' | 'g') => (&s[..s.len() - 1], 1 << 30),
-            Some('T' | 't') => (&s[..s.len() - 1], 1 << 40),
-            _ => (s, 1),
-        };
-        digits
-            .trim()
-            .parse::<u64>()
-            .ok()
-            .and_then(|v| v.checked_mul(mult))
-            .ok_or_else(|| format!("'{s}' is not a byte count like 4G or 500M"))
-    }
+    pub use core_lattice::io::parse_bytes;
 
     /// The axes of `--dim`, `--size` (the lengths given: one for every axis, or one per axis)
     /// and `--boundary` (`periodic` or `wall` for every axis, or one per axis separated by
