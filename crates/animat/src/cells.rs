@@ -81,6 +81,11 @@ const DIR_MAX: u64 = 1 << 18;
 
 const CELLS: usize = (TILE * TILE) as usize;
 
+/// Bytes of one tile: a cell byte and an 8-byte id per cell (36 KiB). A tile is allocated for
+/// each 64 x 64 square holding an animat, so in a dilute world, with animats farther apart than
+/// a tile, this is the memory of each animat.
+pub const TILE_BYTES: u64 = (CELLS * (1 + size_of::<u64>())) as u64;
+
 /// Offset of a cell inside its tile: 8 x 8 blocks of cells, each block 64 consecutive bytes
 /// (one cache line of kind bytes), blocks in row-major order.
 #[inline(always)]
@@ -344,6 +349,15 @@ impl CellIndex {
                 crate::hint::prefetch(&kinds[offset(x, y)]);
             }
         }
+    }
+
+    /// Heap bytes of the index: its tiles (in use or on the free list), the directory and the
+    /// map.
+    pub fn memory_bytes(&self) -> u64 {
+        let slots = self.tiles.capacity() * size_of::<Tile>()
+            + (self.dir.capacity() + self.free.capacity()) * size_of::<u32>()
+            + self.map.capacity() * (size_of::<[i64; 2]>() + size_of::<u32>() + 1);
+        self.tiles.len() as u64 * TILE_BYTES + slots as u64
     }
 
     /// Occupied cells (for consistency checks).

@@ -9,7 +9,7 @@ use anyhow::Context;
 use clap::Parser;
 use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
 use core_lattice::ensemble::{Curve, EnsembleArgs};
-use core_lattice::io::{Positions, RunClock, read_checkpoint, write_checkpoint};
+use core_lattice::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -57,8 +57,10 @@ struct Cli {
     #[arg(long, conflicts_with = "density")]
     start_radius: Option<i64>,
 
+    // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
+    // clap would read `-inf` as an unknown short flag.
     /// Start density in animats per cell, in (0, 0.5]: sets the start radius.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     density: Option<f64>,
 
     /// Vision radius in cells (>= 1).
@@ -73,6 +75,13 @@ struct Cli {
     /// Record neighbour-search seconds and distance evaluations per step in populations.csv.
     #[arg(long)]
     timing: bool,
+
+    /// Memory the world may take, estimated as 256 bytes per animat plus 36 KiB for each
+    /// 64 x 64 square of cells holding one (a dilute world takes 36 KiB per animat): a start
+    /// that needs more is refused, a run that grows past it stops with an error. Suffixes K,
+    /// M, G, T (powers of 1024).
+    #[arg(long, default_value = "4G", value_parser = core_lattice::io::parse_bytes)]
+    max_memory: u64,
 
     /// Write a PNG snapshot every K steps (and of the start and the end).
     #[arg(long)]
@@ -142,6 +151,18 @@ fn params(cli: &Cli) -> Result<Params, String> {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
     p.validate().map_err(|e| culprit(cli, &e))?;
+    let need = p.start_memory_bytes();
+    if cli.resume.is_none() && need > cli.max_memory {
+        return Err(format!(
+            "the start population needs about {} ({} animats in a disc of radius {}: a 36 KiB tile \
+             of the cell index for each 64 x 64 square holding an animat, 256 bytes per animat), \
+             over --max-memory {}; raise --density (or lower --start-radius) or --max-memory",
+            show_bytes(need),
+            p.foxes.saturating_add(p.rabbits),
+            p.start_radius,
+            show_bytes(cli.max_memory)
+        ));
+    }
     if let Some(out) = &cli.out {
         core_lattice::cli::check_out_dir(out)?;
     }
@@ -326,6 +347,17 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             break;
         }
         let s = world.step();
+        if world.memory_bytes() > cli.max_memory {
+            progress.finish();
+            anyhow::bail!(
+                "after step {} the world holds {} animats and takes about {}, over --max-memory {}; \
+                 raise --max-memory (with --checkpoint-every, --resume continues from the last checkpoint)",
+                world.steps(),
+                world.foxes() + world.rabbits(),
+                show_bytes(world.memory_bytes()),
+                show_bytes(cli.max_memory)
+            );
+        }
         rows.push(PopulationRow::of(&world, s));
         if let Some(k) = cli.snapshot_every {
             if world.steps() % k == 0 {

@@ -158,16 +158,20 @@ pub fn write_snapshot(path: &Path, world: &World) -> Result<(), OutputError> {
     }
     let margin = 5;
     let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
-    let span = (x1.saturating_add(margin) - x0 + 1).max(y1.saturating_add(margin) - y0 + 1);
-    let factor = (span + SNAPSHOT_MAX_SIDE - 1) / SNAPSHOT_MAX_SIDE;
-    let cells = (span + factor - 1) / factor;
+    // In i128: animats at both ends of the plane span more than an i64 holds.
+    let wide = |lo: i64, hi: i64| i128::from(hi.saturating_add(margin)) - i128::from(lo) + 1;
+    let span = wide(x0, x1).max(wide(y0, y1));
+    let factor = (span + i128::from(SNAPSHOT_MAX_SIDE) - 1) / i128::from(SNAPSHOT_MAX_SIDE);
+    // At most SNAPSHOT_MAX_SIDE.
+    let cells = ((span + factor - 1) / factor) as i64;
     // A small world is drawn with `zoom` x `zoom` pixels per cell, so the picture is readable.
     let zoom = ((SNAPSHOT_MIN_SIDE + cells - 1) / cells).max(1);
     let side = cells * zoom;
     let mut pixels = vec![0u8; (side * side * 3) as usize];
+    let cell = |p: i64, lo: i64| ((i128::from(p) - i128::from(lo)) / factor) as i64;
     for a in world.animats() {
-        let cx = (a.pos[0] - x0) / factor;
-        let cy = cells - 1 - (a.pos[1] - y0) / factor;
+        let cx = cell(a.pos[0], x0);
+        let cy = cells - 1 - cell(a.pos[1], y0);
         let c: [u8; 3] = match a.species {
             Species::Fox => [255, 60, 40],
             Species::Rabbit => [80, 220, 80],

@@ -26,7 +26,7 @@ struct Cli {
     #[arg(long, default_value_t = 2)]
     dim: usize,
 
-    /// Particles in the final cluster, seed particle included: 1 to 3500000000 in 2D and 3D
+    /// Particles in the final cluster, seed particle included: 1 to 3000000000
     /// (the orthtree's 32-bit indices). Memory: about 11 bytes per particle in 2D and 15 in 3D
     /// at 1e7.
     #[arg(long)]
@@ -40,8 +40,10 @@ struct Cli {
     #[arg(long)]
     out: PathBuf,
 
-    /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters (>= 1).
-    #[arg(long, default_value_t = 5.0)]
+    // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
+    // clap would read `-inf` as an unknown short flag.
+    /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters (1 to 1e4).
+    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0)]
     birth_gap: f64,
 
     /// Far field (|p| > R_b): `return` puts the walker exactly where Brownian motion would first
@@ -50,25 +52,26 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = FarField::Return)]
     far_field: FarField,
 
-    /// Death radius R_d = death-ratio * R_b for `--far-field jump` (> 1) [default: 100].
-    #[arg(long)]
+    /// Death radius R_d = death-ratio * R_b for `--far-field jump` (> 1, at most 1e100)
+    /// [default: 100].
+    #[arg(long, allow_hyphen_values = true)]
     death_ratio: Option<f64>,
 
     /// Near-field step length in diameters (> 0): used when the distance to the cluster minus
     /// one is at most this. Smaller is closer to Brownian motion. The default is where the
     /// accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor about 5 %
     /// low (docs/dla.md, "Accuracy").
-    #[arg(long, default_value_t = dla_pdla::params::DEFAULT_STEP_MIN)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DEFAULT_STEP_MIN)]
     step_min: f64,
 
     /// Precision kappa of the variable-precision distance (> 0.5; the paper uses 2; `inf` is
     /// the exact search). Larger is more exact and slower.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 2.0)]
     precision: f64,
 
     /// Side of the orthtree's leaf cells in diameters (power of two, 1 to 64): speed and
     /// memory only, not the physics.
-    #[arg(long, default_value_t = dla_pdla::params::DLA_LEAF_SIDE)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DLA_LEAF_SIDE)]
     leaf_side: f64,
 
     /// The coarse distance maps in front of the orthtree (one byte per cell of side 8

@@ -115,6 +115,23 @@ pub const PAPER_PRECISION: f64 = 2.0;
 /// leave a walker in place forever.
 pub const MIN_STEP_MIN: f64 = 1e-6;
 
+/// Largest accepted `--birth-gap`. The birth sphere only has to enclose the cluster: where a
+/// walker first comes near the cluster does not depend on how far out it was born (uniformly
+/// on a larger concentric sphere, with the exact far-field return or the jumps of `jump`), so a
+/// larger gap changes nothing but the time each walker wanders. That time grows slowly with the
+/// gap in 2D but like `gap / R_ext` in 3D (a walker must find a cluster of radius `R_ext` from
+/// the birth sphere: `--birth-gap 1e9` would take hours per particle). 1e4 diameters is far
+/// beyond any gap that affects the physics.
+pub const MAX_BIRTH_GAP: f64 = 1e4;
+
+/// Largest accepted `--death-ratio`. The death radius `death_ratio * R_b` must stay a finite
+/// `f64` with room to spare (a walker jumps about its own distance from the origin, and its
+/// squared norm is computed): with `R_b` below `1e4 + R_ext` that holds far beyond 1e100, while
+/// `1e300 * R_b` can overflow to infinity, so that no walker would ever be relaunched and their
+/// coordinates would overflow in turn. The truncation bias of a death radius is of order
+/// `R_b / R_d`, negligible long before 1e100.
+pub const MAX_DEATH_RATIO: f64 = 1e100;
+
 fn default_leaf_side() -> f64 {
     DLA_LEAF_SIDE
 }
@@ -146,12 +163,19 @@ fn dimension_list() -> String {
     dims.join(", ")
 }
 
-/// Largest accepted particle count, in 2D and 3D. The orthtree numbers its nodes, leaves and
-/// point slots with 32-bit indices (at most `2^32 - 2` of each); a DLA cluster uses about 1.05
-/// point slots per particle in 2D and 1.09 in 3D (size classes of the leaf blocks), so 3.5e9
-/// particles leave 10 % headroom. A run that still runs out stops with
+/// Largest accepted particle count. The orthtree numbers its nodes, leaves and point slots
+/// with 32-bit indices (at most `2^32 - 2` of each). Point slots bound the count: a leaf of `n`
+/// points owns a block of at most `1.25 n` slots (size classes a quarter of a power of two
+/// apart above 16 points), and outgrown blocks wait on free lists until they pass 1/8 of the
+/// pool (and 2^16 slots), when the pool is compacted, so a cluster of `N` particles uses at most
+/// `1.25 N * 8 / 7 + 2^16` slots whatever the leaf side: under `2^32 - 2` for `N <= 3e9`.
+/// Leaves and nodes are fewer than particles (each leaf holds a particle; a DLA cluster has
+/// under 0.96 leaves and 0.83 nodes per particle even with the smallest leaf side). Typical
+/// clusters use fewer slots (about 1.05 per particle in 2D and 1.1 in 3D with the default leaf
+/// side), but leaves of hundreds of particles (3D, leaf sides 32 and 64) come close to the
+/// bound: about 1.4 slots per particle, at which 3.5e9 particles would not fit. A run that still runs out (PDLA's reserved room) stops with
 /// [`OrthtreeError::CapacityExceeded`](spatial::orthtree::OrthtreeError::CapacityExceeded).
-pub const MAX_PARTICLES: u64 = 3_500_000_000;
+pub const MAX_PARTICLES: u64 = 3_000_000_000;
 
 /// A value as a user would type it: `0.25`, `1000`, or `1e-300` for the very small and large.
 fn short(v: f64) -> String {
@@ -172,13 +196,17 @@ pub enum ParamsError {
     /// `particles` is 0 or too large.
     #[error("--particles {0} is outside the accepted range 1..={MAX_PARTICLES}")]
     Particles(u64),
-    /// `birth_gap` below 1 or not finite.
+    /// `birth_gap` below 1, above [`MAX_BIRTH_GAP`] or not finite.
     #[error(
-        "--birth-gap {0} is outside the accepted range [1, 1e9] (a walker born closer than one diameter could overlap the cluster)"
+        "--birth-gap {} is outside the accepted range [1, 1e4] (a walker born closer than one diameter could overlap the cluster; a larger gap does not change where walkers arrive, only makes each one wander longer: in 3D about gap / R_ext times longer)",
+        short(*.0)
     )]
     BirthGap(f64),
-    /// `death_ratio` not > 1 or not finite.
-    #[error("--death-ratio {0} is outside the accepted range (1, 1e300]")]
+    /// `death_ratio` not > 1, above [`MAX_DEATH_RATIO`] or not finite.
+    #[error(
+        "--death-ratio {} is outside the accepted range (1, 1e100] (a larger death radius would overflow the walkers' coordinates)",
+        short(*.0)
+    )]
     DeathRatio(f64),
     /// `step_min` not positive or too large.
     #[error(
@@ -236,10 +264,10 @@ impl Params {
         if self.particles == 0 || self.particles > MAX_PARTICLES {
             return Err(ParamsError::Particles(self.particles));
         }
-        if !(self.birth_gap >= 1.0 && self.birth_gap <= 1e9) {
+        if !(self.birth_gap >= 1.0 && self.birth_gap <= MAX_BIRTH_GAP) {
             return Err(ParamsError::BirthGap(self.birth_gap));
         }
-        if !(self.death_ratio > 1.0 && self.death_ratio <= 1e300) {
+        if !(self.death_ratio > 1.0 && self.death_ratio <= MAX_DEATH_RATIO) {
             return Err(ParamsError::DeathRatio(self.death_ratio));
         }
         if !(MIN_STEP_MIN..=1e3).contains(&self.step_min) {
@@ -343,7 +371,7 @@ mod tests {
                     ..d()
                 },
                 "--birth-gap 0.5 ",
-                "[1, 1e9]",
+                "[1, 1e4]",
             ),
             (
                 Params {
@@ -351,7 +379,7 @@ mod tests {
                     ..d()
                 },
                 "--death-ratio 1 ",
-                "(1, 1e300]",
+                "(1, 1e100]",
             ),
             (
                 Params {

@@ -1,6 +1,9 @@
 //! Contact, determinism, growth-sample, PDLA, checkpoint and far-field-jump tests of whole
 //! runs.
 
+mod common;
+
+use common::check_contacts;
 use dla_pdla::sim::{OVERLAP_DISTANCE, SimError};
 use dla_pdla::{Dim, FarField, Params, Simulation, Space};
 
@@ -30,24 +33,6 @@ where
     let mut sim = Simulation::<D>::new(params, seed).unwrap();
     sim.run().unwrap();
     sim
-}
-
-/// Brute force: no two centres closer than 1 - 1e-6; every particle after the first within
-/// 1 + 1e-6 of an earlier one. Returns (min pair distance, max contact distance).
-fn check_contacts<const D: usize>(pos: &[[f64; D]]) -> (f64, f64) {
-    let mut min_pair = f64::INFINITY;
-    let mut max_contact: f64 = 0.0;
-    for i in 1..pos.len() {
-        let mut nearest_earlier = f64::INFINITY;
-        for j in 0..i {
-            let d2: f64 = (0..D).map(|a| (pos[i][a] - pos[j][a]).powi(2)).sum();
-            nearest_earlier = nearest_earlier.min(d2);
-        }
-        let d = nearest_earlier.sqrt();
-        min_pair = min_pair.min(d);
-        max_contact = max_contact.max(d);
-    }
-    (min_pair, max_contact)
 }
 
 fn contacts<const D: usize>(threads: usize)

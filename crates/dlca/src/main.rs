@@ -35,8 +35,10 @@ struct Cli {
     #[arg(long, value_parser = parse_size)]
     size: Option<Sizes>,
 
+    // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
+    // clap would read `-inf` as an unknown short flag.
     /// Fraction of sites holding a particle at the start, in (0, 1).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     fill: Option<f64>,
 
     /// Number of particles at the start, 1 to the number of sites.
@@ -68,16 +70,16 @@ struct Cli {
     boundary: String,
 
     /// Overall move probability of a cluster per sweep, in (0, 1].
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1.0)]
     temperature: f64,
 
     /// Gravity g in [0, 1): the move down the last axis has weight 1+g, up 1-g, others 1.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
     gravity: f64,
 
     /// Mobility exponent gamma >= 0: a cluster of s particles moves with probability
     /// temperature * s^-gamma (0: all clusters equally mobile, as in the paper).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
     mobility_exponent: f64,
 
     /// Stop when at most this many clusters remain (>= 1; the paper stops at 100 to 1000).
@@ -327,6 +329,20 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     }
     progress.finish();
+    if sim.is_frozen() {
+        tracing::warn!(
+            "no cluster can move any more (temperature * s^-gamma is 0 for the smallest cluster, \
+             s = {}): stopped after sweep {} with {} clusters, above --target-clusters {target}",
+            sim.sets()
+                .live()
+                .iter()
+                .map(|&id| sim.sets().sites(id).len())
+                .min()
+                .unwrap_or(0),
+            sim.sweeps(),
+            sim.clusters()
+        );
+    }
     let m = dlca::output::write_outputs(
         &sim,
         cli.seed,

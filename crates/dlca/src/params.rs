@@ -10,6 +10,10 @@ use serde::{Deserialize, Serialize};
 /// included for tests and teaching).
 pub const MAX_MODEL_DIM: usize = 5;
 
+/// Longest accepted lattice side, `2^62` sites: the grid boxes' modular arithmetic adds a
+/// coordinate to a side (`x + L`), which must not overflow `u64`.
+pub const MAX_SIDE: u64 = 1 << 62;
+
 /// Default memory budget for the occupancy lattice: 4 GiB.
 pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
@@ -202,9 +206,19 @@ pub enum ParamError {
         "--fit-min-size {0} is outside the accepted range 2.. (a single particle has no radius of gyration)"
     )]
     FitMinSize(u64),
+    /// A lattice side above [`MAX_SIDE`].
+    #[error("--size: a side of {0} sites is above the longest accepted, 2^62 = {MAX_SIDE}")]
+    SideTooLong(u64),
     /// Particle count too large to number.
-    #[error("{0} particles is more than this implementation supports (2^32 - 2)")]
-    TooManyParticles(u64),
+    #[error(
+        "{given} places {particles} particles, more than this implementation numbers (at most 2^32 - 3 = 4294967293)"
+    )]
+    TooManyParticles {
+        /// The flag and value that asked for them (`--fill 0.6`).
+        given: String,
+        /// Particles asked for.
+        particles: u64,
+    },
 }
 
 impl Params {
@@ -212,6 +226,9 @@ impl Params {
     pub fn lattice(&self) -> Result<Lattice, ParamError> {
         if self.size.is_empty() || self.size.len() > MAX_MODEL_DIM {
             return Err(ParamError::Dimension(self.size.len()));
+        }
+        if let Some(&side) = self.size.iter().find(|&&l| l > MAX_SIDE) {
+            return Err(ParamError::SideTooLong(side));
         }
         Ok(Lattice::new(&self.size, &self.boundary)?)
     }
@@ -252,7 +269,13 @@ impl Params {
         let lattice = self.lattice()?;
         let n = self.particles()?;
         if n >= u64::from(u32::MAX) - 1 {
-            return Err(ParamError::TooManyParticles(n));
+            return Err(ParamError::TooManyParticles {
+                given: match self.init {
+                    Init::Fill(f) => format!("--fill {f}"),
+                    Init::Particles(p) => format!("--particles {p}"),
+                },
+                particles: n,
+            });
         }
         if !(self.temperature > 0.0 && self.temperature <= 1.0) {
             return Err(ParamError::Temperature(self.temperature));
@@ -314,21 +337,7 @@ pub mod flags {
     }
 
     /// `--max-memory`: a byte count, with an optional suffix K, M, G or T (powers of 1024).
-    pub fn parse_bytes(s: &str) -> Result<u64, String> {
-        let (digits, mult) = match s.trim().chars().last() {
-            Some('K' | 'k') => (&s[..s.len() - 1], 1u64 << 10),
-            Some('M' | 'm') => (&s[..s.len() - 1], 1 << 20),
-            Some('G' | 'g') => (&s[..s.len() - 1], 1 << 30),
-            Some('T' | 't') => (&s[..s.len() - 1], 1 << 40),
-            _ => (s, 1),
-        };
-        digits
-            .trim()
-            .parse::<u64>()
-            .ok()
-            .and_then(|v| v.checked_mul(mult))
-            .ok_or_else(|| format!("'{s}' is not a byte count like 4G or 500M"))
-    }
+    pub use core_lattice::io::parse_bytes;
 
     /// The axes of `--dim`, `--size` (the lengths given: one for every axis, or one per axis)
     /// and `--boundary` (`periodic` or `wall` for every axis, or one per axis separated by

@@ -29,7 +29,9 @@ mod step;
 mod tests;
 
 use crate::cells::{CellIndex, WINDOW_MAX, kind_byte};
-use crate::params::{FoxRule, Params, ParamsError, RabbitRule, Species};
+use crate::params::{ANIMAT_BYTES, FoxRule, MAX_ANIMATS, Params, ParamsError, RabbitRule, Species};
+
+pub use crate::cells::{TILE, TILE_BYTES};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
 use near::{NEAR_ROWS, disc_mask};
@@ -201,6 +203,9 @@ pub struct World {
     total_distance_evals: u64,
     foxes: u64,
     rabbits: u64,
+    /// Births that would make more records than this do not happen ([`MAX_ANIMATS`] unless
+    /// lowered by [`World::set_animat_limit`]).
+    animat_limit: u64,
 }
 
 /// A change of the grid, logged during a step and applied in order before the grid is next
@@ -263,6 +268,7 @@ impl World {
             total_distance_evals: 0,
             foxes: 0,
             rabbits: 0,
+            animat_limit: MAX_ANIMATS,
             seed,
             params,
         })
@@ -481,6 +487,26 @@ impl World {
                 .u64(a.hunger.into());
         }
         h.finish_hex()
+    }
+
+    /// Memory the world takes, estimated: the cell index's tiles (36 KiB for each 64 x 64
+    /// square holding an animat, or holding one earlier and kept for reuse) plus
+    /// [`ANIMAT_BYTES`] per animat. The `animat` binary stops a run that outgrows its
+    /// `--max-memory` with this.
+    pub fn memory_bytes(&self) -> u64 {
+        self.cells.memory_bytes() + self.recs.len() as u64 * ANIMAT_BYTES
+    }
+
+    /// Lowers the number of animats a world may hold (at most [`MAX_ANIMATS`], the default): a
+    /// birth that would make more records than this does not happen. For tests of the cap
+    /// without billions of animats.
+    pub fn set_animat_limit(&mut self, limit: u64) {
+        self.animat_limit = limit.min(MAX_ANIMATS);
+    }
+
+    /// Whether a birth may happen now (see [`World::set_animat_limit`]).
+    fn may_give_birth(&self) -> bool {
+        (self.recs.len() as u64) < self.animat_limit
     }
 
     fn index_of(&self, id: u64) -> Option<usize> {

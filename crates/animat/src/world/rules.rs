@@ -243,7 +243,7 @@ impl World {
                         }
                     }
                 }
-                if n > 0 {
+                if n > 0 && self.may_give_birth() {
                     let c = free[self.action_rng.random_range(0..n)];
                     self.add_deferred(a.species, c, 0, 0)
                         .expect("the birth cell was free");

@@ -11,10 +11,12 @@
 //! - [`hash`]: the stable 64-bit state hash models report as `state_hash`.
 //! - [`points`]: point sets (particles, animats) as CSV, `.npy`, legacy VTK or extended XYZ.
 //! - [`provenance`]: date, version, git commit, command line, host and CPU of a run.
+//! - [`bytes`]: byte counts in flags (`4G`) and messages (`4.0 GiB`).
 //! - [`npy`]: rows of `f64` streamed to a NumPy `.npy` file as a run goes (the exception to
 //!   atomic writes: an arrival log that a checkpoint refers to).
 
 pub mod atomic;
+pub mod bytes;
 pub mod checkpoint;
 pub mod hash;
 pub mod image;
@@ -25,6 +27,7 @@ pub mod provenance;
 pub mod table;
 
 pub use atomic::{AtomicFile, remove_stale_temporaries, write_atomic};
+pub use bytes::{parse_bytes, show_bytes};
 pub use checkpoint::{CheckpointError, read_checkpoint, write_checkpoint};
 pub use hash::StateHasher;
 pub use image::{write_png_gray, write_png_rgb};

@@ -1,6 +1,6 @@
-//! Radii of gyration: [`Gyration`] for off-lattice points in `D` dimensions (Welford updates,
-//! accurate far from the origin) and [`LatticeGyration`] for integer lattice points (exact
-//! integer sums, rounded once).
+//! Radii of gyration: [`Gyration`] for off-lattice points in `D` dimensions (Welford updates
+//! relative to the first point, accurate however far the set lies from the origin) and
+//! [`LatticeGyration`] for integer lattice points (exact integer sums, rounded once).
 
 use serde::{Deserialize, Serialize};
 
@@ -10,10 +10,19 @@ use serde::{Deserialize, Serialize};
 ///
 /// Each point updates the mean and the sum of squared deviations by Welford's recurrence, so
 /// the result does not suffer the catastrophic cancellation of `sum x^2 - N mean^2` when the
-/// cluster sits far from the origin. Mergeable across threads.
+/// cluster sits far from the origin. The recurrence runs on the points' offsets from the first
+/// point (the *shift*), not on their coordinates: a mean kept at the coordinates' magnitude is
+/// rounded to their spacing there (1.2e-4 at 1e12), which leaves `R_g^2` of a cluster of radius
+/// 10 centred 1e12 from the origin wrong in the fifth digit; the offsets are exact for points
+/// near the shift, so the sums keep the precision of the cluster's own size. Mergeable across
+/// threads.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Gyration<const D: usize> {
     n: u64,
+    /// The first point: every other enters as its offset from this one.
+    #[serde(with = "serde_arrays")]
+    shift: [f64; D],
+    /// Mean offset from `shift`.
     #[serde(with = "serde_arrays")]
     mean: [f64; D],
     /// Sum over points and axes of squared deviations from the mean.
@@ -43,6 +52,7 @@ impl<const D: usize> Default for Gyration<D> {
     fn default() -> Self {
         Gyration {
             n: 0,
+            shift: [0.0; D],
             mean: [0.0; D],
             m2: 0.0,
         }
@@ -58,9 +68,13 @@ impl<const D: usize> Gyration<D> {
     /// Add one point.
     #[inline]
     pub fn push(&mut self, p: &[f64; D]) {
+        if self.n == 0 {
+            self.shift = *p;
+        }
         self.n += 1;
         let inv_n = 1.0 / self.n as f64;
-        for (m, &x) in self.mean.iter_mut().zip(p) {
+        for ((m, &x), &c) in self.mean.iter_mut().zip(p).zip(&self.shift) {
+            let x = x - c;
             let delta = x - *m;
             *m += delta * inv_n;
             self.m2 += delta * (x - *m);
@@ -78,7 +92,10 @@ impl<const D: usize> Gyration<D> {
         }
         let n = self.n + other.n;
         let (na, nb, nf) = (self.n as f64, other.n as f64, n as f64);
-        for (m, &mo) in self.mean.iter_mut().zip(&other.mean) {
+        for a in 0..D {
+            // The other's mean offset, seen from this shift.
+            let mo = other.mean[a] + (other.shift[a] - self.shift[a]);
+            let m = &mut self.mean[a];
             let delta = mo - *m;
             *m += delta * nb / nf;
             self.m2 += delta * delta * na * nb / nf;
@@ -94,7 +111,7 @@ impl<const D: usize> Gyration<D> {
 
     /// Centre of mass (zeros when empty).
     pub fn centre(&self) -> [f64; D] {
-        self.mean
+        std::array::from_fn(|a| self.shift[a] + self.mean[a])
     }
 
     /// `R_g^2` (0 for zero or one point).

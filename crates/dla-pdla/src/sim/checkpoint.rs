@@ -18,7 +18,7 @@ use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use core_lattice::io::NpyReader;
+use core_lattice::io::{NpyReader, StateHasher};
 use core_lattice::rng::SimRng;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -138,13 +138,21 @@ where
     }
     let log = dir.join(POSITIONS_FILE);
     let bad_log = |why: String| SimError::CheckpointUsage(format!("{}: {why}", log.display()));
-    let mut reader = NpyReader::open(&log).map_err(|e| SimError::CheckpointUsage(e.to_string()))?;
-    if reader.cols() != D {
-        return Err(bad_log(format!("{} columns, not {D}", reader.cols())));
-    }
-    let mut cluster = Cluster::new(&params)?;
-    let mut growth = Growth::new(&params);
+    // Two passes over the log: the first hashes its first `n` rows (the stored positions, so
+    // their hash is the state hash) and refuses a log that is not the checkpoint's before
+    // anything is built from it: a damaged or foreign row far from the origin (1e6 diameters)
+    // would otherwise size the distance maps for it (tens of gigabytes) before the hash could
+    // refuse it. The second stores them.
+    let open = || -> Result<NpyReader, SimError> {
+        let reader = NpyReader::open(&log).map_err(|e| SimError::CheckpointUsage(e.to_string()))?;
+        if reader.cols() != D {
+            return Err(bad_log(format!("{} columns, not {D}", reader.cols())));
+        }
+        Ok(reader)
+    };
     let mut p = [0.0; D];
+    let mut reader = open()?;
+    let mut hasher = StateHasher::new();
     for i in 0..snap.n {
         let more = reader
             .read_beyond(&mut p)
@@ -155,15 +163,35 @@ where
                 snap.n
             )));
         }
-        growth.add(&mut cluster, p, params.particles)?;
+        for x in p {
+            hasher.f64(x);
+        }
     }
-    if growth.hasher.finish_hex() != snap.state_hash {
+    if hasher.finish_hex() != snap.state_hash {
         return Err(bad_log(format!(
             "does not belong to the checkpoint: its first {} positions hash to {}, the checkpoint recorded {}",
             snap.n,
-            growth.hasher.finish_hex(),
+            hasher.finish_hex(),
             snap.state_hash
         )));
+    }
+    let mut reader = open()?;
+    let mut cluster = Cluster::new(&params)?;
+    let mut growth = Growth::new(&params);
+    for _ in 0..snap.n {
+        let more = reader
+            .read_beyond(&mut p)
+            .map_err(|e| SimError::CheckpointUsage(e.to_string()))?;
+        if !more {
+            return Err(bad_log("changed while it was read".into()));
+        }
+        growth.add(&mut cluster, p, params.particles)?;
+    }
+    // Storing a position returns it unchanged (the log holds stored positions), so the
+    // rebuilt state has the hash just checked; anything else is a log that changed between
+    // the passes.
+    if growth.hasher.finish_hex() != snap.state_hash {
+        return Err(bad_log("changed while it was read".into()));
     }
     growth.samples = snap.samples;
     growth.next_sample = snap.next_sample;

@@ -95,10 +95,10 @@ where
 {
     let target = until.min(params.particles);
     // The threads share one set of distance maps, sized for the final cluster now (they
-    // cannot grow once shared).
-    cluster.reserve_maps(
-        Dim::<D>::expected_r_ext(params.particles).max(growth.r_ext) + params.birth_gap,
-    )?;
+    // cannot grow once shared). They must cover the particles (reserve_maps adds each map's
+    // cap): a walker beyond them gets no bound and asks the tree. Not the birth sphere: a
+    // large --birth-gap would cost (gap / cell)^D bytes.
+    cluster.reserve_maps(Dim::<D>::expected_r_ext(params.particles).max(growth.r_ext))?;
     let mut radius = Dim::<D>::expected_r_ext(params.particles) * first_radius();
     while growth.n < target && !halt.load(Ordering::Relaxed) {
         radius = radius.max(growth.r_ext * 1.5) + params.birth_gap;

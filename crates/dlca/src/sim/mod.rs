@@ -53,6 +53,8 @@ pub struct Simulation {
     events: Vec<SearchEvent>,
     records: Records,
     check_invariants: bool,
+    /// No cluster can move any more: see [`Simulation::is_frozen`].
+    frozen: bool,
     // Scratch buffers reused by every move.
     contacts: Vec<ItemId>,
     order: Vec<ItemId>,
@@ -104,10 +106,12 @@ impl Simulation {
             largest: a.largest,
             events: Vec::new(),
             check_invariants: false,
+            frozen: false,
             contacts: Vec::new(),
             order: Vec::new(),
         };
         sim.note_all(notes);
+        sim.update_frozen();
         Ok(sim)
     }
 
@@ -270,10 +274,40 @@ impl Simulation {
         }
     }
 
-    /// Whether the run has reached `--target-clusters` or `--max-sweeps`.
+    /// Whether the run has reached `--target-clusters` or `--max-sweeps`, or no cluster can
+    /// move any more ([`Simulation::is_frozen`]).
     pub fn is_done(&self) -> bool {
         self.clusters() <= self.params.target_clusters
             || self.params.max_sweeps.is_some_and(|m| self.sweep >= m)
+            || self.frozen
+    }
+
+    /// Whether no cluster can ever move again: the move probability `temperature * s^-gamma`
+    /// of the smallest cluster, the most mobile one, is exactly 0 in floating point (a large
+    /// `--mobility-exponent`: `2^-1100` is 0). Clusters only grow, so the state would never
+    /// change again, and a run to `--target-clusters` would sweep forever; it stops instead.
+    pub fn is_frozen(&self) -> bool {
+        self.frozen
+    }
+
+    /// The move probability of a cluster of `size` particles (docs/dlca.md, "The model", step 1).
+    fn move_probability(&self, size: usize) -> f64 {
+        if self.params.mobility_exponent == 0.0 {
+            self.params.temperature
+        } else {
+            self.params.temperature * (size as f64).powf(-self.params.mobility_exponent)
+        }
+    }
+
+    /// Recomputes [`Simulation::is_frozen`] (after a sweep: sizes only grow).
+    fn update_frozen(&mut self) {
+        let smallest = self
+            .engine
+            .live()
+            .iter()
+            .map(|&id| self.engine.len_of(id))
+            .min();
+        self.frozen = smallest.is_some_and(|s| self.move_probability(s) == 0.0);
     }
 
     /// One sweep: every cluster existing at its start, in a fresh random order, tries one move
@@ -294,6 +328,9 @@ impl Simulation {
             }
         }
         self.order = order;
+        if self.params.mobility_exponent > 0.0 {
+            self.update_frozen();
+        }
         let seconds = start.map(|t| t.elapsed().as_secs_f64());
         self.records
             .record_sweep(self.sweep, self.clusters(), self.largest, seconds);
@@ -301,13 +338,8 @@ impl Simulation {
 
     /// One cluster's turn (docs/dlca.md, "The model", steps 1-4).
     fn visit(&mut self, id: ItemId) {
-        let size = self.engine.len_of(id);
         // 1. Move with probability temperature * size^-gamma (no draw when that is 1).
-        let p = if self.params.mobility_exponent == 0.0 {
-            self.params.temperature
-        } else {
-            self.params.temperature * (size as f64).powf(-self.params.mobility_exponent)
-        };
+        let p = self.move_probability(self.engine.len_of(id));
         if p < 1.0 && uniform01(&mut self.rng) >= p {
             return;
         }
