@@ -665,6 +665,95 @@ mod tests {
     }
 
     #[test]
+    fn scan_rect_visits_exactly_the_occupied_cells_of_the_kinds_in_the_rectangle() {
+        use core_lattice::rng::{RngExt, stream};
+        let mut rng = stream(5, 0);
+        let mut c = CellIndex::default();
+        let mut occ = std::collections::BTreeMap::new();
+        // Clustered and scattered animats across tile and block edges, some far away.
+        for i in 0..3000u64 {
+            let p = if i % 10 == 0 {
+                [rng.random_range(-5000..5000), rng.random_range(-5000..5000)]
+            } else {
+                [rng.random_range(-100..100), rng.random_range(-70..90)]
+            };
+            if occ.contains_key(&p) {
+                continue;
+            }
+            let k = kind_byte(i % 3 == 0);
+            c.set(p, k, i);
+            occ.insert(p, k);
+        }
+        // Moves within and across blocks and tiles, and removals, keep the masks right.
+        let keys: Vec<[i64; 2]> = occ.keys().copied().collect();
+        for (n, p) in keys.into_iter().enumerate() {
+            if n % 4 == 0 {
+                c.clear(p);
+                occ.remove(&p);
+            } else if n % 4 == 1 {
+                let to = [
+                    p[0] + rng.random_range(-9..10),
+                    p[1] + rng.random_range(-9..10),
+                ];
+                if !occ.contains_key(&to) {
+                    c.relocate(p, to);
+                    let k = occ.remove(&p).unwrap();
+                    occ.insert(to, k);
+                }
+            }
+        }
+        for _ in 0..300 {
+            let x0 = rng.random_range(-150..150);
+            let y0 = rng.random_range(-150..150);
+            let (w, h) = if rng.random_range(0..10) == 0 {
+                (20000, 20000)
+            } else {
+                (rng.random_range(0..140), rng.random_range(0..140))
+            };
+            let kinds = rng.random_range(1..4u8);
+            let mut seen = Vec::new();
+            let _ = c.scan_rect([x0, x0 + w], [y0, y0 + h], kinds, |x, y, b| {
+                assert_eq!(
+                    b,
+                    c.tiles[c.slot([x >> SHIFT, y >> SHIFT]).unwrap() as usize].kinds[offset(x, y)]
+                );
+                seen.push([x, y]);
+                ControlFlow::Continue(())
+            });
+            seen.sort_unstable();
+            let want: Vec<[i64; 2]> = occ
+                .iter()
+                .filter(|&(p, &k)| {
+                    (x0..=x0 + w).contains(&p[0]) && (y0..=y0 + h).contains(&p[1]) && k & kinds != 0
+                })
+                .map(|(p, _)| *p)
+                .collect();
+            let mut want = want;
+            want.sort_unstable();
+            assert_eq!(seen, want, "rect {x0} {y0} {w} {h} kinds {kinds}");
+        }
+        // A break stops the scan at once; the extremes of the plane are reachable.
+        let mut n = 0;
+        let r = c.scan_rect([i64::MIN, i64::MAX], [i64::MIN, i64::MAX], 3, |_, _, _| {
+            n += 1;
+            ControlFlow::Break(())
+        });
+        assert!(r.is_break() && n == 1);
+        c.set([i64::MAX, i64::MIN], kind_byte(true), 1 << 40);
+        let mut got = Vec::new();
+        let _ = c.scan_rect(
+            [i64::MAX - 3, i64::MAX],
+            [i64::MIN, i64::MIN + 3],
+            2,
+            |x, y, _| {
+                got.push([x, y]);
+                ControlFlow::Continue(())
+            },
+        );
+        assert_eq!(got, vec![[i64::MAX, i64::MIN]]);
+    }
+
+    #[test]
     fn set_get_clear_relocate_and_windows_across_tiles() {
         let mut c = CellIndex::default();
         let pts = [[0, 0], [-1, -1], [63, 64], [64, 63], [-65, 130], [5, -200]];

@@ -111,12 +111,12 @@ impl Rings {
     }
 }
 
-/// Squared distance from `p` to `(x, y)`, saturating (beyond every `u64` limit).
+/// Squared distance from `p` to `(x, y)`, exact (it can exceed every `u64` limit).
 #[inline]
-fn dist2(p: Pos, x: i64, y: i64) -> u64 {
+fn dist2(p: Pos, x: i64, y: i64) -> u128 {
     let dx = u128::from(p[0].abs_diff(x));
     let dy = u128::from(p[1].abs_diff(y));
-    u64::try_from(dx * dx + dy * dy).unwrap_or(u64::MAX)
+    dx * dx + dy * dy
 }
 
 impl World {
@@ -154,10 +154,10 @@ impl World {
                 return;
             }
             evals += 1;
-            let d2 = dist2(p, x, y);
-            if d2 > *limit {
+            // Within the limit, so below 2^64.
+            let Some(d2) = u64::try_from(dist2(p, x, y)).ok().filter(|&d| d <= *limit) else {
                 return;
-            }
+            };
             let bucket = byte >> 2;
             let better = match &mut best {
                 None => true,
@@ -231,7 +231,7 @@ impl World {
         let mut look = |x: i64, y: i64, _: u8| {
             if [x, y] != p {
                 evals += 1;
-                if dist2(p, x, y) <= r2 {
+                if dist2(p, x, y) <= u128::from(r2) {
                     count += 1;
                     if count >= n {
                         return ControlFlow::Break(());
@@ -274,4 +274,94 @@ fn square(p: Pos, r: i128) -> ([i64; 2], [i64; 2]) {
         ]
     };
     (axis(p[0]), axis(p[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{GridBox, Params};
+    use core_lattice::rng::{RngExt, stream};
+
+    /// A world with clustered, scattered and far-flung animats (some at the `i64` limits).
+    fn scene(side: i64) -> World {
+        let p = Params {
+            foxes: 0,
+            rabbits: 0,
+            grid_box: GridBox::Side(side),
+            ..Params::default()
+        };
+        let mut w = World::empty(p, 1).unwrap();
+        let mut rng = stream(11, 0);
+        for i in 0..1500u32 {
+            let pos = match i % 20 {
+                0 => [rng.random_range(-3000..3000), rng.random_range(-3000..3000)],
+                1 if i < 200 => [
+                    i64::MAX - rng.random_range(0..40),
+                    i64::MIN + rng.random_range(0..40),
+                ],
+                _ => [rng.random_range(-60..60), rng.random_range(-60..60)],
+            };
+            let species = if i % 4 == 0 {
+                Species::Fox
+            } else {
+                Species::Rabbit
+            };
+            let _ = w.add(species, pos, 0, 0);
+        }
+        assert!(w.cell_search());
+        w
+    }
+
+    #[test]
+    fn wide_queries_equal_the_exhaustive_answers() {
+        for side in [1, 7, 60, 1 << 30] {
+            let w = scene(side);
+            let all: Vec<_> = w.animats().collect();
+            let mut rng = stream(12, side as u64);
+            for q in 0..400 {
+                // Query points on animats (their own cell is excluded) and on free cells.
+                let p = if q % 3 == 0 {
+                    [rng.random_range(-200..200), rng.random_range(-200..200)]
+                } else {
+                    all[rng.random_range(0..all.len())].pos
+                };
+                let r2: u64 = match q % 5 {
+                    0 => 2,
+                    1 => 81,
+                    2 => 3600,
+                    3 => rng.random_range(0..20_000),
+                    _ => u64::MAX,
+                };
+                let kind = if q % 2 == 0 {
+                    Species::Fox
+                } else {
+                    Species::Rabbit
+                };
+                let within = |k: Option<Species>| {
+                    all.iter()
+                        .filter(move |a| a.pos != p && k.is_none_or(|k| a.species == k))
+                        .filter(move |a| dist2(p, a.pos[0], a.pos[1]) <= u128::from(r2))
+                };
+                let want = within(Some(kind))
+                    .min_by_key(|a| (dist2(p, a.pos[0], a.pos[1]), a.id))
+                    .map(|a| a.pos);
+                let mut t = Tally::default();
+                assert_eq!(
+                    w.wide_nearest(p, kind, r2, &mut t),
+                    want,
+                    "side {side} p {p:?} r2 {r2}"
+                );
+                for k in [Some(kind), None] {
+                    let count = within(k).count();
+                    for n in [0, 1, 3, count, count + 1] {
+                        assert_eq!(
+                            w.wide_at_least(p, k, r2, n, &mut t),
+                            count >= n,
+                            "side {side} p {p:?} r2 {r2} n {n}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 }
