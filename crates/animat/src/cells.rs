@@ -24,6 +24,7 @@
 //! directory agrees with the map for every tile coordinate in its rectangle.
 
 use rustc_hash::FxHashMap;
+use std::ops::ControlFlow;
 
 /// log2 of the tile side.
 const SHIFT: u32 = 6;
@@ -53,6 +54,33 @@ struct Tile {
     kinds: Box<[u8; CELLS]>,
     ids: Box<[u64; CELLS]>,
     count: u32,
+    /// Occupied cells of each 8 x 8 block, by species (index `kind - 1`).
+    block_counts: [[u8; BLOCKS]; 2],
+    /// Bit `b` set when block `b` holds an animat of the species (same index).
+    block_masks: [u64; 2],
+}
+
+/// 8 x 8 blocks of cells in a tile.
+const BLOCKS: usize = CELLS / 64;
+
+impl Tile {
+    /// Counts an occupant of kind byte `k` (not [`FREE`]) in the block of cell offset `off`.
+    #[inline]
+    fn enter(&mut self, k: u8, off: usize) {
+        let (s, b) = (usize::from(k & SPECIES) - 1, off >> 6);
+        self.block_counts[s][b] += 1;
+        self.block_masks[s] |= 1 << b;
+    }
+
+    /// Uncounts an occupant of kind byte `k` (not [`FREE`]) in the block of cell offset `off`.
+    #[inline]
+    fn leave(&mut self, k: u8, off: usize) {
+        let (s, b) = (usize::from(k & SPECIES) - 1, off >> 6);
+        self.block_counts[s][b] -= 1;
+        if self.block_counts[s][b] == 0 {
+            self.block_masks[s] &= !(1 << b);
+        }
+    }
 }
 
 /// The cell index; see the module documentation.
@@ -235,6 +263,8 @@ impl CellIndex {
                                 .try_into()
                                 .expect("CELLS ids"),
                             count: 0,
+                            block_counts: [[0; BLOCKS]; 2],
+                            block_masks: [0; 2],
                         });
                         (self.tiles.len() - 1) as u32
                     }
@@ -248,6 +278,7 @@ impl CellIndex {
         tile.kinds[off] = k | b;
         tile.ids[off] = id;
         tile.count += 1;
+        tile.enter(k, off);
     }
 
     /// Frees cell `p` (which must be occupied).
@@ -259,6 +290,8 @@ impl CellIndex {
         };
         let tile = &mut self.tiles[t as usize];
         debug_assert_ne!(tile.kinds[off], FREE);
+        let k = tile.kinds[off];
+        tile.leave(k, off);
         tile.kinds[off] = FREE;
         tile.count -= 1;
         if tile.count == 0 {
@@ -277,7 +310,12 @@ impl CellIndex {
         if kf == kt {
             if let Some(t) = self.slot(kf) {
                 let tile = &mut self.tiles[t as usize];
-                tile.kinds[ot] = tile.kinds[of];
+                let k = tile.kinds[of];
+                if of >> 6 != ot >> 6 {
+                    tile.leave(k, of);
+                    tile.enter(k, ot);
+                }
+                tile.kinds[ot] = k;
                 tile.ids[ot] = tile.ids[of];
                 tile.kinds[of] = FREE;
                 return;
@@ -333,6 +371,118 @@ impl CellIndex {
             kinds: [t00.0, t10.0, t01.0, t11.0],
             ids: [t00.1, t10.1, t01.1, t11.1],
         })
+    }
+
+    /// Tiles in use (each holds at least one animat).
+    pub fn tiles_in_use(&self) -> usize {
+        self.map.len()
+    }
+
+    /// Calls `f(x, y, byte)` for every occupied cell `(x, y)` of the rectangle `x0..=x1`,
+    /// `y0..=y1` whose species meets `kinds` (bit 0 foxes, bit 1 rabbits: the kind bytes'
+    /// own bits), with its whole cell byte, in no particular order, until `f` breaks. Tiles
+    /// and 8 x 8 blocks without such an animat are skipped without reading their cells, so
+    /// the cost follows the occupied blocks rather than the area; a rectangle covering more
+    /// tile positions than there are tiles in use goes through the tiles in use instead.
+    pub fn scan_rect(
+        &self,
+        [x0, x1]: [i64; 2],
+        [y0, y1]: [i64; 2],
+        kinds: u8,
+        mut f: impl FnMut(i64, i64, u8) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        if x0 > x1 || y0 > y1 || kinds & SPECIES == 0 {
+            return ControlFlow::Continue(());
+        }
+        let (tx0, tx1, ty0, ty1) = (x0 >> SHIFT, x1 >> SHIFT, y0 >> SHIFT, y1 >> SHIFT);
+        let span =
+            (i128::from(tx1) - i128::from(tx0) + 1) * (i128::from(ty1) - i128::from(ty0) + 1);
+        let rect = Rect {
+            x0,
+            x1,
+            y0,
+            y1,
+            kinds,
+        };
+        if span > self.map.len() as i128 {
+            for (&[tx, ty], &t) in &self.map {
+                if (tx0..=tx1).contains(&tx) && (ty0..=ty1).contains(&ty) {
+                    self.scan_tile(t, [tx, ty], &rect, &mut f)?;
+                }
+            }
+        } else {
+            for ty in ty0..=ty1 {
+                for tx in tx0..=tx1 {
+                    if let Some(t) = self.slot([tx, ty]) {
+                        self.scan_tile(t, [tx, ty], &rect, &mut f)?;
+                    }
+                }
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    /// [`CellIndex::scan_rect`] within tile `t` at tile coordinates `key`, which must meet the
+    /// rectangle.
+    fn scan_tile(
+        &self,
+        t: u32,
+        key: [i64; 2],
+        r: &Rect,
+        f: &mut impl FnMut(i64, i64, u8) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        let tile = &self.tiles[t as usize];
+        // `key` is some cell's coordinates shifted right, so shifting back cannot overflow,
+        // nor can adding TILE - 1; the rectangle meets the tile, so the local bounds lie in
+        // 0..TILE.
+        let (ox, oy) = (key[0] << SHIFT, key[1] << SHIFT);
+        let lx0 = (r.x0.max(ox) - ox) as usize;
+        let lx1 = (r.x1.min(ox + (TILE - 1)) - ox) as usize;
+        let ly0 = (r.y0.max(oy) - oy) as usize;
+        let ly1 = (r.y1.min(oy + (TILE - 1)) - oy) as usize;
+        let mut m = 0;
+        if r.kinds & 1 != 0 {
+            m |= tile.block_masks[0];
+        }
+        if r.kinds & 2 != 0 {
+            m |= tile.block_masks[1];
+        }
+        // Only the blocks that meet the rectangle.
+        let cols = ((1u64 << ((lx1 >> 3) - (lx0 >> 3) + 1)) - 1) << (lx0 >> 3);
+        let mut within = 0u64;
+        for br in (ly0 >> 3)..=(ly1 >> 3) {
+            within |= cols << (8 * br);
+        }
+        m &= within;
+        const LOW: u64 = 0x0101_0101_0101_0101;
+        while m != 0 {
+            let b = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let (bx, by) = ((b & 7) * 8, (b >> 3) * 8);
+            // Bit 0 of the bytes of the block row's cells within the rectangle.
+            let (c0, c1) = (lx0.max(bx) - bx, lx1.min(bx + 7) - bx);
+            let cmask = (u64::MAX >> (8 * (7 - c1))) & (u64::MAX << (8 * c0)) & LOW;
+            for ly in ly0.max(by)..=ly1.min(by + 7) {
+                let o = (b << 6) | ((ly & 7) << 3);
+                let w = u64::from_le_bytes(
+                    tile.kinds[o..o + 8]
+                        .try_into()
+                        .expect("a block row is 8 bytes"),
+                );
+                let sel = match r.kinds & SPECIES {
+                    1 => w,
+                    2 => w >> 1,
+                    _ => w | w >> 1,
+                };
+                let mut hits = sel & cmask;
+                while hits != 0 {
+                    let i = (hits.trailing_zeros() / 8) as usize;
+                    hits &= hits - 1;
+                    f(ox + (bx + i) as i64, oy + ly as i64, (w >> (8 * i)) as u8)?;
+                }
+            }
+        }
+        ControlFlow::Continue(())
     }
 
     /// Asks the CPU to start loading the cell bytes [`Window::rows`] reads first around `p`
@@ -395,6 +545,15 @@ fn near_corners(p: [i64; 2]) -> [[i64; 2]; 4] {
         clamp(p[1].saturating_add(2), p[1]),
     );
     [[x0, y0], [x1, y0], [x0, y1], [x1, y1]]
+}
+
+/// The rectangle and species of a [`CellIndex::scan_rect`].
+struct Rect {
+    x0: i64,
+    x1: i64,
+    y0: i64,
+    y1: i64,
+    kinds: u8,
 }
 
 static EMPTY_KINDS: [u8; CELLS] = [FREE; CELLS];
@@ -517,6 +676,95 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn scan_rect_visits_exactly_the_occupied_cells_of_the_kinds_in_the_rectangle() {
+        use core_lattice::rng::{RngExt, stream};
+        let mut rng = stream(5, 0);
+        let mut c = CellIndex::default();
+        let mut occ = std::collections::BTreeMap::new();
+        // Clustered and scattered animats across tile and block edges, some far away.
+        for i in 0..3000u64 {
+            let p = if i % 10 == 0 {
+                [rng.random_range(-5000..5000), rng.random_range(-5000..5000)]
+            } else {
+                [rng.random_range(-100..100), rng.random_range(-70..90)]
+            };
+            if occ.contains_key(&p) {
+                continue;
+            }
+            let k = kind_byte(i % 3 == 0);
+            c.set(p, k, i);
+            occ.insert(p, k);
+        }
+        // Moves within and across blocks and tiles, and removals, keep the masks right.
+        let keys: Vec<[i64; 2]> = occ.keys().copied().collect();
+        for (n, p) in keys.into_iter().enumerate() {
+            if n % 4 == 0 {
+                c.clear(p);
+                occ.remove(&p);
+            } else if n % 4 == 1 {
+                let to = [
+                    p[0] + rng.random_range(-9..10),
+                    p[1] + rng.random_range(-9..10),
+                ];
+                if !occ.contains_key(&to) {
+                    c.relocate(p, to);
+                    let k = occ.remove(&p).unwrap();
+                    occ.insert(to, k);
+                }
+            }
+        }
+        for _ in 0..300 {
+            let x0 = rng.random_range(-150..150);
+            let y0 = rng.random_range(-150..150);
+            let (w, h) = if rng.random_range(0..10) == 0 {
+                (20000, 20000)
+            } else {
+                (rng.random_range(0..140), rng.random_range(0..140))
+            };
+            let kinds = rng.random_range(1..4u8);
+            let mut seen = Vec::new();
+            let _ = c.scan_rect([x0, x0 + w], [y0, y0 + h], kinds, |x, y, b| {
+                assert_eq!(
+                    b,
+                    c.tiles[c.slot([x >> SHIFT, y >> SHIFT]).unwrap() as usize].kinds[offset(x, y)]
+                );
+                seen.push([x, y]);
+                ControlFlow::Continue(())
+            });
+            seen.sort_unstable();
+            let want: Vec<[i64; 2]> = occ
+                .iter()
+                .filter(|&(p, &k)| {
+                    (x0..=x0 + w).contains(&p[0]) && (y0..=y0 + h).contains(&p[1]) && k & kinds != 0
+                })
+                .map(|(p, _)| *p)
+                .collect();
+            let mut want = want;
+            want.sort_unstable();
+            assert_eq!(seen, want, "rect {x0} {y0} {w} {h} kinds {kinds}");
+        }
+        // A break stops the scan at once; the extremes of the plane are reachable.
+        let mut n = 0;
+        let r = c.scan_rect([i64::MIN, i64::MAX], [i64::MIN, i64::MAX], 3, |_, _, _| {
+            n += 1;
+            ControlFlow::Break(())
+        });
+        assert!(r.is_break() && n == 1);
+        c.set([i64::MAX, i64::MIN], kind_byte(true), 1 << 40);
+        let mut got = Vec::new();
+        let _ = c.scan_rect(
+            [i64::MAX - 3, i64::MAX],
+            [i64::MIN, i64::MIN + 3],
+            2,
+            |x, y, _| {
+                got.push([x, y]);
+                ControlFlow::Continue(())
+            },
+        );
+        assert_eq!(got, vec![[i64::MAX, i64::MIN]]);
     }
 
     #[test]

@@ -296,7 +296,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     tracing::info!(
         foxes = world.foxes(),
         rabbits = world.rabbits(),
-        grid = %world.grid().box_size(),
+        grid = %world.box_size(),
         "start"
     );
     let save = |world: &World, rows: &[PopulationRow]| -> anyhow::Result<()> {

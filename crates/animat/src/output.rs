@@ -220,7 +220,7 @@ pub fn manifest(world: &World, seed: u64, clock: &RunClock) -> Result<RunManifes
         .set_result("rabbits", world.rabbits())
         .set_result("state_hash", world.state_hash())
         .set_result("distance_evaluations", world.distance_evals())
-        .set_result("grid_box", world.grid().box_size().to_string())
+        .set_result("grid_box", world.box_size().to_string())
         .set_result(
             "queries",
             serde_json::json!({"adjacent": q.adjacent, "nearest": q.nearest, "count": q.count}),

@@ -50,7 +50,7 @@ pub fn measure(animats: u64, grid: GridBox, cells: bool, steps: u64, seed: u64) 
     world.set_timing(true);
     world.set_cell_search(cells);
     let (mut pop, mut search, mut evals) = (0.0, 0.0, 0.0);
-    let scanned_before = world.grid().stats().items_scanned;
+    let scanned_before = world.grid().map_or(0, |g| g.stats().items_scanned);
     let start = std::time::Instant::now();
     for _ in 0..steps {
         pop += (world.foxes() + world.rabbits()) as f64;
@@ -58,7 +58,7 @@ pub fn measure(animats: u64, grid: GridBox, cells: bool, steps: u64, seed: u64) 
         search += s.search_seconds;
         evals += s.distance_evals as f64;
     }
-    let scanned = (world.grid().stats().items_scanned - scanned_before) as f64;
+    let scanned = (world.grid().map_or(0, |g| g.stats().items_scanned) - scanned_before) as f64;
     let n = steps as f64;
     Ok(Point {
         population: pop / n,

@@ -14,11 +14,14 @@
 //! - `checkpoint`: the [`Snapshot`] of a world between steps and its exact restore;
 //! - `tests`: hand-built scenes.
 //!
-//! Invariants between steps: `recs` holds exactly the live animats, sorted by id, with
-//! `flags` parallel to it and no `DEAD` bit set; every live animat stands alone on its cell
-//! in `cells` and is in `grid` at that cell (`pending` is empty); `foxes` and `rabbits` count
-//! the live animats; every id is below `next_id` and none is reused. During a step `grid` may
-//! lag behind `cells` by the changes logged in `pending` (see `step`).
+//! Invariants between steps: `ranks` lists exactly the live animats in id order, each as the
+//! index of its record in `recs` (with `flags` parallel to `recs`; records of the animats that
+//! died in the last step may remain there, with their `DEAD` bit set, until the next step
+//! drops them), and `ids` holds their ids in the same order (strictly increasing); every live
+//! animat stands alone on its cell in `cells` and is in `grid` at that cell (`pending` is
+//! empty); `foxes` and `rabbits` count the live animats; every id is below `next_id` and none
+//! is reused. During a step `grid` may lag behind `cells` by the changes logged in `pending`
+//! (see `step`).
 
 mod checkpoint;
 mod near;
@@ -27,6 +30,7 @@ mod rules;
 mod step;
 #[cfg(test)]
 mod tests;
+mod wide;
 
 use crate::cells::{CellIndex, WINDOW_MAX, kind_byte};
 use crate::params::{ANIMAT_BYTES, FoxRule, MAX_ANIMATS, Params, ParamsError, RabbitRule, Species};
@@ -35,8 +39,7 @@ pub use crate::cells::{TILE, TILE_BYTES};
 use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
 use near::{NEAR_ROWS, disc_mask};
-use rustc_hash::FxHashSet;
-use spatial::plane::{PlaneError, PlaneGrid, Pos};
+use spatial::plane::{BoxSize, PlaneError, PlaneGrid, Pos};
 
 pub use checkpoint::Snapshot;
 
@@ -82,7 +85,7 @@ pub struct Animat {
 }
 
 /// The stored state of an animat apart from its species and liveness (kept in
-/// [`World::flags`]): 32 bytes, half a cache line.
+/// `World::flags`): 32 bytes, half a cache line.
 #[derive(Debug, Clone, Copy)]
 struct Rec {
     pos: Pos,
@@ -137,6 +140,9 @@ pub enum WorldError {
     /// An error of the search structure.
     #[error(transparent)]
     Plane(#[from] PlaneError),
+    /// More animat records than a `u32` index can address.
+    #[error("too many animats: at most {} records", u32::MAX)]
+    TooMany,
 }
 
 /// Counters of one step.
@@ -176,20 +182,27 @@ pub struct World {
     /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see
     /// [`Near::rows`](near::Near::rows)), when `crowd_radius <= 2`.
     crowd_masks: [u64; NEAR_ROWS],
-    /// Live animats (and, during a step, the ones that died in it and the newborns), sorted
-    /// by id. During a step the records of the animats alive at its start are stale: their
-    /// current state is in `hot`, and is copied back at the end of the step.
+    /// The animats' records in the order of the last step's turns, then the animats born in
+    /// it (in id order); during a step, in the order of its turns, then its newborns. Records
+    /// of dead animats stay (with [`DEAD`] set) until the next step's gather drops them.
     recs: Vec<Rec>,
     /// [`RABBIT`] and [`DEAD`] bits of each record of `recs` (same index).
     flags: Vec<u8>,
-    /// Ids of the rabbits eaten in the current step (their records are dead, though their
-    /// [`DEAD`] bits are not set: finding a record by id would cost a search).
-    eaten: FxHashSet<u64>,
-    /// During a step: the records of the animats alive at its start, in visiting order
-    /// (`hot[j]` is `recs[order[j]]`).
-    hot: Vec<Rec>,
-    /// During a step: the flags of `hot` (`hot_flags[j]` is `flags[order[j]]` at the start).
-    hot_flags: Vec<u8>,
+    /// The live animats in id order, as indices into `recs` (during a step: the animats alive
+    /// at its start, as indices into the previous step's `recs`, until the step's end).
+    ranks: Vec<u32>,
+    /// The ids of `ranks` (same order, so strictly increasing).
+    ids: Vec<u64>,
+    /// During a step: where each animat of `ranks` takes its turn (`inv[k]` is the index in
+    /// `recs` of the animat of rank `k`).
+    inv: Vec<u32>,
+    /// Reused buffers: the records and flags of the previous order while a step gathers them.
+    spare_recs: Vec<Rec>,
+    spare_flags: Vec<u8>,
+    /// During a step: the number of animats alive at its start and the first id born in it
+    /// (newborn `id` has record `born_at + (id - first_born)`).
+    born_at: usize,
+    first_born: u64,
     next_id: u64,
     steps: u64,
     order_rng: SimRng,
@@ -235,7 +248,7 @@ impl World {
             rabbit_rules,
             vision2: v * v,
             crowd2: c * c,
-            cell_search: grid.box_size() != spatial::plane::BoxSize::None,
+            cell_search: grid.box_size() != BoxSize::None,
             grid,
             pending: Vec::new(),
             cells: CellIndex::default(),
@@ -254,9 +267,13 @@ impl World {
             crowd_masks: disc_mask(1, (c * c) as i64),
             recs: Vec::new(),
             flags: Vec::new(),
-            eaten: FxHashSet::default(),
-            hot: Vec::new(),
-            hot_flags: Vec::new(),
+            ranks: Vec::new(),
+            ids: Vec::new(),
+            inv: Vec::new(),
+            spare_recs: Vec::new(),
+            spare_flags: Vec::new(),
+            born_at: 0,
+            first_born: 0,
             next_id: 0,
             steps: 0,
             order_rng: stream(seed, stream_id(STREAM_ORDER, 0)),
@@ -328,8 +345,20 @@ impl World {
         hunger: u32,
     ) -> Result<u64, WorldError> {
         let id = self.add_deferred(species, pos, age, hunger)?;
+        // `add_deferred` keeps the record count within u32.
+        self.ranks.push((self.recs.len() - 1) as u32);
+        self.ids.push(id);
         self.flush_grid();
         Ok(id)
+    }
+
+    /// Logs a change for the grid, which is kept only while the cell search is off (with it
+    /// on, every query is answered from the cell index).
+    #[inline]
+    fn log(&mut self, op: GridOp) {
+        if !self.cell_search {
+            self.pending.push(op);
+        }
     }
 
     /// Brings the grid up to date with the changes logged in `pending`, in order.
@@ -352,7 +381,8 @@ impl World {
         }
     }
 
-    /// [`World::add`], with the grid's insertion logged in `pending`.
+    /// [`World::add`], with the grid's insertion logged in `pending` and without listing the
+    /// animat in `ranks` (a newborn is listed at the end of its birth step).
     fn add_deferred(
         &mut self,
         species: Species,
@@ -363,8 +393,11 @@ impl World {
         if self.cells.occupied(pos) {
             return Err(WorldError::Occupied(pos));
         }
+        if self.recs.len() >= u32::MAX as usize {
+            return Err(WorldError::TooMany);
+        }
         let id = self.next_id;
-        self.pending.push(GridOp::Insert(id, pos, species));
+        self.log(GridOp::Insert(id, pos, species));
         self.cells
             .set(pos, kind_byte(species == Species::Rabbit), id);
         self.next_id += 1;
@@ -413,25 +446,27 @@ impl World {
 
     /// Live animats, sorted by id (between steps).
     pub fn animats(&self) -> impl Iterator<Item = Animat> + '_ {
-        (0..self.recs.len()).filter_map(|i| self.animat_at(i))
+        self.ranks.iter().map(|&i| self.animat_at(i as usize))
     }
 
     /// A live animat by id.
     pub fn get(&self, id: u64) -> Option<Animat> {
-        self.index_of(id).and_then(|i| self.animat_at(i))
+        let k = self.ids.binary_search(&id).ok()?;
+        Some(self.animat_at(self.ranks[k] as usize))
     }
 
-    /// The animat of record `i`, if alive (between steps).
-    fn animat_at(&self, i: usize) -> Option<Animat> {
+    /// The animat of record `i`.
+    fn animat_at(&self, i: usize) -> Animat {
         let f = self.flags[i];
         let r = self.recs[i];
-        (f & DEAD == 0).then_some(Animat {
+        debug_assert_eq!(f & DEAD, 0);
+        Animat {
             id: r.id,
             species: species_of(f),
             pos: r.pos,
             age: r.age,
             hunger: r.hunger,
-        })
+        }
     }
 
     /// Perception queries asked so far.
@@ -439,11 +474,19 @@ impl World {
         self.queries
     }
 
-    /// The search structure (for work counters and diagnostics). It is built with
+    /// The grid boxes, while they are kept: with the cell search off (the grid-boxing paper's
+    /// structure, and the exhaustive `none` mode). With the cell search on every query is
+    /// answered from the cell index and there is no grid to maintain. The grid is built with
     /// [`PlaneGrid::without_cell_counts`] (the world's own cell index answers "is this cell
     /// free"), so its `is_occupied` scans a box rather than doing one lookup.
-    pub fn grid(&self) -> &PlaneGrid<Species> {
-        &self.grid
+    pub fn grid(&self) -> Option<&PlaneGrid<Species>> {
+        (!self.cell_search).then_some(&self.grid)
+    }
+
+    /// The grid-box size: of the grid boxes with the cell search off, and of the boxes the
+    /// wide cell-index queries visit with it on.
+    pub fn box_size(&self) -> BoxSize {
+        self.grid.box_size()
     }
 
     /// Distance evaluations of the search structure since the start.
@@ -465,7 +508,23 @@ impl World {
     /// off measures the grid boxes alone (the paper's structure: Hawick, James & Scogings 2006,
     /// section III).
     pub fn set_cell_search(&mut self, on: bool) {
-        self.cell_search = on && self.grid.box_size() != spatial::plane::BoxSize::None;
+        let on = on && self.grid.box_size() != BoxSize::None;
+        if on == self.cell_search {
+            return;
+        }
+        self.flush_grid();
+        self.total_distance_evals += self.grid.take_distance_evals();
+        self.cell_search = on;
+        self.grid = PlaneGrid::without_cell_counts(self.grid.box_size())
+            .expect("the box size of an existing grid");
+        if !on {
+            for i in 0..self.ranks.len() {
+                let a = self.animat_at(self.ranks[i] as usize);
+                self.grid
+                    .insert(a.id, a.pos, a.species)
+                    .expect("ids are unique");
+            }
+        }
     }
 
     /// Measure the wall time of perception queries (`--timing`); off by default because the
@@ -509,14 +568,10 @@ impl World {
         (self.recs.len() as u64) < self.animat_limit
     }
 
-    fn index_of(&self, id: u64) -> Option<usize> {
-        self.recs.binary_search_by_key(&id, |a| a.id).ok()
-    }
-
     /// Runs `n` steps (stopping early if every animat has died).
     pub fn run(&mut self, n: u64) {
         for _ in 0..n {
-            if self.recs.is_empty() {
+            if self.ranks.is_empty() {
                 break;
             }
             self.step();

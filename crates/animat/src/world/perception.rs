@@ -91,6 +91,9 @@ impl World {
             }
             return None;
         }
+        if self.cell_search {
+            return self.wide_nearest(a.pos, kind, ADJACENT_R2, t);
+        }
         if self.stale(t) {
             return None;
         }
@@ -111,6 +114,9 @@ impl World {
             let found = DIRECTIONS.iter().any(|d| row_cell(rows, d[0], d[1]) == kb);
             t.evals += u64::from(found);
             return found;
+        }
+        if self.cell_search {
+            return self.wide_at_least(a.pos, Some(kind), ADJACENT_R2, 1, t);
         }
         if self.stale(t) {
             return false;
@@ -199,6 +205,9 @@ impl World {
             }
             t.evals += evals;
         }
+        if self.cell_search {
+            return self.wide_nearest(a.pos, kind, self.vision2, t);
+        }
         if self.stale(t) {
             return None;
         }
@@ -246,6 +255,9 @@ impl World {
                 return count >= n;
             }
         }
+        if self.cell_search {
+            return self.wide_at_least(a.pos, None, self.crowd2, n, t);
+        }
         if self.stale(t) {
             return false;
         }
@@ -285,6 +297,9 @@ impl World {
             if found || k_max == self.params.vision {
                 return found;
             }
+        }
+        if self.cell_search {
+            return self.wide_at_least(a.pos, Some(Species::Rabbit), self.vision2, n, t);
         }
         if self.stale(t) {
             return false;

@@ -197,7 +197,7 @@ impl World {
         if !self.is_free(to, d, rows) {
             return;
         }
-        self.pending.push(GridOp::Move(a.id, to));
+        self.log(GridOp::Move(a.id, to));
         self.cells.relocate(a.pos, to);
         a.pos = to;
     }
@@ -216,13 +216,10 @@ impl World {
                 self.try_step(a, d, rows);
             }
             Action::Eat(pos) => {
-                // The rabbit's record is found (and dropped) at the end of the step; until
-                // then the set of eaten ids marks it dead.
+                // Marked dead, the rabbit does not act if its turn is still to come.
                 let rabbit = self.cells.id(pos);
-                self.eaten.insert(rabbit);
-                self.rabbits -= 1;
-                self.pending.push(GridOp::Remove(rabbit));
-                self.cells.clear(pos);
+                let k = self.record_of(rabbit);
+                self.kill(k, rabbit, pos);
                 a.hunger = 0;
             }
             Action::Breed => {
@@ -246,7 +243,7 @@ impl World {
                 if n > 0 && self.may_give_birth() {
                     let c = free[self.action_rng.random_range(0..n)];
                     self.add_deferred(a.species, c, 0, 0)
-                        .expect("the birth cell was free");
+                        .expect("a birth on a free cell, within the record limit");
                 }
             }
         }

@@ -1,13 +1,13 @@
 //! One step of the world ([`World::step`]): the visiting order, each turn (decide, apply, age,
-//! die), and the end of the step (records copied back, dead and eaten animats dropped, grid
-//! brought up to date), plus the re-spreading of the cell index's id buckets between steps.
+//! die), and the end of the step (the live animats listed in id order again, the grid brought
+//! up to date), plus the re-spreading of the cell index's id buckets between steps.
 //!
 //! Invariants: every animat alive at the start of a step acts exactly once unless eaten before
 //! its turn, in the order drawn from the order stream; newborns do not act in their birth
-//! step; an animat's `DEAD` bit is set only in its own turn; at the end of the step the
-//! world's between-steps invariants (see the parent module) hold again.
+//! step; an animat's `DEAD` bit is set in its own turn or when it is eaten; at the end of the
+//! step the world's between-steps invariants (see the parent module) hold again.
 
-use super::{Animat, DEAD, GridOp, RABBIT, Rec, StepStats, World, species_of};
+use super::{Animat, DEAD, GridOp, Rec, StepStats, World, species_of};
 use crate::params::Species;
 use core_lattice::rng::shuffle;
 use spatial::plane::Pos;
@@ -27,31 +27,23 @@ impl World {
         let evals_before = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
         self.total_distance_evals += evals_before;
         self.search_seconds = 0.0;
-        let n = self.recs.len();
+        let n = self.ranks.len();
         self.maybe_rebucket(n);
         let mut order = std::mem::take(&mut self.order);
         order.clear();
         order.extend(0..n as u32);
         shuffle(&mut self.order_rng, &mut order);
-        // The visiting order is random, so reading each turn's record where it is stored (id
-        // order) would start every turn with a cache miss that nothing overlaps. Copying the
-        // records into visiting order first is a loop of independent loads that the CPU
-        // overlaps; the turns then read their records in sequence.
-        let mut hot = std::mem::take(&mut self.hot);
-        hot.clear();
-        hot.extend(order.iter().map(|&k| self.recs[k as usize]));
-        let mut hot_flags = std::mem::take(&mut self.hot_flags);
-        hot_flags.clear();
-        hot_flags.extend(order.iter().map(|&k| self.flags[k as usize]));
+        self.gather(&mut order);
+        self.order = order;
+        self.born_at = n;
+        self.first_born = self.next_id;
         for j in 0..n {
-            let f = hot_flags[j];
-            let r = hot[j];
-            // An animat dies in its own turn or is eaten (listed in `eaten`): the DEAD bit of
-            // one that has not acted yet is never set.
-            debug_assert_eq!(self.flags[order[j] as usize] & DEAD, 0);
-            if f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&r.id) {
+            let f = self.flags[j];
+            // Eaten before its turn.
+            if f & DEAD != 0 {
                 continue;
             }
+            let r = self.recs[j];
             let mut a = Animat {
                 id: r.id,
                 species: species_of(f),
@@ -62,7 +54,8 @@ impl World {
             // The turns' positions are known ahead (an animat moves only in its own turn), so
             // the cells a later turn reads first are asked for now: their misses overlap this
             // turn's work instead of stalling that one's. Part of the search, so timed with it.
-            let ahead = hot
+            let ahead = self
+                .recs
                 .get(j + PREFETCH_TURNS)
                 .filter(|_| self.cell_search)
                 .map(|r| r.pos);
@@ -82,34 +75,15 @@ impl World {
                 self.decide_near(&a)
             };
             self.apply(&mut a, action, rows.as_ref());
-            self.age_and_die(order[j] as usize, &mut a);
-            hot[j] = Rec {
+            self.age_and_die(j, &mut a);
+            self.recs[j] = Rec {
                 pos: a.pos,
                 id: a.id,
                 age: a.age,
                 hunger: a.hunger,
             };
         }
-        self.hot_flags = hot_flags;
-        for (&k, r) in order.iter().zip(&hot) {
-            self.recs[k as usize] = *r;
-        }
-        self.order = order;
-        self.hot = hot;
-        let mut w = 0;
-        for i in 0..self.recs.len() {
-            let f = self.flags[i];
-            let eaten =
-                f & RABBIT != 0 && !self.eaten.is_empty() && self.eaten.contains(&self.recs[i].id);
-            if f & DEAD == 0 && !eaten {
-                self.recs[w] = self.recs[i];
-                self.flags[w] = f;
-                w += 1;
-            }
-        }
-        self.recs.truncate(w);
-        self.flags.truncate(w);
-        self.eaten.clear();
+        self.relist(n);
         self.steps += 1;
         self.flush_grid();
         let evals = self.grid.take_distance_evals() + std::mem::take(&mut self.cell_evals);
@@ -120,16 +94,79 @@ impl World {
         }
     }
 
+    /// Puts the records and flags of the live animats into visiting order (`recs[j]` is the
+    /// animat of rank `order[j]`) and notes where each rank went (`inv`); `order` is left
+    /// holding the records' previous indices. The visiting order is random, so reading each
+    /// turn's record where it was stored would start every turn with a cache miss that
+    /// nothing overlaps; the gathering loops' loads are independent, and the CPU overlaps
+    /// them. Records of animats that died in the last step are left behind.
+    fn gather(&mut self, order: &mut [u32]) {
+        let n = order.len();
+        self.inv.clear();
+        self.inv.resize(n, 0);
+        for (j, k) in order.iter_mut().enumerate() {
+            self.inv[*k as usize] = j as u32;
+            *k = self.ranks[*k as usize];
+        }
+        // Room for the newborns of a step without reallocating in it, as a rule.
+        let room = n + n / 8 + 16;
+        let mut recs = std::mem::take(&mut self.spare_recs);
+        recs.clear();
+        recs.reserve(room);
+        recs.extend(order.iter().map(|&i| self.recs[i as usize]));
+        let mut flags = std::mem::take(&mut self.spare_flags);
+        flags.clear();
+        flags.reserve(room);
+        flags.extend(order.iter().map(|&i| self.flags[i as usize]));
+        self.spare_recs = std::mem::replace(&mut self.recs, recs);
+        self.spare_flags = std::mem::replace(&mut self.flags, flags);
+    }
+
+    /// At the end of a step: lists the live animats in id order again, those alive at the
+    /// start (`n` of them, still in `ranks` and `ids`) and then the newborns.
+    fn relist(&mut self, n: usize) {
+        let mut w = 0;
+        for k in 0..n {
+            let j = self.inv[k];
+            if self.flags[j as usize] & DEAD == 0 {
+                self.ranks[w] = j;
+                self.ids[w] = self.ids[k];
+                w += 1;
+            }
+        }
+        self.ranks.truncate(w);
+        self.ids.truncate(w);
+        for j in n..self.recs.len() {
+            if self.flags[j] & DEAD == 0 {
+                // `add_deferred` keeps the record count within u32.
+                self.ranks.push(j as u32);
+                self.ids.push(self.recs[j].id);
+            }
+        }
+    }
+
+    /// During a step: the record of the live animat `id` (alive at the step's start or born
+    /// in it).
+    pub(super) fn record_of(&self, id: u64) -> usize {
+        if id >= self.first_born {
+            return self.born_at + (id - self.first_born) as usize;
+        }
+        let k = self
+            .ids
+            .binary_search(&id)
+            .expect("a live animat is listed");
+        self.inv[k] as usize
+    }
+
     /// Spreads the id buckets of the cell bytes
     /// ([`CellIndex::bucket`](crate::cells::CellIndex::bucket)) over the ids that can be alive
-    /// during the next step (the live ones, sorted in `recs`, and at most `n` newborns) when the
+    /// during the next step (the live ones, sorted in `ids`, and at most `n` newborns) when the
     /// top bucket could overflow or the lower half of the buckets has gone unused. Buckets only
     /// speed up tie-breaks; any non-decreasing map gives the same answers.
     fn maybe_rebucket(&mut self, n: usize) {
-        let Some(first) = self.recs.first() else {
+        let Some(&lo) = self.ids.first() else {
             return;
         };
-        let lo = first.id;
         let hi = self.next_id.saturating_add(n as u64);
         let (base, shift) = self.cells.bucket_range();
         let wasted = lo.saturating_sub(base) >> shift >= 32;
@@ -142,12 +179,19 @@ impl World {
         while span >> s > 47 {
             s += 1;
         }
-        self.cells
-            .rebucket(lo, s, self.recs.iter().map(|r| (r.pos, r.id)));
+        let recs = &self.recs;
+        self.cells.rebucket(
+            lo,
+            s,
+            self.ranks.iter().map(|&i| {
+                let r = &recs[i as usize];
+                (r.pos, r.id)
+            }),
+        );
     }
 
     /// Marks record `k` (animat `id` on cell `pos`) dead and takes it off the plane.
-    fn kill(&mut self, k: usize, id: u64, pos: Pos) {
+    pub(super) fn kill(&mut self, k: usize, id: u64, pos: Pos) {
         let f = self.flags[k];
         if f & DEAD != 0 {
             return;
@@ -157,7 +201,7 @@ impl World {
             Species::Fox => self.foxes -= 1,
             Species::Rabbit => self.rabbits -= 1,
         }
-        self.pending.push(GridOp::Remove(id));
+        self.log(GridOp::Remove(id));
         self.cells.clear(pos);
     }
 

@@ -29,6 +29,29 @@ fn world(p: Params) -> World {
     World::empty(p, 1).unwrap()
 }
 
+/// Checks that the cell index (and the grid, when kept) hold exactly the live animats, each
+/// on its cell, and that the id lists are in order.
+fn check_consistent(w: &World) {
+    let live: Vec<Animat> = w.animats().collect();
+    assert!(w.ids.windows(2).all(|p| p[0] < p[1]));
+    assert_eq!(w.ids.len(), live.len());
+    assert_eq!(w.cells.len(), live.len());
+    for a in &live {
+        assert_eq!(w.cells.kind(a.pos), kind_byte(a.species == Rabbit));
+        assert_eq!(w.cells.id(a.pos), a.id);
+    }
+    match w.grid() {
+        Some(g) => {
+            g.validate().unwrap();
+            assert_eq!(g.len(), live.len());
+            for a in &live {
+                assert_eq!(g.get(a.id), Some((a.pos, a.species)));
+            }
+        }
+        None => assert!(w.cell_search()),
+    }
+}
+
 fn only(rules_f: &[&str], rules_r: &[&str]) -> Params {
     Params {
         fox_rules: rules_f.iter().map(|s| s.to_string()).collect(),
@@ -63,7 +86,8 @@ fn eat_removes_the_rabbit_and_resets_hunger() {
     assert_eq!(w.rabbits(), 0);
     // Hunger reset to 0 by eating, then +1 at the end of the turn.
     assert_eq!(w.get(f).unwrap().hunger, 1);
-    assert!(!w.grid().is_occupied([1, 0]));
+    assert!(!w.cells.occupied([1, 0]));
+    check_consistent(&w);
     // A fox that is not hungry does not eat.
     let mut w = world(only(&["eat"], &[]));
     w.add(Fox, [0, 0], 0, 4).unwrap();
@@ -94,12 +118,12 @@ fn an_eaten_rabbit_does_not_act() {
                 assert_eq!(w.rabbits(), 0);
                 assert_eq!(w.animats().count(), 1);
                 for c in [[1, 0], [2, 0]] {
-                    assert!(!w.grid().is_occupied(c), "seed {seed}: {c:?} occupied");
+                    assert!(!w.cells.occupied(c), "seed {seed}: {c:?} occupied");
                 }
                 eaten += 1;
             }
         }
-        w.grid().validate().unwrap();
+        check_consistent(&w);
     }
     assert!(fled > 0 && eaten > 0, "fled {fled}, eaten {eaten}");
 }
@@ -425,5 +449,5 @@ fn start_is_on_distinct_cells_in_the_disc() {
     cells.sort();
     cells.dedup();
     assert_eq!(cells.len() as u64, p.foxes + p.rabbits);
-    w.grid().validate().unwrap();
+    check_consistent(&w);
 }

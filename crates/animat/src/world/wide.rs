@@ -1,0 +1,367 @@
+//! Wide queries: the neighbour queries that the cell rings around the animat cannot settle
+//! (a radius beyond the rings, few animats of the wanted kind nearby, or an animat too near
+//! the `i64` limits for a window), answered exactly from the cell index with the grid-box
+//! search of Hawick, James & Scogings (2006), section II.B: the boxes of side `A` in rings
+//! outward from the query's box, stopping once no nearer animat can exist. A box's animats
+//! are read from the cell index ([`CellIndex::scan_rect`](crate::cells::CellIndex::scan_rect)),
+//! which skips empty tiles and blocks, so no list per box has to be kept up to date as the
+//! animats move: with the cell search on, the world maintains no other structure.
+//!
+//! Invariants: every cell within the radius is examined unless the answer is already known
+//! (a count reached, or every remaining cell farther than the best found), the query's own
+//! cell is never counted, and the nearest is the minimum of `(squared distance, id)`, so the
+//! answers equal the grid boxes' and the exhaustive scan's for every box size.
+
+use super::World;
+use super::perception::Tally;
+use crate::cells::{SPECIES, kind_byte};
+use crate::params::Species;
+use spatial::plane::Pos;
+use std::ops::ControlFlow;
+
+/// The species bits of [`CellIndex::scan_rect`](crate::cells::CellIndex::scan_rect) for a
+/// query of `kind` (`None`: both).
+fn kind_bits(kind: Option<Species>) -> u8 {
+    kind.map_or(SPECIES, |k| kind_byte(k == Species::Rabbit))
+}
+
+/// The rings of grid boxes around a query point, as the search visits them.
+struct Rings {
+    /// Box side.
+    a: i128,
+    /// The query point and its box.
+    p: [i128; 2],
+    b: [i128; 2],
+    /// Cells from the point to the nearest edge of its box, plus one: every cell of ring
+    /// `k >= 1` is at least `(k - 1) a + edge` away along some axis.
+    edge: i128,
+}
+
+impl Rings {
+    fn new(a: i64, p: Pos) -> Self {
+        let a = i128::from(a);
+        let p = [i128::from(p[0]), i128::from(p[1])];
+        let b = [p[0].div_euclid(a), p[1].div_euclid(a)];
+        let o = [p[0] - b[0] * a, p[1] - b[1] * a];
+        Rings {
+            a,
+            p,
+            b,
+            edge: (o[0] + 1).min(a - o[0]).min(o[1] + 1).min(a - o[1]),
+        }
+    }
+
+    /// Whether ring `k` can hold a cell within squared distance `limit`.
+    fn reaches(&self, k: i128, limit: u64) -> bool {
+        if k == 0 {
+            return true;
+        }
+        let d = (k - 1) * self.a + self.edge;
+        d * d <= i128::from(limit)
+    }
+
+    /// The last ring that meets the square of half-side `r` around the point.
+    fn last(&self, r: i128) -> i128 {
+        let lo = [
+            (self.p[0] - r).div_euclid(self.a),
+            (self.p[1] - r).div_euclid(self.a),
+        ];
+        let hi = [
+            (self.p[0] + r).div_euclid(self.a),
+            (self.p[1] + r).div_euclid(self.a),
+        ];
+        (self.b[0] - lo[0])
+            .max(hi[0] - self.b[0])
+            .max(self.b[1] - lo[1])
+            .max(hi[1] - self.b[1])
+    }
+
+    /// The cells of box `(dx, dy)` (in boxes from the point's) within the square of half-side
+    /// `r` around the point, as `i64` ranges, or `None` when they are none.
+    fn cells(&self, dx: i128, dy: i128, r: i128) -> Option<([i64; 2], [i64; 2])> {
+        let axis = |b: i128, p: i128| -> Option<[i64; 2]> {
+            let lo = (b * self.a).max(p - r).max(i128::from(i64::MIN));
+            let hi = ((b + 1) * self.a - 1).min(p + r).min(i128::from(i64::MAX));
+            (lo <= hi).then(|| [lo as i64, hi as i64])
+        };
+        Some((
+            axis(self.b[0] + dx, self.p[0])?,
+            axis(self.b[1] + dy, self.p[1])?,
+        ))
+    }
+
+    /// Visits the boxes of ring `k` (in a fixed order) until `visit` breaks.
+    fn ring(
+        &self,
+        k: i128,
+        mut visit: impl FnMut(i128, i128) -> ControlFlow<()>,
+    ) -> ControlFlow<()> {
+        if k == 0 {
+            return visit(0, 0);
+        }
+        for dx in -k..=k {
+            visit(dx, -k)?;
+            visit(dx, k)?;
+        }
+        for dy in (-k + 1)..k {
+            visit(-k, dy)?;
+            visit(k, dy)?;
+        }
+        ControlFlow::Continue(())
+    }
+}
+
+/// Squared distance from `p` to `(x, y)`, exact (it can exceed every `u64` limit).
+#[inline]
+fn dist2(p: Pos, x: i64, y: i64) -> u128 {
+    let dx = u128::from(p[0].abs_diff(x));
+    let dy = u128::from(p[1].abs_diff(y));
+    dx * dx + dy * dy
+}
+
+impl World {
+    /// The box side of the wide search: the grid-box setting, or (for `none`) one box holding
+    /// the whole plane.
+    fn wide_side(&self) -> i64 {
+        self.grid.box_size().side().unwrap_or(i64::MAX)
+    }
+
+    /// Whether visiting the boxes ring by ring up to ring `last` would take more box visits
+    /// than scanning the square once through the tiles in use.
+    fn rings_too_many(&self, last: i128) -> bool {
+        let boxes = (2 * last + 1).saturating_mul(2 * last + 1);
+        boxes > 4 * (self.cells.tiles_in_use() as i128 + 1)
+    }
+
+    /// The position of the nearest animat of `kind` within squared distance `r2` of `p`,
+    /// other than the one on `p`: the minimum of `(squared distance, id)`.
+    pub(super) fn wide_nearest(
+        &self,
+        p: Pos,
+        kind: Species,
+        r2: u64,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        let rings = Rings::new(self.wide_side(), p);
+        let kinds = kind_bits(Some(kind));
+        // Best as (d2, cell, id bucket, id once read); buckets settle most ties without ids.
+        let mut best: Option<(u64, Pos, u8, Option<u64>)> = None;
+        let mut limit = r2;
+        let mut evals = 0;
+        let cells = &self.cells;
+        let mut look = |x: i64, y: i64, byte: u8, limit: &mut u64| {
+            if [x, y] == p {
+                return;
+            }
+            evals += 1;
+            // Within the limit, so below 2^64.
+            let Some(d2) = u64::try_from(dist2(p, x, y)).ok().filter(|&d| d <= *limit) else {
+                return;
+            };
+            let bucket = byte >> 2;
+            let better = match &mut best {
+                None => true,
+                Some((bd, bp, bb, bid)) => {
+                    d2 < *bd
+                        || (d2 == *bd && bucket < *bb)
+                        || (d2 == *bd && bucket == *bb && {
+                            let bi = *bid.get_or_insert_with(|| cells.id(*bp));
+                            cells.id([x, y]) < bi
+                        })
+                }
+            };
+            if better {
+                best = Some((d2, [x, y], bucket, None));
+                *limit = d2;
+            }
+        };
+        let mut k = 0;
+        loop {
+            let r = i128::from(limit.isqrt());
+            let last = rings.last(r);
+            if k > last || !rings.reaches(k, limit) {
+                break;
+            }
+            if self.rings_too_many(last) {
+                // One pass over the whole square; boxes already visited are seen again, which
+                // cannot change a minimum.
+                let (xs, ys) = square(p, r);
+                let _ = cells.scan_rect(xs, ys, kinds, |x, y, b| {
+                    look(x, y, b, &mut limit);
+                    ControlFlow::Continue(())
+                });
+                break;
+            }
+            let _ = rings.ring(k, |dx, dy| {
+                // The square shrinks as better animats are found.
+                let r = i128::from(limit.isqrt());
+                if let Some((xs, ys)) = rings.cells(dx, dy, r) {
+                    let _ = cells.scan_rect(xs, ys, kinds, |x, y, b| {
+                        look(x, y, b, &mut limit);
+                        ControlFlow::Continue(())
+                    });
+                }
+                ControlFlow::Continue(())
+            });
+            k += 1;
+        }
+        t.evals += evals;
+        best.map(|(_, c, _, _)| c)
+    }
+
+    /// Whether at least `n` animats (of `kind`, or of either species) lie within squared
+    /// distance `r2` of `p`, the one on `p` not counted.
+    pub(super) fn wide_at_least(
+        &self,
+        p: Pos,
+        kind: Option<Species>,
+        r2: u64,
+        n: usize,
+        t: &mut Tally,
+    ) -> bool {
+        if n == 0 {
+            return true;
+        }
+        let rings = Rings::new(self.wide_side(), p);
+        let kinds = kind_bits(kind);
+        let r = i128::from(r2.isqrt());
+        let last = rings.last(r);
+        let mut count = 0;
+        let mut evals = 0;
+        let mut look = |x: i64, y: i64, _: u8| {
+            if [x, y] != p {
+                evals += 1;
+                if dist2(p, x, y) <= u128::from(r2) {
+                    count += 1;
+                    if count >= n {
+                        return ControlFlow::Break(());
+                    }
+                }
+            }
+            ControlFlow::Continue(())
+        };
+        let _ = if self.rings_too_many(last) {
+            let (xs, ys) = square(p, r);
+            self.cells.scan_rect(xs, ys, kinds, &mut look)
+        } else {
+            let mut k = 0;
+            loop {
+                if k > last || !rings.reaches(k, r2) {
+                    break ControlFlow::Continue(());
+                }
+                let done = rings.ring(k, |dx, dy| match rings.cells(dx, dy, r) {
+                    Some((xs, ys)) => self.cells.scan_rect(xs, ys, kinds, &mut look),
+                    None => ControlFlow::Continue(()),
+                });
+                if done.is_break() {
+                    break done;
+                }
+                k += 1;
+            }
+        };
+        t.evals += evals;
+        count >= n
+    }
+}
+
+/// The square of half-side `r` around `p`, clamped to the `i64` plane.
+fn square(p: Pos, r: i128) -> ([i64; 2], [i64; 2]) {
+    let axis = |c: i64| {
+        let c = i128::from(c);
+        [
+            (c - r).max(i128::from(i64::MIN)) as i64,
+            (c + r).min(i128::from(i64::MAX)) as i64,
+        ]
+    };
+    (axis(p[0]), axis(p[1]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::{GridBox, Params};
+    use core_lattice::rng::{RngExt, stream};
+
+    /// A world with clustered, scattered and far-flung animats (some at the `i64` limits).
+    fn scene(side: i64) -> World {
+        let p = Params {
+            foxes: 0,
+            rabbits: 0,
+            grid_box: GridBox::Side(side),
+            ..Params::default()
+        };
+        let mut w = World::empty(p, 1).unwrap();
+        let mut rng = stream(11, 0);
+        for i in 0..1500u32 {
+            let pos = match i % 20 {
+                0 => [rng.random_range(-3000..3000), rng.random_range(-3000..3000)],
+                1 if i < 200 => [
+                    i64::MAX - rng.random_range(0..40),
+                    i64::MIN + rng.random_range(0..40),
+                ],
+                _ => [rng.random_range(-60..60), rng.random_range(-60..60)],
+            };
+            let species = if i % 4 == 0 {
+                Species::Fox
+            } else {
+                Species::Rabbit
+            };
+            let _ = w.add(species, pos, 0, 0);
+        }
+        assert!(w.cell_search());
+        w
+    }
+
+    #[test]
+    fn wide_queries_equal_the_exhaustive_answers() {
+        for side in [1, 7, 60, 1 << 30] {
+            let w = scene(side);
+            let all: Vec<_> = w.animats().collect();
+            let mut rng = stream(12, side as u64);
+            for q in 0..400 {
+                // Query points on animats (their own cell is excluded) and on free cells.
+                let p = if q % 3 == 0 {
+                    [rng.random_range(-200..200), rng.random_range(-200..200)]
+                } else {
+                    all[rng.random_range(0..all.len())].pos
+                };
+                let r2: u64 = match q % 5 {
+                    0 => 2,
+                    1 => 81,
+                    2 => 3600,
+                    3 => rng.random_range(0..20_000),
+                    _ => u64::MAX,
+                };
+                let kind = if q % 2 == 0 {
+                    Species::Fox
+                } else {
+                    Species::Rabbit
+                };
+                let within = |k: Option<Species>| {
+                    all.iter()
+                        .filter(move |a| a.pos != p && k.is_none_or(|k| a.species == k))
+                        .filter(move |a| dist2(p, a.pos[0], a.pos[1]) <= u128::from(r2))
+                };
+                let want = within(Some(kind))
+                    .min_by_key(|a| (dist2(p, a.pos[0], a.pos[1]), a.id))
+                    .map(|a| a.pos);
+                let mut t = Tally::default();
+                assert_eq!(
+                    w.wide_nearest(p, kind, r2, &mut t),
+                    want,
+                    "side {side} p {p:?} r2 {r2}"
+                );
+                for k in [Some(kind), None] {
+                    let count = within(k).count();
+                    for n in [0, 1, 3, count, count + 1] {
+                        assert_eq!(
+                            w.wide_at_least(p, k, r2, n, &mut t),
+                            count >= n,
+                            "side {side} p {p:?} r2 {r2} n {n}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
