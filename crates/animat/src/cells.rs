@@ -54,8 +54,9 @@ struct Tile {
     kinds: Box<[u8; CELLS]>,
     ids: Box<[u64; CELLS]>,
     count: u32,
-    /// Occupied cells of each 8 x 8 block, by species (index `kind - 1`).
-    block_counts: [[u8; BLOCKS]; 2],
+    /// Occupied cells of each 8 x 8 block, by species (index `kind - 1`); boxed, so that the
+    /// tile records that every turn reads stay small.
+    block_counts: Box<[[u8; BLOCKS]; 2]>,
     /// Bit `b` set when block `b` holds an animat of the species (same index).
     block_masks: [u64; 2],
 }
@@ -258,7 +259,7 @@ impl CellIndex {
                                 .try_into()
                                 .expect("CELLS ids"),
                             count: 0,
-                            block_counts: [[0; BLOCKS]; 2],
+                            block_counts: Box::new([[0; BLOCKS]; 2]),
                             block_masks: [0; 2],
                         });
                         (self.tiles.len() - 1) as u32
