@@ -139,6 +139,23 @@ pub const WORKLOADS: &[Workload] = &[
         ],
         unit: "animat-steps per second",
     },
+    Workload {
+        name: "animat-1e6-10steps",
+        bin: "animat",
+        args: &[
+            "--foxes",
+            "130430",
+            "--rabbits",
+            "869570",
+            "--density",
+            "0.2",
+            "--steps",
+            "10",
+            "--seed",
+            "1",
+        ],
+        unit: "animat-steps per second",
+    },
 ];
 
 /// The measured result of one workload.

@@ -2,8 +2,10 @@
 //! Scogings 2006, "Grid-Boxing for Spatial Simulation Performance Optimisation", Fig. 9 and
 //! Table I) for grid 60, 120, 240 and none, with log-log gradients; prints markdown tables.
 //!
-//! `cargo run --release -p animat --example search_scaling -- [MAX_N] [NONE_MAX_N] [BOXES_MAX_N] [REPEATS]`
+//! `cargo run --release -p animat --example search_scaling -- [MAX_N] [NONE_MAX_N] [BOXES_MAX_N] [REPEATS] [ONLY]`
 //!
+//! - `ONLY`: run only the series whose label contains it (for example `60 (cells` for the
+//!   default search with 60-cell boxes); all by default.
 //! - Populations 1e3, 3e3, 1e4, ... up to `MAX_N` (default 1e6), start density 0.2 (the
 //!   default start's), default parameters otherwise, seed 1.
 //! - Two search set-ups: the default (cell index first, grid boxes behind it) and the grid boxes
@@ -92,40 +94,40 @@ fn run(label: &str, grid: GridBox, cells: bool, max: u64, repeats: u32) -> Serie
 }
 
 fn main() {
-    let a: Vec<u64> = std::env::args()
-        .skip(1)
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let only = args.get(4).cloned().unwrap_or_default();
+    let a: Vec<u64> = args
+        .iter()
+        .take(4)
         .map(|s| s.parse::<f64>().expect("number") as u64)
         .collect();
     let max = a.first().copied().unwrap_or(1_000_000);
     let none_max = a.get(1).copied().unwrap_or(30_000);
     let boxes_max = a.get(2).copied().unwrap_or(1_000_000);
     let repeats = a.get(3).copied().unwrap_or(2) as u32;
-    let mut all = Vec::new();
+    let mut plan = Vec::new();
     for side in [60, 120, 240] {
-        all.push(run(
-            &format!("{side} (cells + boxes)"),
+        plan.push((
+            format!("{side} (cells + boxes)"),
             GridBox::Side(side),
             true,
             max,
-            repeats,
         ));
     }
     for (side, cap) in [(60, boxes_max), (120, boxes_max / 3), (240, boxes_max / 10)] {
-        all.push(run(
-            &format!("{side} (boxes alone)"),
+        plan.push((
+            format!("{side} (boxes alone)"),
             GridBox::Side(side),
             false,
             cap.min(max),
-            repeats,
         ));
     }
-    all.push(run(
-        "none",
-        GridBox::None,
-        false,
-        none_max.min(max),
-        repeats,
-    ));
+    plan.push(("none".into(), GridBox::None, false, none_max.min(max)));
+    let all: Vec<Series> = plan
+        .into_iter()
+        .filter(|(label, ..)| label.contains(&only))
+        .map(|(label, grid, cells, cap)| run(&label, grid, cells, cap, repeats))
+        .collect();
 
     println!(
         "| grid | N (start) | mean N | steps | search ms/step | search ns/animat | distance evals/animat | whole step ms |"

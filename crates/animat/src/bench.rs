@@ -72,7 +72,10 @@ pub struct SearchCost {
     /// summed).
     pub animat_steps: u64,
     /// Mean seconds per step spent in perception queries (clock read around each animat's
-    /// decision).
+    /// decision), without the time the thread waited for a CPU (on Linux: each step's search
+    /// time scaled by the step's share of time on the CPU, from
+    /// `/proc/thread-self/schedstat`), so that other processes on the machine do not inflate
+    /// it.
     pub search_seconds_per_step: f64,
     /// Mean distance evaluations per step ([`spatial::plane::PlaneGrid::distance_evals`]).
     pub distance_evals_per_step: f64,
@@ -125,9 +128,21 @@ pub fn search_scaling_point_with(
     w.set_cell_search(cell_search);
     let (mut search, mut evals) = (0.0, 0u64);
     let t = Instant::now();
+    let (mut step_start, mut waited_before) = (Instant::now(), thread_run_delay());
     let (turns, done) = measured_steps(&mut w, steps, |s| {
-        search += s.search_seconds;
+        // The decisions are timed by the wall clock, so a step in which the thread waited for
+        // a CPU (other processes on the machine) counts part of the wait as search. Waits
+        // fall on the search in proportion to its share of the step, so the search's own
+        // time is its wall time scaled by the step's share of time on the CPU.
+        let wall = step_start.elapsed().as_secs_f64();
+        let waited = thread_run_delay();
+        let on_cpu = match (waited, waited_before) {
+            (Some(b), Some(a)) if wall > 0.0 => (1.0 - (b - a) / wall).clamp(0.0, 1.0),
+            _ => 1.0,
+        };
+        search += s.search_seconds * on_cpu;
         evals += s.distance_evals;
+        (step_start, waited_before) = (Instant::now(), thread_run_delay());
     });
     let wall = t.elapsed().as_secs_f64();
     let per = |x: f64| if done > 0 { x / done as f64 } else { 0.0 };
@@ -229,8 +244,18 @@ fn state_hash_u64(w: &World) -> u64 {
 /// CPU time of the calling thread in seconds (Linux `/proc/thread-self/schedstat`, whose
 /// first field is nanoseconds on the CPU), or `None` where unavailable.
 pub fn thread_cpu_seconds() -> Option<f64> {
+    schedstat_field(0)
+}
+
+/// Seconds the calling thread has spent runnable but waiting for a CPU (the second field of
+/// Linux `/proc/thread-self/schedstat`), or `None` where unavailable.
+pub fn thread_run_delay() -> Option<f64> {
+    schedstat_field(1)
+}
+
+fn schedstat_field(i: usize) -> Option<f64> {
     let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: u64 = s.split_whitespace().next()?.parse().ok()?;
+    let ns: u64 = s.split_whitespace().nth(i)?.parse().ok()?;
     Some(ns as f64 * 1e-9)
 }
 

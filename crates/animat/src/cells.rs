@@ -15,13 +15,17 @@
 //! Perception reads cells through a [`Window`]: the at most 2 x 2 tiles covering a square of
 //! half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four directory
 //! lookups; every cell read after that is an array index, and [`Window::rows`] reads 8 cells
-//! of a row as one word.
+//! of a row as one word. Wide queries read rectangles ([`CellIndex::scan_rect`]): each tile
+//! keeps, per species, a count and a bit per 8 x 8 block of the animats in it, so empty tiles
+//! and blocks are skipped without reading their cells.
 //!
 //! Invariants: a cell byte is [`FREE`] exactly when no animat stands on the cell, and then its
 //! id slot is unused; an occupied cell's byte holds its occupant's kind and the bucket of its
 //! id under the current bucket map, which is non-decreasing in the id; a tile is in use
-//! exactly while it holds an animat (`count` is its number of occupied cells); the dense
-//! directory agrees with the map for every tile coordinate in its rectangle.
+//! exactly while it holds an animat (`count` is its number of occupied cells); a tile's block
+//! counts are the occupied cells of each species in each block, and its block masks have a bit
+//! set exactly for the blocks with a nonzero count; the dense directory agrees with the map for
+//! every tile coordinate in its rectangle.
 
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
@@ -54,8 +58,9 @@ struct Tile {
     kinds: Box<[u8; CELLS]>,
     ids: Box<[u64; CELLS]>,
     count: u32,
-    /// Occupied cells of each 8 x 8 block, by species (index `kind - 1`).
-    block_counts: [[u8; BLOCKS]; 2],
+    /// Occupied cells of each 8 x 8 block, by species (index `kind - 1`); boxed, so that the
+    /// tile records that every turn reads stay small.
+    block_counts: Box<[[u8; BLOCKS]; 2]>,
     /// Bit `b` set when block `b` holds an animat of the species (same index).
     block_masks: [u64; 2],
 }
@@ -263,7 +268,7 @@ impl CellIndex {
                                 .try_into()
                                 .expect("CELLS ids"),
                             count: 0,
-                            block_counts: [[0; BLOCKS]; 2],
+                            block_counts: Box::new([[0; BLOCKS]; 2]),
                             block_masks: [0; 2],
                         });
                         (self.tiles.len() - 1) as u32

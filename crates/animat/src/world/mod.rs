@@ -7,7 +7,7 @@
 //! `docs/animat.md` states it. The rest of the world lives in child modules, each using only
 //! this module and the ones listed after it:
 //!
-//! - `step`: one step (visiting order, turns, ageing and deaths, end-of-step compaction);
+//! - `step`: one step (visiting order, turns, ageing and deaths, the id order listed again);
 //! - `rules`: the fox and rabbit rule lists, the action each chooses and how actions apply;
 //! - `perception`: the neighbour queries the rules ask, from the cell index or the grid boxes;
 //! - `near`: the per-turn cache of the cells around the acting animat and its bit tricks;
@@ -18,10 +18,10 @@
 //! index of its record in `recs` (with `flags` parallel to `recs`; records of the animats that
 //! died in the last step may remain there, with their `DEAD` bit set, until the next step
 //! drops them), and `ids` holds their ids in the same order (strictly increasing); every live
-//! animat stands alone on its cell in `cells` and is in `grid` at that cell (`pending` is
-//! empty); `foxes` and `rabbits` count the live animats; every id is below `next_id` and none
-//! is reused. During a step `grid` may lag behind `cells` by the changes logged in `pending`
-//! (see `step`).
+//! animat stands alone on its cell in `cells` and, with the cell search off, is in `grid` at
+//! that cell (`pending` is empty; with the cell search on `grid` is empty); `foxes` and
+//! `rabbits` count the live animats; every id is below `next_id` and none is reused. During a
+//! step `grid` may lag behind `cells` by the changes logged in `pending` (see `step`).
 
 mod checkpoint;
 mod near;
@@ -165,8 +165,11 @@ pub struct World {
     rabbit_rules: Vec<RabbitRule>,
     vision2: u64,
     crowd2: u64,
+    /// The grid boxes: kept up to date only with the cell search off (empty, holding the box
+    /// size, with it on).
     grid: PlaneGrid<Species>,
-    /// Grid changes not yet applied (see [`GridOp`]); empty between steps.
+    /// Grid changes not yet applied (see [`GridOp`]); empty between steps and with the cell
+    /// search on.
     pending: Vec<GridOp>,
     /// Which animat stands on each cell (always maintained; read by perception when
     /// `cell_search` is on).
@@ -503,10 +506,11 @@ impl World {
     /// Turns the cell-index search on or off. On by default with grid boxes, off (and ignored)
     /// in the exhaustive `none` mode, which stays the paper's "no grid" baseline. With it on,
     /// adjacency and overcrowding tests read the cells around the animat directly, and nearest
-    /// and counting queries scan cell rings outward up to radius 8 before falling back to the
-    /// grid boxes; both give the exact answers, so the trajectory does not change. Turning it
-    /// off measures the grid boxes alone (the paper's structure: Hawick, James & Scogings 2006,
-    /// section III).
+    /// and counting queries scan cell rings outward up to radius 8 before a wide search over
+    /// the grid boxes that reads their animats from the cell index too; every path gives the
+    /// exact answers, so the trajectory does not change. Turning it off measures the grid boxes
+    /// alone (the paper's structure: Hawick, James & Scogings 2006, section III), which are then
+    /// built from the animats and kept up to date on every change (turning it on drops them).
     pub fn set_cell_search(&mut self, on: bool) {
         let on = on && self.grid.box_size() != BoxSize::None;
         if on == self.cell_search {

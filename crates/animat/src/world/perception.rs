@@ -1,9 +1,10 @@
 //! Perception: the neighbour queries the rules ask ("a fox adjacent?", "the nearest rabbit
 //! within vision", "overcrowded?", "enough prey?"). Each is answered from the cell index first
-//! (the cells around the animat, then rings of cells up to `RING_MAX`) and handed to the grid
-//! boxes ([`spatial::plane::PlaneGrid`]) when the cell index cannot settle it.
+//! (the cells around the animat, then rings of cells up to `RING_MAX`) and handed to the wide
+//! search over grid boxes (`wide`) when the rings cannot settle it; with the cell search off,
+//! every query goes to the grid boxes ([`spatial::plane::PlaneGrid`]).
 //!
-//! Invariants: both paths give the exact answer, ties going to the lower id, so the trajectory
+//! Invariants: every path gives the exact answer, ties going to the lower id, so the trajectory
 //! does not depend on the path or on the grid-box size; a query that needs the grid while
 //! changes are still logged does not read it but marks the decision stale ([`Tally::stale`]),
 //! and the decision is made again once the grid is up to date.
