@@ -1,6 +1,9 @@
 //! Pooled fractal dimension of DLCA clusters over seeds (used to size the statistical tests;
-//! see docs/dlca.md). Usage: `cargo run --release -p dlca --example fractal_dimension -- D L FILL
-//! TARGET SEEDS MIN_SIZE`.
+//! see docs/dlca.md, "Validation"). Usage: `cargo run --release -p dlca --example
+//! fractal_dimension -- D L FILL WHEN SEEDS MIN_SIZE [FIRST_SEED]`, where WHEN is a cluster count
+//! (the clusters left when the run ends there are pooled) or `mean:8,16,32,64` (the clusters
+//! present each time the mean cluster size passes one of these are pooled, as the 4D and 5D
+//! tests do). Seeds FIRST_SEED (default 1) onwards.
 
 use dlca::analysis::{fractal_dimension, gyration};
 use dlca::{Init, Params, Simulation};
@@ -11,31 +14,47 @@ fn main() {
     let dim: usize = arg(1, "2").parse().unwrap();
     let l: u64 = arg(2, "512").parse().unwrap();
     let fill: f64 = arg(3, "0.01").parse().unwrap();
-    let target: u64 = arg(4, "20").parse().unwrap();
+    let when = arg(4, "20");
     let seeds: u64 = arg(5, "8").parse().unwrap();
     let min_size: u64 = arg(6, "10").parse().unwrap();
+    let first: u64 = arg(7, "1").parse().unwrap();
     let mut pooled = Vec::new();
     let t = std::time::Instant::now();
-    for seed in 1..=seeds {
-        let params = Params {
+    for seed in first..first + seeds {
+        let mut params = Params {
             size: vec![l; dim],
             boundary: vec![core_lattice::Boundary::Periodic; dim],
             init: Init::Fill(fill),
-            target_clusters: target,
             ..Params::default()
         };
+        let n = params.particles().unwrap();
+        let targets: Vec<u64> = match when.strip_prefix("mean:") {
+            Some(sizes) => sizes
+                .split(',')
+                .map(|m| (n / m.parse::<u64>().unwrap()).max(1))
+                .collect(),
+            None => vec![when.parse().unwrap()],
+        };
+        params.target_clusters = *targets.last().unwrap();
         let mut sim = Simulation::new(params, seed).unwrap();
-        sim.run();
-        let g = gyration(&sim);
-        let one = fractal_dimension(&g, min_size)
-            .map(|f| f.slope)
-            .unwrap_or(f64::NAN);
-        println!(
-            "seed {seed}: {} sweeps, {} clusters, D = {one:.3}",
-            sim.sweeps(),
-            sim.clusters()
-        );
-        pooled.extend(g);
+        let mut line = format!("seed {seed}:");
+        for target in targets {
+            while sim.clusters() > target {
+                sim.sweep();
+            }
+            let g = gyration(&sim);
+            let one = fractal_dimension(&g, min_size)
+                .map(|f| f.slope)
+                .unwrap_or(f64::NAN);
+            line += &format!(
+                " sweep {} with {} clusters (largest {}): D = {one:.3};",
+                sim.sweeps(),
+                sim.clusters(),
+                sim.largest()
+            );
+            pooled.extend(g);
+        }
+        println!("{line}");
     }
     for m in [min_size, 2 * min_size, 4 * min_size] {
         match fractal_dimension(&pooled, m) {
