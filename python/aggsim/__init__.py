@@ -4,7 +4,7 @@ Three models, each as a function that runs to the end and returns a result objec
 of them also as objects to step forward and look at between steps:
 
 - :func:`dla`: off-lattice diffusion-limited aggregation (DLA), or parallel DLA (PDLA) with
-  ``threads`` > 1, in 2D and 3D (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance
+  ``threads`` > 1, in 2D to 5D (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance
   search for random fractal cluster simulations").
 - :func:`dlca`, :class:`DlcaLattice`: diffusion-limited cluster-cluster aggregation on
   lattices of 1 to 5 dimensions (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial

@@ -91,7 +91,7 @@ impl DlaResult {
 /// Parameters
 /// ----------
 /// dim : int
-///     Space dimension, 2 or 3 (default 2).
+///     Space dimension, 2, 3, 4 or 5 (default 2).
 /// particles : int
 ///     Particles in the final cluster, seed particle included (default 100000).
 /// seed : int
@@ -229,6 +229,8 @@ pub fn dla(
     match params.dim {
         2 => grow::<2>(py, params, seed, &progress, &clock),
         3 => grow::<3>(py, params, seed, &progress, &clock),
+        4 => grow::<4>(py, params, seed, &progress, &clock),
+        5 => grow::<5>(py, params, seed, &progress, &clock),
         d => Err(value_error(dla_pdla::ParamsError::Dim(d))),
     }
 }

@@ -7,7 +7,7 @@ import aggsim
 
 DLA = [
     (["--particles", 0], dict(particles=0)),
-    (["--particles", 10, "--dim", 4], dict(particles=10, dim=4)),
+    (["--particles", 10, "--dim", 6], dict(particles=10, dim=6)),
     (["--particles", 10, "--step-min", 0], dict(particles=10, step_min=0)),
     (["--particles", 10, "--step-min", 1e-300], dict(particles=10, step_min=1e-300)),
     (["--particles", 10, "--precision", 0.5], dict(particles=10, precision=0.5)),

@@ -57,6 +57,10 @@ def same_results(result, run_json, ignore=()):
             ["--particles", 900, "--paper-settings"],
             dict(particles=900, paper_settings=True),
         ),
+        (["--dim", 4, "--particles", 600, "--seed", 3, "--fit-from", 100],
+         dict(dim=4, particles=600, seed=3, fit_from=100)),
+        (["--dim", 5, "--particles", 300, "--seed", 4, "--fit-from", 50],
+         dict(dim=5, particles=300, seed=4, fit_from=50)),
     ],
 )
 def test_dla_equals_the_binary(cli, flags, kwargs):

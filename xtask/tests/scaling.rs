@@ -92,6 +92,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "dla_table2.csv",
         "dla_table2_runs.csv",
         "dla_speedup.csv",
+        "dla_by_dimension.csv",
         "accuracy.csv",
         "accuracy_vpdist.csv",
         "accuracy_vpdist_hist.csv",
@@ -144,8 +145,19 @@ fn tiny_run_produces_every_table_csv_and_plot() {
     // says so; every strategy row of Fig. 6 is present (four strategies, two fills).
     let fig6 = read(d, "dlca_fig6_summary.csv");
     assert_eq!(fig6.lines().filter(|l| l.contains(",yes,")).count(), 8);
-    // Table 2 has the four (d, P) rows.
+    // Table 2 has the four (d, P) rows; D_f by dimension one row per dimension, 2D to 5D,
+    // beside the literature's values.
     assert_eq!(read(d, "dla_table2.csv").lines().count(), 5);
+    let by_dim = read(d, "dla_by_dimension.csv");
+    let dims: Vec<&str> = by_dim
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(dims, ["2", "3", "4", "5"], "{by_dim}");
+    assert!(
+        dla.contains("3.40 (Tolman & Meakin 1989)") && dla.contains("4.33 (Tolman & Meakin 1989)")
+    );
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D and 3D, after
+//! Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D to 5D, after
 //! Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for random fractal
 //! cluster simulations" (sections 3.2 to 3.4).
 //!

@@ -1,4 +1,4 @@
-//! `dla`: off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D and 3D
+//! `dla`: off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA) in 2D to 5D
 //! (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for random fractal
 //! cluster simulations"). A thin layer over the `dla_pdla` library: parse flags, validate,
 //! turn `--dim` into a type (the one run-time dimension dispatch), run, write outputs.
@@ -13,7 +13,7 @@ use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA), 2D and 3D.
+/// Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA), 2D to 5D.
 ///
 /// A seed particle sits at the origin. Walkers (balls of diameter 1) are born on the sphere of
 /// radius R_b = R_ext + birth-gap, jump by the variable-precision distance to the cluster when
@@ -22,13 +22,14 @@ use std::process::ExitCode;
 #[derive(Parser, Debug)]
 #[command(name = "dla", version, allow_negative_numbers = true)]
 struct Cli {
-    /// Space dimension: 2 or 3.
+    /// Space dimension: 2, 3, 4 or 5.
     #[arg(long, default_value_t = 2)]
     dim: usize,
 
-    /// Particles in the final cluster, seed particle included: 1 to 3000000000
-    /// (the orthtree's 32-bit indices). Memory: about 11 bytes per particle in 2D and 15 in 3D
-    /// at 1e7.
+    /// Particles in the final cluster, seed particle included: 1 to 3000000000 in 2D and 3D,
+    /// 2500000000 in 4D and 5D (the orthtree's 32-bit indices). Memory: about 11 bytes per
+    /// particle in 2D and 15 in 3D at 1e7; the tree and distance map take about 25 in 4D at
+    /// 1e5 and 300 in 5D at 3e4 (mostly the map).
     #[arg(long)]
     particles: u64,
 
@@ -110,7 +111,8 @@ struct Cli {
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
     /// (N, D), NumPy's format) as the cluster grows, never held in memory; csv, bin, xyz
     /// (extended XYZ: OVITO, VMD) and vtk (legacy VTK with the arrival index: ParaView) are made
-    /// from it at the end (csv and xyz take about 50 bytes per particle on disk).
+    /// from it at the end (csv and xyz take about 50 bytes per particle on disk). xyz and vtk
+    /// hold three coordinates, so they are refused in 4D and 5D.
     #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
     positions: PositionsFormat,
 
@@ -131,8 +133,9 @@ struct Cli {
     resume: Option<PathBuf>,
 
     /// Write dla.png: the cluster shaded by arrival order (3D: shaded spheres seen from +z,
-    /// nearer brighter), or, when a pixel spans more than a diameter, the number of particles
-    /// per pixel on a log scale (projected on x, y).
+    /// nearer brighter; 4D and 5D: the same picture of the projection on x, y, z), or, when a
+    /// pixel spans more than a diameter, the number of particles per pixel on a log scale
+    /// (projected on x, y).
     #[arg(long)]
     png: bool,
 
@@ -183,6 +186,14 @@ fn params(cli: &Cli) -> Result<Params, String> {
     // Flags that would be silently ignored are refused too.
     p.validate_given(cli.death_ratio.is_some())
         .map_err(|e| e.to_string())?;
+    if p.dim > 3 && matches!(cli.positions, PositionsFormat::Xyz | PositionsFormat::Vtk) {
+        return Err(format!(
+            "--positions {} holds three coordinates, not the {} of --dim {}; use npy, csv or bin",
+            cli.positions.name(),
+            p.dim,
+            p.dim
+        ));
+    }
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }
@@ -251,6 +262,8 @@ fn main() -> ExitCode {
             ensemble.unwrap_or_else(|| match params.dim {
                 2 => run::<2>(cli, params),
                 3 => run::<3>(cli, params),
+                4 => run::<4>(cli, params),
+                5 => run::<5>(cli, params),
                 d => Err(ParamsError::Dim(d).into()),
             })
         },

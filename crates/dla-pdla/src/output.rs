@@ -9,11 +9,11 @@
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results |
 //! | `growth.csv` | `n,radius_of_gyration,r_ext,seconds`, 200 log-spaced sizes per decade |
 //! | `positions.npy` | every position, arrival order, float64 `(N, D)` (NumPy `.npy`) |
-//! | `positions.csv` | `--positions csv`: `x,y` or `x,y,z`, arrival order |
+//! | `positions.csv` | `--positions csv`: `x,y`, `x,y,z`, `x,y,z,w` or `x,y,z,w,v`, arrival order |
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
-//! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C` |
-//! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView) |
-//! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: shaded spheres seen from +z with a depth buffer; the density image projects on x, y) |
+//! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C`; 2D and 3D only |
+//! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView); 2D and 3D only |
+//! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: shaded spheres seen from +z with a depth buffer; 4D and 5D: the same for the projection on x, y, z; the density image projects on x, y) |
 
 use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
@@ -84,6 +84,18 @@ where
     match positions {
         PositionsFormat::None | PositionsFormat::Npy => {}
         PositionsFormat::Bin => write_positions_bin(sim, dir)?,
+        PositionsFormat::Xyz | PositionsFormat::Vtk if D > 3 => {
+            // Both hold three coordinates; writing a projection under the full file's name
+            // would lose data silently.
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "--positions {} holds three coordinates, not {D}; use npy, csv or bin",
+                    positions.name()
+                ),
+            )
+            .into());
+        }
         PositionsFormat::Csv | PositionsFormat::Xyz | PositionsFormat::Vtk => {
             let format = match positions {
                 PositionsFormat::Csv => PointFormat::Csv,
@@ -262,9 +274,10 @@ fn disc_bounds(cx: f64, cy: f64, rad: f64, side: u32) -> (u32, u32, u32, u32) {
     )
 }
 
-/// A 3D cluster seen from +z: each particle a shaded sphere at its true size, the nearest
-/// surface at each pixel kept (a depth buffer), brighter where nearer the viewer and where the
-/// sphere faces the viewer, so the branches in front stand out from those behind.
+/// A 3D cluster (4D and 5D: its projection on x, y, z) seen from +z: each particle a shaded
+/// sphere at its true size, the nearest surface at each pixel kept (a depth buffer), brighter
+/// where nearer the viewer and where the sphere faces the viewer, so the branches in front
+/// stand out from those behind.
 fn depth_shaded<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
@@ -313,7 +326,8 @@ fn write_picture<const D: usize>(
     let extent = sim.r_ext() + 1.0;
     let scale = f64::from(side) / (2.0 * extent);
     let s = side as usize;
-    let px = if scale >= 1.0 && D == 3 {
+    // 4D and 5D: the picture of the projection on (x, y, z), as in 3D.
+    let px = if scale >= 1.0 && D >= 3 {
         depth_shaded(sim, dir, extent, scale, side)?
     } else if scale >= 1.0 {
         let mut px = vec![0u8; s * s];

@@ -157,13 +157,14 @@ impl Default for Params {
     }
 }
 
-/// The accepted dimensions as `2, 3`.
+/// The accepted dimensions as `2, 3, 4, 5`.
 fn dimension_list() -> String {
     let dims: Vec<String> = DIMENSIONS.iter().map(usize::to_string).collect();
     dims.join(", ")
 }
 
-/// Largest accepted particle count. The orthtree numbers its nodes, leaves and point slots
+/// Largest accepted particle count in 2D and 3D ([`max_particles`] gives every dimension's).
+/// The orthtree numbers its nodes, leaves and point slots
 /// with 32-bit indices (at most `2^32 - 2` of each). Point slots bound the count: a leaf of `n`
 /// points owns a block of at most `1.25 n` slots (size classes a quarter of a power of two
 /// apart above 16 points), and outgrown blocks wait on free lists until they pass 1/8 of the
@@ -173,9 +174,29 @@ fn dimension_list() -> String {
 /// under 0.96 leaves and 0.83 nodes per particle even with the smallest leaf side). Typical
 /// clusters use fewer slots (about 1.05 per particle in 2D and 1.1 in 3D with the default leaf
 /// side), but leaves of hundreds of particles (3D, leaf sides 32 and 64) come close to the
-/// bound: about 1.4 slots per particle, at which 3.5e9 particles would not fit. A run that still runs out (PDLA's reserved room) stops with
+/// bound: about 1.4 slots per particle, at which 3.5e9 particles would not fit. A run that
+/// still runs out (PDLA's reserved room) stops with
 /// [`OrthtreeError::CapacityExceeded`](spatial::orthtree::OrthtreeError::CapacityExceeded).
 pub const MAX_PARTICLES: u64 = 3_000_000_000;
+
+/// Largest accepted particle count in `dim` dimensions (0 for a dimension the model does not
+/// run in): [`MAX_PARTICLES`] in 2D and 3D, 2.5e9 in 4D and 5D.
+///
+/// In 4D and 5D a leaf cell of side 8 holds tens of particles (50 to 90 at 1e4-1e5), so
+/// nodes and leaves number a few hundredths per particle, far from their limit, while leaf
+/// blocks are in the size classes of quarter powers of two: up to 25 % of a block is spare,
+/// and up to 1/8 of the pool may sit on free lists before it is compacted, at most
+/// `1.25 / (7/8) = 1.43` point slots per particle (1.15 measured at 1e5 in 4D). 2.5e9
+/// particles then need at most 3.6e9 of the `2^32 - 2` slots. (Memory, not indexing, is the
+/// practical limit there: about 25 bytes per particle in 4D and 40-50 in 5D, plus the distance
+/// map; see `docs/dla.md`.)
+pub const fn max_particles(dim: usize) -> u64 {
+    match dim {
+        2 | 3 => MAX_PARTICLES,
+        4 | 5 => 2_500_000_000,
+        _ => 0,
+    }
+}
 
 /// A value as a user would type it: `0.25`, `1000`, or `1e-300` for the very small and large.
 fn short(v: f64) -> String {
@@ -193,9 +214,18 @@ pub enum ParamsError {
     /// `dim` not one of [`DIMENSIONS`].
     #[error("--dim {0} is outside the accepted range {{{dims}}}", dims = dimension_list())]
     Dim(usize),
-    /// `particles` is 0 or too large.
-    #[error("--particles {0} is outside the accepted range 1..={MAX_PARTICLES}")]
-    Particles(u64),
+    /// `particles` is 0 or above [`max_particles`] for the dimension.
+    #[error(
+        "--particles {particles} is outside the accepted range 1..={max} in {dim}D (the orthtree's 32-bit indices)"
+    )]
+    Particles {
+        /// The value given.
+        particles: u64,
+        /// The dimension.
+        dim: usize,
+        /// The largest accepted in that dimension.
+        max: u64,
+    },
     /// `birth_gap` below 1, above [`MAX_BIRTH_GAP`] or not finite.
     #[error(
         "--birth-gap {} is outside the accepted range [1, 1e4] (a walker born closer than one diameter could overlap the cluster; a larger gap does not change where walkers arrive, only makes each one wander longer: in 3D about gap / R_ext times longer)",
@@ -261,8 +291,13 @@ impl Params {
         if !DIMENSIONS.contains(&self.dim) {
             return Err(ParamsError::Dim(self.dim));
         }
-        if self.particles == 0 || self.particles > MAX_PARTICLES {
-            return Err(ParamsError::Particles(self.particles));
+        let max = max_particles(self.dim);
+        if self.particles == 0 || self.particles > max {
+            return Err(ParamsError::Particles {
+                particles: self.particles,
+                dim: self.dim,
+                max,
+            });
         }
         if !(self.birth_gap >= 1.0 && self.birth_gap <= MAX_BIRTH_GAP) {
             return Err(ParamsError::BirthGap(self.birth_gap));
@@ -314,8 +349,8 @@ mod tests {
         assert!(Params::default().validate().is_ok());
         let d = Params::default;
         let bad = [
-            (Params { dim: 4, ..d() }, "--dim 4 ", "{2, 3}"),
-            (Params { dim: 1, ..d() }, "--dim 1 ", "{2, 3}"),
+            (Params { dim: 6, ..d() }, "--dim 6 ", "{2, 3, 4, 5}"),
+            (Params { dim: 1, ..d() }, "--dim 1 ", "{2, 3, 4, 5}"),
             (
                 Params {
                     particles: 0,
@@ -411,7 +446,30 @@ mod tests {
         assert!(inf.validate().is_ok());
         for &dim in DIMENSIONS {
             assert!(Params { dim, ..d() }.validate().is_ok());
+            let max = max_particles(dim);
+            assert!(max > 1_000_000_000, "{dim}D: {max}");
+            let top = Params {
+                dim,
+                particles: max,
+                ..d()
+            };
+            assert!(top.validate().is_ok());
+            let e = Params {
+                particles: max + 1,
+                ..top
+            }
+            .validate()
+            .unwrap_err()
+            .to_string();
+            assert_eq!(
+                e,
+                format!(
+                    "--particles {} is outside the accepted range 1..={max} in {dim}D (the orthtree's 32-bit indices)",
+                    max + 1
+                )
+            );
         }
+        assert_eq!(max_particles(6), 0);
     }
 
     #[test]

@@ -1,5 +1,5 @@
 //! The space dimension as a type: [`Dim<D>`] implements [`Space<D>`] for every dimension the
-//! model runs in (2 and 3), and owns everything that differs between dimensions: the
+//! model runs in (2, 3, 4 and 5), and owns everything that differs between dimensions: the
 //! isotropic random direction of a move, the exact far-field return to the birth sphere, the
 //! distance map levels, the expected cluster radius and the axis names of position files.
 //!
@@ -17,18 +17,22 @@
 //!
 //! # Adding a dimension
 //!
-//! 1. `impl Space<4> for Dim<4>` here, with a `direction` (any isotropic unit vector, for
+//! 1. `impl Space<6> for Dim<6>` here, with a `direction` (any isotropic unit vector, for
 //!    example [`core_lattice::rng::unit_vector`]), a `return_to_sphere` (the harmonic measure
-//!    of the sphere in that dimension, next to the 2D and 3D ones in [`crate::farfield`]), map
-//!    levels, an `expected_r_ext` and axis names;
+//!    of the sphere: [`return_to_sphere_nd`] serves every dimension from 4 on), map levels
+//!    measured for that dimension, an `expected_r_ext` and axis names (the orthtree takes up
+//!    to 8 dimensions);
 //! 2. add the dimension to [`DIMENSIONS`];
-//! 3. add one arm to the dispatch in `main.rs` (`4 => run::<4>(cli, params)`).
+//! 3. add one arm to each dispatch on the dimension: `main.rs` (`6 => run::<6>(cli, params)`),
+//!    the Python bindings (`python/src/dla.rs`) and `cargo xtask scaling`
+//!    (`xtask/src/scaling/dla.rs`);
+//! 4. check the orthtree's index limits against [`max_particles`](crate::params::max_particles).
 
-use crate::farfield::{return_to_circle, return_to_sphere_3d};
+use crate::farfield::{return_to_circle, return_to_sphere_3d, return_to_sphere_nd};
 use core_lattice::rng::{Rng, uniform01};
 
 /// The dimensions with a [`Space`] implementation, the accepted values of `--dim`.
-pub const DIMENSIONS: &[usize] = &[2, 3];
+pub const DIMENSIONS: &[usize] = &[2, 3, 4, 5];
 
 /// The space dimension `D` as a type; see [`Space`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -59,11 +63,11 @@ pub trait Space<const D: usize> {
     fn expected_r_ext(n: u64) -> f64;
 }
 
-/// A point uniform in the unit disk by rejection from the square (two 32-bit uniforms from one
-/// 64-bit draw, accepted with probability pi/4), normalised: a uniform direction in the plane
-/// without trigonometric functions, isotropic exactly up to the 2^-31 granularity of the point.
+/// A point `(x, y)` uniform in the unit disk (less a disk of radius 1e-6 around the centre) by
+/// rejection from the square (two 32-bit uniforms from one 64-bit draw, accepted with
+/// probability pi/4), and `s = x^2 + y^2`, uniform in `(1e-12, 1]`.
 #[inline(always)]
-fn disk_direction<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64) {
+fn disk_point<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64, f64) {
     const SCALE: f64 = 1.0 / 2_147_483_648.0;
     loop {
         let b = rng.next_u64();
@@ -71,10 +75,31 @@ fn disk_direction<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64) {
         let y = (b as u32 as i32) as f64 * SCALE;
         let s = x * x + y * y;
         if s <= 1.0 && s > 1e-12 {
-            let inv = 1.0 / s.sqrt();
-            return (x * inv, y * inv);
+            return (x, y, s);
         }
     }
+}
+
+/// A [`disk_point`] normalised: a uniform direction in the plane without trigonometric
+/// functions, isotropic exactly up to the 2^-31 granularity of the point.
+#[inline(always)]
+fn disk_direction<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64) {
+    let (x, y, s) = disk_point(rng);
+    let inv = 1.0 / s.sqrt();
+    (x * inv, y * inv)
+}
+
+/// A uniform unit vector in 4D by Marsaglia's method ("Choosing a point from the surface of a
+/// sphere", 1972): two [`disk_point`]s `(x1, x2, s1)` and `(x3, x4, s2)`, then
+/// `(x1, x2, k x3, k x4)` with `k = sqrt((1 - s1) / s2)`. On the 3-sphere `x1^2 + x2^2` is
+/// uniform in `[0, 1]`, as `s1` is, and the second pair only gives a uniform direction in its
+/// plane; no trigonometric functions or logarithms. Exact up to the 2^-31 grid of the points.
+#[inline(always)]
+fn marsaglia_4d<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
+    let (x1, x2, s1) = disk_point(rng);
+    let (x3, x4, s2) = disk_point(rng);
+    let k = ((1.0 - s1) / s2).max(0.0).sqrt();
+    [x1, x2, k * x3, k * x4]
 }
 
 impl Space<2> for Dim<2> {
@@ -137,6 +162,84 @@ impl Space<3> for Dim<3> {
     }
 }
 
+impl Space<4> for Dim<4> {
+    /// One map of 8-diameter cells capped at 32 (about 1 260 cells lowered per insert).
+    /// Instruction counts per particle (cachegrind, 5e3 particles, seeds 1 and 2): 0.60 M,
+    /// against 0.77 M without maps, 0.69 M with the 3D-like second level (32, 128) (it changed
+    /// no move in those runs, whose trajectories were the same: it only costs its inserts) and
+    /// 0.51-0.62 M with 4-diameter cells capped at 16, which hold 16 times the memory and were
+    /// slower at 3e4 (CPU times in `docs/dla.md`, "Dimensions 4 and 5").
+    const MAP_LEVELS: &'static [(f64, f64)] = &[(8.0, 32.0)];
+
+    const AXES: [&'static str; 4] = ["x", "y", "z", "w"];
+
+    /// Marsaglia's method ("Choosing a point from the surface of a sphere", 1972): two points
+    /// `(x1, x2)` and `(x3, x4)` uniform in the unit disk, then `(x1, x2, k x3, k x4)` with
+    /// `k = sqrt((1 - s1) / s2)`, `s` their squared norms.
+    #[inline]
+    fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
+        marsaglia_4d(rng)
+    }
+
+    /// [`return_to_sphere_nd`].
+    #[inline]
+    fn return_to_sphere<R: Rng + ?Sized>(p: &[f64; 4], big_r: f64, rng: &mut R) -> [f64; 4] {
+        return_to_sphere_nd(p, big_r, rng)
+    }
+
+    /// 1.3 times `1.7 n^(1/3.4)`: the literature's 4D dimension 3.40 with the prefactor of
+    /// grown clusters (mean `R_ext` 26.1 at 1e4 over 32 clusters, 50.1 at 1e5 over 8; the
+    /// largest was 1.13 times the mean).
+    #[inline]
+    fn expected_r_ext(n: u64) -> f64 {
+        1.3 * (1.7 * (n as f64).powf(1.0 / 3.4))
+    }
+}
+
+impl Space<5> for Dim<5> {
+    /// One map of 4-diameter cells capped at 16 (about 5 400 cells lowered per insert). A map's
+    /// bound lies up to a cell diagonal below the distance: 17.9 diameters for 8-diameter
+    /// cells in 5D, most of the way to the cluster for walkers near it, 8.9 here. Instruction
+    /// counts per particle (cachegrind, 2e3 particles, seeds 1 and 2): 1.9 M, against 2.5-2.7
+    /// M with (8, 32), 2.6 M with a second level (16, 64) and 2.5-4.1 M without maps; CPU time
+    /// at 1e4 (seeds 1-3) 333-361 microseconds per particle against 453-541 with (8, 32). The
+    /// price is memory: one byte per cell of side 4 over the cube the cluster grows in, 100 to
+    /// 300 bytes per particle from 1e4 to 1e6 particles (`docs/dla.md`).
+    const MAP_LEVELS: &'static [(f64, f64)] = &[(4.0, 16.0)];
+
+    const AXES: [&'static str; 5] = ["x", "y", "z", "w", "v"];
+
+    /// The last axis `v` from the density `(3/4) (1 - v^2)` of one coordinate of a uniform
+    /// point on the 4-sphere, as the median of three uniforms in `[-1, 1]` (whose density is
+    /// `(3/4) (1 - v^2)`), then the other four a 4D direction (Marsaglia's) scaled by
+    /// `sqrt(1 - v^2)`: a uniform point on the 4-sphere is `(sqrt(1 - v^2) w, v)` with `w`
+    /// uniform on the 3-sphere and independent of `v`.
+    #[inline]
+    fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 5] {
+        let a = 2.0 * uniform01(rng) - 1.0;
+        let b = 2.0 * uniform01(rng) - 1.0;
+        let c = 2.0 * uniform01(rng) - 1.0;
+        let v = a.max(b).min(a.min(b).max(c));
+        let rho = (1.0 - v * v).max(0.0).sqrt();
+        let w = marsaglia_4d(rng);
+        [rho * w[0], rho * w[1], rho * w[2], rho * w[3], v]
+    }
+
+    /// [`return_to_sphere_nd`].
+    #[inline]
+    fn return_to_sphere<R: Rng + ?Sized>(p: &[f64; 5], big_r: f64, rng: &mut R) -> [f64; 5] {
+        return_to_sphere_nd(p, big_r, rng)
+    }
+
+    /// 1.3 times `1.95 n^(1/4.3)`: the literature's 5D dimension 4.33 (rounded) with the
+    /// prefactor of grown clusters (mean `R_ext` 12.5 at 3e3 over 32 clusters, 21.3 at 3e4
+    /// over 8; the largest was 1.23 times the mean).
+    #[inline]
+    fn expected_r_ext(n: u64) -> f64 {
+        1.3 * (1.95 * (n as f64).powf(1.0 / 4.3))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -176,18 +279,24 @@ mod tests {
     fn directions_are_unit_vectors_with_isotropic_moments() {
         unit_and_isotropic::<2>();
         unit_and_isotropic::<3>();
+        unit_and_isotropic::<4>();
+        unit_and_isotropic::<5>();
     }
 
     #[test]
     fn every_listed_dimension_has_map_levels_finest_first() {
-        for levels in [Dim::<2>::MAP_LEVELS, Dim::<3>::MAP_LEVELS] {
-            assert!(!levels.is_empty());
+        for levels in [
+            Dim::<2>::MAP_LEVELS,
+            Dim::<3>::MAP_LEVELS,
+            Dim::<4>::MAP_LEVELS,
+            Dim::<5>::MAP_LEVELS,
+        ] {
             assert!(
                 levels
                     .windows(2)
                     .all(|w| w[0].0 < w[1].0 && w[0].1 < w[1].1)
             );
         }
-        assert_eq!(DIMENSIONS, &[2, 3]);
+        assert_eq!(DIMENSIONS, &[2, 3, 4, 5]);
     }
 }

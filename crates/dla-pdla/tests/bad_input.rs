@@ -107,7 +107,15 @@ fn bad_inputs_are_refused_before_any_work() {
         (vec!["--particles", "0", "--out", "out"], "--particles 0"),
         (vec!["--particles", "abc", "--out", "out"], "abc"),
         (vec!["--particles", "-5", "--out", "out"], "-5"),
-        (with(&["--dim", "4"]), "--dim 4"),
+        (with(&["--dim", "6"]), "--dim 6"),
+        (
+            with(&["--dim", "4", "--positions", "vtk"]),
+            "--positions vtk holds three coordinates, not the 4 of --dim 4",
+        ),
+        (
+            with(&["--dim", "5", "--positions", "xyz"]),
+            "--positions xyz holds three coordinates",
+        ),
         (
             with(&["--config", "missing.toml"]),
             "--config missing.toml: cannot read it",

@@ -140,3 +140,208 @@ fn hit_probability_3d_is_r_over_big_r() {
     let sigma = (p * (1.0 - p) / n as f64).sqrt();
     assert!((hits / n as f64 - p).abs() < 5.0 * sigma);
 }
+
+/// The law of `ln s`, `s = |p - y|` the distance from the walker at `r = x R` to the point
+/// `y` where it is next found, in `D >= 4` dimensions, as a CDF table: a hit (probability
+/// `x^-(D - 2)`) with density in the cosine `u` proportional to
+/// `(1 - u^2)^((D - 3)/2) s^-D` (the exterior Poisson kernel `(r^2 - R^2) / |p - y|^D` times the
+/// area of the sphere's slice at `u`), or an escape and a uniform relaunch, density
+/// `(1 - u^2)^((D - 3)/2)`. In `ln s` the densities gain the factor `|du / d ln s| ∝ s^2`; the
+/// grid in `ln s` resolves the peak at `s = r - R` however close `x` is to 1.
+fn return_distance_table<const D: usize>(x: f64, big_r: f64, hits_only: bool) -> Vec<(f64, f64)> {
+    let r = x * big_r;
+    let u_of = |ls: f64| {
+        let s = ls.exp();
+        ((r * r + big_r * big_r - s * s) / (2.0 * r * big_r)).clamp(-1.0, 1.0)
+    };
+    let slice = |u: f64| (1.0 - u * u).max(0.0).powf((D as f64 - 3.0) / 2.0);
+    let (a, b) = ((r - big_r).ln(), (r + big_r).ln());
+    let m = 200_000;
+    let hit = cdf_table(
+        |ls| slice(u_of(ls)) * (ls * (2.0 - D as f64)).exp(),
+        a,
+        b,
+        m,
+    );
+    if hits_only {
+        return hit;
+    }
+    let escape = cdf_table(|ls| slice(u_of(ls)) * (2.0 * ls).exp(), a, b, m);
+    let p_hit = x.powi(2 - D as i32);
+    hit.iter()
+        .zip(&escape)
+        .map(|(&(ls, h), &(_, e))| (ls, p_hit * h + (1.0 - p_hit) * e))
+        .collect()
+}
+
+/// A unit vector from a seed-independent sequence, so the walkers come from many directions.
+fn spread_direction<const D: usize>(i: usize) -> [f64; D] {
+    let mut e: [f64; D] =
+        std::array::from_fn(|k| ((i * (2 * k + 3)) as f64 * 0.618_034 + k as f64).sin());
+    let n = e.iter().map(|v| v * v).sum::<f64>().sqrt();
+    e.iter_mut().for_each(|v| *v /= n);
+    e
+}
+
+/// The hit distance alone (from `return_cosine_nd`), then the whole return (hits and uniform
+/// relaunches, from the returned points, which must lie on the sphere), against the harmonic
+/// measure; walkers from `r = R (1 + 1e-6)` (cosines within 1e-12 of 1) to `r = 5 R`.
+fn ks_nd_return_matches_harmonic_measure<const D: usize>(seed: u64)
+where
+    Dim<D>: Space<D>,
+{
+    let n = 40_000;
+    for (k, &x) in [1.0 + 1e-6, 1.05, 2.0, 5.0].iter().enumerate() {
+        let big_r = 7.0;
+        let r = x * big_r;
+        let mut rng = stream(seed, k as u64);
+        let mut hits = Vec::new();
+        while hits.len() < n {
+            if let Some((u, sin)) = dla_pdla::farfield::return_cosine_nd::<D, _>(r, big_r, &mut rng)
+            {
+                assert!((u * u + sin * sin - 1.0).abs() < 1e-12 && (-1.0..=1.0).contains(&u));
+                // s^2 = (r - R)^2 + 2 r R (1 - u), without the cancellation of r^2 + R^2 - 2rRu.
+                let one_minus_u = sin * sin / (1.0 + u);
+                let s2 = (r - big_r).powi(2) + 2.0 * r * big_r * one_minus_u;
+                hits.push(0.5 * s2.ln());
+            }
+        }
+        assert_ks_below_critical(hits, &return_distance_table::<D>(x, big_r, true), x);
+        if x < 1.01 {
+            // The returned point's rounding (1e-16 R) exceeds the hit distances at this x.
+            continue;
+        }
+        let all: Vec<f64> = (0..n)
+            .map(|i| {
+                let e = spread_direction::<D>(i);
+                let p: [f64; D] = std::array::from_fn(|j| r * e[j]);
+                let q = Dim::<D>::return_to_sphere(&p, big_r, &mut rng);
+                let qn = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+                assert!((qn - big_r).abs() < 1e-9, "{q:?}");
+                let s = p
+                    .iter()
+                    .zip(&q)
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    .sqrt();
+                s.ln()
+            })
+            .collect();
+        assert_ks_below_critical(all, &return_distance_table::<D>(x, big_r, false), x);
+    }
+}
+
+#[test]
+fn ks_4d_return_matches_harmonic_measure() {
+    ks_nd_return_matches_harmonic_measure::<4>(45);
+}
+
+#[test]
+fn ks_5d_return_matches_harmonic_measure() {
+    ks_nd_return_matches_harmonic_measure::<5>(46);
+}
+
+/// A walker at `r` hits the sphere with probability `(R / r)^(D - 2)` (5 standard errors).
+#[test]
+fn hit_probability_nd_is_r_over_big_r_to_the_d_minus_2() {
+    fn check<const D: usize>(seed: u64) {
+        for (k, &x) in [1.05f64, 2.0, 5.0].iter().enumerate() {
+            let mut rng = stream(seed, k as u64);
+            let big_r = 10.0;
+            let n = 100_000;
+            let hits = (0..n)
+                .filter(|_| {
+                    dla_pdla::farfield::return_cosine_nd::<D, _>(x * big_r, big_r, &mut rng)
+                        .is_some()
+                })
+                .count() as f64;
+            let p = x.powi(2 - D as i32);
+            let sigma = (p * (1.0 - p) / n as f64).sqrt();
+            assert!(
+                (hits / n as f64 - p).abs() < 5.0 * sigma,
+                "{D}D x = {x}: {} against {p}",
+                hits / n as f64
+            );
+        }
+    }
+    check::<4>(47);
+    check::<5>(48);
+}
+
+/// The density of one coordinate of a uniform point on the unit sphere of `R^m`:
+/// `(1 - c^2)^((m - 3)/2)` on `[-1, 1]`.
+fn coordinate_table(m: usize) -> Vec<(f64, f64)> {
+    cdf_table(
+        |c| (1.0 - c * c).max(0.0).powf((m as f64 - 3.0) / 2.0),
+        -1.0,
+        1.0,
+        200_000,
+    )
+}
+
+/// The returned point's direction orthogonal to the walker's is uniform on the
+/// `(D - 2)`-sphere (for hits by construction, for relaunches because they are uniform): its
+/// component along a unit vector `f` orthogonal to the walker's direction `e` has the law of a
+/// coordinate on the unit sphere of `R^(D - 1)`, for walkers from many directions. The helper
+/// that draws it keeps exactly orthogonal unit vectors.
+#[test]
+fn ks_nd_return_is_isotropic_about_the_walker() {
+    fn check<const D: usize>(seed: u64)
+    where
+        Dim<D>: Space<D>,
+    {
+        let dot = |a: &[f64; D], b: &[f64; D]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let (big_r, r) = (5.0, 6.0);
+        let mut rng = stream(seed, 0);
+        let n = 40_000;
+        let g: [f64; D] = std::array::from_fn(|j| if j == 0 { 1.0 } else { 0.5 });
+        let comps: Vec<f64> = (0..n)
+            .map(|i| {
+                let e = spread_direction::<D>(i);
+                let w = dla_pdla::farfield::orthogonal_direction(&e, &mut rng);
+                assert!(dot(&w, &e).abs() < 1e-12 && (dot(&w, &w) - 1.0).abs() < 1e-12);
+                let p: [f64; D] = std::array::from_fn(|j| r * e[j]);
+                let q = Dim::<D>::return_to_sphere(&p, big_r, &mut rng);
+                let along = dot(&q, &e) / big_r;
+                let mut f: [f64; D] = std::array::from_fn(|j| g[j] - dot(&g, &e) * e[j]);
+                let norm = dot(&f, &f).sqrt();
+                f.iter_mut().for_each(|v| *v /= norm);
+                dot(&q, &f) / (big_r * (1.0 - along * along).sqrt())
+            })
+            .collect();
+        assert_ks_below_critical(comps, &coordinate_table(D - 1), D as f64);
+    }
+    check::<4>(49);
+    check::<5>(50);
+}
+
+/// `Space::direction` in 4D and 5D is uniform on the sphere: each coordinate, and the
+/// component along the diagonal, has the law `(1 - c^2)^((D - 3)/2)` of a coordinate of a
+/// uniform point (the moments are checked in `space.rs`).
+#[test]
+fn ks_nd_directions_are_uniform_on_the_sphere() {
+    fn check<const D: usize>(seed: u64)
+    where
+        Dim<D>: Space<D>,
+    {
+        let mut rng = stream(seed, 0);
+        let n = 40_000;
+        let table = coordinate_table(D);
+        let dirs: Vec<[f64; D]> = (0..n).map(|_| Dim::<D>::direction(&mut rng)).collect();
+        for axis in 0..=D {
+            let comps: Vec<f64> = dirs
+                .iter()
+                .map(|u| {
+                    if axis < D {
+                        u[axis]
+                    } else {
+                        u.iter().sum::<f64>() / (D as f64).sqrt()
+                    }
+                })
+                .collect();
+            assert_ks_below_critical(comps, &table, axis as f64);
+        }
+    }
+    check::<4>(51);
+    check::<5>(52);
+}

@@ -46,7 +46,13 @@ fn contacts_with<const D: usize>(threads: usize, distance_map: bool)
 where
     Dim<D>: Space<D>,
 {
-    let n = 20_000;
+    contacts_sized::<D>(threads, distance_map, 20_000);
+}
+
+fn contacts_sized<const D: usize>(threads: usize, distance_map: bool, n: u64)
+where
+    Dim<D>: Space<D>,
+{
     let sim = grow_with::<D>(
         Params {
             dim: D,
@@ -100,6 +106,18 @@ fn contacts_3d_two_threads() {
     contacts::<3>(2);
 }
 
+/// 4D and 5D, serial and PDLA, with and without the distance map (smaller clusters: a 5D
+/// particle costs 50 to 100 2D ones).
+#[test]
+fn contacts_4d_and_5d() {
+    for threads in [1, 2] {
+        contacts_sized::<4>(threads, true, 3000);
+        contacts_sized::<5>(threads, true, 1200);
+    }
+    contacts_sized::<4>(1, false, 1500);
+    contacts_sized::<5>(1, false, 600);
+}
+
 /// The walker's near cache answers exactly as the tree does, so it changes nothing but speed:
 /// the same positions with it on and off, for the default walk, the tree-only walk (where the
 /// cache answers most moves), the exact search, and a precision too coarse for the cache to
@@ -142,6 +160,8 @@ where
 fn near_cache_changes_nothing_but_speed() {
     near_cache_is_invisible::<2>(4000);
     near_cache_is_invisible::<3>(3000);
+    near_cache_is_invisible::<4>(1000);
+    near_cache_is_invisible::<5>(400);
 }
 
 #[test]
@@ -399,6 +419,7 @@ where
 #[test]
 fn checkpoint_and_resume_give_the_uninterrupted_state_hash() {
     checkpoint_and_resume::<2>(1234);
+    checkpoint_and_resume::<4>(777);
     let dir = checkpoint_and_resume::<3>(999);
     // A checkpoint of the wrong dimension is refused.
     assert!(Simulation::<2>::resume(dir.path(), None).is_err());

@@ -263,7 +263,7 @@ fn particle_limit_is_refused_by_name_and_its_arithmetic_holds() {
     assert_eq!(
         e,
         format!(
-            "--particles {} is outside the accepted range 1..={MAX_PARTICLES}",
+            "--particles {} is outside the accepted range 1..={MAX_PARTICLES} in 2D (the orthtree's 32-bit indices)",
             MAX_PARTICLES + 1
         )
     );

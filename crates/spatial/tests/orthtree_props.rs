@@ -288,6 +288,14 @@ proptest! {
     }
 }
 
+/// Points in the cube `[-half, half)^D`.
+fn cube<const D: usize>(half: f64, max: usize) -> impl Strategy<Value = Vec<[f64; D]>> {
+    prop::collection::vec(
+        prop::collection::vec(-half..half, D).prop_map(|v| std::array::from_fn(|i| v[i])),
+        1..max,
+    )
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(1500))]
 
@@ -295,12 +303,8 @@ proptest! {
     /// and the transitions between exact and approximate answers.
     #[test]
     fn dense_cluster_near_queries_2d(
-        s in leaf_side(),
-        pts in prop::collection::vec(prop::collection::vec(-12.0..12.0f64, 2), 1..200),
-        qs in prop::collection::vec(prop::collection::vec(-40.0..40.0f64, 2), 1..20),
+        s in leaf_side(), pts in cube::<2>(12.0, 200), qs in cube::<2>(40.0, 20),
     ) {
-        let pts: Vec<[f64; 2]> = pts.iter().map(|v| [v[0], v[1]]).collect();
-        let qs: Vec<[f64; 2]> = qs.iter().map(|v| [v[0], v[1]]).collect();
         check::<2>(s, &pts, &qs, &[1.5])?;
     }
 
@@ -309,5 +313,33 @@ proptest! {
         s in leaf_side(), pts in cloud::<4>(40), qs in queries::<4>(), rs in radii()
     ) {
         check::<4>(s, &pts, &qs, &rs)?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(400))]
+
+    /// `DLA --dim 5`'s tree: 32 children per node.
+    #[test]
+    fn hypercube_tree_5d(
+        s in leaf_side(), pts in cloud::<5>(40), qs in queries::<5>(), rs in radii()
+    ) {
+        check::<5>(s, &pts, &qs, &rs)?;
+    }
+
+    /// Dense clusters in 4D and 5D (as many points per unit volume as the 2D ones have per
+    /// unit area only in a far smaller cube), queried close by.
+    #[test]
+    fn dense_cluster_near_queries_4d(
+        s in leaf_side(), pts in cube::<4>(4.0, 120), qs in cube::<4>(12.0, 12),
+    ) {
+        check::<4>(s, &pts, &qs, &[1.5])?;
+    }
+
+    #[test]
+    fn dense_cluster_near_queries_5d(
+        s in leaf_side(), pts in cube::<5>(3.0, 120), qs in cube::<5>(10.0, 12),
+    ) {
+        check::<5>(s, &pts, &qs, &[1.5])?;
     }
 }

@@ -450,14 +450,14 @@ fn offsets_rounding_to_the_upper_face_carry_into_the_next_cell() {
 
 #[test]
 fn running_out_of_indices_is_a_typed_error_that_changes_nothing() {
-    for limit in [200u64, 1000] {
-        let mut t = Orthtree::<2>::with_leaf_side(1.0).unwrap();
+    fn run<const D: usize>(limit: u64) {
+        let mut t = Orthtree::<D>::with_leaf_side(1.0).unwrap();
         t.set_index_limit(limit);
-        let mut rng = Rng::new(limit);
+        let mut rng = Rng::new(limit + D as u64);
+        let mut point = || -> [f64; D] { std::array::from_fn(|_| rng.uniform() * 1e4) };
         let mut stored = 0usize;
         let err = loop {
-            let p = [rng.uniform() * 1e4, rng.uniform() * 1e4];
-            match t.insert(p) {
+            match t.insert(point()) {
                 Ok(_) => stored += 1,
                 Err(e) => break e,
             }
@@ -468,9 +468,8 @@ fn running_out_of_indices_is_a_typed_error_that_changes_nothing() {
         let before = t.stats();
         // Every further insert is refused the same way and leaves the tree as it was.
         for _ in 0..10 {
-            let p = [rng.uniform() * 1e4, rng.uniform() * 1e4];
             assert!(matches!(
-                t.insert(p),
+                t.insert(point()),
                 Err(OrthtreeError::CapacityExceeded(_))
             ));
         }
@@ -479,6 +478,42 @@ fn running_out_of_indices_is_a_typed_error_that_changes_nothing() {
         assert!(s.nodes as u64 <= limit && s.leaves as u64 <= limit);
         assert!(s.point_slots as u64 <= limit);
     }
+    for limit in [200u64, 1000] {
+        run::<2>(limit);
+        run::<4>(limit);
+        run::<5>(limit);
+    }
+}
+
+/// In 4D and 5D a node is 16 and 32 child slots of 4 bytes, and the memory accounting counts
+/// them with the leaf records and the point records of `4 D` bytes, for a sparse cloud (as DLA
+/// is in high dimensions: most leaves hold one or two particles).
+#[test]
+fn node_memory_in_four_and_five_dimensions() {
+    fn check<const D: usize>() {
+        assert_eq!(Orthtree::<D>::FANOUT, 1 << D);
+        let mut rng = Rng::new(D as u64);
+        let mut t = Orthtree::<D>::with_leaf_side(8.0).unwrap();
+        for _ in 0..5000 {
+            t.insert(std::array::from_fn(|_| (rng.uniform() - 0.5) * 400.0))
+                .unwrap();
+        }
+        let s = t.stats();
+        assert!(t.memory_bytes() >= s.nodes * 4 * (1 << D) + s.leaves * 8 + s.point_slots * 4 * D);
+        // The accounting is not wildly above the records either (slack of the arrays' growth).
+        assert!(
+            (t.memory_bytes() as f64)
+                < 1.3 * (s.nodes * 4 * (1 << D) + s.leaves * 8 + s.point_slots * 4 * D) as f64
+                    + 4096.0,
+            "{s:?}"
+        );
+        eprintln!(
+            "{D}D: {s:?}, {:.1} bytes per point",
+            t.memory_bytes() as f64 / 5000.0
+        );
+    }
+    check::<4>();
+    check::<5>();
 }
 
 /// One writer inserting through `insert_shared` while two readers query: every answer is the
