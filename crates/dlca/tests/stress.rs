@@ -123,7 +123,7 @@ fn tiny_lattices_in_every_dimension() {
 #[test]
 fn full_and_nearly_full_lattices() {
     for (dim, side) in [(1, 64), (2, 16), (3, 6), (4, 4), (5, 3)] {
-        let sites = (side as u64).pow(dim as u32);
+        let sites = u64::pow(side, dim as u32);
         for boundary in [Boundary::Periodic, Boundary::Wall] {
             let b = vec![boundary; dim];
             let size = vec![side; dim];

@@ -82,7 +82,7 @@ impl Rings {
         let axis = |b: i128, p: i128| -> Option<[i64; 2]> {
             let lo = (b * self.a).max(p - r).max(i128::from(i64::MIN));
             let hi = ((b + 1) * self.a - 1).min(p + r).min(i128::from(i64::MAX));
-            (lo <= hi).then(|| [lo as i64, hi as i64])
+            (lo <= hi).then_some([lo as i64, hi as i64])
         };
         Some((
             axis(self.b[0] + dx, self.p[0])?,
