@@ -93,6 +93,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "dla_table2_runs.csv",
         "dla_speedup.csv",
         "dla_by_dimension.csv",
+        "dlca_by_dimension.csv",
         "accuracy.csv",
         "accuracy_vpdist.csv",
         "accuracy_vpdist_hist.csv",
@@ -158,6 +159,15 @@ fn tiny_run_produces_every_table_csv_and_plot() {
     assert!(
         dla.contains("3.40 (Tolman & Meakin 1989)") && dla.contains("4.33 (Tolman & Meakin 1989)")
     );
+    // DLCA's D_f by dimension likewise, 2D to 5D, with the literature's values.
+    let dlca_dims = read(d, "dlca_by_dimension.csv");
+    let dims: Vec<&str> = dlca_dims
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(dims, ["2", "3", "4", "5"], "{dlca_dims}");
+    assert!(dlca_dims.contains("2.25-2.30 ± 0.2"), "{dlca_dims}");
 }
 
 #[test]

@@ -5,8 +5,8 @@
 //! present each time the mean cluster size passes one of these are pooled, as the 4D and 5D
 //! tests do). Seeds FIRST_SEED (default 1) onwards.
 
-use dlca::analysis::{fractal_dimension, gyration};
-use dlca::{Init, Params, Simulation};
+use dlca::analysis::{PoolAt, fractal_dimension, pooled_clusters};
+use dlca::{Init, Params};
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
@@ -18,43 +18,25 @@ fn main() {
     let seeds: u64 = arg(5, "8").parse().unwrap();
     let min_size: u64 = arg(6, "10").parse().unwrap();
     let first: u64 = arg(7, "1").parse().unwrap();
+    let at = match when.strip_prefix("mean:") {
+        Some(sizes) => PoolAt::MeanSizes(sizes.split(',').map(|m| m.parse().unwrap()).collect()),
+        None => PoolAt::End(when.parse().unwrap()),
+    };
+    let params = Params {
+        size: vec![l; dim],
+        boundary: vec![core_lattice::Boundary::Periodic; dim],
+        init: Init::Fill(fill),
+        ..Params::default()
+    };
     let mut pooled = Vec::new();
     let t = std::time::Instant::now();
     for seed in first..first + seeds {
-        let mut params = Params {
-            size: vec![l; dim],
-            boundary: vec![core_lattice::Boundary::Periodic; dim],
-            init: Init::Fill(fill),
-            ..Params::default()
-        };
-        let n = params.particles().unwrap();
-        let targets: Vec<u64> = match when.strip_prefix("mean:") {
-            Some(sizes) => sizes
-                .split(',')
-                .map(|m| (n / m.parse::<u64>().unwrap()).max(1))
-                .collect(),
-            None => vec![when.parse().unwrap()],
-        };
-        params.target_clusters = *targets.last().unwrap();
-        let mut sim = Simulation::new(params, seed).unwrap();
-        let mut line = format!("seed {seed}:");
-        for target in targets {
-            while sim.clusters() > target {
-                sim.sweep();
-            }
-            let g = gyration(&sim);
-            let one = fractal_dimension(&g, min_size)
-                .map(|f| f.slope)
-                .unwrap_or(f64::NAN);
-            line += &format!(
-                " sweep {} with {} clusters (largest {}): D = {one:.3};",
-                sim.sweeps(),
-                sim.clusters(),
-                sim.largest()
-            );
-            pooled.extend(g);
-        }
-        println!("{line}");
+        let g = pooled_clusters(&params, seed, &at).unwrap();
+        let one = fractal_dimension(&g, min_size)
+            .map(|f| f.slope)
+            .unwrap_or(f64::NAN);
+        println!("seed {seed}: {} clusters, D = {one:.3}", g.len());
+        pooled.extend(g);
     }
     for m in [min_size, 2 * min_size, 4 * min_size] {
         match fractal_dimension(&pooled, m) {

@@ -3,6 +3,7 @@
 //! `D` from the fit `log s = D log R_g + c` over the clusters (docs/dlca.md,
 //! "Validation").
 
+use crate::params::{ParamError, Params};
 use crate::sim::Simulation;
 use core_lattice::stats::StatsError;
 use core_lattice::{Direction, Fit, IntHistogram, LatticeGyration, MAX_DIM};
@@ -104,4 +105,48 @@ pub fn fractal_dimension(clusters: &[ClusterMeasure], min_size: u64) -> Result<F
         .map(|c| (c.radius_of_gyration, c.size as f64))
         .unzip();
     Fit::log_log(&rg, &s)
+}
+
+/// When one run contributes its clusters to a pooled fractal-dimension fit
+/// ([`pooled_clusters`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PoolAt {
+    /// The clusters left when the run reaches this many clusters (2D and 3D: clusters of tens
+    /// to hundreds of particles at low fill).
+    End(u64),
+    /// The clusters present each time the mean cluster size `particles / clusters` passes one
+    /// of these, in increasing order. In 4D and 5D one cluster runs away with most particles and
+    /// the end of a run is that cluster and debris, so the clusters are pooled during the
+    /// aggregation instead (docs/dlca.md, "Validation").
+    MeanSizes(Vec<u64>),
+}
+
+/// Run `params` from `seed` and return the clusters it contributes to a pooled fit: at the end
+/// for [`PoolAt::End`], at each mean size for [`PoolAt::MeanSizes`] (their radii of gyration from
+/// [`gyration`]). `params.target_clusters` is replaced by the last moment's cluster count. A run
+/// that stops early (`max_sweeps`, or frozen clusters) contributes the moments it reached.
+pub fn pooled_clusters(
+    params: &Params,
+    seed: u64,
+    at: &PoolAt,
+) -> Result<Vec<ClusterMeasure>, ParamError> {
+    let n = params.particles()?;
+    let targets: Vec<u64> = match at {
+        PoolAt::End(clusters) => vec![*clusters],
+        PoolAt::MeanSizes(sizes) => sizes.iter().map(|&m| (n / m.max(1)).max(1)).collect(),
+    };
+    let mut params = params.clone();
+    params.target_clusters = targets.iter().copied().min().unwrap_or(1).max(1);
+    let mut sim = Simulation::new(params, seed)?;
+    let mut pooled = Vec::new();
+    for target in targets {
+        while sim.clusters() > target && !sim.is_done() {
+            sim.sweep();
+        }
+        if sim.clusters() > target {
+            break;
+        }
+        pooled.extend(gyration(&sim));
+    }
+    Ok(pooled)
 }

@@ -25,57 +25,32 @@
 //! standard error to be small enough for the comparison to mean something.
 
 use core_lattice::Boundary;
-use dlca::analysis::{ClusterMeasure, fractal_dimension, gyration};
-use dlca::{Init, Params, Simulation};
+use dlca::analysis::{ClusterMeasure, PoolAt, fractal_dimension, pooled_clusters};
+use dlca::{Init, Params};
 
-/// Which clusters a run contributes to the pooled fit.
-#[derive(Clone, Copy)]
-enum Measure {
-    /// Those left when the run ends at this many clusters.
-    AtEnd(u64),
-    /// Those present each time the mean cluster size passes one of these.
-    AtMeanSizes(&'static [u64]),
-}
-
-fn pooled_dimension(
-    dim: usize,
-    side: u64,
-    fill: f64,
-    measure: Measure,
-    seeds: u64,
-) -> (f64, f64, usize) {
+fn pooled_dimension(dim: usize, side: u64, fill: f64, at: PoolAt, seeds: u64) -> (f64, f64, usize) {
+    let params = Params {
+        size: vec![side; dim],
+        boundary: vec![Boundary::Periodic; dim],
+        init: Init::Fill(fill),
+        ..Params::default()
+    };
     let mut pooled: Vec<ClusterMeasure> = Vec::new();
     for seed in 1..=seeds {
-        let mut params = Params {
-            size: vec![side; dim],
-            boundary: vec![Boundary::Periodic; dim],
-            init: Init::Fill(fill),
-            ..Params::default()
-        };
-        let n = params.particles().unwrap();
-        let targets: Vec<u64> = match measure {
-            Measure::AtEnd(clusters) => vec![clusters],
-            Measure::AtMeanSizes(sizes) => sizes.iter().map(|&m| (n / m).max(1)).collect(),
-        };
-        params.target_clusters = *targets.last().unwrap();
-        let mut sim = Simulation::new(params, seed).unwrap();
-        for target in targets {
-            while sim.clusters() > target {
-                sim.sweep();
-            }
-            pooled.extend(gyration(&sim));
-        }
+        pooled.extend(pooled_clusters(&params, seed, &at).unwrap());
     }
     let fit = fractal_dimension(&pooled, 10).unwrap();
     (fit.slope, fit.slope_stderr, fit.n)
 }
 
 /// The moments at which 4D and 5D runs contribute their clusters.
-const MEAN_SIZES: &[u64] = &[8, 16, 32, 64];
+fn mean_sizes() -> PoolAt {
+    PoolAt::MeanSizes(vec![8, 16, 32, 64])
+}
 
 #[test]
 fn fractal_dimension_2d_matches_literature() {
-    let (d, se, n) = pooled_dimension(2, 1024, 0.01, Measure::AtEnd(30), 4);
+    let (d, se, n) = pooled_dimension(2, 1024, 0.01, PoolAt::End(30), 4);
     eprintln!("2D DLCA: D = {d:.4} +- {se:.4} over {n} clusters");
     assert!(n >= 80, "only {n} clusters in the fit");
     assert!(se < 0.04, "fit too noisy: stderr {se}");
@@ -89,7 +64,7 @@ fn fractal_dimension_2d_matches_literature() {
 fn fractal_dimension_3d_matches_literature() {
     // 0.25% fill: in 3D, D still rises visibly with concentration at 1% (docs/dlca.md,
     // "Validation"), and the literature value is the dilute limit.
-    let (d, se, n) = pooled_dimension(3, 128, 0.0025, Measure::AtEnd(20), 12);
+    let (d, se, n) = pooled_dimension(3, 128, 0.0025, PoolAt::End(20), 12);
     eprintln!("3D DLCA: D = {d:.4} +- {se:.4} over {n} clusters");
     assert!(n >= 80, "only {n} clusters in the fit");
     assert!(se < 0.06, "fit too noisy: stderr {se}");
@@ -106,7 +81,7 @@ fn fractal_dimension_4d_matches_literature() {
     // spread of 0.030 between groups of eight; on larger, more dilute lattices 1.99-2.00
     // (40^4 at 0.1%, 48^4 at 0.05%). Window: the literature's +-0.08 plus about three of those
     // spreads.
-    let (d, se, n) = pooled_dimension(4, 32, 0.002, Measure::AtMeanSizes(MEAN_SIZES), 8);
+    let (d, se, n) = pooled_dimension(4, 32, 0.002, mean_sizes(), 8);
     eprintln!("4D DLCA: D = {d:.4} +- {se:.4} over {n} clusters");
     assert!(n >= 400, "only {n} clusters in the fit");
     assert!(se < 0.04, "fit too noisy: stderr {se}");
@@ -124,7 +99,7 @@ fn fractal_dimension_5d_matches_literature() {
     // 0.1%, 24^5 at 0.03%). The excess over the literature's centre is the runaway cluster of
     // the 5D kernel (module docs): it grows with the mean size at which clusters are pooled.
     // Window: the literature's +-0.2 plus three of those spreads.
-    let (d, se, n) = pooled_dimension(5, 16, 0.002, Measure::AtMeanSizes(MEAN_SIZES), 8);
+    let (d, se, n) = pooled_dimension(5, 16, 0.002, mean_sizes(), 8);
     eprintln!("5D DLCA: D = {d:.4} +- {se:.4} over {n} clusters");
     assert!(n >= 200, "only {n} clusters in the fit");
     assert!(se < 0.05, "fit too noisy: stderr {se}");

@@ -1,7 +1,8 @@
 //! Hawick, James & Scogings (2006), DLCA (sections III, IV.A): clusters against sweeps (Fig. 5),
 //! time per sweep over clusters for each strategy and the grid boxes' speed-up (Fig. 6), histograms
 //! of candidate clusters examined per move (Figs. 4, 7, 8), and the log-log gradient of the sweep
-//! cost against N for each strategy.
+//! cost against N for each strategy, and the fractal dimension in 2D to 5D beside the
+//! literature's (`dlca_dimension`).
 
 use super::ensemble::columns;
 use super::{Ctx, log_spaced};
@@ -47,6 +48,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     fig6(ctx, &mut doc)?;
     histograms(ctx, &mut doc)?;
     cost_against_n(ctx, &mut doc)?;
+    super::dlca_dimension::by_dimension(ctx, &mut doc)?;
     doc.write(&ctx.path("dlca.md"))
 }
 

@@ -10,6 +10,7 @@ pub mod accuracy;
 pub mod animat;
 pub mod dla;
 pub mod dlca;
+pub mod dlca_dimension;
 pub mod ensemble;
 
 use crate::report::{Doc, Table, build_id, machine, sig, utc_now};
