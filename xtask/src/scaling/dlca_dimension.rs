@@ -177,9 +177,10 @@ pub fn by_dimension(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
          fits each group of {GROUP} seeds apart and gives the mean and standard error over \
          groups, the honest error bar. The lattices are the test suite's \
          (`crates/dlca/tests/fractal.rs`) with more seeds: their clusters hold tens to \
-         hundreds of particles, so 4D sits near the top of the literature's range and 5D \
-         above it (the runaway cluster's accretion); `docs/dlca.md`, \"Validation\", gives \
-         the finite-size behaviour on larger, more dilute lattices."
+         hundreds of particles: 4D sits in the literature's range, 5D above its centre but \
+         inside its error (the runaway cluster's accretion grows with the pooled sizes); \
+         `docs/dlca.md`, \"Validation\", gives the finite-size behaviour on larger, more \
+         dilute lattices."
     ));
     Ok(())
 }

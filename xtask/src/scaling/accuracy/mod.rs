@@ -74,8 +74,9 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     doc.p(
         "Each sweep grows, for every setting, one ensemble of clusters with the `dla` binary \
          (`dla --seeds ...`), the same seeds for every setting, its members two at a time, one \
-         per core, so every setting is timed under the same load; the time is the member's \
-         wall time per particle. Errors are against the sweep's reference, its first row. The \
+         per core; the time is the member's CPU time per particle (its process's user and \
+         system time, from `run.json`), which another job on a shared host inflates far less \
+         than the wall time, so settings run at different moments compare. Errors are against the sweep's reference, its first row. The \
          R_g prefactor is A in R_g = A N^(1/D_ref), taken per cluster as the mean of \
          ln R_g - ln N / D_ref over the fitted samples with the reference's D, so it measures \
          the clusters' size at fixed N without the noise of a free intercept; its relative \

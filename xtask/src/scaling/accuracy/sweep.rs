@@ -157,7 +157,7 @@ struct Measured {
 
 /// What the sweep takes from one member of a setting's ensemble.
 struct Run {
-    /// Wall microseconds of the run per particle.
+    /// CPU microseconds of the run per particle (user and system time of the member's process).
     us_per_particle: f64,
     /// Its fitted fractal dimension.
     fractal_dimension: f64,
@@ -218,7 +218,7 @@ impl Sweep {
                 )?;
                 let get = |k: &str| m.results.get(k).copied().unwrap_or(f64::NAN);
                 runs.push(Run {
-                    us_per_particle: get("wall_seconds") / get("particles") * 1e6,
+                    us_per_particle: get("cpu_seconds") / get("particles") * 1e6,
                     fractal_dimension: get("fractal_dimension"),
                     n: growth[0].clone(),
                     radius_of_gyration: growth[1].clone(),
