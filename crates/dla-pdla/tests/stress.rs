@@ -15,8 +15,6 @@
 //! | NaN, infinities and out-of-range values in every float flag | must be refused with exit code 2 naming the flag |
 //! | a checkpoint's `positions.npy` with NaN, infinity, 1e300 or 1e6 in a row | the rows were stored before the log was checked against the checkpoint's hash: a row 1e6 out sized the distance maps for it (a 62 GB allocation, an abort) |
 //! | runs of 1 and 2 particles | no fit, radii 0 and 1/2: finite outputs, no panic |
-//!
-//! Heavier cases (statistics of the extremes, large clusters) run in `cargo xtask stress`.
 
 mod common;
 
