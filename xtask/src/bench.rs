@@ -67,6 +67,37 @@ pub const WORKLOADS: &[Workload] = &[
         args: &["--dim", "3", "--particles", "1000000", "--seed", "1"],
         unit: "particles per second",
     },
+    // The 3D PDLA pair: the speed-up is the ratio of their wall times.
+    Workload {
+        name: "dla-3d-3e5-1thread",
+        bin: "dla",
+        args: &[
+            "--dim",
+            "3",
+            "--particles",
+            "300000",
+            "--threads",
+            "1",
+            "--seed",
+            "21",
+        ],
+        unit: "particles per second",
+    },
+    Workload {
+        name: "dla-3d-3e5-2threads",
+        bin: "dla",
+        args: &[
+            "--dim",
+            "3",
+            "--particles",
+            "300000",
+            "--threads",
+            "2",
+            "--seed",
+            "21",
+        ],
+        unit: "particles per second",
+    },
     Workload {
         name: "dlca-1024-50k-to-1",
         bin: "dlca",
