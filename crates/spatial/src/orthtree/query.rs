@@ -499,10 +499,26 @@ impl<const D: usize> Orthtree<D> {
         f: &mut F,
     ) {
         let q = half * 0.5;
+        // Per axis, the squared distance from p to the lower and the upper half of the node,
+        // summed into each child's `box_dist_sq` bit for bit (as in `visit`).
+        let mut slab = [[0.0f64; 2]; D];
+        for i in 0..D {
+            let x = p[i];
+            let lo = (c[i] - half - x).max(x - c[i]).max(0.0);
+            let hi = (c[i] - x).max(x - (c[i] + half)).max(0.0);
+            slab[i] = [lo * lo, hi * hi];
+        }
         let base = node as usize * Self::FANOUT;
         for ci in 0..Self::FANOUT {
             let child = self.child(base + ci);
             if child == EMPTY {
+                continue;
+            }
+            let mut d2 = 0.0;
+            for (i, sl) in slab.iter().enumerate() {
+                d2 += sl[ci >> i & 1];
+            }
+            if d2 > r_sq {
                 continue;
             }
             let mut cc = c;
@@ -512,9 +528,6 @@ impl<const D: usize> Orthtree<D> {
                 } else {
                     *x -= q;
                 }
-            }
-            if box_dist_sq(p, &cc, q) > r_sq {
-                continue;
             }
             if level == 1 {
                 self.range_leaf(p, r_sq, child, cc, q, f);
