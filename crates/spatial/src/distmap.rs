@@ -706,7 +706,11 @@ mod tests {
         for p in probes {
             let d = brute(pts, p);
             for m in [&map, &shared] {
-                let (lb, ub, capped) = m.bounds(p).expect("inside the map");
+                let Some((lb, ub, capped)) = m.bounds(p) else {
+                    // Outside the map: it covers cap + cell beyond every point and box.
+                    assert!(d > cap, "{p:?} outside the map but near");
+                    continue;
+                };
                 assert!(lb <= d, "bound {lb} above the distance {d} at {p:?}");
                 assert!(
                     ub + diag >= d,
@@ -714,8 +718,10 @@ mod tests {
                 );
                 assert_eq!(m.lower_bound(p).map(|(l, _)| l), Some(lb));
                 assert!(capped || ub.is_finite());
-                let (le, _) = exact.lower_bound(p).unwrap();
-                assert!(lb >= le - diag - cap / 255.0 - 1e-9, "{lb} vs {le}");
+                // The per-point map may be smaller (boxes reach farther), so may not hold p.
+                if let Some((le, _)) = exact.lower_bound(p) {
+                    assert!(lb >= le - diag - cap / 255.0 - 1e-9, "{lb} vs {le}");
+                }
             }
         }
     }

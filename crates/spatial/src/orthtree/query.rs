@@ -316,6 +316,27 @@ impl<const D: usize> Orthtree<D> {
             }
         }
         let half = self.leaf_side * cells * 0.5;
+        // The cells' paths from the root are one path down to the first level whose child
+        // index differs between them (the bit of `k - root_origin` it reads, `l - 1`, lies
+        // above every bit in which an axis's two cell indices differ): walk it once.
+        let mut split = level;
+        for i in 0..D {
+            if two[i] {
+                let diff = ((lo[i] ^ (lo[i] + 1)) as u64) << level;
+                split = split.max(64 - diff.leading_zeros());
+            }
+        }
+        let k0: [i64; D] = std::array::from_fn(|i| self.root_origin[i] + (lo[i] << level));
+        let mut top = self.root;
+        let mut top_level = self.root_level;
+        while top_level > split {
+            let child = self.child(top as usize * Self::FANOUT + self.child_index(&k0, top_level));
+            if child == EMPTY {
+                return;
+            }
+            top = child;
+            top_level -= 1;
+        }
         // p's own cell first, then by number of flipped axes (good bounds early).
         'cells: for &m in &CHILD_ORDER[D][..Self::FANOUT] {
             let combo = home ^ m as usize;
@@ -327,8 +348,8 @@ impl<const D: usize> Orthtree<D> {
                 }
                 k[i] = self.root_origin[i] + ((lo[i] + bit as i64) << level);
             }
-            let mut node = self.root;
-            let mut l = self.root_level;
+            let mut node = top;
+            let mut l = top_level;
             while l > level {
                 let child = self.child(node as usize * Self::FANOUT + self.child_index(&k, l));
                 if child == EMPTY {
