@@ -20,7 +20,8 @@ use core_lattice::rng::Rng;
 use spatial::orthtree::{Orthtree, VpEstimate, dist_sq};
 
 /// A walker jumps by the distance map's bound `lb` when `lb - 1` exceeds this (diameters);
-/// closer to the cluster the tree's sharper bound pays for its cost.
+/// closer to the cluster the tree's sharper bound pays for its cost. The default of
+/// [`Space::MAP_JUMP_MIN`]; 3D uses its own.
 pub const MAP_JUMP_MIN: f64 = 2.0;
 /// The far field starts at `|p| > r_b * FAR_FIELD_MARGIN`.
 pub const FAR_FIELD_MARGIN: f64 = 1.0 + 1e-9;
@@ -95,10 +96,14 @@ where
         // (region / cap)^2 moves to cross them, a cost growing with the cluster. There the
         // tree's distance, a few hundred nanoseconds, gives the long jump instead.
         let mut floor = 0.0;
-        if let Some((lb, capped)) = cluster.map_bound(&self.p) {
+        if let Some((lb, ub, capped)) = cluster.map_bounds(&self.p) {
+            // The map bounds the distance from above too: a walker with no answer yet (just
+            // born or returned) or a looser one starts its tree query from the few nodes
+            // around that ball rather than from the root.
+            state.upper = state.upper.min(ub);
             if capped {
                 floor = lb;
-            } else if lb - 1.0 > MAP_JUMP_MIN {
+            } else if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
                 self.jump(lb - 1.0, rng);
                 state.upper += (lb - 1.0) * (1.0 + 1e-9);
                 return None;

@@ -223,7 +223,9 @@ impl<const D: usize> DistanceMap<D> {
             if !(j >= 0.0 && j < self.side as f64) {
                 return None;
             }
-            idx += j as usize * stride;
+            // j is a whole number in [0, side): through i64 the conversion is one instruction
+            // and a check, where a direct f64 -> usize conversion is a longer sequence.
+            idx += j as i64 as usize * stride;
             stride *= self.side;
             centre[i] = (k + 0.5) * self.cell;
         }
@@ -247,6 +249,36 @@ impl<const D: usize> DistanceMap<D> {
         Some((
             m * (1.0 - SHRINK) - e2.sqrt() * (1.0 + SHRINK) - 1e-12,
             v == CAPPED,
+        ))
+    }
+
+    /// [`lower_bound`](Self::lower_bound) and, for a cell that is not capped, an upper bound
+    /// of the same distance: the nearest point is less than one quantum above the stored
+    /// value from the cell's centre `z`, so less than that plus `|p - z|` from `p` (widened by
+    /// a relative `2^-40` for rounding); `+inf` for a capped cell. As `(lower, upper,
+    /// capped)`. After [`insert_box`](Self::insert_box) the upper bound is one to the nearest
+    /// box: add the boxes' diagonal for one to the points in them.
+    #[inline]
+    pub fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+        let (idx, z) = self.index(p)?;
+        let v = self.values[idx].load(Ordering::Relaxed);
+        let mut e2 = 0.0;
+        for i in 0..D {
+            let e = p[i] - z[i];
+            e2 += e * e;
+        }
+        let m = f64::from(v) * self.quantum;
+        let e = e2.sqrt();
+        let capped = v == CAPPED;
+        let upper = if capped {
+            f64::INFINITY
+        } else {
+            (m + self.quantum + e) * (1.0 + SHRINK) + 1e-12
+        };
+        Some((
+            m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12,
+            upper,
+            capped,
         ))
     }
 
@@ -287,6 +319,108 @@ impl<const D: usize> DistanceMap<D> {
             }
         });
         Ok(inside)
+    }
+
+    /// Adds every point of the closed box `[lo, hi]` at once: lowers each cell to the
+    /// quantised distance from its centre to the box, which is at most the distance to any
+    /// point in it. A caller that has added a box need not add the points inside it later: the
+    /// map stays a lower bound, looser by at most the box's diagonal near it. Grows the map
+    /// first like [`insert`](Self::insert). `lo <= hi` on every axis.
+    pub fn insert_box(&mut self, lo: &[f64; D], hi: &[f64; D]) -> Result<(), DistanceMapError> {
+        let need = finite_max_norm(lo)?.max(finite_max_norm(hi)?) + self.cap + self.cell;
+        if need >= self.reach() {
+            self.grow(need)?;
+        }
+        self.points += 1;
+        self.lower_box_rows(lo, hi, |v, w| {
+            if w < v.load(Ordering::Relaxed) {
+                v.store(w, Ordering::Relaxed);
+            }
+        });
+        Ok(())
+    }
+
+    /// [`insert_box`](Self::insert_box) through a shared reference, as
+    /// [`insert_shared`](Self::insert_shared) is to [`insert`](Self::insert): atomic
+    /// `fetch_min`, no growth (cells outside the map are skipped; `false` then).
+    pub fn insert_box_shared(
+        &self,
+        lo: &[f64; D],
+        hi: &[f64; D],
+    ) -> Result<bool, DistanceMapError> {
+        let inside =
+            finite_max_norm(lo)?.max(finite_max_norm(hi)?) + self.cap + self.cell < self.reach();
+        self.lower_box_rows(lo, hi, |v, w| {
+            if w < v.load(Ordering::Relaxed) {
+                v.fetch_min(w, Ordering::Relaxed);
+            }
+        });
+        Ok(inside)
+    }
+
+    /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of the
+    /// box `[blo, bhi]`, with `w` the quantised distance from the centre to the box, whenever
+    /// `w` could be below the stored value.
+    fn lower_box_rows(&self, blo: &[f64; D], bhi: &[f64; D], mut lower: impl FnMut(&AtomicU8, u8)) {
+        let mut lo = [0i64; D];
+        let mut hi = [0i64; D];
+        for i in 0..D {
+            lo[i] = (ceil((blo[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
+            hi[i] = (floor((bhi[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
+            if lo[i] > hi[i] {
+                return;
+            }
+        }
+        let cap2 = self.cap * self.cap;
+        // Distance along axis i from the centre of cell k to the box.
+        let gap = |i: usize, k: i64| {
+            let z = (k as f64 + 0.5) * self.cell;
+            (blo[i] - z).max(z - bhi[i]).max(0.0)
+        };
+        let mut k = lo;
+        loop {
+            let mut s = 0.0;
+            let mut base = 0usize;
+            let mut stride = self.side;
+            for i in 1..D {
+                let e = gap(i, k[i]);
+                s += e * e;
+                base += (k[i] + self.half) as usize * stride;
+                stride *= self.side;
+            }
+            if s < cap2 {
+                // Centres within sqrt(cap^2 - s) of the box along axis 0.
+                let w = (cap2 - s).sqrt();
+                let a = (ceil((blo[0] - w) * self.inv_cell - 0.5) as i64).max(lo[0]);
+                let b = (floor((bhi[0] + w) * self.inv_cell - 0.5) as i64).min(hi[0]);
+                if a <= b {
+                    let row = &self.values
+                        [base + (a + self.half) as usize..=base + (b + self.half) as usize];
+                    for (j, v) in row.iter().enumerate() {
+                        let e = gap(0, a + j as i64);
+                        let d2 = e * e + s;
+                        if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
+                            let d = d2.sqrt() * self.inv_quantum;
+                            if d < f64::from(CAPPED) {
+                                lower(v, d as u8);
+                            }
+                        }
+                    }
+                }
+            }
+            let mut axis = 1;
+            loop {
+                if axis >= D {
+                    return;
+                }
+                if k[axis] < hi[axis] {
+                    k[axis] += 1;
+                    break;
+                }
+                k[axis] = lo[axis];
+                axis += 1;
+            }
+        }
     }
 
     /// Grows the map (if needed) so that it covers `|x_i| < reach`.
@@ -530,6 +664,100 @@ mod tests {
             cap in prop_oneof![Just(16.0), Just(32.0)],
         ) {
             check(cell, cap, &pts, &probes);
+        }
+    }
+
+    /// Points added through boxes that hold them (as `dla` adds its coarser maps' points by
+    /// their tree leaf's box) and points added one by one: the bound never exceeds the exact
+    /// distance to any of them, the upper bound of [`DistanceMap::bounds`] is never below it,
+    /// and a box's bound is at most its diagonal looser than the point's would be.
+    fn check_boxes<const D: usize>(
+        cell: f64,
+        cap: f64,
+        side: f64,
+        pts: &[[f64; D]],
+        probes: &[[f64; D]],
+    ) {
+        let mut map = DistanceMap::<D>::new(cell, cap).unwrap();
+        let mut exact = DistanceMap::<D>::new(cell, cap).unwrap();
+        let mut shared = DistanceMap::<D>::new(cell, cap).unwrap();
+        let reach = pts
+            .iter()
+            .flat_map(|q| q.iter())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+            + side
+            + cap
+            + cell
+            + 1.0;
+        shared.reserve(reach).unwrap();
+        for (n, q) in pts.iter().enumerate() {
+            let lo = q.map(|x| (x / side).floor() * side);
+            let hi = lo.map(|x| x + side);
+            if n % 3 == 0 {
+                map.insert(q).unwrap();
+                assert!(shared.insert_shared(q).unwrap());
+            } else {
+                map.insert_box(&lo, &hi).unwrap();
+                assert!(shared.insert_box_shared(&lo, &hi).unwrap());
+            }
+            exact.insert(q).unwrap();
+        }
+        let diag = side * (D as f64).sqrt();
+        for p in probes {
+            let d = brute(pts, p);
+            for m in [&map, &shared] {
+                let Some((lb, ub, capped)) = m.bounds(p) else {
+                    // Outside the map: it covers cap + cell beyond every point and box.
+                    assert!(d > cap, "{p:?} outside the map but near");
+                    continue;
+                };
+                assert!(lb <= d, "bound {lb} above the distance {d} at {p:?}");
+                assert!(
+                    ub + diag >= d,
+                    "upper bound {ub} too low for the distance {d}"
+                );
+                assert_eq!(m.lower_bound(p).map(|(l, _)| l), Some(lb));
+                assert!(capped || ub.is_finite());
+                // The per-point map may be smaller (boxes reach farther), so may not hold p.
+                if let Some((le, _)) = exact.lower_bound(p) {
+                    assert!(lb >= le - diag - cap / 255.0 - 1e-9, "{lb} vs {le}");
+                }
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(32))]
+
+        #[test]
+        fn box_inserts_keep_the_bound_2d(
+            pts in proptest::collection::vec(pt::<2>(60.0), 1..40),
+            probes in proptest::collection::vec(pt::<2>(90.0), 1..40),
+            cell in prop_oneof![Just(8.0), Just(64.0)],
+            cap in prop_oneof![Just(64.0), Just(40.0)],
+        ) {
+            check_boxes(cell, cap, 8.0, &pts, &probes);
+        }
+
+        #[test]
+        fn box_inserts_keep_the_bound_3d(
+            pts in proptest::collection::vec(pt::<3>(30.0), 1..30),
+            probes in proptest::collection::vec(pt::<3>(45.0), 1..30),
+            cell in prop_oneof![Just(8.0), Just(32.0)],
+            cap in prop_oneof![Just(32.0), Just(128.0)],
+        ) {
+            check_boxes(cell, cap, 8.0, &pts, &probes);
+        }
+
+        #[test]
+        fn box_inserts_keep_the_bound_4d_5d(
+            pts4 in proptest::collection::vec(pt::<4>(20.0), 1..15),
+            probes4 in proptest::collection::vec(pt::<4>(30.0), 1..15),
+            pts5 in proptest::collection::vec(pt::<5>(12.0), 1..10),
+            probes5 in proptest::collection::vec(pt::<5>(18.0), 1..10),
+        ) {
+            check_boxes(8.0, 32.0, 4.0, &pts4, &probes4);
+            check_boxes(4.0, 16.0, 2.0, &pts5, &probes5);
         }
     }
 

@@ -316,6 +316,27 @@ impl<const D: usize> Orthtree<D> {
             }
         }
         let half = self.leaf_side * cells * 0.5;
+        // The cells' paths from the root are one path down to the first level whose child
+        // index differs between them (the bit of `k - root_origin` it reads, `l - 1`, lies
+        // above every bit in which an axis's two cell indices differ): walk it once.
+        let mut split = level;
+        for i in 0..D {
+            if two[i] {
+                let diff = ((lo[i] ^ (lo[i] + 1)) as u64) << level;
+                split = split.max(64 - diff.leading_zeros());
+            }
+        }
+        let k0: [i64; D] = std::array::from_fn(|i| self.root_origin[i] + (lo[i] << level));
+        let mut top = self.root;
+        let mut top_level = self.root_level;
+        while top_level > split {
+            let child = self.child(top as usize * Self::FANOUT + self.child_index(&k0, top_level));
+            if child == EMPTY {
+                return;
+            }
+            top = child;
+            top_level -= 1;
+        }
         // p's own cell first, then by number of flipped axes (good bounds early).
         'cells: for &m in &CHILD_ORDER[D][..Self::FANOUT] {
             let combo = home ^ m as usize;
@@ -327,8 +348,8 @@ impl<const D: usize> Orthtree<D> {
                 }
                 k[i] = self.root_origin[i] + ((lo[i] + bit as i64) << level);
             }
-            let mut node = self.root;
-            let mut l = self.root_level;
+            let mut node = top;
+            let mut l = top_level;
             while l > level {
                 let child = self.child(node as usize * Self::FANOUT + self.child_index(&k, l));
                 if child == EMPTY {
@@ -499,10 +520,26 @@ impl<const D: usize> Orthtree<D> {
         f: &mut F,
     ) {
         let q = half * 0.5;
+        // Per axis, the squared distance from p to the lower and the upper half of the node,
+        // summed into each child's `box_dist_sq` bit for bit (as in `visit`).
+        let mut slab = [[0.0f64; 2]; D];
+        for i in 0..D {
+            let x = p[i];
+            let lo = (c[i] - half - x).max(x - c[i]).max(0.0);
+            let hi = (c[i] - x).max(x - (c[i] + half)).max(0.0);
+            slab[i] = [lo * lo, hi * hi];
+        }
         let base = node as usize * Self::FANOUT;
         for ci in 0..Self::FANOUT {
             let child = self.child(base + ci);
             if child == EMPTY {
+                continue;
+            }
+            let mut d2 = 0.0;
+            for (i, sl) in slab.iter().enumerate() {
+                d2 += sl[ci >> i & 1];
+            }
+            if d2 > r_sq {
                 continue;
             }
             let mut cc = c;
@@ -512,9 +549,6 @@ impl<const D: usize> Orthtree<D> {
                 } else {
                     *x -= q;
                 }
-            }
-            if box_dist_sq(p, &cc, q) > r_sq {
-                continue;
             }
             if level == 1 {
                 self.range_leaf(p, r_sq, child, cc, q, f);
