@@ -71,7 +71,7 @@ impl<const D: usize> Cluster<D> {
                     }
                 }
             }
-            None => self.update_maps(&q)?,
+            None => self.update_maps(&q, new_leaf)?,
         }
         Ok(q)
     }
@@ -98,16 +98,20 @@ impl<const D: usize> Cluster<D> {
     }
 
     /// Lowers the (possibly shared) maps for a stored particle `q`, atomically; the maps do not
-    /// grow (see [`reserve_maps`](Self::reserve_maps)).
-    pub fn update_maps(&self, q: &[f64; D]) -> Result<(), SimError> {
+    /// grow (see [`reserve_maps`](Self::reserve_maps)). `new_leaf`: `q` is the first particle
+    /// of its tree leaf, whose box then lowers the coarser maps, once for every particle the
+    /// leaf will hold, in whichever phase (serial or PDLA) the leaf opened. Until its first
+    /// particle's update is done, a walker may read a coarse bound that misses the leaf, as it
+    /// may read any map before a stored particle's update: PDLA's re-check at sticking
+    /// catches what such a jump could cause.
+    pub fn update_maps(&self, q: &[f64; D], new_leaf: bool) -> Result<(), SimError> {
         if let Some((fine, coarse)) = self.maps.split_first() {
             fine.insert_shared(q)?;
-            // Every particle lowers the coarser maps by its whole leaf box (idempotent), so
-            // a particle added later in serial to a leaf that already exists finds its box
-            // there, whichever phase stored the leaf's first particle.
-            let (lo, hi) = self.leaf_box(q);
-            for map in coarse {
-                map.insert_box_shared(&lo, &hi)?;
+            if new_leaf {
+                let (lo, hi) = self.leaf_box(q);
+                for map in coarse {
+                    map.insert_box_shared(&lo, &hi)?;
+                }
             }
         }
         Ok(())

@@ -415,8 +415,8 @@ where
             if overlap {
                 continue;
             }
-            let q = match tree.insert_shared(stick, self.readers_epoch()) {
-                Ok(q) => q,
+            let (q, new_leaf) = match tree.insert_shared(stick, self.readers_epoch()) {
+                Ok(stored) => stored,
                 Err(OrthtreeError::NeedsExclusive) => {
                     // The walker is dropped; the next phase reserves more room.
                     guard.needs_room = true;
@@ -450,7 +450,7 @@ where
             // The stuck particle lowers the shared distance maps once, atomically; until it
             // has, another thread's walker may jump by a stale bound, which the re-check at
             // its sticking catches like any move made before a particle was stored.
-            if let Err(e) = self.cluster.update_maps(&q) {
+            if let Err(e) = self.cluster.update_maps(&q, new_leaf) {
                 return self.fail(&mut self.lock(), e);
             }
         }

@@ -263,6 +263,10 @@ impl<const D: usize> Orthtree<D> {
     /// shared tree, the variable-precision paper, section 3.4). Inserts are serialised by the
     /// tree's writer lock; a query running meanwhile sees the tree before or after the insert.
     ///
+    /// Returns the stored position, as [`insert`](Self::insert) does, and whether the point
+    /// opened a new leaf (the first point of its leaf cell): callers that index the leaves'
+    /// boxes, such as DLA's coarse distance maps, act once per leaf.
+    ///
     /// Needs the root to contain `p` and the room reserved by
     /// [`prepare_shared`](Self::prepare_shared); otherwise it fails with
     /// [`OrthtreeError::NeedsExclusive`] and changes nothing (insert the point with
@@ -277,7 +281,7 @@ impl<const D: usize> Orthtree<D> {
         &self,
         p: [f64; D],
         readers_epoch: u64,
-    ) -> Result<[f64; D], OrthtreeError> {
+    ) -> Result<([f64; D], bool), OrthtreeError> {
         let (k, code) = self.locate(&p)?;
         if self.root == EMPTY || !self.root_contains(&k) {
             return Err(OrthtreeError::NeedsExclusive);
@@ -298,7 +302,7 @@ impl<const D: usize> Orthtree<D> {
             // Release: a reader that reads the new value sees every record stored before it.
             self.shared.epoch.fetch_add(1, Ordering::AcqRel);
         }
-        Ok(self.decoded(&k, &code))
+        Ok((self.decoded(&k, &code), leaf_len == 0))
     }
 
     /// The reclamation epoch a reader announces (see [`insert_shared`](Self::insert_shared)).

@@ -592,7 +592,7 @@ fn shared_inserts_while_readers_query() {
                 .map(|e| e.load(Ordering::Acquire))
                 .min()
                 .unwrap();
-            assert_eq!(t.insert_shared(p, readers).unwrap(), stored[i]);
+            assert_eq!(t.insert_shared(p, readers).unwrap().0, stored[i]);
             published.store(i + 1, Ordering::Release);
             // Readers are far slower than the writer here (their answers are checked by brute
             // force); let them catch up now and then, as PDLA's walkers do at every birth.
