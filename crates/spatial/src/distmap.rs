@@ -358,6 +358,20 @@ impl<const D: usize> DistanceMap<D> {
         Ok(inside)
     }
 
+    /// Lowers cell `v` to the squared distance `d2` (in length units) if that is below its
+    /// value, through `lower` (a plain or an atomic store); cells at or beyond the cap stay.
+    #[inline(always)]
+    fn lower_cell(&self, v: &AtomicU8, d2: f64, lower: &mut impl FnMut(&AtomicU8, u8)) {
+        // Most cells are already nearer another point: one table read and a compare, no
+        // square root.
+        if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
+            let d = d2.sqrt() * self.inv_quantum;
+            if d < f64::from(CAPPED) {
+                lower(v, d as u8);
+            }
+        }
+    }
+
     /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of the
     /// box `[blo, bhi]`, with `w` the quantised distance from the centre to the box, whenever
     /// `w` could be below the stored value.
@@ -398,27 +412,12 @@ impl<const D: usize> DistanceMap<D> {
                         [base + (a + self.half) as usize..=base + (b + self.half) as usize];
                     for (j, v) in row.iter().enumerate() {
                         let e = gap(0, a + j as i64);
-                        let d2 = e * e + s;
-                        if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
-                            let d = d2.sqrt() * self.inv_quantum;
-                            if d < f64::from(CAPPED) {
-                                lower(v, d as u8);
-                            }
-                        }
+                        self.lower_cell(v, e * e + s, &mut lower);
                     }
                 }
             }
-            let mut axis = 1;
-            loop {
-                if axis >= D {
-                    return;
-                }
-                if k[axis] < hi[axis] {
-                    k[axis] += 1;
-                    break;
-                }
-                k[axis] = lo[axis];
-                axis += 1;
+            if !next_row(&mut k, &lo, &hi) {
+                return;
             }
         }
     }
@@ -503,32 +502,15 @@ impl<const D: usize> DistanceMap<D> {
                         [base + (a + self.half) as usize..=base + (b + self.half) as usize];
                     let x0 = (a as f64 + 0.5) * self.cell - q[0];
                     for (j, v) in row.iter().enumerate() {
-                        // Most cells are already nearer another point: one table read and a
-                        // compare, no square root. (Rows are far shorter than 2^31 cells; i32
-                        // converts in one instruction.)
+                        // Rows are far shorter than 2^31 cells; i32 converts in one instruction.
                         let x = x0 + f64::from(j as i32) * self.cell;
-                        let d2 = x * x + s;
-                        if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
-                            let d = d2.sqrt() * self.inv_quantum;
-                            if d < f64::from(CAPPED) {
-                                lower(v, d as u8);
-                            }
-                        }
+                        self.lower_cell(v, x * x + s, &mut lower);
                     }
                 }
             }
             // Next row.
-            let mut axis = 1;
-            loop {
-                if axis >= D {
-                    return;
-                }
-                if k[axis] < hi[axis] {
-                    k[axis] += 1;
-                    break;
-                }
-                k[axis] = lo[axis];
-                axis += 1;
+            if !next_row(&mut k, &lo, &hi) {
+                return;
             }
         }
     }
@@ -590,6 +572,20 @@ fn finite_max_norm<const D: usize>(q: &[f64; D]) -> Result<f64, DistanceMapError
         m = m.max(x.abs());
     }
     Ok(m)
+}
+
+/// Advances the row index `k[1..]` through the box of cells `lo..=hi` (axis 0 runs along a
+/// row), odometer fashion; `false` once the last row is done.
+#[inline(always)]
+fn next_row<const D: usize>(k: &mut [i64; D], lo: &[i64; D], hi: &[i64; D]) -> bool {
+    for axis in 1..D {
+        if k[axis] < hi[axis] {
+            k[axis] += 1;
+            return true;
+        }
+        k[axis] = lo[axis];
+    }
+    false
 }
 
 #[cfg(test)]
