@@ -1,0 +1,316 @@
+//! Unit and property tests of the distance maps against brute force.
+
+use super::*;
+use proptest::prelude::*;
+
+fn brute<const D: usize>(pts: &[[f64; D]], p: &[f64; D]) -> f64 {
+    pts.iter()
+        .map(|q| {
+            let mut s = 0.0;
+            for i in 0..D {
+                s += (p[i] - q[i]) * (p[i] - q[i]);
+            }
+            s.sqrt()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn check<const D: usize>(cell: f64, cap: f64, pts: &[[f64; D]], probes: &[[f64; D]]) {
+    let mut map = DistanceMap::<D>::new(cell, cap).unwrap();
+    for (n, q) in pts.iter().enumerate() {
+        map.insert(q).unwrap();
+        // Check after every few inserts, so growth in the middle is covered.
+        if n % 7 == 6 || n + 1 == pts.len() {
+            let sofar = &pts[..=n];
+            for p in probes {
+                let Some((lb, capped)) = map.lower_bound(p) else {
+                    // Outside the map: the map must cover cap + cell beyond every point.
+                    assert!(brute(sofar, p) > cap, "{p:?} outside the map but near");
+                    continue;
+                };
+                let d = brute(sofar, p);
+                assert!(lb <= d, "bound {lb} above the distance {d} at {p:?}");
+                if !capped {
+                    let diag = cell * (D as f64).sqrt();
+                    assert!(
+                        lb >= d - diag - cap / 255.0 - 1e-9,
+                        "bound {lb} too loose for distance {d}"
+                    );
+                } else {
+                    let half_diag = 0.5 * cell * (D as f64).sqrt();
+                    assert!(d >= cap - half_diag - 1e-9, "capped cell at distance {d}");
+                }
+            }
+        }
+    }
+}
+
+fn pt<const D: usize>(range: f64) -> impl Strategy<Value = [f64; D]> {
+    proptest::array::uniform::<_, D>(-range..range)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn bound_is_valid_and_tight_2d(
+        pts in proptest::collection::vec(pt::<2>(60.0), 1..40),
+        probes in proptest::collection::vec(pt::<2>(90.0), 1..40),
+        cell in prop_oneof![Just(1.0), Just(4.0), Just(8.0), Just(3.0)],
+        cap in prop_oneof![Just(16.0), Just(64.0), Just(10.5)],
+    ) {
+        check(cell, cap, &pts, &probes);
+    }
+
+    #[test]
+    fn bound_is_valid_and_tight_3d(
+        pts in proptest::collection::vec(pt::<3>(30.0), 1..25),
+        probes in proptest::collection::vec(pt::<3>(45.0), 1..25),
+        cell in prop_oneof![Just(2.0), Just(8.0)],
+        cap in prop_oneof![Just(16.0), Just(32.0)],
+    ) {
+        check(cell, cap, &pts, &probes);
+    }
+}
+
+/// Points added through boxes that hold them (as `dla` adds its coarser maps' points by
+/// their tree leaf's box) and points added one by one: the bound never exceeds the exact
+/// distance to any of them, the upper bound of [`DistanceMap::bounds`] is never below it,
+/// and a box's bound is at most its diagonal looser than the point's would be.
+fn check_boxes<const D: usize>(
+    cell: f64,
+    cap: f64,
+    side: f64,
+    pts: &[[f64; D]],
+    probes: &[[f64; D]],
+) {
+    let mut map = DistanceMap::<D>::new(cell, cap).unwrap();
+    let mut exact = DistanceMap::<D>::new(cell, cap).unwrap();
+    let mut shared = DistanceMap::<D>::new(cell, cap).unwrap();
+    let reach = pts
+        .iter()
+        .flat_map(|q| q.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()))
+        + side
+        + cap
+        + cell
+        + 1.0;
+    shared.reserve(reach).unwrap();
+    for (n, q) in pts.iter().enumerate() {
+        let lo = q.map(|x| (x / side).floor() * side);
+        let hi = lo.map(|x| x + side);
+        if n % 3 == 0 {
+            map.insert(q).unwrap();
+            assert!(shared.insert_shared(q).unwrap());
+        } else {
+            map.insert_box(&lo, &hi).unwrap();
+            assert!(shared.insert_box_shared(&lo, &hi).unwrap());
+        }
+        exact.insert(q).unwrap();
+    }
+    let diag = side * (D as f64).sqrt();
+    for p in probes {
+        let d = brute(pts, p);
+        for m in [&map, &shared] {
+            let Some((lb, ub, capped)) = m.bounds(p) else {
+                // Outside the map: it covers cap + cell beyond every point and box.
+                assert!(d > cap, "{p:?} outside the map but near");
+                continue;
+            };
+            assert!(lb <= d, "bound {lb} above the distance {d} at {p:?}");
+            assert!(
+                ub + diag >= d,
+                "upper bound {ub} too low for the distance {d}"
+            );
+            assert_eq!(m.lower_bound(p).map(|(l, _)| l), Some(lb));
+            assert!(capped || ub.is_finite());
+            // The per-point map may be smaller (boxes reach farther), so may not hold p.
+            if let Some((le, _)) = exact.lower_bound(p) {
+                assert!(lb >= le - diag - cap / 255.0 - 1e-9, "{lb} vs {le}");
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    #[test]
+    fn box_inserts_keep_the_bound_2d(
+        pts in proptest::collection::vec(pt::<2>(60.0), 1..40),
+        probes in proptest::collection::vec(pt::<2>(90.0), 1..40),
+        cell in prop_oneof![Just(8.0), Just(64.0)],
+        cap in prop_oneof![Just(64.0), Just(40.0)],
+    ) {
+        check_boxes(cell, cap, 8.0, &pts, &probes);
+    }
+
+    #[test]
+    fn box_inserts_keep_the_bound_3d(
+        pts in proptest::collection::vec(pt::<3>(30.0), 1..30),
+        probes in proptest::collection::vec(pt::<3>(45.0), 1..30),
+        cell in prop_oneof![Just(8.0), Just(32.0)],
+        cap in prop_oneof![Just(32.0), Just(128.0)],
+    ) {
+        check_boxes(cell, cap, 8.0, &pts, &probes);
+    }
+
+    #[test]
+    fn box_inserts_keep_the_bound_4d_5d(
+        pts4 in proptest::collection::vec(pt::<4>(20.0), 1..15),
+        probes4 in proptest::collection::vec(pt::<4>(30.0), 1..15),
+        pts5 in proptest::collection::vec(pt::<5>(12.0), 1..10),
+        probes5 in proptest::collection::vec(pt::<5>(18.0), 1..10),
+    ) {
+        check_boxes(8.0, 32.0, 4.0, &pts4, &probes4);
+        check_boxes(4.0, 16.0, 2.0, &pts5, &probes5);
+    }
+}
+
+/// A cell's value is a minimum over the points, independent of their order: two threads
+/// adding halves of a point set to one reserved map through `insert_shared` leave exactly
+/// the bytes of the sequential map; points beyond the map are clipped, never wrong.
+#[test]
+fn shared_inserts_from_two_threads_equal_sequential_inserts() {
+    let mut rng = crate::testdata::SplitMix::new(0x9e37_79b9_7f4a_7c15);
+    let mut next = || rng.uniform();
+    let pts: Vec<[f64; 2]> = (0..4000)
+        .map(|_| [next() * 400.0 - 200.0, next() * 400.0 - 200.0])
+        .collect();
+    let mut seq = DistanceMap::<2>::new(8.0, 64.0).unwrap();
+    for q in &pts {
+        seq.insert(q).unwrap();
+    }
+    let mut shared = DistanceMap::<2>::new(8.0, 64.0).unwrap();
+    shared.reserve(seq.reach()).unwrap();
+    assert_eq!(shared.reach(), seq.reach());
+    let (a, b) = pts.split_at(pts.len() / 2);
+    std::thread::scope(|s| {
+        for half in [a, b] {
+            let map = &shared;
+            s.spawn(move || {
+                for q in half {
+                    assert!(map.insert_shared(q).unwrap());
+                }
+            });
+        }
+    });
+    for x in (-260..260).step_by(3) {
+        for y in (-260..260).step_by(5) {
+            let p = [x as f64, y as f64];
+            assert_eq!(seq.value(&p), shared.value(&p), "{p:?}");
+        }
+    }
+    // A point beyond the map: clipped, reported, and the stored cells stay valid bounds.
+    let far = [seq.reach() - 10.0, 0.0];
+    assert!(!shared.insert_shared(&far).unwrap());
+    let mut all = pts.clone();
+    all.push(far);
+    let p = [seq.reach() - 30.0, 3.0];
+    let (lb, _) = shared.lower_bound(&p).unwrap();
+    assert!(lb <= brute(&all, &p));
+    assert!(shared.insert_shared(&[f64::NAN, 0.0]).is_err());
+}
+
+/// The rows' ranges from the table of widths cover every cell the exactly solved ranges
+/// cover, and the extra cells they visit are never lowered: the same bytes either way,
+/// in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
+/// centres among random ones.
+#[test]
+fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
+    fn same<const D: usize>(cell: f64, cap: f64, seed: u64) {
+        let mut rng = seed;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let span = 6.0 * cap;
+        let mut pts: Vec<[f64; D]> = (0..600)
+            .map(|_| std::array::from_fn(|_| (next() - 0.5) * span))
+            .collect();
+        // Corners and centres of cells: the rounding edge cases of the ranges.
+        for k in -3..3 {
+            pts.push(std::array::from_fn(|i| (k + i as i64) as f64 * cell));
+            pts.push(std::array::from_fn(|i| (k as f64 + 0.5 + i as f64) * cell));
+        }
+        let mut table = DistanceMap::<D>::new(cell, cap).unwrap();
+        assert!(!table.widths.is_empty());
+        let mut exact = table.clone();
+        exact.widths = Box::default();
+        for q in &pts {
+            table.insert(q).unwrap();
+            exact.insert(q).unwrap();
+        }
+        assert_eq!(table.side, exact.side);
+        let bytes = |m: &DistanceMap<D>| -> Vec<u8> {
+            m.values.iter().map(|v| v.load(Ordering::Relaxed)).collect()
+        };
+        let lowered = bytes(&table).iter().filter(|&&v| v < CAPPED).count();
+        assert!(lowered > 100, "{lowered} cells lowered");
+        assert!(bytes(&table) == bytes(&exact), "cell {cell}, cap {cap}");
+    }
+    same::<2>(8.0, 64.0, 1);
+    same::<2>(64.0, 512.0, 2);
+    same::<2>(3.0, 10.5, 3);
+    same::<2>(1.0, 64.0, 4);
+    same::<3>(8.0, 32.0, 5);
+    same::<3>(32.0, 128.0, 6);
+    same::<3>(2.5, 11.0, 7);
+}
+
+#[test]
+fn growth_keeps_old_cells() {
+    // Points marching outward force several growths; values near the first point must
+    // survive them.
+    let mut map = DistanceMap::<2>::new(8.0, 64.0).unwrap();
+    map.insert(&[0.0, 0.0]).unwrap();
+    let before = map.value(&[3.0, 3.0]).unwrap();
+    let reach0 = map.reach();
+    for i in 1..200 {
+        map.insert(&[i as f64 * 5.0, -(i as f64) * 3.0]).unwrap();
+    }
+    assert!(map.reach() > 4.0 * reach0);
+    assert_eq!(map.value(&[3.0, 3.0]).unwrap(), before);
+    assert_eq!(map.len(), 200);
+    // The cell centre (4, 4) is 5.66 from the origin: the bound there loses at most one
+    // quantum (64 / 255).
+    let (lb, capped) = map.lower_bound(&[4.0, 4.0]).unwrap();
+    let d = 32f64.sqrt();
+    assert!(!capped && lb <= d && lb > d - 64.0 / 255.0, "{lb}");
+}
+
+#[test]
+fn far_cells_are_capped_and_outside_is_none() {
+    let mut map = DistanceMap::<3>::new(8.0, 32.0).unwrap();
+    assert!(map.lower_bound(&[0.0; 3]).is_none());
+    map.insert(&[1.0, 2.0, 3.0]).unwrap();
+    // Centre (4, 4, 4) is sqrt(14) from the point: floor(sqrt(14) / (32 / 255)) = 29.
+    assert_eq!(map.value(&[1.0, 2.0, 3.0]), Some(29));
+    assert_eq!(map.value(&[-35.0, 35.0, 39.0]), Some(CAPPED));
+    assert!(map.lower_bound(&[1e6, 0.0, 0.0]).is_none());
+    assert!(map.memory_bytes() >= 10 * 10 * 10);
+}
+
+#[test]
+fn bad_parameters_and_points_are_refused() {
+    assert_eq!(
+        DistanceMap::<2>::new(0.0, 1.0).unwrap_err(),
+        DistanceMapError::CellSide(0.0)
+    );
+    assert!(matches!(
+        DistanceMap::<2>::new(1.0, f64::NAN).unwrap_err(),
+        DistanceMapError::Cap(_)
+    ));
+    let mut map = DistanceMap::<2>::new(1.0, 4.0).unwrap();
+    assert!(matches!(
+        map.insert(&[0.0, f64::INFINITY]).unwrap_err(),
+        DistanceMapError::NonFinite { axis: 1, .. }
+    ));
+    assert!(matches!(
+        map.insert(&[1e300, 0.0]).unwrap_err(),
+        DistanceMapError::TooLarge { .. }
+    ));
+    assert!(map.is_empty());
+}
