@@ -238,6 +238,14 @@ impl<const D: usize> DistanceMap<D> {
     /// negative (no information).
     #[inline]
     pub fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
+        let (m, e, v) = self.read(p)?;
+        Some((Self::lower_from(m, e), v == CAPPED))
+    }
+
+    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and the
+    /// stored byte.
+    #[inline(always)]
+    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
         let (idx, z) = self.index(p)?;
         let v = self.values[idx].load(Ordering::Relaxed);
         let mut e2 = 0.0;
@@ -245,11 +253,14 @@ impl<const D: usize> DistanceMap<D> {
             let e = p[i] - z[i];
             e2 += e * e;
         }
-        let m = f64::from(v) * self.quantum;
-        Some((
-            m * (1.0 - SHRINK) - e2.sqrt() * (1.0 + SHRINK) - 1e-12,
-            v == CAPPED,
-        ))
+        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
+    }
+
+    /// The lower bound from a cell's stored distance `m` and `|p - centre|` `e`, shrunk for
+    /// rounding.
+    #[inline(always)]
+    fn lower_from(m: f64, e: f64) -> f64 {
+        m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12
     }
 
     /// [`lower_bound`](Self::lower_bound) and, for a cell that is not capped, an upper bound
@@ -260,26 +271,14 @@ impl<const D: usize> DistanceMap<D> {
     /// box: add the boxes' diagonal for one to the points in them.
     #[inline]
     pub fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
-        let (idx, z) = self.index(p)?;
-        let v = self.values[idx].load(Ordering::Relaxed);
-        let mut e2 = 0.0;
-        for i in 0..D {
-            let e = p[i] - z[i];
-            e2 += e * e;
-        }
-        let m = f64::from(v) * self.quantum;
-        let e = e2.sqrt();
+        let (m, e, v) = self.read(p)?;
         let capped = v == CAPPED;
         let upper = if capped {
             f64::INFINITY
         } else {
             (m + self.quantum + e) * (1.0 + SHRINK) + 1e-12
         };
-        Some((
-            m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12,
-            upper,
-            capped,
-        ))
+        Some((Self::lower_from(m, e), upper, capped))
     }
 
     /// The stored byte of the cell holding `p` (for tests and diagnostics).
