@@ -264,6 +264,19 @@ impl<const D: usize> WalkState<D> {
         self.near.added(q);
     }
 
+    /// Whether a stored particle lies within `r` of `p`, answered by the near cache when its
+    /// ball covers that one (`None`: ask the tree). The cache holds every particle of its ball
+    /// stored before the walker's last [`particle_added`](Self::particle_added).
+    #[inline]
+    pub(crate) fn any_within_cached(&self, p: &[f64; D], r: f64) -> Option<bool> {
+        if !self.near.covers(p, r) {
+            return None;
+        }
+        let mut found = false;
+        self.near.for_each_within(p, r, |_| found = true);
+        Some(found)
+    }
+
     /// Whether the near cache is built and holds `p` (tests: how often the cache serves).
     #[cfg(test)]
     pub(crate) fn cache_holds(&self, p: &[f64; D]) -> bool {

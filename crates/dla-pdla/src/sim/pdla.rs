@@ -71,9 +71,9 @@ fn first_radius() -> f64 {
 /// particles go through a shared log under a mutex held to re-check, insert, append and
 /// account for one particle. At sticking a thread re-checks (section 3.4) that no particle
 /// stored since its walker's last look at the tree lies within [`OVERLAP_DISTANCE`]: against
-/// the tree before taking the lock, and under the lock against the particles stored since;
-/// if one does the walker is discarded and counted. Before every move a thread adds the
-/// particles others stored to its walker's near cache.
+/// the walker's near cache or the tree before taking the lock, and under the lock against the
+/// particles stored since; if one does the walker is discarded and counted. Before every move
+/// a thread adds the particles others stored to its walker's near cache.
 ///
 /// The tree's room for the phase is reserved up front (address space, not memory); a particle
 /// that needs more, or lands outside the reserved root, ends the phase at a quiescent point and
@@ -330,14 +330,27 @@ where
         }
     }
 
-    /// Brings `me` up to date if another thread stored particles; `false` to stop.
-    #[inline]
+    /// Brings `me` up to date if another thread stored particles; `false` to stop. Runs
+    /// before every move, so the common case (nothing new) is one load; `stop` and `halt`
+    /// are read when something was published, at every walker's birth and under the lock at
+    /// sticking: a thread that misses them finishes its walker and stops there.
+    #[inline(always)]
     fn sync(&self, me: &mut Thread<D>) -> bool {
-        if self.stop.load(Ordering::Relaxed) || self.halt.load(Ordering::Relaxed) {
+        self.published.load(Ordering::Acquire) == me.applied || self.catch_up(me)
+    }
+
+    /// Whether the run goes on: neither stopped by a thread nor halted from outside.
+    #[inline]
+    fn running(&self) -> bool {
+        !(self.stop.load(Ordering::Relaxed) || self.halt.load(Ordering::Relaxed))
+    }
+
+    /// [`sync`](Self::sync) when other threads stored particles.
+    #[cold]
+    #[inline(never)]
+    fn catch_up(&self, me: &mut Thread<D>) -> bool {
+        if !self.running() {
             return false;
-        }
-        if self.published.load(Ordering::Acquire) == me.applied {
-            return true;
         }
         let done = {
             let log = self.lock();
@@ -372,7 +385,7 @@ where
     ) {
         let tree = self.cluster.tree();
         loop {
-            if !self.sync(me) {
+            if !(self.running() && self.sync(me)) {
                 return;
             }
             // The walker holds nothing from the tree yet: announce the epoch.
@@ -389,13 +402,21 @@ where
                     return;
                 }
             };
-            // Particles published before this load are in the tree the pre-check reads; the
-            // ones after it are checked under the lock.
-            let seen = self.published.load(Ordering::Acquire);
             // A jump or step can end inside a particle another thread stored during it; once
-            // that particle is seen the next move would stick at once, overlapping it.
-            let mut overlap = false;
-            tree.for_each_within(&stick, OVERLAP_DISTANCE, |_| overlap = true);
+            // that particle is seen the next move would stick at once, overlapping it. The
+            // pre-check covers the particles before `seen`, the check under the lock the ones
+            // after: the walker's near cache holds those it has taken from the log when its
+            // ball covers the sticking point (near the cluster, the usual case); else the
+            // tree, which holds every particle published before the load.
+            let (seen, mut overlap) = match me.walk.any_within_cached(&stick, OVERLAP_DISTANCE) {
+                Some(found) => (me.applied, found),
+                None => {
+                    let seen = self.published.load(Ordering::Acquire);
+                    let mut found = false;
+                    tree.for_each_within(&stick, OVERLAP_DISTANCE, |_| found = true);
+                    (seen, found)
+                }
+            };
             let mut guard = self.lock();
             if guard.growth.n >= self.target
                 || self.stop.load(Ordering::Relaxed)
