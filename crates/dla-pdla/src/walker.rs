@@ -264,6 +264,19 @@ impl<const D: usize> WalkState<D> {
         self.near.added(q);
     }
 
+    /// Whether the near cache can still answer anything at `p` (it is built and `p` lies
+    /// inside its ball). A cache that cannot is dropped here: it needs no more particles
+    /// ([`particle_added`](Self::particle_added)) until it is rebuilt from the tree, which then
+    /// holds them all.
+    #[inline]
+    pub(crate) fn near_useful(&mut self, p: &[f64; D]) -> bool {
+        if self.near.covers(p, 0.0) {
+            return true;
+        }
+        self.near.reset();
+        false
+    }
+
     /// Whether a stored particle lies within `r` of `p`, answered by the near cache when its
     /// ball covers that one (`None`: ask the tree). The cache holds every particle of its ball
     /// stored before the walker's last [`particle_added`](Self::particle_added).

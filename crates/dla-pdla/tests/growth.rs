@@ -271,9 +271,12 @@ fn discard_guard_fails_loudly_instead_of_spinning() {
 
 /// No two particles of `positions` overlap, and every particle but the first touches an
 /// earlier one (it stuck at contact, to rounding); `tree` holds exactly these positions.
-fn assert_valid_cluster(tree: &spatial::orthtree::Orthtree<2>, positions: &[[f64; 2]]) {
+fn assert_valid_cluster<const D: usize>(
+    tree: &spatial::orthtree::Orthtree<D>,
+    positions: &[[f64; D]],
+) {
     assert_eq!(tree.len(), positions.len());
-    let mut a: Vec<[f64; 2]> = tree.iter().collect();
+    let mut a: Vec<[f64; D]> = tree.iter().collect();
     let mut b = positions.to_vec();
     a.sort_by(|x, y| x.partial_cmp(y).unwrap());
     b.sort_by(|x, y| x.partial_cmp(y).unwrap());
@@ -285,7 +288,7 @@ fn assert_valid_cluster(tree: &spatial::orthtree::Orthtree<2>, positions: &[[f64
         if i > 0 {
             let touches = positions[..i]
                 .iter()
-                .any(|q| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt() <= 1.0 + 1e-6);
+                .any(|q| spatial::orthtree::dist_sq(p, q).sqrt() <= 1.0 + 1e-6);
             assert!(touches, "particle {i} at {p:?} touches no earlier particle");
         }
     }
@@ -306,6 +309,24 @@ fn pdla_tree_holds_exactly_the_recorded_positions_touching_and_without_overlap()
     assert_eq!(sim.positions().unwrap().len(), 5000);
     // Threads stick walkers concurrently, yet no two particles overlap, and every particle
     // but the seed touches an earlier one.
+    assert_valid_cluster(sim.tree(), sim.positions().unwrap());
+}
+
+/// More threads than cores (threads preempted mid-walk, catching up on many particles at
+/// once), in 3D with its own distance maps: still overlap-free and touching.
+#[test]
+fn pdla_with_more_threads_than_cores_in_3d_is_a_valid_cluster() {
+    let params = Params {
+        dim: 3,
+        particles: 4000,
+        threads: 4,
+        serial_until: 100,
+        keep_positions: true,
+        ..Params::default()
+    };
+    let mut sim = Simulation::<3>::new(params, 11).unwrap();
+    sim.run().unwrap();
+    assert_eq!(sim.particles(), 4000);
     assert_valid_cluster(sim.tree(), sim.positions().unwrap());
 }
 

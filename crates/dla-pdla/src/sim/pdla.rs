@@ -157,20 +157,26 @@ where
         error: None,
         needs_room: false,
     });
-    // Particles stored so far (log positions are absolute: the earlier ones come first).
-    let published = AtomicUsize::new(start);
-    let applied: Vec<AtomicUsize> = (0..threads).map(|_| AtomicUsize::new(start)).collect();
-    let epochs: Vec<Announced> = (0..threads).map(|_| Announced::default()).collect();
-    let stop = AtomicBool::new(false);
     let r_ext0 = log.lock().growth.r_ext;
+    // Particles stored so far (log positions are absolute: the earlier ones come first).
+    let published = Published {
+        count: AtomicUsize::new(start),
+        r_ext: AtomicU64::new(r_ext0.to_bits()),
+    };
+    let slots: Vec<Slot> = (0..threads)
+        .map(|_| Slot {
+            epoch: AtomicU64::new(0),
+            applied: AtomicUsize::new(start),
+        })
+        .collect();
+    let stop = AtomicBool::new(false);
     let wait_nanos = AtomicU64::new(0);
     let started = Instant::now();
     let ctx = Ctx {
         cluster,
         log: &log,
         published: &published,
-        applied: &applied,
-        epochs: &epochs,
+        slots: &slots,
         stop: &stop,
         halt,
         target,
@@ -192,7 +198,7 @@ where
                 let mut rng = stream(seed, stream_id(PURPOSE_PDLA, index));
                 ctx.walk(&mut me, params, &mut rng, progress);
                 // A finished thread no longer holds anything from the tree.
-                ctx.epochs[t].0.store(u64::MAX, Ordering::Release);
+                ctx.slots[t].epoch.store(u64::MAX, Ordering::Release);
             });
         }
     });
@@ -268,21 +274,35 @@ struct Thread<const D: usize> {
     walk: WalkState<D>,
 }
 
-/// The reclamation epoch a thread announced at its walker's birth (see
-/// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared)), on a cache line of
-/// its own.
-#[derive(Default)]
+/// What one thread tells the others, on cache lines of its own (the threads read each other's
+/// only at inserts and log trims).
 #[repr(align(128))]
-struct Announced(AtomicU64);
+struct Slot {
+    /// The reclamation epoch the thread announced at its walker's birth (see
+    /// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared)).
+    epoch: AtomicU64,
+    /// Log entries the thread has taken (an absolute log index).
+    applied: AtomicUsize,
+}
+
+/// What a stored particle publishes, read before every move, on cache lines of its own (away
+/// from the log's mutex, which every store and catch-up writes).
+#[repr(align(128))]
+struct Published {
+    /// Particles stored (the log's end, an absolute index).
+    count: AtomicUsize,
+    /// `f64` bits of the largest centre distance over them (written under the lock, so it
+    /// only grows).
+    r_ext: AtomicU64,
+}
 
 /// References shared by the PDLA threads.
 #[derive(Clone, Copy)]
 struct Ctx<'a, const D: usize> {
     cluster: &'a Cluster<D>,
     log: &'a Mutex<Log<D>>,
-    published: &'a AtomicUsize,
-    applied: &'a [AtomicUsize],
-    epochs: &'a [Announced],
+    published: &'a Published,
+    slots: &'a [Slot],
     stop: &'a AtomicBool,
     /// Set from outside (a signal): stop at the next quiescent point.
     halt: &'a AtomicBool,
@@ -319,7 +339,9 @@ where
         me.pending
             .extend_from_slice(&log.points[me.applied - log.base..]);
         me.applied = log.base + log.points.len();
-        self.applied[me.index].store(me.applied, Ordering::Relaxed);
+        self.slots[me.index]
+            .applied
+            .store(me.applied, Ordering::Relaxed);
     }
 
     /// Gives `me.pending` to the walker's near cache (no lock held).
@@ -330,13 +352,14 @@ where
         }
     }
 
-    /// Brings `me` up to date if another thread stored particles; `false` to stop. Runs
-    /// before every move, so the common case (nothing new) is one load; `stop` and `halt`
-    /// are read when something was published, at every walker's birth and under the lock at
-    /// sticking: a thread that misses them finishes its walker and stops there.
+    /// Brings `me`, whose walker is at `p`, up to date if another thread stored particles;
+    /// `false` to stop. Runs before every move, so the common case (nothing new) is one load;
+    /// `stop` and `halt` are read when something was published, at every walker's birth and
+    /// under the lock at sticking: a thread that misses them finishes its walker and stops
+    /// there.
     #[inline(always)]
-    fn sync(&self, me: &mut Thread<D>) -> bool {
-        self.published.load(Ordering::Acquire) == me.applied || self.catch_up(me)
+    fn sync(&self, me: &mut Thread<D>, p: &[f64; D]) -> bool {
+        self.published.count.load(Ordering::Acquire) == me.applied || self.catch_up(me, p)
     }
 
     /// Whether the run goes on: neither stopped by a thread nor halted from outside.
@@ -345,12 +368,24 @@ where
         !(self.stop.load(Ordering::Relaxed) || self.halt.load(Ordering::Relaxed))
     }
 
-    /// [`sync`](Self::sync) when other threads stored particles.
+    /// [`sync`](Self::sync) when other threads stored particles. Only a walker whose near
+    /// cache can still answer needs the new particles themselves, from the log under its lock;
+    /// any other takes the count and `r_ext` without the lock (its cache, if any, is dropped,
+    /// and a rebuild reads the tree, which holds every published particle).
     #[cold]
     #[inline(never)]
-    fn catch_up(&self, me: &mut Thread<D>) -> bool {
+    fn catch_up(&self, me: &mut Thread<D>, p: &[f64; D]) -> bool {
         if !self.running() {
             return false;
+        }
+        if !me.walk.near_useful(p) {
+            let n = self.published.count.load(Ordering::Acquire);
+            me.r_ext = me
+                .r_ext
+                .max(f64::from_bits(self.published.r_ext.load(Ordering::Relaxed)));
+            me.applied = n;
+            self.slots[me.index].applied.store(n, Ordering::Relaxed);
+            return (n as u64) < self.target;
         }
         let done = {
             let log = self.lock();
@@ -368,9 +403,9 @@ where
 
     /// The smallest epoch the threads announced (see [`Announced`]).
     fn readers_epoch(&self) -> u64 {
-        self.epochs
+        self.slots
             .iter()
-            .map(|e| e.0.load(Ordering::Acquire))
+            .map(|s| s.epoch.load(Ordering::Acquire))
             .min()
             .unwrap_or(u64::MAX)
     }
@@ -385,20 +420,20 @@ where
     ) {
         let tree = self.cluster.tree();
         loop {
-            if !(self.running() && self.sync(me)) {
+            me.walk.reset();
+            if !(self.running() && self.sync(me, &[0.0; D])) {
                 return;
             }
             // The walker holds nothing from the tree yet: announce the epoch.
-            self.epochs[me.index]
-                .0
+            self.slots[me.index]
+                .epoch
                 .store(tree.epoch(), Ordering::Release);
             let mut w = Walker::born(me.r_ext + params.birth_gap, rng);
-            me.walk.reset();
             let stick = loop {
                 if let Some(p) = w.advance(&mut me.walk, self.cluster, me.r_ext, params, rng) {
                     break p;
                 }
-                if !self.sync(me) {
+                if !self.sync(me, &w.p) {
                     return;
                 }
             };
@@ -411,7 +446,7 @@ where
             let (seen, mut overlap) = match me.walk.any_within_cached(&stick, OVERLAP_DISTANCE) {
                 Some(found) => (me.applied, found),
                 None => {
-                    let seen = self.published.load(Ordering::Acquire);
+                    let seen = self.published.count.load(Ordering::Acquire);
                     let mut found = false;
                     tree.for_each_within(&stick, OVERLAP_DISTANCE, |_| found = true);
                     (seen, found)
@@ -450,15 +485,19 @@ where
             log.growth.account(q, self.final_target);
             log.points.push(q);
             self.published
+                .r_ext
+                .store(log.growth.r_ext.to_bits(), Ordering::Relaxed);
+            self.published
+                .count
                 .store(log.base + log.points.len(), Ordering::Release);
             if log.growth.n % 1024 == 0 {
                 progress(log.growth.n);
             }
             if log.points.len() >= 2 * LOG_TRIM {
                 let oldest = self
-                    .applied
+                    .slots
                     .iter()
-                    .map(|a| a.load(Ordering::Relaxed))
+                    .map(|s| s.applied.load(Ordering::Relaxed))
                     .min()
                     .unwrap_or(log.base);
                 let drop = oldest - log.base;
