@@ -47,6 +47,13 @@ pub trait Space<const D: usize> {
     /// within the cap, so the cost of an insert grows like `(cap / cell)^D`.
     const MAP_LEVELS: &'static [(f64, f64)];
 
+    /// A sparse fine map in front of [`MAP_LEVELS`](Self::MAP_LEVELS), as `(cell side, cap,
+    /// block side in cells)` (diameters; see [`spatial::distmap::SparseDistanceMap`]), or
+    /// `None`. Its bound lies within a small cell's diagonal of the distance, so walkers a few
+    /// diameters from the cluster jump by it instead of asking the tree; blocks of cells are
+    /// allocated only within its cap of the cluster.
+    const SPARSE_LEVEL: Option<(f64, f64, usize)> = None;
+
     /// A walker jumps by a map's bound `lb` (cell not capped) when `lb - 1` exceeds this, in
     /// diameters; closer in it asks the tree or its near cache, whose sharper bound pays for
     /// its cost there.
@@ -141,6 +148,10 @@ impl Space<3> for Dim<3> {
     /// A fine map of 8-diameter cells capped at 32 and a coarse one of 32-diameter cells
     /// capped at 128 (about 270 cells lowered per insert and map).
     const MAP_LEVELS: &'static [(f64, f64)] = &[(8.0, 32.0), (32.0, 128.0)];
+
+    /// Cells of 2 diameters capped at 8, in blocks of 8^3 cells (512 bytes, 16 diameters a
+    /// side): about 270 cells lowered per insert.
+    const SPARSE_LEVEL: Option<(f64, f64, usize)> = Some((2.0, 8.0, 8));
 
     /// One diameter: a 3D walker a few diameters from the cluster is often beyond the reach of
     /// the near cache, so a tree query there costs more than the shorter jumps by the map's
