@@ -425,32 +425,33 @@ impl<const D: usize> SparseDistanceMap<D> {
         lower: &mut impl FnMut(&AtomicU8, u8),
     ) {
         let slot = &self.table[brow + (u >> self.shift)];
-        let mut block = match slot.load(Ordering::Acquire) {
-            UNKNOWN => return,
-            ABSENT => None,
-            entry => Some(self.block(entry)),
-        };
         let x0 = ((u as i64 - self.half) as f64 + 0.5) * self.cell - q[0];
-        for (n, c) in (u..=end).enumerate() {
+        let entry = match slot.load(Ordering::Acquire) {
+            UNKNOWN => return,
+            ABSENT => {
+                // Allocate only if some cell of the segment comes within the cap: the centre
+                // nearest q along the row.
+                let n = (-x0 * self.inv_cell + 0.5).max(0.0).min((end - u) as f64);
+                let x = x0 + floor(n) * self.cell;
+                if x * x + s >= self.cap * self.cap {
+                    return;
+                }
+                match self.allocate(slot) {
+                    UNKNOWN => return,
+                    entry => entry,
+                }
+            }
+            entry => entry,
+        };
+        let block = self.block(entry);
+        let row = &block[crow | (u & self.mask)..=crow | (end & self.mask)];
+        for (n, v) in row.iter().enumerate() {
             let x = x0 + f64::from(n as i32) * self.cell;
             let d2 = x * x + s;
-            let at = crow | (c & self.mask);
-            let now = block.map_or(0, |b| b[at].load(Ordering::Relaxed));
-            if d2 < self.below[usize::from(now)] {
+            if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
                 let d = d2.sqrt() * self.inv_quantum;
                 if d < f64::from(CAPPED) {
-                    let b = match block {
-                        Some(b) => b,
-                        None => match self.allocate(slot) {
-                            UNKNOWN => return,
-                            entry => {
-                                let b = self.block(entry);
-                                block = Some(b);
-                                b
-                            }
-                        },
-                    };
-                    lower(&b[at], CAPPED - d as u8);
+                    lower(v, CAPPED - d as u8);
                 }
             }
         }
