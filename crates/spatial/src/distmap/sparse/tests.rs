@@ -23,13 +23,7 @@ fn brute<const D: usize>(pts: &[[f64; D]], p: &[f64; D]) -> f64 {
 /// never above the distance, the upper bound never below it, a capped cell (or an absent
 /// block) at least `cap` less half a diagonal away, an uncapped one within a diagonal and a
 /// quantum.
-fn check<const D: usize>(
-    cell: f64,
-    cap: f64,
-    block: usize,
-    pts: &[[f64; D]],
-    probes: &[[f64; D]],
-) {
+fn check<const D: usize>(cell: f64, cap: f64, block: usize, pts: &[[f64; D]], probes: &[[f64; D]]) {
     let mut sparse = SparseDistanceMap::<D>::new(cell, cap, block).unwrap();
     let mut dense = DistanceMap::<D>::new(cell, cap).unwrap();
     let diag = cell * (D as f64).sqrt();
@@ -56,7 +50,10 @@ fn check<const D: usize>(
             if capped {
                 assert!(d >= cap - 0.5 * diag - 1e-9, "capped cell at distance {d}");
             } else {
-                assert!(lb >= d - diag - cap / 255.0 - 1e-9, "{lb} too loose for {d}");
+                assert!(
+                    lb >= d - diag - cap / 255.0 - 1e-9,
+                    "{lb} too loose for {d}"
+                );
             }
         }
     }
@@ -115,7 +112,10 @@ fn chains_of_touching_points_in_3d() {
     for q in &pts {
         map.insert(q).unwrap();
     }
-    assert!(map.blocks() > 0 && map.blocks() < map.table.len(), "{map:?}");
+    assert!(
+        map.blocks() > 0 && map.blocks() < map.table.len(),
+        "{map:?}"
+    );
     assert!(map.memory_bytes() > map.blocks() * 64);
 }
 
