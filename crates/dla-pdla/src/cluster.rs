@@ -201,7 +201,7 @@ impl<const D: usize> Cluster<D> {
     /// says the distance is at least its cap less `|p - z|`; that floor is combined with the
     /// dense maps' answer (the larger lower bound; the dense map's upper bound and capped
     /// flag), or returned as capped when no dense map covers `p`.
-    #[inline]
+    #[inline(always)]
     pub fn map_bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
         let mut floor = None;
         if let Some(sparse) = &self.maps.sparse {
@@ -219,7 +219,7 @@ impl<const D: usize> Cluster<D> {
     }
 
     /// [`map_bounds`](Self::map_bounds) of the dense levels alone.
-    #[inline]
+    #[inline(always)]
     fn dense_bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
         let mut best = None;
         for (level, map) in self.maps.levels.iter().enumerate() {
