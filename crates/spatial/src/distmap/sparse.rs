@@ -62,6 +62,14 @@ pub const UNKNOWN: u32 = u32::MAX;
 /// Bytes of a slab chunk (at least one block).
 const CHUNK_BYTES: usize = 1 << 16;
 
+/// The two blocks an insert used last, by table index: consecutive rows of a point's ball
+/// mostly fall in the same one or two blocks. A published block never changes its entry, so
+/// they stay valid.
+struct Recent<'a> {
+    at: [usize; 2],
+    block: [&'a [AtomicU8]; 2],
+}
+
 /// The sparse fine distance map (see the module documentation).
 pub struct SparseDistanceMap<const D: usize> {
     cell: f64,
@@ -370,6 +378,10 @@ impl<const D: usize> SparseDistanceMap<D> {
         let t0 = q[0] * self.inv_cell - 0.5;
         let kq: [i64; D] = std::array::from_fn(|i| floor(q[i] * self.inv_cell - 0.5) as i64);
         let shift = self.shift as usize;
+        let mut recent = Recent {
+            at: [usize::MAX; 2],
+            block: [&[]; 2],
+        };
         loop {
             let mut s = 0.0;
             let mut j2 = 0usize;
@@ -399,7 +411,7 @@ impl<const D: usize> SparseDistanceMap<D> {
                     // The row's cells block by block.
                     while u <= last {
                         let end = (u | self.mask).min(last);
-                        self.lower_segment(q, s, brow, crow, u, end, &mut lower);
+                        self.lower_segment(q, s, brow, crow, u, end, &mut lower, &mut recent);
                         u = end + 1;
                     }
                 }
@@ -414,8 +426,8 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// squared off-axis distance `s`, block row `brow` and in-block offset `crow`.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn lower_segment(
-        &self,
+    fn lower_segment<'a>(
+        &'a self,
         q: &[f64; D],
         s: f64,
         brow: usize,
@@ -423,27 +435,22 @@ impl<const D: usize> SparseDistanceMap<D> {
         u: usize,
         end: usize,
         lower: &mut impl FnMut(&AtomicU8, u8),
+        recent: &mut Recent<'a>,
     ) {
-        let slot = &self.table[brow + (u >> self.shift)];
+        let at = brow + (u >> self.shift);
         let x0 = ((u as i64 - self.half) as f64 + 0.5) * self.cell - q[0];
-        let entry = match slot.load(Ordering::Acquire) {
-            UNKNOWN => return,
-            ABSENT => {
-                // Allocate only if some cell of the segment comes within the cap: the centre
-                // nearest q along the row.
-                let n = (-x0 * self.inv_cell + 0.5).max(0.0).min((end - u) as f64);
-                let x = x0 + floor(n) * self.cell;
-                if x * x + s >= self.cap * self.cap {
-                    return;
-                }
-                match self.allocate(slot) {
-                    UNKNOWN => return,
-                    entry => entry,
-                }
-            }
-            entry => entry,
+        let block = if recent.at[0] == at {
+            recent.block[0]
+        } else if recent.at[1] == at {
+            recent.block[1]
+        } else {
+            let Some(block) = self.find_block(at, x0, s, end - u) else {
+                return;
+            };
+            recent.at = [at, recent.at[0]];
+            recent.block = [block, recent.block[0]];
+            block
         };
-        let block = self.block(entry);
         let row = &block[crow | (u & self.mask)..=crow | (end & self.mask)];
         for (n, v) in row.iter().enumerate() {
             let x = x0 + f64::from(n as i32) * self.cell;
@@ -455,6 +462,32 @@ impl<const D: usize> SparseDistanceMap<D> {
                 }
             }
         }
+    }
+
+    /// The block at table index `at` for a segment of `len + 1` cells starting `x0` from `q`
+    /// along the row, `s` off it: allocated if absent and some cell of the segment comes
+    /// within the cap; `None` if it stays absent or is unknown.
+    #[inline(always)]
+    fn find_block(&self, at: usize, x0: f64, s: f64, len: usize) -> Option<&[AtomicU8]> {
+        let slot = &self.table[at];
+        let entry = match slot.load(Ordering::Acquire) {
+            UNKNOWN => return None,
+            ABSENT => {
+                // Allocate only if some cell of the segment comes within the cap: the centre
+                // nearest q along the row.
+                let n = (-x0 * self.inv_cell + 0.5).max(0.0).min(len as f64);
+                let x = x0 + floor(n) * self.cell;
+                if x * x + s >= self.cap * self.cap {
+                    return None;
+                }
+                match self.allocate(slot) {
+                    UNKNOWN => return None,
+                    entry => entry,
+                }
+            }
+            entry => entry,
+        };
+        (entry != UNKNOWN).then(|| self.block(entry))
     }
 
     /// Enlarges the table to cover `|x_i| < need` (by at least a quarter), copying the old
