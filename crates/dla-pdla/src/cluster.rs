@@ -1,8 +1,10 @@
 //! The stored particles as the walkers see them: the orthtree (the variable-precision
 //! distance `vpdist` and exact first contact of Sosa-Herrera & Rodriguez-Romo, "Variable
 //! precision distance search for random fractal cluster simulations") and, in front of it, the
-//! coarse distance maps of [`spatial::distmap`] (levels from [`Space::MAP_LEVELS`]) that let a
-//! walker a few diameters or more from the cluster jump without a tree query.
+//! distance maps of [`spatial::distmap`] that let a walker a few diameters or more from the
+//! cluster jump without a tree query: where a dimension has one ([`Space::SPARSE_LEVEL`]), a
+//! fine sparse map (cells of a diameter or two, blocks allocated only near the cluster) for
+//! walkers within its cap, then the dense levels of [`Space::MAP_LEVELS`] for those farther out.
 //!
 //! Invariants: in serial growth every stored particle has lowered every map, so a map's bound
 //! never exceeds the exact distance to the nearest stored particle (in PDLA a particle another
@@ -13,7 +15,7 @@
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use spatial::distmap::DistanceMap;
+use spatial::distmap::{DistanceMap, SparseDistanceMap};
 use spatial::orthtree::Orthtree;
 use std::sync::Arc;
 
@@ -28,7 +30,23 @@ use std::sync::Arc;
 #[derive(Debug, Clone, Default)]
 pub struct Cluster<const D: usize> {
     tree: Orthtree<D>,
-    maps: Arc<[DistanceMap<D>]>,
+    maps: Arc<Maps<D>>,
+}
+
+/// The distance maps: the optional sparse fine level, then the dense levels, finest first.
+#[derive(Debug)]
+struct Maps<const D: usize> {
+    sparse: Option<SparseDistanceMap<D>>,
+    levels: Box<[DistanceMap<D>]>,
+}
+
+impl<const D: usize> Default for Maps<D> {
+    fn default() -> Self {
+        Maps {
+            sparse: None,
+            levels: Box::default(),
+        }
+    }
 }
 
 impl<const D: usize> Cluster<D> {
@@ -39,14 +57,19 @@ impl<const D: usize> Cluster<D> {
     {
         Ok(Cluster {
             tree: Orthtree::with_leaf_side(params.leaf_side)?,
-            maps: if params.distance_map {
-                Dim::<D>::MAP_LEVELS
-                    .iter()
-                    .map(|&(cell, cap)| DistanceMap::new(cell, cap))
-                    .collect::<Result<_, _>>()?
+            maps: Arc::new(if params.distance_map {
+                Maps {
+                    sparse: Dim::<D>::SPARSE_LEVEL
+                        .map(|(cell, cap, block)| SparseDistanceMap::new(cell, cap, block))
+                        .transpose()?,
+                    levels: Dim::<D>::MAP_LEVELS
+                        .iter()
+                        .map(|&(cell, cap)| DistanceMap::new(cell, cap))
+                        .collect::<Result<_, _>>()?,
+                }
             } else {
-                Arc::new([])
-            },
+                Maps::default()
+            }),
         })
     }
 
@@ -60,7 +83,10 @@ impl<const D: usize> Cluster<D> {
         let (lo, hi) = self.leaf_box(&q);
         match Arc::get_mut(&mut self.maps) {
             Some(maps) => {
-                if let Some((fine, coarse)) = maps.split_first_mut() {
+                if let Some(sparse) = &mut maps.sparse {
+                    sparse.insert(&q)?;
+                }
+                if let Some((fine, coarse)) = maps.levels.split_first_mut() {
                     fine.insert(&q)?;
                     // The coarser maps hold the boxes of the tree's leaves: lowered once, by
                     // the first particle of a leaf, for every particle the leaf will hold.
@@ -105,7 +131,10 @@ impl<const D: usize> Cluster<D> {
     /// may read any map before a stored particle's update: PDLA's re-check at sticking
     /// catches what such a jump could cause.
     pub fn update_maps(&self, q: &[f64; D], new_leaf: bool) -> Result<(), SimError> {
-        if let Some((fine, coarse)) = self.maps.split_first() {
+        if let Some(sparse) = &self.maps.sparse {
+            sparse.insert_shared(q)?;
+        }
+        if let Some((fine, coarse)) = self.maps.levels.split_first() {
             fine.insert_shared(q)?;
             if new_leaf {
                 let (lo, hi) = self.leaf_box(q);
@@ -121,7 +150,10 @@ impl<const D: usize> Cluster<D> {
     /// they cannot grow, and this does nothing).
     pub fn reserve_maps(&mut self, r: f64) -> Result<(), SimError> {
         if let Some(maps) = Arc::get_mut(&mut self.maps) {
-            for map in maps {
+            if let Some(sparse) = &mut maps.sparse {
+                sparse.reserve(r + sparse.cap() + sparse.cell_side())?;
+            }
+            for map in maps.levels.iter_mut() {
                 map.reserve(r + map.cap() + map.cell_side())?;
             }
         }
@@ -138,37 +170,59 @@ impl<const D: usize> Cluster<D> {
         self.tree.set_index_limit(limit);
     }
 
-    /// The distance maps, finest first (empty when off).
+    /// The dense distance maps, finest first (empty when off).
     pub fn maps(&self) -> &[DistanceMap<D>] {
-        &self.maps
+        &self.maps.levels
+    }
+
+    /// The sparse fine map in front of the dense ones, if the dimension has one and the maps
+    /// are on.
+    pub fn sparse_map(&self) -> Option<&SparseDistanceMap<D>> {
+        self.maps.sparse.as_ref()
     }
 
     /// A lower bound of the distance from `p` to the nearest particle from the distance maps,
     /// and whether it is capped: the finest map that covers `p` with a cell that is not capped
     /// (`false`), or else the last capped bound found (`true`: the distance may be far larger).
+    /// A capped sparse cell's bound (`cap - |p - z|`) is a floor under the dense maps' bound.
     /// `None` when the maps are off or none covers `p`.
     #[inline]
     pub fn map_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
-        let mut best = None;
-        for map in self.maps.iter() {
-            if let Some((lb, capped)) = map.lower_bound(p) {
-                best = Some((lb, capped));
-                if !capped {
-                    break;
-                }
-            }
-        }
-        best
+        self.map_bounds(p).map(|(lb, _, capped)| (lb, capped))
     }
 
     /// [`map_bound`](Self::map_bound) with an upper bound of the same distance from the map
     /// that gave the lower one (`+inf` when that map's cell is capped; see
     /// [`DistanceMap::bounds`]; a coarser map holds leaf boxes, so its bound gains a leaf
     /// diagonal), as `(lower, upper, capped)`.
-    #[inline]
+    ///
+    /// The sparse fine map is asked first: a cell that is not capped answers alone (its bound
+    /// is within a small cell's diagonal of the distance). A capped one (or an absent block)
+    /// says the distance is at least its cap less `|p - z|`; that floor is combined with the
+    /// dense maps' answer (the larger lower bound; the dense map's upper bound and capped
+    /// flag), or returned as capped when no dense map covers `p`.
+    #[inline(always)]
     pub fn map_bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+        let mut floor = None;
+        if let Some(sparse) = &self.maps.sparse {
+            match sparse.bounds(p) {
+                Some((lb, ub, false)) => return Some((lb, ub, false)),
+                Some((lb, _, true)) => floor = Some(lb),
+                None => {}
+            }
+        }
+        match (self.dense_bounds(p), floor) {
+            (Some((lb, ub, capped)), Some(f)) => Some((lb.max(f), ub, capped)),
+            (None, Some(f)) => Some((f, f64::INFINITY, true)),
+            (best, None) => best,
+        }
+    }
+
+    /// [`map_bounds`](Self::map_bounds) of the dense levels alone.
+    #[inline(always)]
+    fn dense_bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
         let mut best = None;
-        for (level, map) in self.maps.iter().enumerate() {
+        for (level, map) in self.maps.levels.iter().enumerate() {
             if let Some((lb, mut ub, capped)) = map.bounds(p) {
                 if level > 0 {
                     ub += self.tree.leaf_side() * (D as f64).sqrt() * (1.0 + 1e-12);
@@ -192,11 +246,17 @@ impl<const D: usize> Cluster<D> {
         self.tree.is_empty()
     }
 
-    /// Heap bytes of the tree and the map.
+    /// Heap bytes of the tree and the maps.
     pub fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
             + self
                 .maps
+                .sparse
+                .as_ref()
+                .map_or(0, SparseDistanceMap::memory_bytes)
+            + self
+                .maps
+                .levels
                 .iter()
                 .map(DistanceMap::memory_bytes)
                 .sum::<usize>()

@@ -75,8 +75,9 @@ struct Cli {
     #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DLA_LEAF_SIDE)]
     leaf_side: f64,
 
-    /// The coarse distance maps in front of the orthtree (one byte per cell of side 8
-    /// diameters plus a coarser map; under 1 byte per particle at 1e6 in 2D): walkers away from
+    /// The distance maps in front of the orthtree (one byte per cell of side 8 diameters plus a
+    /// coarser map; under 1 byte per particle at 1e6 in 2D; in 3D also a sparse map of
+    /// 2-diameter cells near the cluster, about 6 bytes per particle at 1e6): walkers away from
     /// the cluster jump by their bound without a tree query. Speed and memory only, not the
     /// physics (but another trajectory and state hash); `off` is the paper's tree-only walk.
     #[arg(long, value_enum, default_value_t = Toggle::On)]

@@ -47,6 +47,13 @@ pub trait Space<const D: usize> {
     /// within the cap, so the cost of an insert grows like `(cap / cell)^D`.
     const MAP_LEVELS: &'static [(f64, f64)];
 
+    /// A sparse fine map in front of [`MAP_LEVELS`](Self::MAP_LEVELS), as `(cell side, cap,
+    /// block side in cells)` (diameters; see [`spatial::distmap::SparseDistanceMap`]), or
+    /// `None`. Its bound lies within a small cell's diagonal of the distance, so walkers a few
+    /// diameters from the cluster jump by it instead of asking the tree; blocks of cells are
+    /// allocated only within its cap of the cluster.
+    const SPARSE_LEVEL: Option<(f64, f64, usize)> = None;
+
     /// A walker jumps by a map's bound `lb` (cell not capped) when `lb - 1` exceeds this, in
     /// diameters; closer in it asks the tree or its near cache, whose sharper bound pays for
     /// its cost there.
@@ -142,11 +149,18 @@ impl Space<3> for Dim<3> {
     /// capped at 128 (about 270 cells lowered per insert and map).
     const MAP_LEVELS: &'static [(f64, f64)] = &[(8.0, 32.0), (32.0, 128.0)];
 
-    /// One diameter: a 3D walker a few diameters from the cluster is often beyond the reach of
-    /// the near cache, so a tree query there costs more than the shorter jumps by the map's
-    /// bound (6 % fewer instructions at 1e5 than with 2, with the map's upper bound seeding
-    /// the tree query).
-    const MAP_JUMP_MIN: f64 = 1.0;
+    /// Cells of 2 diameters capped at 8, in blocks of 8^3 cells (512 bytes, 16 diameters a
+    /// side): about 270 cells visited per insert, and about 6 bytes per particle at 1e6 (the
+    /// cap's neighbourhood of a 3D cluster fills much of its ball). A cap of 6 saves less in
+    /// inserts than its walkers lose; four bits per cell (half the memory) lose more in
+    /// moves than they save (`docs/benchmarks.md`, "3D DLA").
+    const SPARSE_LEVEL: Option<(f64, f64, usize)> = Some((2.0, 8.0, 8));
+
+    /// Half a diameter: the sparse map's bound lies within a 2-diameter cell's diagonal of the
+    /// distance, so even its short jumps near the cluster cost less than the tree queries and
+    /// near-cache answers they replace (callgrind at 1e5: 0.98x the instructions of 1 diameter,
+    /// 0.84x those of 2).
+    const MAP_JUMP_MIN: f64 = 0.5;
 
     const AXES: [&'static str; 3] = ["x", "y", "z"];
 

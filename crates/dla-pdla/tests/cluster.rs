@@ -60,10 +60,43 @@ where
         used > 3000,
         "the maps cover the birth region ({used} of 4000)"
     );
+    // Near the cluster, where the sparse fine map (3D) answers: probes up to 10 diameters
+    // from a random particle.
+    let mut fine = 0;
+    for _ in 0..2000 {
+        let a = pos[(core_lattice::rng::uniform01(&mut rng) * pos.len() as f64) as usize];
+        let mut p = a;
+        for x in &mut p {
+            *x += (2.0 * core_lattice::rng::uniform01(&mut rng) - 1.0) * 10.0 / (D as f64).sqrt();
+        }
+        let exact = pos
+            .iter()
+            .map(|q| (0..D).map(|i| (p[i] - q[i]).powi(2)).sum::<f64>().sqrt())
+            .fold(f64::INFINITY, f64::min);
+        if let Some((lb, ub, capped)) = cluster.map_bounds(&p) {
+            assert!(
+                lb <= exact && exact <= ub,
+                "{D}D near: {lb} <= {exact} <= {ub} fails"
+            );
+            if !capped && ub - lb < 4.0 {
+                fine += 1;
+            }
+        }
+    }
+    if let Some(sparse) = cluster.sparse_map() {
+        assert!(
+            fine > 1000,
+            "{D}D: the sparse map answers near the cluster ({fine})"
+        );
+        if threads == 1 {
+            assert_eq!(sparse.len(), n);
+        }
+    }
 }
 
 /// After serial growth and after PDLA (shared maps lowered by both threads), in 2D and 3D
-/// (two maps, the coarser one holding leaf boxes) and 4D and 5D (one map).
+/// (two maps, the coarser one holding leaf boxes; 3D also the sparse fine map in front) and
+/// 4D and 5D (one map).
 #[test]
 fn map_bound_is_below_the_exact_distance() {
     bound_is_below_exact::<2>(3000, 1);

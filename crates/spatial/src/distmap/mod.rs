@@ -45,6 +45,9 @@
 
 use crate::round::{ceil, floor};
 use std::fmt;
+
+mod sparse;
+pub use sparse::{SparseDistanceMap, UNKNOWN};
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Largest stored value: the cell is at least `cap` from every point.

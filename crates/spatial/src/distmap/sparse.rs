@@ -1,0 +1,532 @@
+//! A fine distance map stored sparsely: the cells of [`DistanceMap`](super::DistanceMap)
+//! (one byte per cell, a lower bound of the distance from its centre to the nearest point,
+//! capped at `cap`), kept in blocks of `B^D` cells that exist only where some cell lies within
+//! `cap` of a point, so that small cells (a diameter or two) near a fractal cluster cost memory
+//! in proportion to the cluster's neighbourhood rather than to the cube it grows in.
+//!
+//! A dense map of cells that small holds one byte for every cell of the cluster's bounding cube
+//! (in 3D, cells of two diameters over a cluster of radius 300 would be 27 MB); a DLA cluster's
+//! `cap`-neighbourhood is a fraction of that cube, and only its blocks are allocated.
+//!
+//! # Layout and reads
+//!
+//! - A *block table*, one `u32` per block over a cube of blocks centred on the origin (grown by
+//!   a quarter like the dense map's cells, while the map is not shared): `0` means the block is
+//!   absent, [`UNKNOWN`] that it could not be allocated, anything else is `1 +` the block's
+//!   number in the slab.
+//! - A *slab* of blocks in chunks of about 64 KiB, each chunk allocated when its first block is
+//!   handed out. Blocks are numbered in the order they were first written.
+//! - A cell stores its *nearness* `255 - v`, `v = min(255, floor(m / u))` as in the dense map
+//!   (`m` the distance from the cell's centre to the nearest point, `u = cap / 255`): fresh
+//!   zeroed memory then reads as "capped", so a block needs no initialisation and a block that
+//!   is absent answers like a block of capped cells.
+//!
+//! A read is the table entry and then the cell: two dependent memory accesses (plus the chunk's
+//! pointer, a small array that stays in cache).
+//!
+//! # Why an absent block is a valid "at least `cap`"
+//!
+//! An insert lowers every cell whose centre lies within `cap` of the point (the same rows as the
+//! dense map), and allocates a block before writing its first cell. A block is therefore
+//! absent only if no point inserted so far lies within `cap` of any of its cells' centres, and
+//! [`bounds`](SparseDistanceMap::bounds) returns `cap - |p - z|` for it, as for a capped cell
+//! of the dense map. A block that could not be allocated (a shared map whose reserved slab ran
+//! out) is marked [`UNKNOWN`] and gives no answer at all (`None`), never a capped one.
+//!
+//! # Sharing (PDLA)
+//!
+//! [`insert_shared`](SparseDistanceMap::insert_shared) works through `&self` while other
+//! threads read: a cell is lowered with an atomic `fetch_max` of its nearness, and a block is
+//! allocated lock-free: a slab number from an atomic counter, the chunk created once through a
+//! [`OnceLock`] before the number is published, and the table entry set by a compare-and-swap
+//! from "absent" (`Release`; readers load it with `Acquire`). A thread that loses the race uses
+//! the winner's block; its own number stays unused (all capped, never referenced). The table
+//! does not grow while shared: [`reserve`](SparseDistanceMap::reserve) sizes it and the slab's
+//! chunk slots for the whole cluster beforehand, so a shared insert never runs out of slots in
+//! practice, and if it did the block would be marked [`UNKNOWN`].
+//!
+//! The bound and its rounding margins are the dense map's (see the parent module): never above
+//! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
+//! capped.
+
+use super::{CAPPED, DistanceMapError, SHRINK, WIDTHS_MAX, finite_max_norm, next_row};
+use crate::round::{ceil, floor};
+use std::fmt;
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicU8, AtomicU32, AtomicUsize, Ordering};
+
+/// Table entry of a block that was never written: every cell is capped.
+const ABSENT: u32 = 0;
+/// Table entry of a block that could not be allocated: no information.
+pub const UNKNOWN: u32 = u32::MAX;
+/// Bytes of a slab chunk (at least one block).
+const CHUNK_BYTES: usize = 1 << 16;
+
+/// The two blocks an insert used last, by table index: consecutive rows of a point's ball
+/// mostly fall in the same one or two blocks. A published block never changes its entry, so
+/// they stay valid.
+struct Recent<'a> {
+    at: [usize; 2],
+    block: [&'a [AtomicU8]; 2],
+}
+
+/// The sparse fine distance map (see the module documentation).
+pub struct SparseDistanceMap<const D: usize> {
+    cell: f64,
+    inv_cell: f64,
+    cap: f64,
+    quantum: f64,
+    inv_quantum: f64,
+    /// `log2` of the block side in cells.
+    shift: u32,
+    /// Block side in cells, less one.
+    mask: usize,
+    /// Cells per block, `B^D`.
+    block_cells: usize,
+    /// The table covers cells `k` in `[-half, half)` per axis; `half` is a multiple of `B`.
+    half: i64,
+    /// `2 * half`: cells per axis.
+    side: usize,
+    /// Blocks per axis.
+    bside: usize,
+    /// One entry per block, axis 0 fastest: [`ABSENT`], [`UNKNOWN`] or `1 +` slab number.
+    table: Vec<AtomicU32>,
+    /// The slab's chunks, each `chunk_blocks` blocks, created on first use.
+    chunks: Vec<OnceLock<Box<[AtomicU8]>>>,
+    /// `log2` of the blocks per chunk.
+    chunk_shift: u32,
+    /// Slab numbers handed out.
+    next: AtomicUsize,
+    points: u64,
+    /// `below[s]`: a squared distance below which a cell of nearness `s` may be lowered,
+    /// `((255 - s) u)^2` widened by a relative `2^-40`.
+    below: Box<[f64; 256]>,
+    /// Row half-widths by squared distance in whole cells, as in the dense map.
+    widths: Box<[f64]>,
+}
+
+impl<const D: usize> fmt::Debug for SparseDistanceMap<D> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("SparseDistanceMap")
+            .field("cell", &self.cell)
+            .field("cap", &self.cap)
+            .field("block_side", &(self.mask + 1))
+            .field("cells_per_axis", &self.side)
+            .field("blocks", &self.blocks())
+            .field("points", &self.points)
+            .finish()
+    }
+}
+
+impl<const D: usize> SparseDistanceMap<D> {
+    /// An empty map with cell side `cell`, cap distance `cap` and blocks of `block_side^D`
+    /// cells (`block_side` a power of two, `block_side^D` at most 2^20). Nothing is allocated
+    /// until the first insert.
+    pub fn new(cell: f64, cap: f64, block_side: usize) -> Result<Self, DistanceMapError> {
+        if !(cell.is_finite() && cell > 0.0) {
+            return Err(DistanceMapError::CellSide(cell));
+        }
+        if !(cap.is_finite() && cap > 0.0) {
+            return Err(DistanceMapError::Cap(cap));
+        }
+        let block_cells = block_side.checked_pow(D as u32).unwrap_or(usize::MAX);
+        if !block_side.is_power_of_two() || block_cells > 1 << 20 {
+            return Err(DistanceMapError::TooLarge {
+                cells_per_axis: block_side as f64,
+            });
+        }
+        let quantum = cap / f64::from(CAPPED);
+        let mut below = Box::new([0.0; 256]);
+        for (s, b) in below.iter_mut().enumerate() {
+            let d = (255 - s) as f64 * quantum;
+            *b = d * d * (1.0 + SHRINK);
+        }
+        let r2 = (cap / cell) * (cap / cell);
+        if r2 > WIDTHS_MAX {
+            return Err(DistanceMapError::TooLarge {
+                cells_per_axis: 2.0 * cap / cell,
+            });
+        }
+        let widths = (0..=r2 as usize)
+            .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
+            .collect();
+        let chunk_blocks = (CHUNK_BYTES / block_cells).max(1);
+        Ok(SparseDistanceMap {
+            cell,
+            inv_cell: 1.0 / cell,
+            cap,
+            quantum,
+            inv_quantum: 1.0 / quantum,
+            shift: block_side.trailing_zeros(),
+            mask: block_side - 1,
+            block_cells,
+            half: 0,
+            side: 0,
+            bside: 0,
+            table: Vec::new(),
+            chunks: Vec::new(),
+            chunk_shift: chunk_blocks.trailing_zeros(),
+            next: AtomicUsize::new(0),
+            points: 0,
+            below,
+            widths,
+        })
+    }
+
+    /// The cell side.
+    pub fn cell_side(&self) -> f64 {
+        self.cell
+    }
+
+    /// The cap distance.
+    pub fn cap(&self) -> f64 {
+        self.cap
+    }
+
+    /// Points inserted through [`insert`](Self::insert).
+    pub fn len(&self) -> u64 {
+        self.points
+    }
+
+    /// Whether no point has been inserted through [`insert`](Self::insert).
+    pub fn is_empty(&self) -> bool {
+        self.points == 0
+    }
+
+    /// Half the side of the covered cube.
+    pub fn reach(&self) -> f64 {
+        self.half as f64 * self.cell
+    }
+
+    /// Blocks handed out (allocated, including any lost to a race between shared inserts).
+    pub fn blocks(&self) -> usize {
+        self.next.load(Ordering::Relaxed)
+    }
+
+    /// Heap bytes held: the table and the chunks created.
+    pub fn memory_bytes(&self) -> usize {
+        let chunk = self.block_cells << self.chunk_shift;
+        self.table.capacity() * 4
+            + self.chunks.capacity() * size_of::<OnceLock<Box<[AtomicU8]>>>()
+            + self.chunks.iter().filter(|c| c.get().is_some()).count() * chunk
+    }
+
+    /// The cells of block `entry` (a table entry other than [`ABSENT`] and [`UNKNOWN`]).
+    #[inline(always)]
+    fn block(&self, entry: u32) -> &[AtomicU8] {
+        let n = entry as usize - 1;
+        let chunk = self.chunks[n >> self.chunk_shift]
+            .get()
+            .expect("a block is published after its chunk is created");
+        let start = (n & ((1 << self.chunk_shift) - 1)) * self.block_cells;
+        &chunk[start..start + self.block_cells]
+    }
+
+    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and its
+    /// distance byte `v`; `None` outside the table or in an [`UNKNOWN`] block.
+    #[inline(always)]
+    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
+        let mut bidx = 0usize;
+        let mut cidx = 0usize;
+        let mut stride = 1usize;
+        let mut e2 = 0.0;
+        for i in 0..D {
+            let k = floor(p[i] * self.inv_cell);
+            let j = k + self.half as f64;
+            if !(j >= 0.0 && j < self.side as f64) {
+                return None;
+            }
+            let j = j as i64 as usize;
+            bidx += (j >> self.shift) * stride;
+            stride *= self.bside;
+            cidx |= (j & self.mask) << (self.shift as usize * i);
+            let e = p[i] - (k + 0.5) * self.cell;
+            e2 += e * e;
+        }
+        let v = match self.table[bidx].load(Ordering::Acquire) {
+            ABSENT => CAPPED,
+            UNKNOWN => return None,
+            entry => CAPPED - self.block(entry)[cidx].load(Ordering::Relaxed),
+        };
+        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
+    }
+
+    /// A lower bound of the distance from `p` to the nearest inserted point and whether the
+    /// cell is capped (see [`DistanceMap::lower_bound`](super::DistanceMap::lower_bound)).
+    #[inline]
+    pub fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
+        let (m, e, v) = self.read(p)?;
+        Some((m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12, v == CAPPED))
+    }
+
+    /// The lower bound, an upper bound (`+inf` for a capped cell) and whether the cell is
+    /// capped, as [`DistanceMap::bounds`](super::DistanceMap::bounds).
+    #[inline]
+    pub fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+        let (m, e, v) = self.read(p)?;
+        let capped = v == CAPPED;
+        let upper = if capped {
+            f64::INFINITY
+        } else {
+            (m + self.quantum + e) * (1.0 + SHRINK) + 1e-12
+        };
+        Some((
+            m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12,
+            upper,
+            capped,
+        ))
+    }
+
+    /// The distance byte of the cell holding `p` (255 in an absent block), for tests.
+    pub fn value(&self, p: &[f64; D]) -> Option<u8> {
+        self.read(p).map(|(_, _, v)| v)
+    }
+
+    /// Adds the point `q`: lowers every cell whose centre lies within `cap` of it, allocating
+    /// blocks as needed and growing the table first if `q` comes within `cap + cell` of its
+    /// edge.
+    pub fn insert(&mut self, q: &[f64; D]) -> Result<(), DistanceMapError> {
+        let need = finite_max_norm(q)? + self.cap + self.cell;
+        if need >= self.reach() {
+            self.grow(need)?;
+        }
+        // Room for every block the point's ball can touch.
+        let per_axis = (2.0 * self.cap * self.inv_cell) as usize / (self.mask + 1) + 2;
+        self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
+        self.points += 1;
+        self.lower_rows(q, |v, s| {
+            if s > v.load(Ordering::Relaxed) {
+                v.store(s, Ordering::Relaxed);
+            }
+        });
+        Ok(())
+    }
+
+    /// Adds `q` through a shared reference while other threads read and insert: cells are
+    /// lowered by an atomic `fetch_max` of their nearness, blocks allocated lock-free (module
+    /// documentation). The table does not grow: cells outside it are skipped. Returns `false`
+    /// when part of `q`'s ball fell outside the table.
+    pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
+        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
+        self.lower_rows(q, |v, s| {
+            if s > v.load(Ordering::Relaxed) {
+                v.fetch_max(s, Ordering::Relaxed);
+            }
+        });
+        Ok(inside)
+    }
+
+    /// Grows the table (if needed) to cover `|x_i| < reach`, and reserves chunk slots for
+    /// every block of the table, so that shared inserts can allocate any block.
+    pub fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
+        if !reach.is_finite() {
+            return Err(DistanceMapError::NonFinite {
+                axis: 0,
+                value: reach,
+            });
+        }
+        if reach >= self.reach() {
+            self.grow(reach)?;
+        }
+        self.ensure_slots(self.blocks() + self.table.len());
+        Ok(())
+    }
+
+    /// Makes room for chunk slots up to slab number `blocks` (exclusive access).
+    fn ensure_slots(&mut self, blocks: usize) {
+        let slots = (blocks >> self.chunk_shift) + 1;
+        if self.chunks.len() < slots {
+            self.chunks.resize_with(slots, OnceLock::new);
+        }
+    }
+
+    /// A block for the table entry `slot` (absent when read): a fresh slab number published by
+    /// a compare-and-swap, or the entry another thread published first; [`UNKNOWN`] when the
+    /// slab has no room.
+    #[cold]
+    fn allocate(&self, slot: &AtomicU32) -> u32 {
+        let n = self.next.fetch_add(1, Ordering::Relaxed);
+        let chunk = n >> self.chunk_shift;
+        let entry = if chunk < self.chunks.len() && n < UNKNOWN as usize - 1 {
+            let bytes = self.block_cells << self.chunk_shift;
+            self.chunks[chunk].get_or_init(|| (0..bytes).map(|_| AtomicU8::new(0)).collect());
+            n as u32 + 1
+        } else {
+            UNKNOWN
+        };
+        match slot.compare_exchange(ABSENT, entry, Ordering::AcqRel, Ordering::Acquire) {
+            Ok(_) => entry,
+            Err(current) => current,
+        }
+    }
+
+    /// Calls `lower(cell, s)` for every cell whose centre lies within `cap` of `q` and whose
+    /// nearness could rise to `s` (the quantised distance's complement), allocating a block at
+    /// its first such cell.
+    #[inline]
+    fn lower_rows(&self, q: &[f64; D], mut lower: impl FnMut(&AtomicU8, u8)) {
+        let mut lo = [0i64; D];
+        let mut hi = [0i64; D];
+        for i in 0..D {
+            lo[i] = (ceil((q[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
+            hi[i] = (floor((q[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
+            if lo[i] > hi[i] {
+                return;
+            }
+        }
+        let mut k = lo;
+        let t0 = q[0] * self.inv_cell - 0.5;
+        let kq: [i64; D] = std::array::from_fn(|i| floor(q[i] * self.inv_cell - 0.5) as i64);
+        let shift = self.shift as usize;
+        let mut recent = Recent {
+            at: [usize::MAX; 2],
+            block: [&[]; 2],
+        };
+        loop {
+            let mut s = 0.0;
+            let mut j2 = 0usize;
+            let mut brow = 0usize;
+            let mut crow = 0usize;
+            let mut stride = self.bside;
+            for i in 1..D {
+                let e = q[i] - (k[i] as f64 + 0.5) * self.cell;
+                s += e * e;
+                let j = if k[i] <= kq[i] {
+                    kq[i] - k[i]
+                } else {
+                    k[i] - kq[i] - 1
+                };
+                j2 += (j * j) as usize;
+                let u = (k[i] + self.half) as usize;
+                brow += (u >> shift) * stride;
+                stride *= self.bside;
+                crow |= (u & self.mask) << (shift * i);
+            }
+            if let Some(&h) = self.widths.get(j2) {
+                let a = (ceil(t0 - h) as i64).max(lo[0]);
+                let b = (floor(t0 + h) as i64).min(hi[0]);
+                if a <= b {
+                    let last = (b + self.half) as usize;
+                    let mut u = (a + self.half) as usize;
+                    // The row's cells block by block.
+                    while u <= last {
+                        let end = (u | self.mask).min(last);
+                        self.lower_segment(q, s, brow, crow, u, end, &mut lower, &mut recent);
+                        u = end + 1;
+                    }
+                }
+            }
+            if !next_row(&mut k, &lo, &hi) {
+                return;
+            }
+        }
+    }
+
+    /// Lowers cells `u..=end` (table coordinates along axis 0, one block) of the row with
+    /// squared off-axis distance `s`, block row `brow` and in-block offset `crow`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn lower_segment<'a>(
+        &'a self,
+        q: &[f64; D],
+        s: f64,
+        brow: usize,
+        crow: usize,
+        u: usize,
+        end: usize,
+        lower: &mut impl FnMut(&AtomicU8, u8),
+        recent: &mut Recent<'a>,
+    ) {
+        let at = brow + (u >> self.shift);
+        let x0 = ((u as i64 - self.half) as f64 + 0.5) * self.cell - q[0];
+        let block = if recent.at[0] == at {
+            recent.block[0]
+        } else if recent.at[1] == at {
+            recent.block[1]
+        } else {
+            let Some(block) = self.find_block(at, x0, s, end - u) else {
+                return;
+            };
+            recent.at = [at, recent.at[0]];
+            recent.block = [block, recent.block[0]];
+            block
+        };
+        let row = &block[crow | (u & self.mask)..=crow | (end & self.mask)];
+        for (n, v) in row.iter().enumerate() {
+            let x = x0 + f64::from(n as i32) * self.cell;
+            let d2 = x * x + s;
+            if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
+                let d = d2.sqrt() * self.inv_quantum;
+                if d < f64::from(CAPPED) {
+                    lower(v, CAPPED - d as u8);
+                }
+            }
+        }
+    }
+
+    /// The block at table index `at` for a segment of `len + 1` cells starting `x0` from `q`
+    /// along the row, `s` off it: allocated if absent and some cell of the segment comes
+    /// within the cap; `None` if it stays absent or is unknown.
+    #[inline(always)]
+    fn find_block(&self, at: usize, x0: f64, s: f64, len: usize) -> Option<&[AtomicU8]> {
+        let slot = &self.table[at];
+        let entry = match slot.load(Ordering::Acquire) {
+            UNKNOWN => return None,
+            ABSENT => {
+                // Allocate only if some cell of the segment comes within the cap: the centre
+                // nearest q along the row.
+                let n = (-x0 * self.inv_cell + 0.5).max(0.0).min(len as f64);
+                let x = x0 + floor(n) * self.cell;
+                if x * x + s >= self.cap * self.cap {
+                    return None;
+                }
+                match self.allocate(slot) {
+                    UNKNOWN => return None,
+                    entry => entry,
+                }
+            }
+            entry => entry,
+        };
+        (entry != UNKNOWN).then(|| self.block(entry))
+    }
+
+    /// Enlarges the table to cover `|x_i| < need` (by at least a quarter), copying the old
+    /// entries into the middle of the new table (blocks keep their slab numbers).
+    fn grow(&mut self, need: f64) -> Result<(), DistanceMapError> {
+        let b = (self.mask + 1) as f64;
+        let cells = ((need * self.inv_cell).ceil().max(self.half as f64 * 1.25) / b).ceil() * b;
+        let side = 2.0 * cells;
+        let bside = side / b;
+        let total = bside.powi(D as i32);
+        if !(side < f64::from(u32::MAX) && total < (u32::MAX as f64) / 2.0) {
+            return Err(DistanceMapError::TooLarge {
+                cells_per_axis: side,
+            });
+        }
+        let half = cells as i64;
+        let bside = bside as usize;
+        let mut table: Vec<AtomicU32> = (0..total as usize).map(|_| AtomicU32::new(0)).collect();
+        if self.bside > 0 {
+            let off = ((half - self.half) as usize) >> self.shift;
+            for (r, old) in self.table.iter_mut().enumerate() {
+                let mut rem = r;
+                let mut at = 0;
+                let mut stride = 1;
+                for _ in 0..D {
+                    at += (rem % self.bside + off) * stride;
+                    rem /= self.bside;
+                    stride *= bside;
+                }
+                *table[at].get_mut() = *old.get_mut();
+            }
+        }
+        self.table = table;
+        self.half = half;
+        self.side = side as usize;
+        self.bside = bside;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests;
