@@ -215,6 +215,10 @@ pub struct Measurement {
     /// down, so the fastest is the least disturbed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub wall_seconds_runs: Vec<f64>,
+    /// Multi-threaded workloads: the host's core-to-core round trip just before the run, in
+    /// nanoseconds ([`crate::probe::core_round_trip_ns`]); the threads' speed-up depends on it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub core_round_trip_ns: Option<f64>,
 }
 
 /// The fastest of a workload's repeats, with every repeat's wall seconds attached.
@@ -346,6 +350,21 @@ pub fn measure(w: &Workload, bin_dir: &Path) -> Result<Measurement> {
     let bin = bin_dir.join(w.bin);
     let command = format!("target/release/{} {} -q --out DIR", w.bin, w.args.join(" "));
     eprintln!("==> {}: {command}", w.name);
+    let threads = w
+        .args
+        .iter()
+        .position(|a| *a == "--threads")
+        .and_then(|i| w.args.get(i + 1))
+        .and_then(|t| t.parse::<usize>().ok())
+        .unwrap_or(1);
+    let core_round_trip_ns = if threads > 1 {
+        crate::probe::core_round_trip_ns(5, 20_000)
+    } else {
+        None
+    };
+    if let Some(ns) = core_round_trip_ns {
+        eprintln!("    core-to-core round trip {ns:.0} ns");
+    }
     let start = Instant::now();
     let output = Command::new(&bin)
         .args(w.args)
@@ -383,6 +402,7 @@ pub fn measure(w: &Workload, bin_dir: &Path) -> Result<Measurement> {
             .and_then(|v| v.as_str())
             .map(String::from),
         wall_seconds_runs: Vec::new(),
+        core_round_trip_ns,
     };
     eprintln!(
         "    {:.2} s wall, {:.3e} {}, peak RSS {} MB",
@@ -471,14 +491,17 @@ pub fn run(
         eprintln!("==> fastest of {repeat} per workload");
         for m in &workloads {
             eprintln!(
-                "    {:<28} {:.2} s (runs: {})",
+                "    {:<28} {:.2} s (runs: {}){}",
                 m.name,
                 m.wall_seconds,
                 m.wall_seconds_runs
                     .iter()
                     .map(|t| format!("{t:.2}"))
                     .collect::<Vec<_>>()
-                    .join(", ")
+                    .join(", "),
+                m.core_round_trip_ns
+                    .map(|ns| format!(", core-to-core round trip {ns:.0} ns"))
+                    .unwrap_or_default()
             );
         }
     }
@@ -538,6 +561,7 @@ mod tests {
             bytes_per_item: None,
             state_hash: Some(hash.into()),
             wall_seconds_runs: Vec::new(),
+            core_round_trip_ns: None,
         }
     }
 

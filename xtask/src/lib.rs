@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod plot;
+pub mod probe;
 pub mod report;
 pub mod scale;
 pub mod scaling;
