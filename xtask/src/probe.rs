@@ -25,18 +25,24 @@ pub fn core_round_trip_ns(rounds: usize, trips: u64) -> Option<f64> {
     if std::thread::available_parallelism().map_or(1, usize::from) < 2 {
         return None;
     }
+    // The first `warm` trips are not timed: they wait for the second thread to be scheduled
+    // (which can take milliseconds if it starts on the core the first one spins on).
+    let warm = 1000;
     let mut means: Vec<f64> = (0..rounds.max(1))
         .map(|_| {
             let flag = Line(AtomicU64::new(0));
             std::thread::scope(|s| {
                 s.spawn(|| {
-                    for i in 0..trips {
+                    for i in 0..warm + trips {
                         while flag.0.load(Ordering::Acquire) != 2 * i + 1 {}
                         flag.0.store(2 * i + 2, Ordering::Release);
                     }
                 });
-                let start = Instant::now();
-                for i in 0..trips {
+                let mut start = Instant::now();
+                for i in 0..warm + trips {
+                    if i == warm {
+                        start = Instant::now();
+                    }
                     flag.0.store(2 * i + 1, Ordering::Release);
                     while flag.0.load(Ordering::Acquire) != 2 * i + 2 {}
                 }
