@@ -112,6 +112,34 @@ pub struct DistanceMap<const D: usize> {
 /// Largest `(cap / cell)^2` for which [`DistanceMap`] tabulates its row widths.
 const WIDTHS_MAX: f64 = 4096.0;
 
+/// The quantum `cap / 255` and the two tables of a map with cells of side `cell` capped at
+/// `cap` (both checked): `below[v]`, the squared distance below which a cell holding `v` may
+/// be lowered, `(v u)^2` widened by a relative [`SHRINK`], and the row half-widths by squared
+/// distance in whole cells (empty when `(cap / cell)^2` exceeds [`WIDTHS_MAX`]).
+fn tables(cell: f64, cap: f64) -> Result<(f64, Box<[f64; 256]>, Box<[f64]>), DistanceMapError> {
+    if !(cell.is_finite() && cell > 0.0) {
+        return Err(DistanceMapError::CellSide(cell));
+    }
+    if !(cap.is_finite() && cap > 0.0) {
+        return Err(DistanceMapError::Cap(cap));
+    }
+    let quantum = cap / f64::from(CAPPED);
+    let mut below = Box::new([0.0; 256]);
+    for (v, b) in below.iter_mut().enumerate() {
+        let d = v as f64 * quantum;
+        *b = d * d * (1.0 + SHRINK);
+    }
+    let r2 = (cap / cell) * (cap / cell);
+    let widths = if r2 <= WIDTHS_MAX {
+        (0..=r2 as usize)
+            .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
+            .collect()
+    } else {
+        Box::default()
+    };
+    Ok((quantum, below, widths))
+}
+
 impl<const D: usize> Clone for DistanceMap<D> {
     fn clone(&self) -> Self {
         DistanceMap {
@@ -149,26 +177,7 @@ impl<const D: usize> DistanceMap<D> {
     /// An empty map with cell side `cell` and cap distance `cap` (both in the units of the
     /// points). Nothing is allocated until the first insert.
     pub fn new(cell: f64, cap: f64) -> Result<Self, DistanceMapError> {
-        if !(cell.is_finite() && cell > 0.0) {
-            return Err(DistanceMapError::CellSide(cell));
-        }
-        if !(cap.is_finite() && cap > 0.0) {
-            return Err(DistanceMapError::Cap(cap));
-        }
-        let quantum = cap / f64::from(CAPPED);
-        let mut below = Box::new([0.0; 256]);
-        for (v, b) in below.iter_mut().enumerate() {
-            let d = v as f64 * quantum;
-            *b = d * d * (1.0 + SHRINK);
-        }
-        let r2 = (cap / cell) * (cap / cell);
-        let widths = if r2 <= WIDTHS_MAX {
-            (0..=r2 as usize)
-                .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
-                .collect()
-        } else {
-            Box::default()
-        };
+        let (quantum, below, widths) = tables(cell, cap)?;
         Ok(DistanceMap {
             below,
             widths,

@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::{CAPPED, DistanceMapError, SHRINK, WIDTHS_MAX, finite_max_norm, next_row};
+use super::{CAPPED, DistanceMapError, SHRINK, finite_max_norm, next_row, tables};
 use crate::round::{ceil, floor};
 use std::fmt;
 use std::sync::OnceLock;
@@ -123,33 +123,20 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// cells (`block_side` a power of two, `block_side^D` at most 2^20). Nothing is allocated
     /// until the first insert.
     pub fn new(cell: f64, cap: f64, block_side: usize) -> Result<Self, DistanceMapError> {
-        if !(cell.is_finite() && cell > 0.0) {
-            return Err(DistanceMapError::CellSide(cell));
-        }
-        if !(cap.is_finite() && cap > 0.0) {
-            return Err(DistanceMapError::Cap(cap));
-        }
+        let (quantum, mut below, widths) = tables(cell, cap)?;
         let block_cells = block_side.checked_pow(D as u32).unwrap_or(usize::MAX);
         if !block_side.is_power_of_two() || block_cells > 1 << 20 {
             return Err(DistanceMapError::TooLarge {
                 cells_per_axis: block_side as f64,
             });
         }
-        let quantum = cap / f64::from(CAPPED);
-        let mut below = Box::new([0.0; 256]);
-        for (s, b) in below.iter_mut().enumerate() {
-            let d = (255 - s) as f64 * quantum;
-            *b = d * d * (1.0 + SHRINK);
-        }
-        let r2 = (cap / cell) * (cap / cell);
-        if r2 > WIDTHS_MAX {
+        // Cells store their nearness `255 - v`: the dense map's table read backwards.
+        below.reverse();
+        if widths.is_empty() {
             return Err(DistanceMapError::TooLarge {
                 cells_per_axis: 2.0 * cap / cell,
             });
         }
-        let widths = (0..=r2 as usize)
-            .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
-            .collect();
         let chunk_blocks = (CHUNK_BYTES / block_cells).max(1);
         Ok(SparseDistanceMap {
             cell,
