@@ -112,11 +112,20 @@ pub struct DistanceMap<const D: usize> {
 /// Largest `(cap / cell)^2` for which [`DistanceMap`] tabulates its row widths.
 const WIDTHS_MAX: f64 = 4096.0;
 
-/// The quantum `cap / 255` and the two tables of a map with cells of side `cell` capped at
-/// `cap` (both checked): `below[v]`, the squared distance below which a cell holding `v` may
-/// be lowered, `(v u)^2` widened by a relative [`SHRINK`], and the row half-widths by squared
-/// distance in whole cells (empty when `(cap / cell)^2` exceeds [`WIDTHS_MAX`]).
-fn tables(cell: f64, cap: f64) -> Result<(f64, Box<[f64; 256]>, Box<[f64]>), DistanceMapError> {
+/// What a map with cells of side `cell` capped at `cap` derives from them (see [`tables`]).
+struct Tables {
+    /// `cap / 255`.
+    quantum: f64,
+    /// `below[v]`: the squared distance below which a cell holding `v` may be lowered,
+    /// `(v u)^2` widened by a relative [`SHRINK`].
+    below: Box<[f64; 256]>,
+    /// Row half-widths by squared distance in whole cells; empty when `(cap / cell)^2` exceeds
+    /// [`WIDTHS_MAX`].
+    widths: Box<[f64]>,
+}
+
+/// The [`Tables`] of a map with cells of side `cell` capped at `cap`, both checked.
+fn tables(cell: f64, cap: f64) -> Result<Tables, DistanceMapError> {
     if !(cell.is_finite() && cell > 0.0) {
         return Err(DistanceMapError::CellSide(cell));
     }
@@ -137,7 +146,11 @@ fn tables(cell: f64, cap: f64) -> Result<(f64, Box<[f64; 256]>, Box<[f64]>), Dis
     } else {
         Box::default()
     };
-    Ok((quantum, below, widths))
+    Ok(Tables {
+        quantum,
+        below,
+        widths,
+    })
 }
 
 impl<const D: usize> Clone for DistanceMap<D> {
@@ -177,7 +190,11 @@ impl<const D: usize> DistanceMap<D> {
     /// An empty map with cell side `cell` and cap distance `cap` (both in the units of the
     /// points). Nothing is allocated until the first insert.
     pub fn new(cell: f64, cap: f64) -> Result<Self, DistanceMapError> {
-        let (quantum, below, widths) = tables(cell, cap)?;
+        let Tables {
+            quantum,
+            below,
+            widths,
+        } = tables(cell, cap)?;
         Ok(DistanceMap {
             below,
             widths,

@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::{CAPPED, DistanceMapError, SHRINK, finite_max_norm, next_row, tables};
+use super::{CAPPED, DistanceMapError, SHRINK, Tables, finite_max_norm, next_row, tables};
 use crate::round::{ceil, floor};
 use std::fmt;
 use std::sync::OnceLock;
@@ -123,7 +123,11 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// cells (`block_side` a power of two, `block_side^D` at most 2^20). Nothing is allocated
     /// until the first insert.
     pub fn new(cell: f64, cap: f64, block_side: usize) -> Result<Self, DistanceMapError> {
-        let (quantum, mut below, widths) = tables(cell, cap)?;
+        let Tables {
+            quantum,
+            mut below,
+            widths,
+        } = tables(cell, cap)?;
         let block_cells = block_side.checked_pow(D as u32).unwrap_or(usize::MAX);
         if !block_side.is_power_of_two() || block_cells > 1 << 20 {
             return Err(DistanceMapError::TooLarge {
