@@ -73,7 +73,8 @@ fn first_radius() -> f64 {
 /// stored since its walker's last look at the tree lies within [`OVERLAP_DISTANCE`]: against
 /// the walker's near cache or the tree before taking the lock, and under the lock against the
 /// particles stored since; if one does the walker is discarded and counted. Before every move
-/// a thread adds the particles others stored to its walker's near cache.
+/// a thread reads the number of particles published and, when others stored some and its
+/// walker's near cache can still answer, adds them to the cache (see `Ctx::catch_up`).
 ///
 /// The tree's room for the phase is reserved up front (address space, not memory); a particle
 /// that needs more, or lands outside the reserved root, ends the phase at a quiescent point and
@@ -401,7 +402,7 @@ where
         self.stop.store(true, Ordering::Relaxed);
     }
 
-    /// The smallest epoch the threads announced (see [`Announced`]).
+    /// The smallest epoch the threads announced (see [`Slot`]).
     fn readers_epoch(&self) -> u64 {
         self.slots
             .iter()
