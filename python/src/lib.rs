@@ -35,6 +35,11 @@ fn defaults<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
 /// The aggsim models (DLA/PDLA, DLCA, animats) at native speed, results as NumPy arrays.
 #[pymodule]
 fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // A build for a newer instruction set than this processor's fails the import with a
+    // message, not with an illegal instruction in the middle of a run.
+    if let Some(why) = core_lattice::cpu::unsupported() {
+        return Err(pyo3::exceptions::PyImportError::new_err(format!("aggsim: {why}")));
+    }
     m.add_function(wrap_pyfunction!(dla::dla, m)?)?;
     m.add_function(wrap_pyfunction!(dlca::dlca, m)?)?;
     m.add_function(wrap_pyfunction!(animat::animat, m)?)?;

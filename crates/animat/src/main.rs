@@ -196,6 +196,9 @@ const CURVES: &[Curve] = &[Curve {
 }];
 
 fn main() -> ExitCode {
+    if let Some(code) = core_lattice::cli::refuse_unsupported_cpu("animat") {
+        return code;
+    }
     if let Some(code) = core_lattice::ensemble::merge_main("animat", CURVES) {
         return code;
     }

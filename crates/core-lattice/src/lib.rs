@@ -10,6 +10,7 @@
 //! - [`stats`]: Welford mean/variance, integer and logarithmic histograms, least-squares and
 //!   log-log fits with standard errors, and radius-of-gyration accumulators that stay accurate
 //!   far from the origin.
+//! - [`cpu`]: the processor features the build was compiled for, checked at start.
 //! - [`io`]: atomic file writes, the run manifest `run.json`, the checkpoint envelope, PNG and
 //!   CSV writers, and the stable state hash.
 //! - `cli` (feature `cli`): the model binaries' contract (usage errors: one line, exit code 2,
@@ -21,6 +22,7 @@
 
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod cpu;
 #[cfg(feature = "cli")]
 pub mod ensemble;
 pub mod io;

@@ -247,6 +247,9 @@ const CURVES: &[Curve] = &[Curve {
 }];
 
 fn main() -> ExitCode {
+    if let Some(code) = core_lattice::cli::refuse_unsupported_cpu("dla") {
+        return code;
+    }
     if let Some(code) = core_lattice::ensemble::merge_main("dla", CURVES) {
         return code;
     }

@@ -253,6 +253,9 @@ const CURVES: &[Curve] = &[
 ];
 
 fn main() -> ExitCode {
+    if let Some(code) = core_lattice::cli::refuse_unsupported_cpu("dlca") {
+        return code;
+    }
     if let Some(code) = core_lattice::ensemble::merge_main("dlca", CURVES) {
         return code;
     }

@@ -1,11 +1,25 @@
 //! Rounding to integers without a library call: on baseline x86-64 (no SSE4.1) `f64::floor`
 //! and `f64::ceil` are calls into libm, which the hot loops of the orthtree and the distance
-//! maps cannot afford.
+//! maps cannot afford. Where the build has SSE4.1 (the workspace's `x86-64-v3` level) or is not
+//! x86-64 at all, the standard functions compile to one rounding instruction and are used.
+
+/// Whether `f64::floor` is a library call in this build.
+const FLOOR_IS_A_CALL: bool = cfg!(all(target_arch = "x86_64", not(target_feature = "sse4.1")));
 
 /// `x.floor()` for finite `x` inside the `i64` range (values beyond it saturate, which every
 /// caller clamps or excludes).
 #[inline(always)]
 pub(crate) fn floor(x: f64) -> f64 {
+    if FLOOR_IS_A_CALL {
+        floor_by_cast(x)
+    } else {
+        x.floor()
+    }
+}
+
+/// `floor` through a conversion to `i64` and back (two instructions and a compare).
+#[inline(always)]
+fn floor_by_cast(x: f64) -> f64 {
     let t = x as i64 as f64;
     if t > x { t - 1.0 } else { t }
 }
@@ -13,7 +27,11 @@ pub(crate) fn floor(x: f64) -> f64 {
 /// `x.ceil()`, likewise.
 #[inline(always)]
 pub(crate) fn ceil(x: f64) -> f64 {
-    -floor(-x)
+    if FLOOR_IS_A_CALL {
+        -floor(-x)
+    } else {
+        x.ceil()
+    }
 }
 
 #[cfg(test)]
@@ -36,6 +54,8 @@ mod tests {
         ] {
             assert_eq!(floor(x), x.floor(), "{x}");
             assert_eq!(ceil(x), x.ceil(), "{x}");
+            assert_eq!(floor_by_cast(x), x.floor(), "{x}");
+            assert_eq!(-floor_by_cast(-x), x.ceil(), "{x}");
         }
     }
 }

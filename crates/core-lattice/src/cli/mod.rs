@@ -158,6 +158,15 @@ pub fn usage(message: impl Into<String>) -> anyhow::Error {
     UsageError(message.into()).into()
 }
 
+/// The first step of a model binary: `Some(exit code 1)`, after one line on standard error, when
+/// the processor lacks an instruction-set feature the build was compiled to use
+/// ([`cpu`](crate::cpu)), rather than an illegal instruction later in the run.
+pub fn refuse_unsupported_cpu(program: &str) -> Option<ExitCode> {
+    let why = crate::cpu::unsupported()?;
+    eprintln!("{program}: {why}");
+    Some(ExitCode::from(EXIT_RUN_FAILED))
+}
+
 /// The whole life of a model binary: parse the flags (help, version and parse errors handled
 /// as in [`parse_or_exit`]), set up logging from the [`LogArgs`] that `logging` reads off them,
 /// turn the flags into validated parameters (an `Err` is a usage error), then `run`. A
