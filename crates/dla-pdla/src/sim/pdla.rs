@@ -472,7 +472,7 @@ where
             if overlap {
                 continue;
             }
-            let (q, new_leaf) = match tree.insert_shared(stick, self.readers_epoch()) {
+            let (q, new_leaf) = match tree.insert_shared(stick, || self.readers_epoch()) {
                 Ok(stored) => stored,
                 Err(OrthtreeError::NeedsExclusive) => {
                     // The walker is dropped; the next phase reserves more room.

@@ -275,12 +275,17 @@ impl<const D: usize> Orthtree<D> {
     /// **Reclamation.** A leaf that outgrows its block moves to a larger one; the old block may
     /// still be scanned by a reader, so it is retired, not reused. Every reader announces the
     /// [`epoch`](Self::epoch) it read at a point where it holds nothing from the tree (a
-    /// walker's birth, say); `readers_epoch` is the smallest such announcement over the
-    /// readers (`u64::MAX` when none is reading), and blocks retired before it are reused.
+    /// walker's birth, say); `readers_epoch` returns the smallest such announcement over the
+    /// readers (`u64::MAX` when none is reading), and blocks retired before it are reused. The
+    /// readers' announcements live on their own cache lines, which another core writes: the
+    /// insert asks `readers_epoch` only when that can free a block (the oldest retired block
+    /// is not before the last answer) and the epoch has advanced since it last asked, about
+    /// once per 64 inserts. An old answer stays safe, as announcements only grow within a
+    /// phase ([`prepare_shared`](Self::prepare_shared) forgets it).
     pub fn insert_shared(
         &self,
         p: [f64; D],
-        readers_epoch: u64,
+        readers_epoch: impl FnOnce() -> u64,
     ) -> Result<([f64; D], bool), OrthtreeError> {
         let (k, code) = self.locate(&p)?;
         if self.root == EMPTY || !self.root_contains(&k) {
@@ -292,8 +297,13 @@ impl<const D: usize> Orthtree<D> {
         if !self.has_room(&w, leaf_len) {
             return Err(OrthtreeError::NeedsExclusive);
         }
-        w.pool.reclaim(&self.slots, readers_epoch);
         let epoch = self.shared.epoch.load(Ordering::Relaxed);
+        if w.pool.oldest_retired() >= Some(w.readers_known) && epoch > w.readers_asked_at {
+            w.readers_known = readers_epoch();
+            w.readers_asked_at = epoch;
+        }
+        let known = w.readers_known;
+        w.pool.reclaim(&self.slots, known);
         self.place(&mut w, &k, code, Some(epoch));
         self.shared.len.fetch_add(1, Ordering::Relaxed);
         w.since_epoch += 1;
@@ -327,6 +337,9 @@ impl<const D: usize> Orthtree<D> {
         let fanout = Self::FANOUT;
         let levels = self.root_level as usize;
         let w = Self::writer_mut(&mut self.shared);
+        // A new phase has new readers, whose announcements start from nothing.
+        w.readers_known = 0;
+        w.readers_asked_at = 0;
         // Per point now, at least what a small tree of one leaf per point would need.
         let small = n < 4096;
         let per = |used: usize, floor: f64| {

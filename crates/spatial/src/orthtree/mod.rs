@@ -291,6 +291,10 @@ struct Writer {
     pool: LeafPool,
     /// Shared inserts since the epoch was last advanced.
     since_epoch: u32,
+    /// The smallest epoch the readers had announced when last asked, and the tree's epoch
+    /// then (see [`Orthtree::insert_shared`]); reset for each phase of shared inserts.
+    readers_known: u64,
+    readers_asked_at: u64,
 }
 
 /// State the writer changes and readers may look at, in its own allocation so that updating
@@ -300,8 +304,22 @@ struct Shared {
     writer: Mutex<Writer>,
     /// Number of stored points.
     len: AtomicUsize,
-    /// Reclamation epoch of shared inserts (see [`Orthtree::insert_shared`]).
-    epoch: AtomicU64,
+    /// Reclamation epoch of shared inserts (see [`Orthtree::insert_shared`]), on a cache line
+    /// of its own: readers load it at every announcement, and `len` beside it changes at
+    /// every insert.
+    epoch: OwnLine<AtomicU64>,
+}
+
+/// A value alone on its cache lines (128 bytes: two lines, for adjacent-line prefetchers).
+#[derive(Debug)]
+#[repr(align(128))]
+struct OwnLine<T>(T);
+
+impl<T> std::ops::Deref for OwnLine<T> {
+    type Target = T;
+    fn deref(&self) -> &T {
+        &self.0
+    }
 }
 
 /// Shared inserts between two advances of the reclamation epoch.
@@ -400,7 +418,7 @@ impl<const D: usize> Clone for Orthtree<D> {
             shared: Box::new(Shared {
                 writer: Mutex::new(w),
                 len: AtomicUsize::new(self.len()),
-                epoch: AtomicU64::new(self.shared.epoch.load(Ordering::Acquire)),
+                epoch: OwnLine(AtomicU64::new(self.shared.epoch.load(Ordering::Acquire))),
             }),
             index_limit: self.index_limit,
         }
@@ -448,9 +466,11 @@ impl<const D: usize> Orthtree<D> {
                     leaves: 0,
                     pool: LeafPool::new(),
                     since_epoch: 0,
+                    readers_known: 0,
+                    readers_asked_at: 0,
                 }),
                 len: AtomicUsize::new(0),
-                epoch: AtomicU64::new(1),
+                epoch: OwnLine(AtomicU64::new(1)),
             }),
             index_limit: MAX_INDEX,
         }

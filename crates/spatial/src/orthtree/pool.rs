@@ -180,6 +180,11 @@ impl LeafPool {
         Leaf { start, len: n + 1 }
     }
 
+    /// The epoch of the oldest retired block, if any.
+    pub(super) fn oldest_retired(&self) -> Option<u64> {
+        self.retired.front().map(|r| r.epoch)
+    }
+
     /// Moves the retired blocks of epochs before `safe` (every reader has announced `safe` or
     /// later since) to the free lists.
     pub(super) fn reclaim<const D: usize>(&mut self, slots: &Arena<[u32; D]>, safe: u64) {

@@ -587,11 +587,13 @@ fn shared_inserts_while_readers_query() {
         }
         let _done = Done(done);
         for (i, &p) in pts.iter().enumerate().skip(head) {
-            let readers = epochs
-                .iter()
-                .map(|e| e.load(Ordering::Acquire))
-                .min()
-                .unwrap();
+            let readers = || {
+                epochs
+                    .iter()
+                    .map(|e| e.load(Ordering::Acquire))
+                    .min()
+                    .unwrap()
+            };
             assert_eq!(t.insert_shared(p, readers).unwrap().0, stored[i]);
             published.store(i + 1, Ordering::Release);
             // Readers are far slower than the writer here (their answers are checked by brute
@@ -649,7 +651,7 @@ fn shared_inserts_that_need_exclusive_access_change_nothing() {
     t.prepare_shared(10, 50.0).unwrap();
     let before = (t.len(), t.stats(), t.root_cell());
     assert_eq!(
-        t.insert_shared([1e6, 0.0], u64::MAX),
+        t.insert_shared([1e6, 0.0], || u64::MAX),
         Err(OrthtreeError::NeedsExclusive)
     );
     assert_eq!((t.len(), t.stats(), t.root_cell()), before);
@@ -661,7 +663,7 @@ fn shared_inserts_that_need_exclusive_access_change_nothing() {
             (i / 20 % 20) as f64 * 4.0 - 40.0 + 0.5,
         ];
         let before = (t.len(), t.stats());
-        match t.insert_shared(p, u64::MAX) {
+        match t.insert_shared(p, || u64::MAX) {
             Ok(_) => i += 1,
             Err(e) => {
                 assert_eq!((t.len(), t.stats()), before);
@@ -674,4 +676,44 @@ fn shared_inserts_that_need_exclusive_access_change_nothing() {
     t.finish_shared();
     t.insert([1e6, 0.0]).unwrap();
     assert_eq!(t.len() as u64, i + 2);
+}
+
+/// Shared inserts ask for the readers' epochs (cache lines other cores write) about once per
+/// advance of the epoch, not at every insert, and still reuse retired blocks once the readers
+/// have moved past them.
+#[test]
+fn shared_inserts_ask_the_readers_once_per_epoch() {
+    let grow = |reader_keeps_up: bool| {
+        let mut t = Orthtree::<2>::with_leaf_side(8.0).unwrap();
+        t.insert([0.0, 0.0]).unwrap();
+        t.prepare_shared(400_000, 100.0).unwrap();
+        let mut asked = 0;
+        // Points crowded into a few leaves, which outgrow their blocks again and again.
+        for i in 0..20_000u64 {
+            let p = [
+                (i % 97) as f64 * 0.3 - 14.0,
+                (i / 97 % 89) as f64 * 0.3 - 13.0,
+            ];
+            let announced = if reader_keeps_up { t.epoch() } else { 1 };
+            t.insert_shared(p, || {
+                asked += 1;
+                announced
+            })
+            .unwrap();
+        }
+        let slots = t.stats().point_slots;
+        t.finish_shared();
+        (asked, slots)
+    };
+    let (asked, slots) = grow(true);
+    assert!(
+        (1..=20_000 / 64 + 2).contains(&asked),
+        "asked {asked} times"
+    );
+    // A reader stuck at the first epoch keeps every retired block from reuse.
+    let (_, stuck_slots) = grow(false);
+    assert!(
+        slots < stuck_slots,
+        "{slots} slots, {stuck_slots} with a stuck reader"
+    );
 }
