@@ -248,10 +248,13 @@ impl<const D: usize> DistanceMap<D> {
         let mut centre = [0.0; D];
         for i in 0..D {
             let k = floor(p[i] * self.inv_cell);
-            let j = k + self.half as f64;
-            if !(j >= 0.0 && j < self.side as f64) {
+            // The cube is `side = 2 half` cells a side; a signed integer converts to `f64` in
+            // one instruction, an unsigned one in several. NaN fails the test.
+            let half = self.half as f64;
+            if !(k >= -half && k < half) {
                 return None;
             }
+            let j = k + half;
             // j is a whole number in [0, side): through i64 the conversion is one instruction
             // and a check, where a direct f64 -> usize conversion is a longer sequence.
             idx += j as i64 as usize * stride;

@@ -223,10 +223,12 @@ impl<const D: usize> SparseDistanceMap<D> {
         let mut e2 = 0.0;
         for i in 0..D {
             let k = floor(p[i] * self.inv_cell);
-            let j = k + self.half as f64;
-            if !(j >= 0.0 && j < self.side as f64) {
+            // `side = 2 half`, tested through the signed `half` as the dense map does.
+            let half = self.half as f64;
+            if !(k >= -half && k < half) {
                 return None;
             }
+            let j = k + half;
             let j = j as i64 as usize;
             bidx += (j >> self.shift) * stride;
             stride *= self.bside;
