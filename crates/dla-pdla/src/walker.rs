@@ -277,6 +277,13 @@ impl<const D: usize> WalkState<D> {
         false
     }
 
+    /// Drops the near cache: it missed particles another PDLA thread stored, and a rebuild
+    /// reads them from the tree.
+    #[inline]
+    pub(crate) fn drop_near(&mut self) {
+        self.near.reset();
+    }
+
     /// Whether a stored particle lies within `r` of `p`, answered by the near cache when its
     /// ball covers that one (`None`: ask the tree). The cache holds every particle of its ball
     /// stored before the walker's last [`particle_added`](Self::particle_added).

@@ -16,6 +16,7 @@
 mod checkpoint;
 mod growth;
 mod pdla;
+mod ring;
 mod serial;
 #[cfg(test)]
 mod tests;

@@ -3,15 +3,16 @@
 //! shared tree, stuck particles stored and published under one lock, and a re-check at
 //! sticking that discards a walker overlapping a particle stored meanwhile.
 //!
-//! Invariants: the log holds the stored particles in one total order, the order in which they
-//! entered the tree; a particle is stored only if no particle stored before it lies within
+//! Invariants: the stored particles have one total order, the order in which they entered the
+//! tree under the log's lock (their published count, and their entries in the [`Ring`]); a
+//! particle is stored only if no particle stored before it lies within
 //! [`OVERLAP_DISTANCE`]; every stored particle is accounted for once, under the log's lock; a
 //! run that only discards stops with [`SimError::DiscardLivelock`].
 
 use super::growth::Growth;
+use super::ring::Ring;
 use crate::cluster::Cluster;
 use crate::error::SimError;
-use crate::farfield::norm;
 use crate::params::Params;
 use crate::space::{Dim, Space};
 use crate::walker::{WalkState, Walker};
@@ -68,13 +69,14 @@ fn first_radius() -> f64 {
 /// All threads walk on one orthtree (the paper's shared tree), which takes no lock to query:
 /// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared) lets a query run
 /// while a particle is inserted, and a walker's view is at most one insert behind. Stuck
-/// particles go through a shared log under a mutex held to re-check, insert, append and
-/// account for one particle. At sticking a thread re-checks (section 3.4) that no particle
+/// particles go through a shared log under a mutex held to re-check, insert, record (in the
+/// [`Ring`] of the newest positions) and account for one particle. At sticking a thread re-checks (section 3.4) that no particle
 /// stored since its walker's last look at the tree lies within [`OVERLAP_DISTANCE`]: against
 /// the walker's near cache or the tree before taking the lock, and under the lock against the
 /// particles stored since; if one does the walker is discarded and counted. Before every move
 /// a thread reads the number of particles published and, when others stored some and its
-/// walker's near cache can still answer, adds them to the cache (see `Ctx::catch_up`).
+/// walker's near cache can still answer, adds them to the cache from the ring, without the
+/// lock (see `Ctx::catch_up`).
 ///
 /// The tree's room for the phase is reserved up front (address space, not memory); a particle
 /// that needs more, or lands outside the reserved root, ends the phase at a quiescent point and
@@ -151,8 +153,6 @@ where
     let threads = params.threads;
     let start = growth.n as usize;
     let log = Mutex::new(Log {
-        points: Vec::new(),
-        base: start,
         growth: std::mem::replace(growth, Growth::new(params)),
         guard: DiscardGuard::default(),
         error: None,
@@ -164,10 +164,10 @@ where
         count: AtomicUsize::new(start),
         r_ext: AtomicU64::new(r_ext0.to_bits()),
     };
+    let ring = Ring::new();
     let slots: Vec<Slot> = (0..threads)
         .map(|_| Slot {
             epoch: AtomicU64::new(0),
-            applied: AtomicUsize::new(start),
         })
         .collect();
     let stop = AtomicBool::new(false);
@@ -177,6 +177,7 @@ where
         cluster,
         log: &log,
         published: &published,
+        ring: &ring,
         slots: &slots,
         stop: &stop,
         halt,
@@ -249,12 +250,9 @@ impl DiscardGuard {
     }
 }
 
-/// The shared side of PDLA: stored particles in order, and everything a stored particle changes.
+/// The shared side of PDLA: everything a stored particle changes (the positions themselves go
+/// to the [`Ring`] and the tree).
 struct Log<const D: usize> {
-    /// Stored positions from absolute index `base` on (older ones every thread has seen are
-    /// dropped).
-    points: Vec<[f64; D]>,
-    base: usize,
     growth: Growth<D>,
     guard: DiscardGuard,
     error: Option<SimError>,
@@ -266,31 +264,29 @@ struct Log<const D: usize> {
 struct Thread<const D: usize> {
     /// Largest centre distance over the particles seen.
     r_ext: f64,
-    /// Particles taken from the log (an absolute log index).
+    /// Particles stored that the thread has taken into account (an absolute index).
     applied: usize,
-    /// Taken from the log but not yet given to the walker (filled under the lock).
+    /// Read from the ring but not yet given to the walker.
     pending: Vec<[f64; D]>,
     index: usize,
     /// The memory of the thread's current walker.
     walk: WalkState<D>,
 }
 
-/// What one thread tells the others, on cache lines of its own (the threads read each other's
-/// only at inserts and log trims).
+/// What one thread tells the others, on cache lines of its own (the tree's writer reads the
+/// others' about once per 64 inserts).
 #[repr(align(128))]
 struct Slot {
     /// The reclamation epoch the thread announced at its walker's birth (see
     /// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared)).
     epoch: AtomicU64,
-    /// Log entries the thread has taken (an absolute log index).
-    applied: AtomicUsize,
 }
 
 /// What a stored particle publishes, read before every move, on cache lines of its own (away
-/// from the log's mutex, which every store and catch-up writes).
+/// from the log's mutex, which every store writes).
 #[repr(align(128))]
 struct Published {
-    /// Particles stored (the log's end, an absolute index).
+    /// Particles stored (an absolute count: the ring's entries below it are written).
     count: AtomicUsize,
     /// `f64` bits of the largest centre distance over them (written under the lock, so it
     /// only grows).
@@ -303,6 +299,8 @@ struct Ctx<'a, const D: usize> {
     cluster: &'a Cluster<D>,
     log: &'a Mutex<Log<D>>,
     published: &'a Published,
+    /// The newest stored positions, for the threads' near caches.
+    ring: &'a Ring<D>,
     slots: &'a [Slot],
     stop: &'a AtomicBool,
     /// Set from outside (a signal): stop at the next quiescent point.
@@ -314,9 +312,6 @@ struct Ctx<'a, const D: usize> {
     /// Nanoseconds threads spent waiting for the log's mutex (summed over threads).
     wait_nanos: &'a AtomicU64,
 }
-
-/// Log entries are dropped once every thread has seen them and this many have piled up.
-const LOG_TRIM: usize = 4096;
 
 impl<const D: usize> Ctx<'_, D>
 where
@@ -335,24 +330,6 @@ where
         g
     }
 
-    /// Copies the log entries `me` has not seen into `me.pending` (the caller holds the lock).
-    fn take_pending(&self, log: &Log<D>, me: &mut Thread<D>) {
-        me.pending
-            .extend_from_slice(&log.points[me.applied - log.base..]);
-        me.applied = log.base + log.points.len();
-        self.slots[me.index]
-            .applied
-            .store(me.applied, Ordering::Relaxed);
-    }
-
-    /// Gives `me.pending` to the walker's near cache (no lock held).
-    fn see_pending(&self, me: &mut Thread<D>) {
-        for q in me.pending.drain(..) {
-            me.walk.particle_added(&q);
-            me.r_ext = me.r_ext.max(norm(&q));
-        }
-    }
-
     /// Brings `me`, whose walker is at `p`, up to date if another thread stored particles;
     /// `false` to stop. Runs before every move, so the common case (nothing new) is one load;
     /// `stop` and `halt` are read when something was published, at every walker's birth and
@@ -369,32 +346,34 @@ where
         !(self.stop.load(Ordering::Relaxed) || self.halt.load(Ordering::Relaxed))
     }
 
-    /// [`sync`](Self::sync) when other threads stored particles. Only a walker whose near
-    /// cache can still answer needs the new particles themselves, from the log under its lock;
-    /// any other takes the count and `r_ext` without the lock (its cache, if any, is dropped,
-    /// and a rebuild reads the tree, which holds every published particle).
+    /// [`sync`](Self::sync) when other threads stored particles: takes the count and `r_ext`.
+    /// Only a walker whose near cache can still answer needs the new particles themselves, read
+    /// from the ring without a lock; one whose cache cannot (or that the writers lapped) drops
+    /// the cache, and a rebuild reads the tree, which holds every published particle.
     #[cold]
     #[inline(never)]
     fn catch_up(&self, me: &mut Thread<D>, p: &[f64; D]) -> bool {
         if !self.running() {
             return false;
         }
-        if !me.walk.near_useful(p) {
-            let n = self.published.count.load(Ordering::Acquire);
-            me.r_ext = me
-                .r_ext
-                .max(f64::from_bits(self.published.r_ext.load(Ordering::Relaxed)));
-            me.applied = n;
-            self.slots[me.index].applied.store(n, Ordering::Relaxed);
-            return (n as u64) < self.target;
+        let n = self.published.count.load(Ordering::Acquire);
+        me.r_ext = me
+            .r_ext
+            .max(f64::from_bits(self.published.r_ext.load(Ordering::Relaxed)));
+        if me.walk.near_useful(p) {
+            if self
+                .ring
+                .read(me.applied, n, &self.published.count, &mut me.pending)
+            {
+                for q in me.pending.drain(..) {
+                    me.walk.particle_added(&q);
+                }
+            } else {
+                me.walk.drop_near();
+            }
         }
-        let done = {
-            let log = self.lock();
-            self.take_pending(&log, me);
-            log.growth.n >= self.target
-        };
-        self.see_pending(me);
-        !done
+        me.applied = n;
+        (n as u64) < self.target
     }
 
     fn fail(&self, log: &mut Log<D>, e: SimError) {
@@ -441,7 +420,7 @@ where
             // A jump or step can end inside a particle another thread stored during it; once
             // that particle is seen the next move would stick at once, overlapping it. The
             // pre-check covers the particles before `seen`, the check under the lock the ones
-            // after: the walker's near cache holds those it has taken from the log when its
+            // after: the walker's near cache holds those it has taken from the ring when its
             // ball covers the sticking point (near the cluster, the usual case); else the
             // tree, which holds every particle published before the load.
             let (seen, mut overlap) = match me.walk.any_within_cached(&stick, OVERLAP_DISTANCE) {
@@ -461,11 +440,22 @@ where
                 return;
             }
             // Re-check under the lock (section 3.4) against the particles other threads
-            // stored since the pre-check (a handful at most).
-            let r_sq = OVERLAP_DISTANCE * OVERLAP_DISTANCE;
-            overlap |= guard.points[seen - guard.base..]
-                .iter()
-                .any(|x| dist_sq(&stick, x) <= r_sq);
+            // stored since the pre-check (a handful at most; the tree, in the rare case that
+            // the ring no longer holds them all).
+            let now = self.published.count.load(Ordering::Relaxed);
+            if !overlap && now > seen {
+                let r_sq = OVERLAP_DISTANCE * OVERLAP_DISTANCE;
+                let mut since = std::mem::take(&mut me.pending);
+                overlap = if self.ring.read(seen, now, &self.published.count, &mut since) {
+                    since.iter().any(|x| dist_sq(&stick, x) <= r_sq)
+                } else {
+                    let mut found = false;
+                    tree.for_each_within(&stick, OVERLAP_DISTANCE, |_| found = true);
+                    found
+                };
+                since.clear();
+                me.pending = since;
+            }
             if let Err(e) = guard.guard.record(overlap) {
                 return self.fail(&mut guard, e);
             }
@@ -484,28 +474,14 @@ where
             };
             let log = &mut *guard;
             log.growth.account(q, self.final_target);
-            log.points.push(q);
+            let n = log.growth.n as usize;
+            self.ring.write(n - 1, &q);
             self.published
                 .r_ext
                 .store(log.growth.r_ext.to_bits(), Ordering::Relaxed);
-            self.published
-                .count
-                .store(log.base + log.points.len(), Ordering::Release);
-            if log.growth.n % 1024 == 0 {
-                progress(log.growth.n);
-            }
-            if log.points.len() >= 2 * LOG_TRIM {
-                let oldest = self
-                    .slots
-                    .iter()
-                    .map(|s| s.applied.load(Ordering::Relaxed))
-                    .min()
-                    .unwrap_or(log.base);
-                let drop = oldest - log.base;
-                if drop >= LOG_TRIM {
-                    log.points.drain(..drop);
-                    log.base = oldest;
-                }
+            self.published.count.store(n, Ordering::Release);
+            if n % 1024 == 0 {
+                progress(n as u64);
             }
             drop(guard);
             // The stuck particle lowers the shared distance maps once, atomically; until it
