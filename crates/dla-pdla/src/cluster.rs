@@ -77,6 +77,18 @@ impl<const D: usize> Cluster<D> {
     /// orthtree's fixed-point rounding of `p`, which is what the maps and every observable
     /// see). With shared maps they are updated through [`update_maps`](Self::update_maps).
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], SimError> {
+        self.insert_beside(p, None)
+    }
+
+    /// [`insert`](Self::insert) of a particle that stuck to the stored particle `touched`: the
+    /// per-particle maps visit only the cells nearer the new particle than `touched`, the only
+    /// ones it can lower (the maps end up byte for byte as with [`insert`](Self::insert);
+    /// [`spatial::distmap::DistanceMap::insert_beside`]).
+    pub fn insert_beside(
+        &mut self,
+        p: [f64; D],
+        touched: Option<&[f64; D]>,
+    ) -> Result<[f64; D], SimError> {
         let leaves = self.tree.leaf_count();
         let q = self.tree.insert(p)?;
         let new_leaf = self.tree.leaf_count() > leaves;
@@ -84,10 +96,16 @@ impl<const D: usize> Cluster<D> {
         match Arc::get_mut(&mut self.maps) {
             Some(maps) => {
                 if let Some(sparse) = &mut maps.sparse {
-                    sparse.insert(&q)?;
+                    match touched {
+                        Some(t) => sparse.insert_beside(&q, t)?,
+                        None => sparse.insert(&q)?,
+                    }
                 }
                 if let Some((fine, coarse)) = maps.levels.split_first_mut() {
-                    fine.insert(&q)?;
+                    match touched {
+                        Some(t) => fine.insert_beside(&q, t)?,
+                        None => fine.insert(&q)?,
+                    }
                     // The coarser maps hold the boxes of the tree's leaves: lowered once, by
                     // the first particle of a leaf, for every particle the leaf will hold.
                     if new_leaf {

@@ -142,19 +142,20 @@ where
         // when the cache is on.
         let t = if state.near.covers(&self.p, r) {
             // The same particles as the tree's range query (see `near`), so the same contact.
-            let mut best = f64::INFINITY;
+            let mut best = (f64::INFINITY, [0.0; D]);
             state
                 .near
                 .for_each_within(&self.p, r, |q| contact(&self.p, &u, &q, &mut best));
-            (best <= params.step_min).then_some(best)
+            (best.0 <= params.step_min).then_some(best)
         } else {
-            first_contact(tree, &self.p, &u, params.step_min)
+            first_contact_with(tree, &self.p, &u, params.step_min)
         };
-        if let Some(t) = t {
+        if let Some((t, touched)) = t {
             let mut q = self.p;
             for i in 0..D {
                 q[i] += t * u[i];
             }
+            state.touched = Some(touched);
             return Some(q);
         }
         for i in 0..D {
@@ -189,14 +190,25 @@ pub fn first_contact<const D: usize>(
     u: &[f64; D],
     len: f64,
 ) -> Option<f64> {
-    let mut best = f64::INFINITY;
-    tree.for_each_within(p, len + 1.0, |q| contact(p, u, &q, &mut best));
-    (best <= len).then_some(best)
+    first_contact_with(tree, p, u, len).map(|(t, _)| t)
 }
 
-/// Lowers `best` to the contact time with centre `q` along `p + t u`, if there is one.
+/// [`first_contact`] and the centre touched.
+fn first_contact_with<const D: usize>(
+    tree: &Orthtree<D>,
+    p: &[f64; D],
+    u: &[f64; D],
+    len: f64,
+) -> Option<(f64, [f64; D])> {
+    let mut best = (f64::INFINITY, [0.0; D]);
+    tree.for_each_within(p, len + 1.0, |q| contact(p, u, &q, &mut best));
+    (best.0 <= len).then_some(best)
+}
+
+/// Lowers `best` (a time and the centre touched then) to the contact time with centre `q`
+/// along `p + t u`, if there is one.
 #[inline(always)]
-fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut f64) {
+fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut (f64, [f64; D])) {
     let mut b = 0.0;
     let mut w2 = 0.0;
     for i in 0..D {
@@ -215,8 +227,8 @@ fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut 
         // Stable form of -b - sqrt(disc) (b < 0): c / (-b + sqrt(disc)).
         c / (-b + disc.sqrt())
     };
-    if t < *best {
-        *best = t;
+    if t < best.0 {
+        *best = (t, *q);
     }
 }
 
@@ -228,6 +240,8 @@ fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut 
 pub(crate) struct WalkState<const D: usize> {
     upper: f64,
     anchor: Option<[f64; D]>,
+    /// The stored particle the walker's last move ended in contact with.
+    touched: Option<[f64; D]>,
     /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
     /// wherever the cache answers (`(kappa - 1/2)` leaf diagonals cover [`NEAR_RADIUS`]).
     near_on: bool,
@@ -245,6 +259,7 @@ impl<const D: usize> WalkState<D> {
         WalkState {
             upper: f64::INFINITY,
             anchor: None,
+            touched: None,
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
             near: NearCache::new(),
         }
@@ -254,7 +269,13 @@ impl<const D: usize> WalkState<D> {
     pub(crate) fn reset(&mut self) {
         self.upper = f64::INFINITY;
         self.anchor = None;
+        self.touched = None;
         self.near.reset();
+    }
+
+    /// The stored particle the walker touched, once a move has returned its sticking position.
+    pub(crate) fn touched(&self) -> Option<&[f64; D]> {
+        self.touched.as_ref()
     }
 
     /// A particle another PDLA thread stored while this walker moves: the near cache keeps it

@@ -185,7 +185,7 @@ where
         if !more {
             return Err(bad_log("changed while it was read".into()));
         }
-        growth.add(&mut cluster, p, params.particles)?;
+        growth.add(&mut cluster, p, None, params.particles)?;
     }
     // Storing a position returns it unchanged (the log holds stored positions), so the
     // rebuilt state has the hash just checked; anything else is a log that changed between

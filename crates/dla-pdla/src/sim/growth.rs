@@ -153,9 +153,10 @@ impl<const D: usize> Growth<D> {
         &mut self,
         cluster: &mut Cluster<D>,
         p: [f64; D],
+        touched: Option<&[f64; D]>,
         target: u64,
     ) -> Result<[f64; D], SimError> {
-        let q = cluster.insert(p)?;
+        let q = cluster.insert_beside(p, touched)?;
         self.account(q, target);
         Ok(q)
     }

@@ -70,7 +70,7 @@ where
         }
         let mut cluster = Cluster::new(&params)?;
         let mut growth = Growth::new(&params);
-        growth.add(&mut cluster, [0.0; D], params.particles)?;
+        growth.add(&mut cluster, [0.0; D], None, params.particles)?;
         Ok(Simulation {
             serial: Serial::new(&params, seed),
             params,

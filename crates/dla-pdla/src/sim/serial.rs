@@ -54,7 +54,7 @@ impl<const D: usize> Serial<D> {
         loop {
             if let Some(p) = w.advance(&mut self.walk, cluster, growth.r_ext, params, &mut self.rng)
             {
-                return growth.add(cluster, p, params.particles);
+                return growth.add(cluster, p, self.walk.touched(), params.particles);
             }
         }
     }

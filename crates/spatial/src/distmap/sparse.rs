@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::{CAPPED, DistanceMapError, SHRINK, Tables, finite_max_norm, next_row, tables};
+use super::{Beside, CAPPED, DistanceMapError, SHRINK, Tables, finite_max_norm, next_row, tables};
 use crate::round::{ceil, floor};
 use std::fmt;
 use std::sync::OnceLock;
@@ -279,6 +279,21 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// blocks as needed and growing the table first if `q` comes within `cap + cell` of its
     /// edge.
     pub fn insert(&mut self, q: &[f64; D]) -> Result<(), DistanceMapError> {
+        self.insert_with(q, None)
+    }
+
+    /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
+    /// the same cells and blocks, visiting only the cells nearer `q` than `p` (about half), since
+    /// no other cell can be lowered by `q` (see [`DistanceMap::insert_beside`](super::DistanceMap::insert_beside)).
+    pub fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
+        self.insert_with(q, Beside::new(q, p, self.cap, self.cell))
+    }
+
+    fn insert_with(
+        &mut self,
+        q: &[f64; D],
+        side: Option<Beside<D>>,
+    ) -> Result<(), DistanceMapError> {
         let need = finite_max_norm(q)? + self.cap + self.cell;
         if need >= self.reach() {
             self.grow(need)?;
@@ -287,7 +302,7 @@ impl<const D: usize> SparseDistanceMap<D> {
         let per_axis = (2.0 * self.cap * self.inv_cell) as usize / (self.mask + 1) + 2;
         self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
         self.points += 1;
-        self.lower_rows(q, |v, s| {
+        self.lower_rows(q, side.as_ref(), |v, s| {
             if s > v.load(Ordering::Relaxed) {
                 v.store(s, Ordering::Relaxed);
             }
@@ -301,7 +316,7 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// when part of `q`'s ball fell outside the table.
     pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
         let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, |v, s| {
+        self.lower_rows(q, None, |v, s| {
             if s > v.load(Ordering::Relaxed) {
                 v.fetch_max(s, Ordering::Relaxed);
             }
@@ -357,7 +372,12 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// nearness could rise to `s` (the quantised distance's complement), allocating a block at
     /// its first such cell.
     #[inline]
-    fn lower_rows(&self, q: &[f64; D], mut lower: impl FnMut(&AtomicU8, u8)) {
+    fn lower_rows(
+        &self,
+        q: &[f64; D],
+        side: Option<&Beside<D>>,
+        mut lower: impl FnMut(&AtomicU8, u8),
+    ) {
         let mut lo = [0i64; D];
         let mut hi = [0i64; D];
         for i in 0..D {
@@ -398,6 +418,10 @@ impl<const D: usize> SparseDistanceMap<D> {
             if let Some(&h) = self.widths.get(j2) {
                 let a = (ceil(t0 - h) as i64).max(lo[0]);
                 let b = (floor(t0 + h) as i64).min(hi[0]);
+                let (a, b) = match side {
+                    Some(side) => side.clip(&k, self.cell, self.inv_cell, a, b),
+                    None => (a, b),
+                };
                 if a <= b {
                     let last = (b + self.half) as usize;
                     let mut u = (a + self.half) as usize;

@@ -314,3 +314,93 @@ fn bad_parameters_and_points_are_refused() {
     ));
     assert!(map.is_empty());
 }
+
+/// A point inserted beside the point it touches (visiting only the cells nearer it) leaves the
+/// dense and the sparse maps exactly as a full insert does: every byte and every block.
+#[test]
+fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
+    /// A random aggregate: each point one diameter from an earlier one (some along an axis,
+    /// where the half-space's normal has a zero component), with the earlier one.
+    fn aggregate<const D: usize>(n: usize, seed: u64) -> Vec<([f64; D], Option<[f64; D]>)> {
+        let mut rng = seed;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut pts: Vec<([f64; D], Option<[f64; D]>)> = vec![([0.3; D], None)];
+        while pts.len() < n {
+            let p = pts[(next() * pts.len() as f64) as usize % pts.len()].0;
+            let u: [f64; D] = if pts.len() % 7 == 0 {
+                std::array::from_fn(|i| if i == pts.len() % D { -1.0 } else { 0.0 })
+            } else {
+                let u: [f64; D] = std::array::from_fn(|_| next() - 0.5);
+                let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
+                u.map(|x| x / len)
+            };
+            pts.push((std::array::from_fn(|i| p[i] + u[i]), Some(p)));
+        }
+        pts
+    }
+    fn dense<const D: usize>(cell: f64, cap: f64, seed: u64) {
+        let pts = aggregate::<D>(700, seed);
+        let mut full = DistanceMap::<D>::new(cell, cap).unwrap();
+        let mut beside = full.clone();
+        for (q, p) in &pts {
+            full.insert(q).unwrap();
+            match p {
+                Some(p) => beside.insert_beside(q, p).unwrap(),
+                None => beside.insert(q).unwrap(),
+            }
+        }
+        let bytes = |m: &DistanceMap<D>| -> Vec<u8> {
+            m.values.iter().map(|v| v.load(Ordering::Relaxed)).collect()
+        };
+        let lowered = bytes(&full).iter().filter(|&&v| v < CAPPED).count();
+        assert!(lowered > 100, "{lowered} cells lowered");
+        assert!(bytes(&full) == bytes(&beside), "cell {cell}, cap {cap}");
+    }
+    fn sparse<const D: usize>(cell: f64, cap: f64, seed: u64) {
+        let pts = aggregate::<D>(700, seed);
+        let mut full = SparseDistanceMap::<D>::new(cell, cap, 8).unwrap();
+        let mut beside = SparseDistanceMap::<D>::new(cell, cap, 8).unwrap();
+        for (q, p) in &pts {
+            full.insert(q).unwrap();
+            match p {
+                Some(p) => beside.insert_beside(q, p).unwrap(),
+                None => beside.insert(q).unwrap(),
+            }
+        }
+        assert_eq!(full.blocks(), beside.blocks());
+        // Every cell centre of the cube the cluster's cap-neighbourhood lies in.
+        let reach = pts
+            .iter()
+            .flat_map(|(q, _)| q.iter().map(|x| x.abs()))
+            .fold(0.0, f64::max)
+            + cap
+            + cell;
+        let per_axis = (2.0 * reach / cell).ceil() as usize;
+        let (mut cells, mut lowered) = (0, 0);
+        for idx in 0..per_axis.pow(D as u32) {
+            let mut rem = idx;
+            let c: [f64; D] = std::array::from_fn(|_| {
+                let k = rem % per_axis;
+                rem /= per_axis;
+                -reach + (k as f64 + 0.5) * cell
+            });
+            let v = full.value(&c);
+            assert_eq!(v, beside.value(&c), "at {c:?}");
+            cells += 1;
+            lowered += usize::from(v.is_some_and(|v| v < CAPPED));
+        }
+        assert!(lowered > 100 && cells > lowered, "{lowered} of {cells}");
+    }
+    dense::<2>(8.0, 64.0, 1);
+    dense::<2>(1.0, 6.0, 2);
+    dense::<3>(8.0, 32.0, 3);
+    dense::<3>(2.5, 11.0, 4);
+    dense::<4>(8.0, 32.0, 5);
+    sparse::<3>(2.0, 8.0, 6);
+    sparse::<2>(2.0, 8.0, 7);
+}
