@@ -115,7 +115,7 @@ impl<const D: usize> Cluster<D> {
                     }
                 }
             }
-            None => self.update_maps(&q, new_leaf)?,
+            None => self.update_maps(&q, touched, new_leaf)?,
         }
         Ok(q)
     }
@@ -147,13 +147,27 @@ impl<const D: usize> Cluster<D> {
     /// leaf will hold, in whichever phase (serial or PDLA) the leaf opened. Until its first
     /// particle's update is done, a walker may read a coarse bound that misses the leaf, as it
     /// may read any map before a stored particle's update: PDLA's re-check at sticking
-    /// catches what such a jump could cause.
-    pub fn update_maps(&self, q: &[f64; D], new_leaf: bool) -> Result<(), SimError> {
+    /// catches what such a jump could cause. `touched`: the stored particle `q` stuck to, if
+    /// known; the per-particle maps then visit only the cells nearer `q` (as
+    /// [`insert_beside`](Self::insert_beside)), the others being lowered by that particle's
+    /// own update, done or under way.
+    pub fn update_maps(
+        &self,
+        q: &[f64; D],
+        touched: Option<&[f64; D]>,
+        new_leaf: bool,
+    ) -> Result<(), SimError> {
         if let Some(sparse) = &self.maps.sparse {
-            sparse.insert_shared(q)?;
+            match touched {
+                Some(t) => sparse.insert_shared_beside(q, t)?,
+                None => sparse.insert_shared(q)?,
+            };
         }
         if let Some((fine, coarse)) = self.maps.levels.split_first() {
-            fine.insert_shared(q)?;
+            match touched {
+                Some(t) => fine.insert_shared_beside(q, t)?,
+                None => fine.insert_shared(q)?,
+            };
             if new_leaf {
                 let (lo, hi) = self.leaf_box(q);
                 for map in coarse {

@@ -487,7 +487,7 @@ where
             // The stuck particle lowers the shared distance maps once, atomically; until it
             // has, another thread's walker may jump by a stale bound, which the re-check at
             // its sticking catches like any move made before a particle was stored.
-            if let Err(e) = self.cluster.update_maps(&q, new_leaf) {
+            if let Err(e) = self.cluster.update_maps(&q, me.walk.touched(), new_leaf) {
                 return self.fail(&mut self.lock(), e);
             }
         }

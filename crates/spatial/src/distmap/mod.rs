@@ -417,8 +417,27 @@ impl<const D: usize> DistanceMap<D> {
     /// Returns `false` when part of `q`'s disk fell outside the map. [`len`](Self::len) does
     /// not count these points.
     pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
+        self.insert_shared_with(q, None)
+    }
+
+    /// [`insert_shared`](Self::insert_shared) of a point `q` that touches `p`, visiting the cells
+    /// [`insert_beside`](Self::insert_beside) visits. If `p`'s own insert is still under way
+    /// in another thread, the cells skipped here are lowered by it when it completes.
+    pub fn insert_shared_beside(
+        &self,
+        q: &[f64; D],
+        p: &[f64; D],
+    ) -> Result<bool, DistanceMapError> {
+        self.insert_shared_with(q, Beside::new(q, p, self.cap, self.cell))
+    }
+
+    fn insert_shared_with(
+        &self,
+        q: &[f64; D],
+        side: Option<Beside<D>>,
+    ) -> Result<bool, DistanceMapError> {
         let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, None, |v, w| {
+        self.lower_rows(q, side.as_ref(), |v, w| {
             if w < v.load(Ordering::Relaxed) {
                 v.fetch_min(w, Ordering::Relaxed);
             }

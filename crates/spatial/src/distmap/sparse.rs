@@ -315,8 +315,27 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// documentation). The table does not grow: cells outside it are skipped. Returns `false`
     /// when part of `q`'s ball fell outside the table.
     pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
+        self.insert_shared_with(q, None)
+    }
+
+    /// [`insert_shared`](Self::insert_shared) of a point `q` that touches `p`, visiting the cells
+    /// [`insert_beside`](Self::insert_beside) visits (see
+    /// [`DistanceMap::insert_shared_beside`](super::DistanceMap::insert_shared_beside)).
+    pub fn insert_shared_beside(
+        &self,
+        q: &[f64; D],
+        p: &[f64; D],
+    ) -> Result<bool, DistanceMapError> {
+        self.insert_shared_with(q, Beside::new(q, p, self.cap, self.cell))
+    }
+
+    fn insert_shared_with(
+        &self,
+        q: &[f64; D],
+        side: Option<Beside<D>>,
+    ) -> Result<bool, DistanceMapError> {
         let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, None, |v, s| {
+        self.lower_rows(q, side.as_ref(), |v, s| {
             if s > v.load(Ordering::Relaxed) {
                 v.fetch_max(s, Ordering::Relaxed);
             }
