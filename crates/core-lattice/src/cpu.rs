@@ -2,7 +2,7 @@
 //!
 //! On x86-64 the workspace builds for the `x86-64-v3` level (AVX2, FMA, BMI1/2, LZCNT, MOVBE;
 //! Intel from Haswell, 2013, AMD from Excavator and Zen), set in `.cargo/config.toml`: the DLA
-//! kernels then execute about 0.87 times the instructions of a baseline build, with identical
+//! kernels then execute about 0.8 times the instructions of a baseline build, with identical
 //! results (Rust does not contract or reorder floating-point operations, so the state hashes do
 //! not change). A binary run on a processor without those features would die of an illegal
 //! instruction somewhere in a run; [`unsupported`] lets the binaries and the Python module
