@@ -38,7 +38,9 @@ fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // A build for a newer instruction set than this processor's fails the import with a
     // message, not with an illegal instruction in the middle of a run.
     if let Some(why) = core_lattice::cpu::unsupported() {
-        return Err(pyo3::exceptions::PyImportError::new_err(format!("aggsim: {why}")));
+        return Err(pyo3::exceptions::PyImportError::new_err(format!(
+            "aggsim: {why}"
+        )));
     }
     m.add_function(wrap_pyfunction!(dla::dla, m)?)?;
     m.add_function(wrap_pyfunction!(dlca::dlca, m)?)?;

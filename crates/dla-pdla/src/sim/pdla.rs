@@ -70,10 +70,11 @@ fn first_radius() -> f64 {
 /// [`Orthtree::insert_shared`](spatial::orthtree::Orthtree::insert_shared) lets a query run
 /// while a particle is inserted, and a walker's view is at most one insert behind. Stuck
 /// particles go through a shared log under a mutex held to re-check, insert, record (in the
-/// [`Ring`] of the newest positions) and account for one particle. At sticking a thread re-checks (section 3.4) that no particle
-/// stored since its walker's last look at the tree lies within [`OVERLAP_DISTANCE`]: against
-/// the walker's near cache or the tree before taking the lock, and under the lock against the
-/// particles stored since; if one does the walker is discarded and counted. Before every move
+/// [`Ring`] of the newest positions) and account for one particle. At sticking a thread
+/// re-checks (section 3.4) that no particle stored since its walker's last look at the tree
+/// lies within [`OVERLAP_DISTANCE`]: against the walker's near cache or the tree before taking
+/// the lock, and under the lock against the particles stored since; if one does the walker is
+/// discarded and counted. Before every move
 /// a thread reads the number of particles published and, when others stored some and its
 /// walker's near cache can still answer, adds them to the cache from the ring, without the
 /// lock (see `Ctx::catch_up`).

@@ -284,7 +284,8 @@ impl<const D: usize> SparseDistanceMap<D> {
 
     /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
     /// the same cells and blocks, visiting only the cells nearer `q` than `p` (about half), since
-    /// no other cell can be lowered by `q` (see [`DistanceMap::insert_beside`](super::DistanceMap::insert_beside)).
+    /// no other cell can be lowered by `q` (see
+    /// [`DistanceMap::insert_beside`](super::DistanceMap::insert_beside)).
     pub fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
         self.insert_with(q, Beside::new(q, p, self.cap, self.cell))
     }
