@@ -46,67 +46,11 @@
 use crate::round::{ceil, floor};
 use std::fmt;
 
+mod beside;
 mod sparse;
+use beside::Beside;
 pub use sparse::{SparseDistanceMap, UNKNOWN};
 
-/// The cells a new point `q` can lower when it touches a point `p` inserted before it (DLA's
-/// stuck particle and the one it stuck to): those nearer `q` than `p`, the half-space
-/// `(c - m) . w < MARGIN` with `m` the midpoint and `w = p - q`. Every other cell already holds
-/// at most its distance to `p` (quantised down), which is at most its distance to `q`, so an
-/// insert that skips them leaves the map, and a sparse map's blocks, exactly as a full insert
-/// would: about half the cells and rows of the ball for the same result.
-///
-/// `MARGIN` (1e-6 squared diameters, far above the rounding of the centres' coordinates) keeps
-/// every skipped cell strictly nearer `p`, so the rounding of the distances cannot make `q`'s
-/// quantised value the lower one.
-#[derive(Debug, Clone, Copy)]
-struct Beside<const D: usize> {
-    mid: [f64; D],
-    w: [f64; D],
-    /// A bound of `|c_0 - m_0|` over the cells an insert visits.
-    slack: f64,
-}
-
-impl<const D: usize> Beside<D> {
-    const MARGIN: f64 = 1e-6;
-
-    /// The half-space for `q` touching `p`; `None` (insert every cell) unless the two are
-    /// finite and between half a diameter and two apart.
-    fn new(q: &[f64; D], p: &[f64; D], cap: f64, cell: f64) -> Option<Self> {
-        let w: [f64; D] = std::array::from_fn(|i| p[i] - q[i]);
-        let w2: f64 = w.iter().map(|x| x * x).sum();
-        (0.25..=4.0).contains(&w2).then(|| Beside {
-            mid: std::array::from_fn(|i| 0.5 * (p[i] + q[i])),
-            w,
-            slack: cap + 2.0 * cell + 2.0,
-        })
-    }
-
-    /// Narrows the cell range `a..=b` along axis 0 of the row at cell indices `k[1..]` to the
-    /// half-space (an empty range when none of it is inside).
-    #[inline(always)]
-    fn clip(&self, k: &[i64; D], cell: f64, inv_cell: f64, a: i64, b: i64) -> (i64, i64) {
-        let mut off = 0.0;
-        for i in 1..D {
-            off += ((k[i] as f64 + 0.5) * cell - self.mid[i]) * self.w[i];
-        }
-        // Keep the cells with (c_0 - m_0) w_0 < r; a cell on the boundary is kept.
-        let r = Self::MARGIN - off;
-        let w0 = self.w[0];
-        if w0.abs() > 1e-3 {
-            let x = (self.mid[0] + r / w0) * inv_cell - 0.5;
-            if w0 > 0.0 {
-                (a, b.min(floor(x) as i64))
-            } else {
-                (a.max(ceil(x) as i64), b)
-            }
-        } else if r + 1e-3 * self.slack > 0.0 {
-            (a, b)
-        } else {
-            (a, a - 1)
-        }
-    }
-}
 use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Largest stored value: the cell is at least `cap` from every point.

@@ -216,16 +216,21 @@ fn shared_inserts_from_two_threads_equal_sequential_inserts() {
 /// cover, and the extra cells they visit are never lowered: the same bytes either way,
 /// in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
 /// centres among random ones.
+/// Uniform numbers in `[0, 1)` from a xorshift generator seeded with `seed` (non-zero).
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut rng = seed;
+    move || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[test]
 fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
     fn same<const D: usize>(cell: f64, cap: f64, seed: u64) {
-        let mut rng = seed;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(seed);
         let span = 6.0 * cap;
         let mut pts: Vec<[f64; D]> = (0..600)
             .map(|_| std::array::from_fn(|_| (next() - 0.5) * span))
@@ -322,13 +327,7 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
     /// A random aggregate: each point one diameter from an earlier one (some along an axis,
     /// where the half-space's normal has a zero component), with the earlier one.
     fn aggregate<const D: usize>(n: usize, seed: u64) -> Vec<([f64; D], Option<[f64; D]>)> {
-        let mut rng = seed;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(seed);
         let mut pts: Vec<([f64; D], Option<[f64; D]>)> = vec![([0.3; D], None)];
         while pts.len() < n {
             let p = pts[(next() * pts.len() as f64) as usize % pts.len()].0;
