@@ -1,12 +1,12 @@
 //! Conversions shared by the models: `run.json` values to Python objects, a manifest onto a
 //! result object's attributes, integer arguments, and columns to dicts of NumPy arrays.
 
-use core_lattice::io::RunManifest;
 use numpy::{Element, IntoPyArray};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use serde_json::Value;
+use sim_run::io::RunManifest;
 
 /// A JSON value as the Python object `json.loads` would give.
 pub fn json<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {

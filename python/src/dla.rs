@@ -4,11 +4,11 @@
 
 use crate::convert::{Columns, count, run_error, set_manifest, value_error};
 use crate::run::{Progress, interruptible};
-use core_lattice::io::RunClock;
 use dla_pdla::{Dim, FarField, Params, SimError, Simulation, Space};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
+use sim_run::io::RunClock;
 use std::sync::atomic::Ordering;
 
 /// The library's defaults, which are the `dla` binary's.

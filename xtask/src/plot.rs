@@ -1,4 +1,4 @@
-//! The charts of `cargo xtask`: the plotting module of `core_lattice` (feature `plot`), which
+//! The charts of `cargo xtask`: the plotting module of `sim_run` (feature `plot`), which
 //! the models' ensembles use too.
 
-pub use core_lattice::plot::*;
+pub use sim_run::plot::*;

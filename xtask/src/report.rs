@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use core_lattice::Welford;
-use core_lattice::io::{CsvField, CsvWriter, write_atomic};
+use sim_run::io::{CsvField, CsvWriter, write_atomic};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::SystemTime;
@@ -50,7 +50,7 @@ impl Table {
         s
     }
 
-    /// Write the table as CSV, atomically, through core-lattice's [`CsvWriter`] (which quotes
+    /// Write the table as CSV, atomically, through sim-run's [`CsvWriter`] (which quotes
     /// cells that need it).
     pub fn write_csv(&self, path: &Path) -> Result<()> {
         let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
@@ -126,12 +126,12 @@ pub fn std_dev(xs: &[f64]) -> f64 {
 
 /// Today's date and time in UTC, `YYYY-MM-DD HH:MM UTC`, from the system clock.
 pub fn utc_now() -> String {
-    core_lattice::io::provenance::utc_minutes(SystemTime::now())
+    sim_run::io::provenance::utc_minutes(SystemTime::now())
 }
 
 /// The build: `aggsim 0.1.0 at commit <hash>` (the commit when built from a git checkout).
 pub fn build_id() -> String {
-    match core_lattice::io::provenance::GIT_COMMIT {
+    match sim_run::io::provenance::GIT_COMMIT {
         Some(c) => format!("aggsim {} at commit {c}", env!("CARGO_PKG_VERSION")),
         None => format!(
             "aggsim {} (not built from a git checkout)",
@@ -142,7 +142,7 @@ pub fn build_id() -> String {
 
 /// One line describing the machine: CPU model, logical cores, memory, kernel, rustc.
 pub fn machine() -> String {
-    let cpu = core_lattice::io::provenance::cpu_model();
+    let cpu = sim_run::io::provenance::cpu_model();
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);

@@ -27,3 +27,8 @@ pub mod world;
 
 pub use params::{FoxRule, GridBox, Params, ParamsError, RabbitRule, Species};
 pub use world::{Animat, QueryCounts, Snapshot, StepStats, World, WorldError};
+
+/// The README's examples, compiled and run as doctests so that they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

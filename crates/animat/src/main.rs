@@ -7,9 +7,9 @@ use animat::output::{self, PopulationRow};
 use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::{Interrupted, LogArgs, flag_differences, usage};
-use core_lattice::ensemble::{Curve, EnsembleArgs};
-use core_lattice::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
+use sim_run::cli::{Interrupted, LogArgs, flag_differences, usage};
+use sim_run::ensemble::{Curve, EnsembleArgs};
+use sim_run::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -80,7 +80,7 @@ struct Cli {
     /// 64 x 64 square of cells holding one (a dilute world takes 36 KiB per animat): a start
     /// that needs more is refused, a run that grows past it stops with an error. Suffixes K,
     /// M, G, T (powers of 1024).
-    #[arg(long, default_value = "4G", value_parser = core_lattice::io::parse_bytes)]
+    #[arg(long, default_value = "4G", value_parser = sim_run::io::parse_bytes)]
     max_memory: u64,
 
     /// Write a PNG snapshot every K steps (and of the start and the end).
@@ -164,7 +164,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         ));
     }
     if let Some(out) = &cli.out {
-        core_lattice::cli::check_out_dir(out)?;
+        sim_run::cli::check_out_dir(out)?;
     }
     Ok(p)
 }
@@ -196,13 +196,13 @@ const CURVES: &[Curve] = &[Curve {
 }];
 
 fn main() -> ExitCode {
-    if let Some(code) = core_lattice::cli::refuse_unsupported_cpu("animat") {
+    if let Some(code) = sim_run::cli::refuse_unsupported_cpu("animat") {
         return code;
     }
-    if let Some(code) = core_lattice::ensemble::merge_main("animat", CURVES) {
+    if let Some(code) = sim_run::ensemble::merge_main("animat", CURVES) {
         return code;
     }
-    core_lattice::cli::main_with(
+    sim_run::cli::main_with(
         "animat",
         |c: &Cli| c.log,
         params,
@@ -288,10 +288,10 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     };
     world.set_timing(cli.timing);
-    core_lattice::cli::prepare_out_dir(cli.out())
+    sim_run::cli::prepare_out_dir(cli.out())
         .with_context(|| format!("creating output directory {}", cli.out().display()))?;
     // The effective parameters, so that `--config OUT/config.toml` repeats the run.
-    core_lattice::io::write_atomic(
+    sim_run::io::write_atomic(
         cli.out().join("config.toml"),
         animat::config::to_toml(world.params())?.as_bytes(),
     )
@@ -328,9 +328,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     progress.set_position(world.steps().min(cli.steps));
     // With checkpoints, SIGINT/SIGTERM save the run after the current step and stop it.
     let stop = match cli.checkpoint_every {
-        Some(_) => {
-            Some(core_lattice::cli::stop_on_signals().context("installing signal handlers")?)
-        }
+        Some(_) => Some(sim_run::cli::stop_on_signals().context("installing signal handlers")?),
         None => None,
     };
     while world.steps() < cli.steps {

@@ -10,12 +10,12 @@
 
 use crate::params::Species;
 use crate::world::{StepStats, World};
-use core_lattice::io::{
+use sim_run::io::{
     Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_png_rgb, write_points,
 };
 use std::path::Path;
 
-pub use core_lattice::io::OutputError;
+pub use sim_run::io::OutputError;
 
 /// One row of `populations.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -77,7 +77,7 @@ pub fn write_populations(
     Ok(())
 }
 
-/// Writes `positions.<format>` (see [`core_lattice::io::points`]): every live animat at the
+/// Writes `positions.<format>` (see [`sim_run::io::points`]): every live animat at the
 /// end, in id order, with its `id`, `species` (0 fox, 1 rabbit in `.npy` and VTK; the name in
 /// CSV and XYZ), `age` and `hunger`.
 ///

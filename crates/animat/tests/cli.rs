@@ -142,7 +142,7 @@ fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
     cmd.args(world)
         .args(steps)
         .args(["--checkpoint-every", "5", "--out", cut.to_str().unwrap()]);
-    if !core_lattice::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+    if !sim_run::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
         eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
     }
 
@@ -171,7 +171,7 @@ fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
         .args(steps)
         .args(["--checkpoint-every", "5", "--out", term.to_str().unwrap()]);
     let (running, code) =
-        core_lattice::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+        sim_run::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
     if running {
         assert_eq!(code, Some(130));
     }
@@ -291,7 +291,7 @@ fn a_quiet_run_without_a_terminal_sends_a_heartbeat_and_qq_silences_it() {
 #[test]
 fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
     let dir = tempfile::tempdir().unwrap();
-    core_lattice::testing::provenance_and_color_contract(
+    sim_run::testing::provenance_and_color_contract(
         Path::new(env!("CARGO_BIN_EXE_animat")),
         dir.path(),
         &["--steps", "5", "--seed", "2"],
@@ -329,7 +329,7 @@ fn positions_in_every_format_hold_the_same_animats() {
     assert!(rows.len() > 100);
 
     let npy = run(Some("npy"));
-    let mut r = core_lattice::io::NpyReader::open(npy.join("positions.npy")).unwrap();
+    let mut r = sim_run::io::NpyReader::open(npy.join("positions.npy")).unwrap();
     assert_eq!((r.rows(), r.cols()), (rows.len() as u64, 2));
     let species = std::fs::read(npy.join("positions_species.npy")).unwrap();
     let mut p = [0.0; 2];

@@ -17,7 +17,7 @@
 
 use animat::params::{ANIMAT_BYTES, MAX_ANIMATS, MAX_RADIUS};
 use animat::{GridBox, Params, Species, World};
-use core_lattice::testing::refusals;
+use sim_run::testing::refusals;
 use std::collections::HashSet;
 use std::path::Path;
 

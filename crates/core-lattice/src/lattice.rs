@@ -15,6 +15,7 @@
 //!
 //! Coordinates are 0-based. Axis 0 is `x_1`, the fastest-varying axis of the k-index.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::ops::Deref;
@@ -23,8 +24,9 @@ use std::ops::Deref;
 pub const MAX_DIM: usize = 8;
 
 /// What happens at the two ends of one axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Boundary {
     /// Site `L - 1` and site `0` are neighbours (a torus along this axis), as in the grid-boxing
     /// paper.
@@ -171,7 +173,8 @@ pub type Offset = AxisVec<i64>;
 ///
 /// Directions are numbered `0..2d`: direction `2a` is `-e_a` and `2a + 1` is `+e_a`, so
 /// `dir ^ 1` is the opposite direction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Direction(u8);
 
 impl Direction {
@@ -218,8 +221,12 @@ pub struct Blocked;
 ///
 /// Built only through validating constructors, so every `Lattice` value has `1 <= d <= 8`,
 /// non-zero sides and a volume that fits in `u64`. Deserialisation validates too.
-#[derive(Clone, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(try_from = "LatticeSpec", into = "LatticeSpec")]
+#[derive(Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(try_from = "LatticeSpec", into = "LatticeSpec")
+)]
 pub struct Lattice {
     dim: usize,
     sizes: [u64; MAX_DIM],
@@ -233,7 +240,8 @@ pub struct Lattice {
 }
 
 /// The serialised form of a [`Lattice`]: its side lengths and boundaries.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct LatticeSpec {
     /// Side length of each axis.
     pub sizes: Vec<u64>,
@@ -611,6 +619,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "serde")]
     fn serde_validates() {
         let l = Lattice::new(&[8, 4], &[Boundary::Periodic, Boundary::Wall]).unwrap();
         let json = serde_json::to_string(&l).unwrap();

@@ -340,6 +340,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "serde")]
     fn state_survives_serde() {
         let mut a = stream(1, 2);
         for _ in 0..10 {

@@ -50,3 +50,8 @@ pub use params::{FarField, Params, ParamsError};
 pub use sim::{Sample, Simulation};
 pub use space::{Dim, Space};
 pub use walker::Walker;
+
+/// The README's examples, compiled and run as doctests so that they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

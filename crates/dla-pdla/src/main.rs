@@ -5,11 +5,11 @@
 
 use anyhow::Context;
 use clap::Parser;
-use core_lattice::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
-use core_lattice::ensemble::{Curve, EnsembleArgs};
-use core_lattice::io::RunClock;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
+use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
+use sim_run::ensemble::{Curve, EnsembleArgs};
+use sim_run::io::RunClock;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -198,7 +198,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }
-    core_lattice::cli::check_out_dir(&cli.out)?;
+    sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
 
@@ -247,13 +247,13 @@ const CURVES: &[Curve] = &[Curve {
 }];
 
 fn main() -> ExitCode {
-    if let Some(code) = core_lattice::cli::refuse_unsupported_cpu("dla") {
+    if let Some(code) = sim_run::cli::refuse_unsupported_cpu("dla") {
         return code;
     }
-    if let Some(code) = core_lattice::ensemble::merge_main("dla", CURVES) {
+    if let Some(code) = sim_run::ensemble::merge_main("dla", CURVES) {
         return code;
     }
-    core_lattice::cli::main_with_config(
+    sim_run::cli::main_with_config(
         "dla",
         |c: &Cli| c.log,
         params,
@@ -280,11 +280,11 @@ where
 {
     let clock = RunClock::start();
     let total = params.particles;
-    if cli.positions == PositionsFormat::Vtk && total > core_lattice::io::points::VTK_MAX_POINTS {
+    if cli.positions == PositionsFormat::Vtk && total > sim_run::io::points::VTK_MAX_POINTS {
         return Err(usage(format!(
             "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {total}; \
              use --positions npy",
-            core_lattice::io::points::VTK_MAX_POINTS
+            sim_run::io::points::VTK_MAX_POINTS
         )));
     }
     tracing::info!(?params, seed = cli.seed, "starting growth");
@@ -296,10 +296,10 @@ where
         })?,
         Some(dir) => resume::<D>(dir, &params, cli.seed)?,
     };
-    core_lattice::cli::prepare_out_dir(&cli.out)
+    sim_run::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
-    core_lattice::cli::config::save(&cli.out)
+    sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
     let positions =
         cli.png || cli.positions != PositionsFormat::None || cli.checkpoint_every.is_some();
@@ -318,8 +318,7 @@ where
     let report = |n| progress.set_position(n);
     match cli.checkpoint_every {
         Some(every) => {
-            let stop =
-                core_lattice::cli::stop_on_signals().context("installing signal handlers")?;
+            let stop = sim_run::cli::stop_on_signals().context("installing signal handlers")?;
             if !sim.run_checkpointed(every, &stop, &report)? {
                 progress.finish();
                 return Err(Interrupted(format!(

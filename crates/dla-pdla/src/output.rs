@@ -17,15 +17,15 @@
 
 use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
-use core_lattice::io::{
+use serde_json::json;
+use sim_run::io::{
     AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, RunClock, RunManifest, write_png_gray,
     write_points,
 };
-use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 
-pub use core_lattice::io::OutputError;
+pub use sim_run::io::OutputError;
 
 /// Format of the optional positions file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -201,7 +201,7 @@ pub fn each_position<const D: usize>(
         }
         return Ok(());
     }
-    let npy = |e: core_lattice::io::NpyError| std::io::Error::other(e.to_string());
+    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
     let path = dir.join(POSITIONS_FILE);
     let mut r = NpyReader::open(&path).map_err(npy)?;
     if r.cols() != D || r.rows() != sim.particles() {

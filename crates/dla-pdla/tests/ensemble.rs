@@ -6,7 +6,7 @@ use std::path::Path;
 #[test]
 fn ensembles_run_combine_restart_and_merge() {
     let dir = tempfile::tempdir().unwrap();
-    core_lattice::testing::ensemble_contract(
+    sim_run::testing::ensemble_contract(
         Path::new(env!("CARGO_BIN_EXE_dla")),
         "dla",
         dir.path(),
@@ -29,10 +29,8 @@ fn checkpointed_members_are_resumed() {
     cmd.args(["--seeds", "1..=2", "--jobs", "1", "-qq", "--out"])
         .arg(&ens)
         .args(flags);
-    let running = core_lattice::testing::kill_group_once_written(
-        &mut cmd,
-        &ens.join("seed-0001/checkpoint.bin"),
-    );
+    let running =
+        sim_run::testing::kill_group_once_written(&mut cmd, &ens.join("seed-0001/checkpoint.bin"));
     assert!(running, "the ensemble ended before it could be killed");
     assert!(
         !ens.join("seed-0001/run.json").exists(),

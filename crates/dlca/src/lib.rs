@@ -37,3 +37,8 @@ mod store;
 
 pub use params::{Init, ParamError, Params, Search};
 pub use sim::{Simulation, Snapshot};
+
+/// The README's examples, compiled and run as doctests so that they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -5,12 +5,12 @@
 
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
-use core_lattice::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
-use core_lattice::ensemble::{Curve, EnsembleArgs};
-use core_lattice::io::{Positions, RunClock};
-use core_lattice::io::{read_checkpoint, write_checkpoint};
 use dlca::params::flags;
 use dlca::{Params, Search, Simulation, Snapshot};
+use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
+use sim_run::ensemble::{Curve, EnsembleArgs};
+use sim_run::io::{Positions, RunClock};
+use sim_run::io::{read_checkpoint, write_checkpoint};
 use std::sync::atomic::Ordering;
 
 /// File name of checkpoints in the output directory.
@@ -190,7 +190,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         fit_min_size: cli.fit_min_size,
     };
     p.validate().map_err(|e| e.to_string())?;
-    core_lattice::cli::check_out_dir(&cli.out)?;
+    sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
 
@@ -253,13 +253,13 @@ const CURVES: &[Curve] = &[
 ];
 
 fn main() -> ExitCode {
-    if let Some(code) = core_lattice::cli::refuse_unsupported_cpu("dlca") {
+    if let Some(code) = sim_run::cli::refuse_unsupported_cpu("dlca") {
         return code;
     }
-    if let Some(code) = core_lattice::ensemble::merge_main("dlca", CURVES) {
+    if let Some(code) = sim_run::ensemble::merge_main("dlca", CURVES) {
         return code;
     }
-    core_lattice::cli::main_with_config(
+    sim_run::cli::main_with_config(
         "dlca",
         |c: &Cli| c.log,
         params,
@@ -281,10 +281,10 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         None => Simulation::new(params, cli.seed).map_err(|e| usage(e.to_string()))?,
     };
     // Created before the run so a long run cannot end with nowhere to write.
-    core_lattice::cli::prepare_out_dir(&cli.out)
+    sim_run::cli::prepare_out_dir(&cli.out)
         .with_context(|| format!("creating output directory {}", cli.out.display()))?;
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
-    core_lattice::cli::config::save(&cli.out)
+    sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
     tracing::info!("{}", sim.strategy_reason());
     let initial = sim.clusters();
@@ -296,9 +296,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     );
     // With checkpoints, SIGINT/SIGTERM save the run after the current sweep and stop it.
     let stop = match cli.checkpoint_every {
-        Some(_) => {
-            Some(core_lattice::cli::stop_on_signals().context("installing signal handlers")?)
-        }
+        Some(_) => Some(sim_run::cli::stop_on_signals().context("installing signal handlers")?),
         None => None,
     };
     let save = |s: &Simulation| {

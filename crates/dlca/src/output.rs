@@ -6,17 +6,17 @@
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results |
 //! | `sweeps.csv` | `sweep,clusters,largest` (and `seconds` with `--timing`), from sweep 0 |
 //! | `sizes.csv` | `size,count`: the final cluster size distribution |
-//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`core_lattice::io::points`]) |
+//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`sim_run::io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
 //! | `dlca.png` | with `--png`: the final state, one colour per cluster, a square of pixels per site on lattices under 512 sites wide |
 
 use crate::analysis::{ClusterMeasure, fractal_dimension, gyration, size_distribution};
 use crate::sim::Simulation;
-use core_lattice::io::{
+use serde_json::json;
+use sim_run::io::{
     Attribute, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_png_rgb, write_points,
 };
-use serde_json::json;
 use spatial::lattice::ItemId;
 use std::path::Path;
 
@@ -29,7 +29,7 @@ pub fn write_outputs(
     dir: &Path,
     png: bool,
     positions: Option<PointFormat>,
-) -> Result<core_lattice::io::RunManifest, OutputError> {
+) -> Result<sim_run::io::RunManifest, OutputError> {
     let params = sim.params();
     let dim = sim.lattice().dim();
 
@@ -132,7 +132,7 @@ pub fn manifest(
     seed: u64,
     clock: &RunClock,
     measures: Option<&[ClusterMeasure]>,
-) -> Result<core_lattice::io::RunManifest, OutputError> {
+) -> Result<sim_run::io::RunManifest, OutputError> {
     let params = sim.params();
     let mut fit_results = serde_json::Map::new();
     if let Some(measures) = measures {
@@ -216,7 +216,7 @@ fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputE
 
 /// A colour for cluster `id`: a hash spread over bright hues, never black.
 fn colour(id: u32) -> [u8; 3] {
-    let h = core_lattice::io::hash::xxh3_64(&id.to_le_bytes());
+    let h = sim_run::io::hash::xxh3_64(&id.to_le_bytes());
     let c = |shift: u32| 64 + ((h >> shift) & 0xBF) as u8;
     [c(0), c(16), c(32)]
 }

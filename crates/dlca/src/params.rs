@@ -337,7 +337,7 @@ pub mod flags {
     }
 
     /// `--max-memory`: a byte count, with an optional suffix K, M, G or T (powers of 1024).
-    pub use core_lattice::io::parse_bytes;
+    pub use sim_run::io::parse_bytes;
 
     /// The axes of `--dim`, `--size` (the lengths given: one for every axis, or one per axis)
     /// and `--boundary` (`periodic` or `wall` for every axis, or one per axis separated by

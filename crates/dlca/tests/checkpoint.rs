@@ -2,8 +2,8 @@
 //! interrupted (docs/dlca.md, "Outputs"), for every strategy, through the checkpoint envelope.
 
 use core_lattice::Boundary;
-use core_lattice::io::checkpoint::{decode_checkpoint, encode_checkpoint};
 use dlca::{Init, Params, Search, Simulation, Snapshot};
+use sim_run::io::checkpoint::{decode_checkpoint, encode_checkpoint};
 
 fn configs() -> Vec<Params> {
     vec![

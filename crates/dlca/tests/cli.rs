@@ -187,7 +187,7 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_dlca"));
     cmd.args(run)
         .args(["--checkpoint-every", "50", "--out", cut.to_str().unwrap()]);
-    if !core_lattice::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+    if !sim_run::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
         eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
     }
     let resumed = tmp.path().join("resumed");
@@ -215,7 +215,7 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
     cmd.args(run)
         .args(["--checkpoint-every", "50", "--out", term.to_str().unwrap()]);
     let (running, code) =
-        core_lattice::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+        sim_run::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
     if running {
         assert_eq!(code, Some(130));
     }
@@ -242,7 +242,7 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
 #[test]
 fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
     let dir = tempfile::tempdir().unwrap();
-    core_lattice::testing::provenance_and_color_contract(
+    sim_run::testing::provenance_and_color_contract(
         Path::new(env!("CARGO_BIN_EXE_dlca")),
         dir.path(),
         &["--size", "32", "--fill", "0.05", "--seed", "2"],
@@ -283,7 +283,7 @@ fn positions_in_every_format_hold_the_same_particles() {
     assert_eq!(rows.len(), 48);
 
     let npy = run("npy");
-    let mut r = core_lattice::io::NpyReader::open(npy.join("particles.npy")).unwrap();
+    let mut r = sim_run::io::NpyReader::open(npy.join("particles.npy")).unwrap();
     assert_eq!((r.rows(), r.cols()), (48, 2));
     let ids = std::fs::read(npy.join("particles_cluster.npy")).unwrap();
     let mut p = [0.0; 2];
@@ -325,7 +325,7 @@ fn positions_in_every_format_hold_the_same_particles() {
 #[test]
 fn config_files_repeat_runs_and_flags_override_them() {
     let dir = tempfile::tempdir().unwrap();
-    core_lattice::testing::config_contract(
+    sim_run::testing::config_contract(
         Path::new(env!("CARGO_BIN_EXE_dlca")),
         dir.path(),
         &["--size", "32x16", "--fill", "0.05", "--seed", "4", "--png"],

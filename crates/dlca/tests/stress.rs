@@ -19,10 +19,10 @@
 //! | one particle with `--gyration` | a radius of gyration of 0 and no fit: finite outputs, no panic |
 
 use core_lattice::Boundary;
-use core_lattice::testing::refusals;
 use dlca::analysis::{fractal_dimension, gyration};
 use dlca::params::MAX_SIDE;
 use dlca::{Init, Params, Search, Simulation};
+use sim_run::testing::refusals;
 use std::path::Path;
 
 const STRATEGIES: [Search; 5] = [

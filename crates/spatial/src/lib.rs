@@ -18,3 +18,8 @@ pub mod orthtree;
 pub mod plane;
 mod round;
 pub mod testdata;
+
+/// The README's examples, compiled and run as doctests so that they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -7,12 +7,12 @@ use crate::run::{Progress, interruptible};
 use ::dlca::analysis::{gyration, size_distribution};
 use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, flags};
 use ::dlca::{Params, Search, Simulation};
-use core_lattice::io::RunClock;
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
+use sim_run::io::RunClock;
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 

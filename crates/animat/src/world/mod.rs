@@ -36,9 +36,9 @@ use crate::cells::{CellIndex, WINDOW_MAX, kind_byte};
 use crate::params::{ANIMAT_BYTES, FoxRule, MAX_ANIMATS, Params, ParamsError, RabbitRule, Species};
 
 pub use crate::cells::{TILE, TILE_BYTES};
-use core_lattice::io::StateHasher;
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
 use near::{NEAR_ROWS, disc_mask};
+use sim_run::io::StateHasher;
 use spatial::plane::{BoxSize, PlaneError, PlaneGrid, Pos};
 
 pub use checkpoint::Snapshot;

@@ -3,6 +3,7 @@
 //! refuses bad input with a typed [`StatsError`] instead of returning NaN.
 
 use super::StatsError;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 /// The checks every fit makes first: equal lengths, at least 3 points, all finite.
@@ -29,8 +30,9 @@ fn check_points(x: &[f64], y: &[f64]) -> Result<(), StatsError> {
 }
 
 /// The axes a [`Fit`] was made on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum FitScale {
     /// `y = slope * x + intercept`.
     Linear,
@@ -44,7 +46,8 @@ pub enum FitScale {
 ///
 /// On log-log axes `intercept` is `ln A` (natural logarithm) and its standard error that of
 /// `ln A`; [`Fit::prefactor`] gives `A`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Fit {
     /// Fitted slope (on log-log axes the exponent).
     pub slope: f64,

@@ -2,6 +2,7 @@
 //! relative to the first point, accurate however far the set lies from the origin) and
 //! [`LatticeGyration`] for integer lattice points (exact integer sums, rounded once).
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 /// Radius of gyration of a point set in `D` dimensions,
@@ -16,14 +17,15 @@ use serde::{Deserialize, Serialize};
 /// 10 centred 1e12 from the origin wrong in the fifth digit; the offsets are exact for points
 /// near the shift, so the sums keep the precision of the cluster's own size. Mergeable across
 /// threads.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Gyration<const D: usize> {
     n: u64,
     /// The first point: every other enters as its offset from this one.
-    #[serde(with = "serde_arrays")]
+    #[cfg_attr(feature = "serde", serde(with = "serde_arrays"))]
     shift: [f64; D],
     /// Mean offset from `shift`.
-    #[serde(with = "serde_arrays")]
+    #[cfg_attr(feature = "serde", serde(with = "serde_arrays"))]
     mean: [f64; D],
     /// Sum over points and axes of squared deviations from the mean.
     m2: f64,
@@ -31,6 +33,7 @@ pub struct Gyration<const D: usize> {
 
 /// serde for `[f64; D]` with const generic `D` (serde implements arrays only up to 32 and not
 /// for generic lengths).
+#[cfg(feature = "serde")]
 mod serde_arrays {
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
@@ -134,7 +137,8 @@ impl<const D: usize> Gyration<D> {
 ///
 /// Sums are kept exactly in `i128`; the result is rounded only once, at the end. Supports
 /// coordinates up to `|x| < 2^40` and up to `2^40` points.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct LatticeGyration {
     dim: usize,
     n: u64,

@@ -3,12 +3,14 @@
 //! is always the sum of the bins (plus the log histogram's underflow).
 
 use super::StatsError;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 /// A histogram of non-negative integers with one bin per value, growing as needed: the number of
 /// candidate clusters examined per move (Hawick, James & Scogings 2006, Figs. 4, 7, 8), cluster
 /// sizes.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct IntHistogram {
     counts: Vec<u64>,
     total: u64,
@@ -88,7 +90,8 @@ impl IntHistogram {
 /// A histogram of positive reals in logarithmic bins: bin `i` covers
 /// `[min * 10^(i/b), min * 10^((i+1)/b))` with `b` bins per decade. Values below `min` are counted
 /// apart (`underflow`). Used for wide distributions: cluster sizes, query errors, step lengths.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct LogHistogram {
     min: f64,
     bins_per_decade: u32,

@@ -1,10 +1,12 @@
 //! [`Welford`]: running count, mean, variance, minimum and maximum in one pass; mergeable, so
 //! per-thread accumulators combine exactly as if every value had been seen by one.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 /// Running count, mean and variance (Welford 1962), stable for large means and long runs.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Welford {
     n: u64,
     mean: f64,

@@ -4,7 +4,7 @@
 //! (`checkpoint.bin`, beside it) holds only what is not in that file: the parameters, the seed,
 //! the walk's random stream, the number of parallel phases run, the particle count `n` and the state hash after the first `n`
 //! rows, the growth samples and the seconds grown. It is a few kilobytes at any size, written
-//! atomically in `core_lattice`'s checksummed `AGGSIMCK` envelope (model
+//! atomically in `sim_run`'s checksummed `AGGSIMCK` envelope (model
 //! [`CHECKPOINT_MODEL`]) after `positions.npy` has been flushed and synced.
 //!
 //! Invariant: restoring stores the first `n` rows of `positions.npy` again in arrival order,
@@ -18,9 +18,9 @@ use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use core_lattice::io::{NpyReader, StateHasher};
 use core_lattice::rng::SimRng;
 use serde::{Deserialize, Serialize};
+use sim_run::io::{NpyReader, StateHasher};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -95,7 +95,7 @@ pub(crate) fn write<const D: usize>(
         last_off_schedule: growth.last_off_schedule,
         seconds: growth.started.elapsed().as_secs_f64(),
     };
-    core_lattice::io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &snap)?;
+    sim_run::io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &snap)?;
     Ok(())
 }
 
@@ -109,8 +109,7 @@ pub(crate) fn read<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
-    let snap: Snapshot =
-        core_lattice::io::read_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL)?;
+    let snap: Snapshot = sim_run::io::read_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL)?;
     let mut params = snap.params;
     params.validate()?;
     if params.dim != D {

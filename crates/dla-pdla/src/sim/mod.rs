@@ -35,7 +35,7 @@ use crate::cluster::Cluster;
 use crate::params::Params;
 use crate::space::{Dim, Space};
 use core_lattice::Fit;
-use core_lattice::io::NpyWriter;
+use sim_run::io::NpyWriter;
 use spatial::orthtree::Orthtree;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};

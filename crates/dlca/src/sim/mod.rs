@@ -24,9 +24,9 @@ use crate::params::{ParamError, Params, Search};
 use crate::record::Records;
 use crate::store::{ClusterArrays, ClusterStore, Engine};
 use core_lattice::Lattice;
-use core_lattice::io::StateHasher;
 use core_lattice::rng::{DirectionSampler, SimRng, shuffle, stream, stream_id, uniform01};
 use placement::{initial_clusters, place_particles};
+use sim_run::io::StateHasher;
 use spatial::lattice::{ItemId, SiteSets};
 use std::time::Instant;
 

@@ -2,13 +2,13 @@
 //! never a panic, never a wrong state.
 
 use core_lattice::SimRng;
-use core_lattice::io::checkpoint::{
-    CheckpointError, FORMAT_VERSION, MAGIC, decode_checkpoint, encode_checkpoint,
-};
-use core_lattice::io::{read_checkpoint, write_checkpoint};
 use core_lattice::rng::{RngExt, stream};
 use proptest::prelude::*;
 use serde::{Deserialize, Serialize};
+use sim_run::io::checkpoint::{
+    CheckpointError, FORMAT_VERSION, MAGIC, decode_checkpoint, encode_checkpoint,
+};
+use sim_run::io::{read_checkpoint, write_checkpoint};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 struct State {

@@ -49,9 +49,9 @@ pub struct ScalarStats {
 
 impl ScalarStats {
     /// The statistics of `values` (not empty), by Welford's update
-    /// ([`crate::stats::Welford`], as every mean and error in the workspace).
+    /// ([`core_lattice::stats::Welford`], as every mean and error in the workspace).
     pub fn of(values: &[f64]) -> Self {
-        let mut w = crate::stats::Welford::new();
+        let mut w = core_lattice::stats::Welford::new();
         values.iter().for_each(|&v| w.push(v));
         let n = values.len();
         let (std, stderr) = if n > 1 {

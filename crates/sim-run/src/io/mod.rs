@@ -52,5 +52,5 @@ pub enum OutputError {
     Json(#[from] serde_json::Error),
     /// A stored lattice site that does not decode: the model's state is inconsistent.
     #[error(transparent)]
-    Lattice(#[from] crate::lattice::LatticeError),
+    Lattice(#[from] core_lattice::LatticeError),
 }

@@ -1,6 +1,6 @@
 //! PNG charts with plotters (feature `plot`), drawn into a memory buffer and written with the
 //! project's atomic PNG writer: the figures of `cargo xtask` and of the models' ensembles.
-//! Text uses the DejaVu Sans font committed under `crates/core-lattice/assets/fonts/` and
+//! Text uses the DejaVu Sans font committed under `crates/sim-run/assets/fonts/` and
 //! registered with plotters' `ab_glyph` backend, so no system font library is needed.
 
 use anyhow::{Context, Result, anyhow};
@@ -9,7 +9,7 @@ use std::path::Path;
 use std::sync::Once;
 
 /// The font file committed with the repository (Bitstream Vera licence, see
-/// `crates/core-lattice/assets/fonts/DejaVu-LICENSE.txt`).
+/// `crates/sim-run/assets/fonts/DejaVu-LICENSE.txt`).
 static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 
 fn register_font() {

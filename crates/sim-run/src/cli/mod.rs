@@ -160,9 +160,9 @@ pub fn usage(message: impl Into<String>) -> anyhow::Error {
 
 /// The first step of a model binary: `Some(exit code 1)`, after one line on standard error, when
 /// the processor lacks an instruction-set feature the build was compiled to use
-/// ([`cpu`](crate::cpu)), rather than an illegal instruction later in the run.
+/// ([`cpu`](core_lattice::cpu)), rather than an illegal instruction later in the run.
 pub fn refuse_unsupported_cpu(program: &str) -> Option<ExitCode> {
-    let why = crate::cpu::unsupported()?;
+    let why = core_lattice::cpu::unsupported()?;
     eprintln!("{program}: {why}");
     Some(ExitCode::from(EXIT_RUN_FAILED))
 }

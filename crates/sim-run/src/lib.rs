@@ -1,0 +1,51 @@
+//! # sim-run
+//!
+//! Everything around a simulation run that is not the simulation: what the model binaries of
+//! the workspace share, usable by any program that runs seeded simulations.
+//!
+//! - [`io`]: atomic file writes, the run manifest `run.json` (parameters, seed, wall and CPU
+//!   time, peak memory, provenance), the versioned and checksummed checkpoint envelope,
+//!   NumPy `.npy` files streamed row by row, PNG and CSV writers, point files (CSV, `.npy`,
+//!   VTK, XYZ) and the stable state hash.
+//! - `cli` (feature `cli`): the model binaries' contract (usage errors: one line, exit code 2,
+//!   nothing created; failed runs: exit code 1), `--out` checks, config files, logging,
+//!   progress and heartbeat.
+//! - `ensemble` (feature `cli`): `--seeds` for every binary, members as child processes or over
+//!   the ranks of an MPI job (feature `mpi`), restart, and the merged statistics.
+//! - `plot` (feature `plot`): PNG charts with error bands.
+//! - `testing` (feature `test-support`): the bad-input harness of the binaries' tests.
+//!
+//! Conventions: a run is a pure function of its parameters and seed; bad input is a typed
+//! error, never a panic; every output file is written atomically (a reader never sees half a
+//! file).
+//!
+//! ```
+//! use sim_run::io::{read_checkpoint, write_checkpoint};
+//!
+//! #[derive(serde::Serialize, serde::Deserialize, PartialEq, Debug)]
+//! struct State { step: u64, x: Vec<f64> }
+//!
+//! let dir = tempfile::tempdir().unwrap();
+//! let path = dir.path().join("state.ckpt");
+//! let state = State { step: 3, x: vec![0.5, -1.25] };
+//! write_checkpoint(&path, "my-model", &state).unwrap();
+//! let back: State = read_checkpoint(&path, "my-model").unwrap();
+//! assert_eq!(back, state);
+//! // A checkpoint of another model is refused with a typed error, never misread.
+//! assert!(read_checkpoint::<State>(&path, "other-model").is_err());
+//! ```
+
+#[cfg(feature = "cli")]
+pub mod cli;
+#[cfg(feature = "cli")]
+pub mod ensemble;
+pub mod io;
+#[cfg(feature = "plot")]
+pub mod plot;
+#[cfg(feature = "test-support")]
+pub mod testing;
+
+/// The README's examples, compiled and run as doctests so that they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
