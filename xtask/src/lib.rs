@@ -5,6 +5,7 @@
 //! test (`tests/scaling.rs`) runs it at a tiny size.
 
 pub mod bench;
+pub mod ci;
 pub mod plot;
 pub mod probe;
 pub mod report;

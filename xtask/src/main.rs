@@ -1,6 +1,6 @@
 //! Project automation, run as `cargo xtask <command>` (the alias lives in `.cargo/config.toml`).
 //!
-//! - `cargo xtask ci`: the checks CI runs: formatting, clippy with warnings denied (also on the
+//! - `cargo xtask ci`: the checks CI runs (the one list, in `xtask::ci`): formatting, clippy with warnings denied (also on the
 //!   model libraries without their `cli` feature), rustdoc with
 //!   warnings denied, and the test suite (the README's test command).
 //! - `cargo xtask scaling [--quick] [--only ...] [--out DIR]`: regenerate the papers' tables
@@ -8,10 +8,9 @@
 //! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and
 //!   memory figures as JSON, and their ratios to a saved baseline.
 
-use anyhow::{Context, Result, bail};
+use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
-use std::process::Command;
 use std::time::Instant;
 use xtask::scaling::{Experiment, Options, Scale};
 use xtask::{cargo, workspace_root};
@@ -28,13 +27,20 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Run every CI check: `cargo fmt --check`, `cargo clippy --all-targets -- -D warnings`,
-    /// the model libraries' clippy without their `cli` feature, `cargo doc --no-deps` with
-    /// warnings denied, and `cargo test --workspace`.
+    /// Run every CI check, in order (the list is in xtask/src/ci.rs; `.ci/run` installs what
+    /// they need and runs this): formatting, clippy with warnings denied (also the libraries
+    /// without their default features), rustdoc, `cargo test --workspace`, `cargo package` of
+    /// every library crate, the Python package and its tests, and feature `mpi` where Open MPI
+    /// is installed.
     Ci {
-        /// Skip the test suite (formatting, lints and docs only).
+        /// Skip the test suite (the step `tests`).
         #[arg(long)]
         no_tests: bool,
+        /// Skip these steps (repeat or comma-separate): format, clippy, libraries-alone,
+        /// rustdoc, tests, package, python-format, python-clippy, python-install,
+        /// python-tests, mpi-clippy, mpi-tests.
+        #[arg(long, value_delimiter = ',')]
+        skip: Vec<String>,
     },
     /// Regenerate the papers' tables and figures from our own runs, with fitted exponents and
     /// error bars beside the published values: markdown, CSV and PNG under --out. Builds the
@@ -88,95 +94,14 @@ enum Cmd {
     },
 }
 
-/// One CI step: a description and a cargo invocation.
-struct Step {
-    name: &'static str,
-    args: &'static [&'static str],
-    env: &'static [(&'static str, &'static str)],
-}
-
-/// The steps of `cargo xtask ci`, in order. The test step is the README's test command.
-const CI_STEPS: &[Step] = &[
-    Step {
-        name: "format",
-        args: &["fmt", "--all", "--", "--check"],
-        env: &[],
-    },
-    Step {
-        name: "clippy",
-        args: &[
-            "clippy",
-            "--workspace",
-            "--all-targets",
-            "--",
-            "-D",
-            "warnings",
-        ],
-        env: &[],
-    },
-    Step {
-        name: "libraries without the cli feature",
-        args: &[
-            "clippy",
-            "-p",
-            "dlca",
-            "-p",
-            "dla-pdla",
-            "-p",
-            "animat",
-            "--no-default-features",
-            "--",
-            "-D",
-            "warnings",
-        ],
-        env: &[],
-    },
-    Step {
-        name: "rustdoc",
-        args: &["doc", "--workspace", "--no-deps"],
-        env: &[("RUSTDOCFLAGS", "-D warnings")],
-    },
-    Step {
-        name: "tests",
-        args: &["test", "--workspace"],
-        env: &[],
-    },
-];
-
-fn run_step(step: &Step) -> Result<()> {
-    eprintln!("==> {}: cargo {}", step.name, step.args.join(" "));
-    let start = Instant::now();
-    let status = Command::new(cargo())
-        .args(step.args)
-        .envs(step.env.iter().copied())
-        .current_dir(workspace_root())
-        .status()
-        .with_context(|| format!("could not start cargo for the {} step", step.name))?;
-    if !status.success() {
-        bail!("{} step failed ({status})", step.name);
-    }
-    eprintln!(
-        "    {} passed in {:.1} s",
-        step.name,
-        start.elapsed().as_secs_f64()
-    );
-    Ok(())
-}
-
-fn ci(no_tests: bool) -> Result<()> {
-    for step in CI_STEPS {
-        if no_tests && step.name == "tests" {
-            continue;
-        }
-        run_step(step)?;
-    }
-    eprintln!("==> all CI checks passed");
-    Ok(())
-}
-
 fn main() -> Result<()> {
     match Cli::parse().command {
-        Cmd::Ci { no_tests } => ci(no_tests),
+        Cmd::Ci { no_tests, mut skip } => {
+            if no_tests {
+                skip.push("tests".to_string());
+            }
+            xtask::ci::run(&skip)
+        }
         Cmd::Scaling {
             quick,
             only,
@@ -251,26 +176,8 @@ mod tests {
             Cli::try_parse_from(["xtask", "ci", "--no-tests"])
                 .unwrap()
                 .command,
-            Cmd::Ci { no_tests: true }
+            Cmd::Ci { no_tests: true, .. }
         ));
         assert!(Cli::try_parse_from(["xtask", "frobnicate"]).is_err());
-    }
-
-    /// The README's test command is the one `cargo xtask ci` and `.ci/run` run.
-    #[test]
-    fn readme_test_command_matches_ci() {
-        let root = workspace_root();
-        let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
-        let ci_script = std::fs::read_to_string(root.join(".ci/run")).unwrap();
-        let test_step = CI_STEPS.iter().find(|s| s.name == "tests").unwrap();
-        let command = format!("cargo {}", test_step.args.join(" "));
-        assert!(
-            readme.contains(&command),
-            "README does not mention `{command}`"
-        );
-        assert!(
-            ci_script.lines().any(|l| l.trim() == command),
-            ".ci/run does not run `{command}`"
-        );
     }
 }
