@@ -117,7 +117,16 @@ pub const STEPS: &[Step] = &[
     Step {
         name: "package",
         needs: Needs::Rust,
-        run: Run::Cargo(&["package", "--workspace", "--exclude", "xtask"], &[]),
+        run: Run::Cargo(
+            &[
+                "package",
+                "--workspace",
+                "--exclude",
+                "xtask",
+                "--allow-dirty",
+            ],
+            &[],
+        ),
     },
     // The Python package (python/, its own Cargo workspace): formatted, linted, built and
     // installed by pip (maturin, release) into a fresh virtual environment, and its tests run
