@@ -40,6 +40,10 @@ struct Frame<const D: usize> {
 }
 
 /// Iterator over the stored positions of an [`Orthtree`], from [`Orthtree::iter`].
+///
+/// Its stack only holds reached nodes (the root, and children read from the slots of reached
+/// nodes), with their levels, and `leaf` a reached leaf's points: the invariant its `unsafe`
+/// calls rely on.
 #[derive(Debug, Clone)]
 pub struct Points<'a, const D: usize> {
     tree: &'a Orthtree<D>,
@@ -72,7 +76,8 @@ impl<const D: usize> Iterator for Points<'_, D> {
             }
             let ci = top.next;
             top.next += 1;
-            let child = tree.child(top.node as usize * Orthtree::<D>::FANOUT + ci);
+            // SAFETY: `top.node` is a reached node (the stack's invariant), `ci < FANOUT`.
+            let child = unsafe { tree.child(top.node as usize * Orthtree::<D>::FANOUT + ci) };
             if child == EMPTY {
                 continue;
             }
@@ -84,7 +89,10 @@ impl<const D: usize> Iterator for Points<'_, D> {
                 }
             }
             if top.level == 1 {
-                self.leaf = tree.leaf_points(child);
+                // SAFETY: a non-empty slot of a reached level-1 node: a reached leaf. A reader
+                // announces an epoch only while it holds no iterator (`insert_shared`'s
+                // promise), so the block outlives this borrow.
+                self.leaf = unsafe { tree.leaf_points(child) };
                 self.leaf_origin = origin.map(|o| o as f64 * tree.leaf_side);
                 self.pos = 0;
             } else {
