@@ -112,6 +112,27 @@ pub const STEPS: &[Step] = &[
         needs: Needs::Rust,
         run: Run::Cargo(TEST_ARGS, &[]),
     },
+    // The orthtree's shared-insert protocol, model-checked with loom on the real code
+    // (docs/spatial.md), in a target directory of its own so the ordinary build is not redone.
+    Step {
+        name: "loom",
+        needs: Needs::Rust,
+        run: Run::Cargo(
+            &[
+                "test",
+                "-p",
+                "spatial",
+                "--test",
+                "loom_shared",
+                "--release",
+            ],
+            &[
+                ("RUSTFLAGS", "--cfg loom"),
+                ("CARGO_TARGET_DIR", "target/loom"),
+                ("LOOM_MAX_PREEMPTIONS", "2"),
+            ],
+        ),
+    },
     // Each library crate as it would be published (nothing is published): packaged, then
     // built on its own from the package, with its workspace dependencies packaged beside it.
     Step {

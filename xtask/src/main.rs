@@ -37,7 +37,7 @@ enum Cmd {
         #[arg(long)]
         no_tests: bool,
         /// Skip these steps (repeat or comma-separate): format, clippy, libraries-alone,
-        /// rustdoc, tests, package, python-format, python-clippy, python-install,
+        /// rustdoc, tests, loom, package, python-format, python-clippy, python-install,
         /// python-tests, mpi-clippy, mpi-tests.
         #[arg(long, value_delimiter = ',')]
         skip: Vec<String>,

@@ -463,7 +463,12 @@ where
             if overlap {
                 continue;
             }
-            let (q, new_leaf) = match tree.insert_shared(stick, || self.readers_epoch()) {
+            // SAFETY: every thread announces its epoch at a walker's birth only, where it holds
+            // nothing from the tree (`walk`, Release store), or u64::MAX once it stops reading;
+            // `readers_epoch` is the minimum over all threads' slots (Acquire loads).
+            #[allow(unsafe_code)]
+            let inserted = unsafe { tree.insert_shared(stick, || self.readers_epoch()) };
+            let (q, new_leaf) = match inserted {
                 Ok(stored) => stored,
                 Err(OrthtreeError::NeedsExclusive) => {
                     // The walker is dropped; the next phase reserves more room.

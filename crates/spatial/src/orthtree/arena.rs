@@ -8,26 +8,46 @@
 //! which moves large buffers by remapping pages, so it neither copies nor doubles the peak) and
 //! needs `&mut`; a shared writer only appends within the capacity reserved beforehand.
 //!
-//! Invariants the tree keeps (and the reason the `unsafe` blocks here are sound):
+//! # The unsafe boundary
+//!
+//! The accessors that read or write elements ([`Arena::get`], [`Arena::slice`],
+//! [`Arena::init`], [`Arena::prefix_mut`], [`Arena::duplicate`]) are `unsafe fn`: the arena
+//! checks bounds against its capacity, but whether an element is initialised, and whether
+//! another thread may be reading it, is known only to the tree. Their `# Safety` sections say
+//! what the caller guarantees. The tree keeps these invariants, and every call site says with
+//! a `// SAFETY:` note which one makes it sound there:
 //!
 //! - an element is written with [`Arena::init`] before anything that leads a reader to it
 //!   (a child slot, a leaf record) is published with a `Release` store, and readers follow such
 //!   links with `Acquire` loads, so a reader only ever reads initialised elements;
-//! - child slots and leaf records, which are overwritten while readers look, are atomics; point
-//!   records are plain integers and are only written while no reader can reach them: fresh
-//!   slots beyond a leaf's published length, and blocks a shared writer has retired are only
-//!   reused once every reader has passed a quiescent point (see `pool.rs`).
+//! - child slots and leaf records, which are overwritten while readers look, are atomics, and
+//!   a reachable one is only ever stored into, never re-initialised; point records are plain
+//!   integers and are only written while no reader can reach them: fresh slots beyond a leaf's
+//!   published length, and blocks a shared writer has retired are only reused once every
+//!   reader has announced a later epoch (see `pool.rs`).
 //!
-//! This module and `animat`'s prefetch hint are the workspace's only `unsafe` code: a
-//! growable buffer that readers index while a writer appends is exactly what `Vec` cannot offer
-//! (its length would be written under the readers' feet).
+//! The helpers above them that take a node or leaf index (the tree's `child`, `leaf`,
+//! `leaf_points`, the pool's block operations, the query walks) are `unsafe fn` too, for the
+//! same reason: an index is only valid if it was reached from the root. The public API is
+//! safe; `insert_shared` relies on its caller's `readers_epoch` being truthful (see its
+//! documentation).
+//!
+//! Under `cfg(loom)` the atomics come from loom (`sync.rs`) and every element access is also
+//! recorded on a loom cell, so the model-checked test `tests/loom_shared.rs` sees each read
+//! and write of the arenas and reports any that is not ordered by the protocol.
+//!
+//! This module and `animat`'s prefetch hint are the workspace's only unsafe operations (raw
+//! pointers, allocation); the orthtree's other modules only call the `unsafe fn`s above, each
+//! call in an `unsafe` block with its `// SAFETY:` note (`#[allow(unsafe_code)]` on those
+//! modules). A growable buffer that readers index while a writer appends is exactly what `Vec`
+//! cannot offer (its length would be written under the readers' feet).
 //!
 //! [`Orthtree::insert_shared`]: super::Orthtree::insert_shared
 #![allow(unsafe_code)]
 
+use super::sync::{AtomicU32, AtomicU64, Ordering};
 use std::alloc::{self, Layout};
 use std::ptr::NonNull;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 
 /// Element types an [`Arena`] holds: plain old data without drop glue, copied by value.
 pub(super) trait Element: Send + Sync + Sized {
@@ -58,6 +78,11 @@ impl<const D: usize> Element for [u32; D] {
 pub(super) struct Arena<T: Element> {
     ptr: NonNull<T>,
     cap: usize,
+    /// Under `cfg(loom)` only: one loom cell per element, which `get`, `slice` (reads) and
+    /// `init` (writes) touch, so that loom checks every element access for a data race (it
+    /// cannot see plain memory).
+    #[cfg(loom)]
+    track: Vec<loom::cell::UnsafeCell<()>>,
 }
 
 // SAFETY: the arena owns its buffer; `T` is Send + Sync and access follows the invariants of
@@ -73,6 +98,8 @@ impl<T: Element> Arena<T> {
         Arena {
             ptr: NonNull::dangling(),
             cap: 0,
+            #[cfg(loom)]
+            track: Vec::new(),
         }
     }
 
@@ -82,36 +109,74 @@ impl<T: Element> Arena<T> {
         self.cap
     }
 
-    /// Element `i`, which must be initialised (bounds-checked against the capacity).
+    /// Element `i` (bounds-checked against the capacity).
+    ///
+    /// # Safety
+    ///
+    /// Element `i` was written by [`init`](Self::init), and that write happens before this
+    /// call: on the writer's own thread, or published to this thread by a `Release` store that
+    /// it has read with an `Acquire` load (a child slot or leaf record leading here). No
+    /// [`init`](Self::init) of element `i` may run while the returned reference lives (the tree
+    /// never rewrites a reachable child slot or leaf record: it stores into them atomically).
     #[inline(always)]
-    pub(super) fn get(&self, i: usize) -> &T {
+    pub(super) unsafe fn get(&self, i: usize) -> &T {
         assert!(i < self.cap, "arena index {i} out of capacity {}", self.cap);
-        // SAFETY: in bounds; initialised by the tree's invariants (module docs).
+        #[cfg(loom)]
+        self.track[i].with(|_| ());
+        // SAFETY: in bounds (asserted); initialised and not rewritten while borrowed (the
+        // caller's contract).
         unsafe { &*self.ptr.as_ptr().add(i) }
     }
 
-    /// Elements `start..start + len`, which must be initialised and not written while the
-    /// slice lives (a leaf's published block; module docs).
+    /// Elements `start..start + len` (bounds-checked against the capacity).
+    ///
+    /// # Safety
+    ///
+    /// Every element of the range was written by [`init`](Self::init) before this call, as
+    /// for [`get`](Self::get) (a leaf's block, reached through its leaf record loaded with
+    /// `Acquire`), and none of them is written while the slice lives: the writer only appends
+    /// beyond a published length, and reuses a replaced block only after every reader that
+    /// could hold it has announced a later epoch (`pool.rs`).
     #[inline(always)]
-    pub(super) fn slice(&self, start: usize, len: usize) -> &[T] {
+    pub(super) unsafe fn slice(&self, start: usize, len: usize) -> &[T] {
         assert!(start <= self.cap && len <= self.cap - start);
-        // SAFETY: in bounds; initialised and not written concurrently (module docs).
+        #[cfg(loom)]
+        for t in &self.track[start..start + len] {
+            t.with(|_| ());
+        }
+        // SAFETY: in bounds (asserted); initialised and not written while borrowed (the
+        // caller's contract).
         unsafe { std::slice::from_raw_parts(self.ptr.as_ptr().add(start), len) }
     }
 
-    /// Writes element `i` (fresh, or one no reader can reach: module docs).
+    /// Writes element `i`, fresh or overwriting (bounds-checked against the capacity).
+    ///
+    /// # Safety
+    ///
+    /// No other thread can reach element `i` while it is written, and no reference to it is
+    /// live: it lies beyond everything published to readers (fresh nodes, leaf records and
+    /// slots, linked afterwards by a `Release` store), or in a block that no reader can still
+    /// hold (freed with exclusive access, or retired and reclaimed after every reader
+    /// announced a later epoch). Overwriting leaks nothing: elements have no drop glue.
     #[inline]
-    pub(super) fn init(&self, i: usize, value: T) {
+    pub(super) unsafe fn init(&self, i: usize, value: T) {
         assert!(i < self.cap, "arena index {i} out of capacity {}", self.cap);
-        // SAFETY: in bounds; no reader holds a reference to element i (module docs), and `T`
-        // has no drop glue, so overwriting an initialised element leaks nothing.
+        #[cfg(loom)]
+        self.track[i].with_mut(|_| ());
+        // SAFETY: in bounds (asserted); nobody reads or borrows element i meanwhile (the
+        // caller's contract), and `T` has no drop glue.
         unsafe { self.ptr.as_ptr().add(i).write(value) }
     }
 
-    /// The first `len` elements, mutably (exclusive access).
-    pub(super) fn prefix_mut(&mut self, len: usize) -> &mut [T] {
+    /// The first `len` elements, mutably (`&mut self`: no reader).
+    ///
+    /// # Safety
+    ///
+    /// The first `len` elements were written by [`init`](Self::init).
+    pub(super) unsafe fn prefix_mut(&mut self, len: usize) -> &mut [T] {
         assert!(len <= self.cap);
-        // SAFETY: in bounds, initialised (the caller's `len`), and `&mut self` excludes readers.
+        // SAFETY: in bounds (asserted), initialised (the caller's contract), and `&mut self`
+        // excludes every other access.
         unsafe { std::slice::from_raw_parts_mut(self.ptr.as_ptr(), len) }
     }
 
@@ -139,17 +204,28 @@ impl<T: Element> Arena<T> {
             Some(p) => {
                 self.ptr = p;
                 self.cap = cap;
+                #[cfg(loom)]
+                self.track
+                    .resize_with(cap, || loom::cell::UnsafeCell::new(()));
             }
             None => alloc::handle_alloc_error(new),
         }
     }
 
     /// A new arena of capacity `cap` holding copies of the first `len` elements.
-    pub(super) fn duplicate(&self, len: usize, cap: usize) -> Self {
+    ///
+    /// # Safety
+    ///
+    /// The first `len` elements were written by [`init`](Self::init), and none of them is
+    /// being written meanwhile (as for [`get`](Self::get)).
+    pub(super) unsafe fn duplicate(&self, len: usize, cap: usize) -> Self {
         let mut out = Arena::new();
         out.set_capacity(0, cap.max(len));
         for i in 0..len {
-            out.init(i, self.get(i).duplicate());
+            // SAFETY: `out` is new and not shared, so nothing else can reach its element i;
+            // element i of `self` is initialised and not being written (the caller's
+            // contract).
+            unsafe { out.init(i, self.get(i).duplicate()) };
         }
         out
     }
@@ -161,6 +237,8 @@ impl<T: Element> Arena<T> {
             unsafe { alloc::dealloc(self.ptr.as_ptr().cast(), layout) };
             self.ptr = NonNull::dangling();
             self.cap = 0;
+            #[cfg(loom)]
+            self.track.clear();
         }
     }
 }

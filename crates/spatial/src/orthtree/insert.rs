@@ -8,11 +8,15 @@
 
 use super::arena::slow_growth;
 use super::pool::LeafPool;
+use super::sync::{AtomicU32, AtomicU64, Ordering, increment_mut};
 use super::{
     CODE_SCALE, COORD_LIMIT_LEAVES, EMPTY, EPOCH_INSERTS, Leaf, Orthtree, OrthtreeError, Writer,
     decode,
 };
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+
+/// Room [`Orthtree::prepare_shared`] reserves beyond its estimate, per arena (small in the
+/// model-checked build, where every reserved element is a loom object).
+const RESERVE_FLOOR: usize = if cfg!(loom) { 16 } else { 4096 };
 
 impl<const D: usize> Orthtree<D> {
     /// Leaf cell of `p` in leaf sides and the fixed-point offsets inside it, after checking the
@@ -63,12 +67,16 @@ impl<const D: usize> Orthtree<D> {
         let mut node = self.root;
         let mut level = self.root_level;
         loop {
-            let child = self.child(node as usize * Self::FANOUT + self.child_index(k, level));
+            // SAFETY: `node` is the root or was read from a slot of its parent at level + 1 >= 2,
+            // so it is a reached node; the child index is below FANOUT.
+            let child =
+                unsafe { self.child(node as usize * Self::FANOUT + self.child_index(k, level)) };
             if child == EMPTY {
                 return 0;
             }
             if level == 1 {
-                return self.leaf(child).len;
+                // SAFETY: a non-empty slot of a reached level-1 node: a reached leaf.
+                return unsafe { self.leaf(child) }.len;
             }
             node = child;
             level -= 1;
@@ -101,11 +109,20 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// Initialises internal node `w.nodes` with empty child slots (not yet linked).
-    fn new_node(&self, w: &mut Writer) -> u32 {
+    ///
+    /// # Safety
+    ///
+    /// `w` is this tree's writer state, held by the caller (its lock, or exclusive access):
+    /// then node `w.nodes` is beyond every node published, so no reader can reach its slots.
+    unsafe fn new_node(&self, w: &mut Writer) -> u32 {
         let n = w.nodes;
         for i in 0..Self::FANOUT {
-            self.children
-                .init(n * Self::FANOUT + i, AtomicU32::new(EMPTY));
+            // SAFETY: node n is not linked yet (the caller's contract), so no reader reaches
+            // its slots.
+            unsafe {
+                self.children
+                    .init(n * Self::FANOUT + i, AtomicU32::new(EMPTY));
+            }
         }
         w.nodes += 1;
         n as u32
@@ -148,10 +165,11 @@ impl<const D: usize> Orthtree<D> {
             }
         }
         let mut w = self.writer();
-        let n = self.new_node(&mut w);
+        // SAFETY: `w` is this tree's writer, and `&mut self` excludes readers.
+        let n = unsafe { self.new_node(&mut w) };
         drop(w);
-        self.children
-            .get(n as usize * Self::FANOUT + slot)
+        // SAFETY: node n was just initialised on this thread; `&mut self` excludes readers.
+        unsafe { self.children.get(n as usize * Self::FANOUT + slot) }
             .store(self.root, Ordering::Relaxed);
         self.root = n;
         self.root_level += 1;
@@ -171,7 +189,8 @@ impl<const D: usize> Orthtree<D> {
             self.root_level = 1;
             self.reserve_for_insert(0);
             let mut w = self.writer();
-            let n = self.new_node(&mut w);
+            // SAFETY: `w` is this tree's writer, and `&mut self` excludes readers.
+            let n = unsafe { self.new_node(&mut w) };
             drop(w);
             self.root = n;
         }
@@ -187,35 +206,59 @@ impl<const D: usize> Orthtree<D> {
     /// reader sees either the tree before the insert or after it, and every node it reaches
     /// holds a point. Old blocks are retired at epoch `retire` if given (readers may scan
     /// them), else freed.
-    fn place(&self, w: &mut Writer, k: &[i64; D], code: [u32; D], retire: Option<u64>) {
+    ///
+    /// # Safety
+    ///
+    /// `w` is this tree's writer state, held by the caller (its lock, or exclusive access),
+    /// and `retire` is `Some(current epoch)` whenever other threads may be reading the tree.
+    unsafe fn place(&self, w: &mut Writer, k: &[i64; D], code: [u32; D], retire: Option<u64>) {
         let mut node = self.root;
         let mut level = self.root_level;
         loop {
             let slot = node as usize * Self::FANOUT + self.child_index(k, level);
-            let child = self.children.get(slot).load(Ordering::Relaxed);
+            // SAFETY: `node` is the root or was read from its parent's slot below, so it is
+            // initialised (by this writer or one whose lock release we acquired); the writer
+            // only stores into reachable slots.
+            let child = unsafe { self.children.get(slot) }.load(Ordering::Relaxed);
             if child == EMPTY {
                 // Build the missing part of the path bottom-up, then link it.
-                let rec = w
-                    .pool
-                    .push(&self.slots, Leaf { start: 0, len: 0 }, code, retire);
+                // SAFETY: `w` is this tree's writer and `retire` follows the readers (the
+                // caller's contract); the empty record has no block.
+                let rec = unsafe {
+                    w.pool
+                        .push(&self.slots, Leaf { start: 0, len: 0 }, code, retire)
+                };
                 let l = w.leaves;
-                self.leaves.init(l, AtomicU64::new(rec.pack()));
+                // SAFETY: leaf record l is beyond every published leaf: no reader reaches it
+                // until the `Release` store below links the path.
+                unsafe { self.leaves.init(l, AtomicU64::new(rec.pack())) };
                 w.leaves += 1;
                 let mut below = l as u32;
                 for lv in 1..level {
-                    let n = self.new_node(w);
-                    self.children
-                        .get(n as usize * Self::FANOUT + self.child_index(k, lv))
-                        .store(below, Ordering::Relaxed);
+                    // SAFETY: `w` is this tree's writer (the caller's contract).
+                    let n = unsafe { self.new_node(w) };
+                    // SAFETY: node n was just initialised on this thread.
+                    unsafe {
+                        self.children
+                            .get(n as usize * Self::FANOUT + self.child_index(k, lv))
+                    }
+                    .store(below, Ordering::Relaxed);
                     below = n;
                 }
-                self.children.get(slot).store(below, Ordering::Release);
+                // SAFETY: as for the load of this slot above.
+                unsafe { self.children.get(slot) }.store(below, Ordering::Release);
                 return;
             }
             if level == 1 {
-                let record = self.leaves.get(child as usize);
+                // SAFETY: a non-empty slot of a level-1 node holds an initialised leaf record
+                // (written before it was linked, by this writer or one whose lock release we
+                // acquired); the writer only stores into it.
+                let record = unsafe { self.leaves.get(child as usize) };
                 let leaf = Leaf::unpack(record.load(Ordering::Relaxed));
-                let rec = w.pool.push(&self.slots, leaf, code, retire);
+                // SAFETY: `leaf` is this pool's current record of the leaf (only the writer
+                // changes it), `w` is this tree's writer and `retire` follows the readers (the
+                // caller's contract).
+                let rec = unsafe { w.pool.push(&self.slots, leaf, code, retire) };
                 record.store(rec.pack(), Ordering::Release);
                 return;
             }
@@ -248,13 +291,20 @@ impl<const D: usize> Orthtree<D> {
         self.reserve_for_insert(leaf_len);
         {
             let mut w = self.writer();
-            self.place(&mut w, &k, code, None);
+            // SAFETY: `w` is this tree's writer; `&mut self` excludes readers, so the old
+            // block may be freed at once (`None`).
+            unsafe { self.place(&mut w, &k, code, None) };
         }
-        *self.shared.len.get_mut() += 1;
+        increment_mut(&mut self.shared.len);
         let w = Self::writer_mut(&mut self.shared);
         if w.pool.wants_compaction() {
-            let leaves = self.leaves.prefix_mut(w.leaves);
-            w.pool.compact(&mut self.slots, leaves);
+            // SAFETY: the first `w.leaves` leaf records are initialised (`place` writes each
+            // before counting it); `self.slots` is the arena of `w.pool`, whose blocks these
+            // records describe.
+            unsafe {
+                let leaves = self.leaves.prefix_mut(w.leaves);
+                w.pool.compact(&mut self.slots, leaves);
+            }
         }
         Ok(self.decoded(&k, &code))
     }
@@ -282,7 +332,19 @@ impl<const D: usize> Orthtree<D> {
     /// is not before the last answer) and the epoch has advanced since it last asked, about
     /// once per 64 inserts. An old answer stays safe, as announcements only grow within a
     /// phase ([`prepare_shared`](Self::prepare_shared) forgets it).
-    pub fn insert_shared(
+    ///
+    /// # Safety
+    ///
+    /// `readers_epoch` must not return more than the smallest epoch announced by a thread
+    /// that may still be reading the tree, and a thread may announce only where it holds
+    /// nothing from the tree (no query running, no [`Points`] iterator alive), with a
+    /// `Release` store that `readers_epoch` reads with `Acquire`. A block is reused on that
+    /// word: an answer that is too large lets the writer overwrite points a reader is
+    /// scanning, a data race. `tests/loom_shared.rs` model-checks the protocol when this is
+    /// kept. (`|| u64::MAX` is sound exactly when no other thread reads the tree.)
+    ///
+    /// [`Points`]: super::Points
+    pub unsafe fn insert_shared(
         &self,
         p: [f64; D],
         readers_epoch: impl FnOnce() -> u64,
@@ -303,8 +365,14 @@ impl<const D: usize> Orthtree<D> {
             w.readers_asked_at = epoch;
         }
         let known = w.readers_known;
-        w.pool.reclaim(&self.slots, known);
-        self.place(&mut w, &k, code, Some(epoch));
+        // SAFETY: `w` is this tree's writer, locked. `known` is an answer of `readers_epoch`
+        // (or 0): every reader has announced that epoch or a later one since it held nothing
+        // from the tree (the caller's promise, see above), so no reader holds a block retired
+        // before it.
+        unsafe { w.pool.reclaim(&self.slots, known) };
+        // SAFETY: `w` is this tree's writer, locked, and old blocks are retired at the current
+        // epoch, as readers may be scanning them.
+        unsafe { self.place(&mut w, &k, code, Some(epoch)) };
         self.shared.len.fetch_add(1, Ordering::Relaxed);
         w.since_epoch += 1;
         if w.since_epoch >= EPOCH_INSERTS {
@@ -345,7 +413,7 @@ impl<const D: usize> Orthtree<D> {
         let per = |used: usize, floor: f64| {
             let ratio = used as f64 / n as f64;
             let ratio = if small { ratio.max(floor) } else { ratio };
-            used + (ratio * points as f64 * 1.25) as usize + 4096
+            used + (ratio * points as f64 * 1.25) as usize + RESERVE_FLOOR
         };
         let nodes = per(w.nodes, 1.0) + levels;
         self.children.set_capacity(
@@ -358,7 +426,9 @@ impl<const D: usize> Orthtree<D> {
         let slots = per(w.pool.len, 2.0);
         self.slots
             .set_capacity(w.pool.len, self.slots.capacity().max(slots));
-        w.pool.reclaim(&self.slots, u64::MAX);
+        // SAFETY: `&mut self`: no reader holds anything from the tree, so every retired block
+        // can be reused; `self.slots` is the arena of `w.pool`.
+        unsafe { w.pool.reclaim(&self.slots, u64::MAX) };
         Ok(())
     }
 
@@ -367,7 +437,9 @@ impl<const D: usize> Orthtree<D> {
     pub fn finish_shared(&mut self) {
         let fanout = Self::FANOUT;
         let w = Self::writer_mut(&mut self.shared);
-        w.pool.reclaim(&self.slots, u64::MAX);
+        // SAFETY: `&mut self`: no reader holds anything from the tree, so every retired block
+        // can be reused; `self.slots` is the arena of `w.pool`.
+        unsafe { w.pool.reclaim(&self.slots, u64::MAX) };
         let keep = |len: usize| len + (len / 8).max(64);
         self.children.set_capacity(
             w.nodes * fanout,

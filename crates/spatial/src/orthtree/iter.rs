@@ -40,6 +40,10 @@ struct Frame<const D: usize> {
 }
 
 /// Iterator over the stored positions of an [`Orthtree`], from [`Orthtree::iter`].
+///
+/// Its stack only holds reached nodes (the root, and children read from the slots of reached
+/// nodes), with their levels, and `leaf` a reached leaf's points: the invariant its `unsafe`
+/// calls rely on.
 #[derive(Debug, Clone)]
 pub struct Points<'a, const D: usize> {
     tree: &'a Orthtree<D>,
@@ -58,7 +62,9 @@ impl<const D: usize> Iterator for Points<'_, D> {
         loop {
             if let Some(code) = self.leaf.get(self.pos) {
                 self.pos += 1;
-                self.remaining -= 1;
+                // Saturating: a shared insert during the iteration can add points beyond the
+                // count taken at its start.
+                self.remaining = self.remaining.saturating_sub(1);
                 let mut x = [0.0; D];
                 for i in 0..D {
                     x[i] = decode(self.leaf_origin[i], code[i], tree.step);
@@ -72,7 +78,8 @@ impl<const D: usize> Iterator for Points<'_, D> {
             }
             let ci = top.next;
             top.next += 1;
-            let child = tree.child(top.node as usize * Orthtree::<D>::FANOUT + ci);
+            // SAFETY: `top.node` is a reached node (the stack's invariant), `ci < FANOUT`.
+            let child = unsafe { tree.child(top.node as usize * Orthtree::<D>::FANOUT + ci) };
             if child == EMPTY {
                 continue;
             }
@@ -84,7 +91,10 @@ impl<const D: usize> Iterator for Points<'_, D> {
                 }
             }
             if top.level == 1 {
-                self.leaf = tree.leaf_points(child);
+                // SAFETY: a non-empty slot of a reached level-1 node: a reached leaf. A reader
+                // announces an epoch only while it holds no iterator (`insert_shared`'s
+                // promise), so the block outlives this borrow.
+                self.leaf = unsafe { tree.leaf_points(child) };
                 self.leaf_origin = origin.map(|o| o as f64 * tree.leaf_side);
                 self.pos = 0;
             } else {
@@ -104,6 +114,9 @@ impl<const D: usize> Iterator for Points<'_, D> {
     }
 }
 
+/// Exact when no [`insert_shared`](Orthtree::insert_shared) runs during the iteration (PDLA
+/// never iterates while it shares the tree); points such an insert adds may be yielded beyond
+/// the length taken at the start.
 impl<const D: usize> ExactSizeIterator for Points<'_, D> {}
 
 impl<'a, const D: usize> IntoIterator for &'a Orthtree<D> {

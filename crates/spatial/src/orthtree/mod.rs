@@ -93,6 +93,12 @@
 //!   so it is *retired* with the current epoch and reused only once every reader has announced
 //!   a later [`epoch`](Orthtree::epoch) (epoch-based reclamation; a walker announces at birth).
 //! - Compaction never runs while shared.
+//! - Soundness rests on the readers' side of that protocol: `insert_shared` trusts its
+//!   `readers_epoch` to answer no more than the smallest epoch announced by a thread still
+//!   reading, and readers announce only while they hold nothing from the tree (see
+//!   [`insert_shared`](Orthtree::insert_shared)). `tests/loom_shared.rs` model-checks the
+//!   protocol with loom on this code (`docs/spatial.md` has the command); `arena.rs` describes
+//!   the `unsafe fn`s and their contracts.
 //!
 //! # Variable-precision distance and its error bound
 //!
@@ -153,19 +159,28 @@
 //! # Ok::<(), spatial::orthtree::OrthtreeError>(())
 //! ```
 
+// `unsafe_code` is allowed in the orthtree's modules only: `arena` holds the raw buffers (the
+// only unsafe operations), the others call its `unsafe fn`s and their own, each call with a
+// `// SAFETY:` note (see `arena.rs`, "The unsafe boundary").
 mod arena;
+#[allow(unsafe_code)]
 mod insert;
+#[allow(unsafe_code)]
 mod iter;
+#[allow(unsafe_code)]
 mod pool;
+#[allow(unsafe_code)]
 mod query;
+mod sync;
 #[cfg(test)]
+#[allow(unsafe_code)]
 mod tests;
 
 use arena::Arena;
 use pool::LeafPool;
 use std::fmt;
-use std::sync::atomic::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Mutex, MutexGuard};
+use sync::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 
 pub use iter::Points;
 pub use query::{Neighbour, VpEstimate, dist_sq};
@@ -322,8 +337,9 @@ impl<T> std::ops::Deref for OwnLine<T> {
     }
 }
 
-/// Shared inserts between two advances of the reclamation epoch.
-const EPOCH_INSERTS: u32 = 64;
+/// Shared inserts between two advances of the reclamation epoch (1 in the model-checked
+/// build, so that a tiny loom test reaches block reuse).
+const EPOCH_INSERTS: u32 = if cfg!(loom) { 1 } else { 64 };
 
 /// Quadtree (`D = 2`), octree (`D = 3`) or `2^D`-ary tree of points with exact nearest-distance
 /// and variable-precision distance queries (the variable-precision paper, sections 3.1 and 3.3,
@@ -400,8 +416,29 @@ impl<const D: usize> fmt::Debug for Orthtree<D> {
 }
 
 impl<const D: usize> Clone for Orthtree<D> {
+    #[allow(unsafe_code)]
     fn clone(&self) -> Self {
-        let w = self.writer().clone();
+        // The writer's lock is held until the arenas are copied: a shared insert running
+        // meanwhile would write point slots inside the copied prefix (appends, reused blocks).
+        let guard = self.writer();
+        let w = &*guard;
+        // SAFETY: the writer's counts, read under its lock, are the initialised prefixes of
+        // the arenas (nodes, leaf records, pool slots), and the lock held keeps a shared writer
+        // from writing any of them meanwhile (readers only read).
+        let (children, leaves, slots) = unsafe {
+            (
+                self.children
+                    .duplicate(w.nodes * Self::FANOUT, self.children.capacity()),
+                self.leaves.duplicate(w.leaves, self.leaves.capacity()),
+                self.slots.duplicate(w.pool.len, self.slots.capacity()),
+            )
+        };
+        let shared = Box::new(Shared {
+            writer: Mutex::new(w.clone()),
+            len: AtomicUsize::new(self.len()),
+            epoch: OwnLine(AtomicU64::new(self.shared.epoch.load(Ordering::Acquire))),
+        });
+        drop(guard);
         Self {
             leaf_side: self.leaf_side,
             step: self.step,
@@ -410,16 +447,10 @@ impl<const D: usize> Clone for Orthtree<D> {
             root_level: self.root_level,
             root_origin: self.root_origin,
             anchor: self.anchor,
-            children: self
-                .children
-                .duplicate(w.nodes * Self::FANOUT, self.children.capacity()),
-            leaves: self.leaves.duplicate(w.leaves, self.leaves.capacity()),
-            slots: self.slots.duplicate(w.pool.len, self.slots.capacity()),
-            shared: Box::new(Shared {
-                writer: Mutex::new(w),
-                len: AtomicUsize::new(self.len()),
-                epoch: OwnLine(AtomicU64::new(self.shared.epoch.load(Ordering::Acquire))),
-            }),
+            children,
+            leaves,
+            slots,
+            shared,
             index_limit: self.index_limit,
         }
     }
@@ -515,21 +546,51 @@ impl<const D: usize> Orthtree<D> {
 
     /// Child slot `i` (a reader's view: `Acquire`, so a node, leaf or point reached through
     /// it is initialised).
+    ///
+    /// # Safety
+    ///
+    /// `i` is `n * FANOUT + c` with `c < FANOUT` and `n` a *reached* node: the root, or a
+    /// non-empty value read (by this function, or by the writer) from a child slot of a
+    /// reached node of level `>= 2`.
     #[inline(always)]
-    fn child(&self, i: usize) -> u32 {
-        self.children.get(i).load(Ordering::Acquire)
+    #[allow(unsafe_code)]
+    unsafe fn child(&self, i: usize) -> u32 {
+        // SAFETY: node n's slots were initialised by `new_node` before n was linked with a
+        // `Release` store that the load which reached n read with `Acquire` (or on this
+        // thread); child slots are never re-initialised while reachable.
+        unsafe { self.children.get(i) }.load(Ordering::Acquire)
     }
 
     /// Leaf record `i` (`Acquire`, so the points of its block are written).
+    ///
+    /// # Safety
+    ///
+    /// `i` is a *reached* leaf: a non-empty value read from a child slot of a reached
+    /// level-1 node (see [`child`](Self::child)).
     #[inline(always)]
-    fn leaf(&self, i: u32) -> Leaf {
-        Leaf::unpack(self.leaves.get(i as usize).load(Ordering::Acquire))
+    #[allow(unsafe_code)]
+    unsafe fn leaf(&self, i: u32) -> Leaf {
+        // SAFETY: leaf i's record was initialised before the `Release` store linking it, which
+        // the caller's `Acquire` load of the child slot read; reachable records are only
+        // stored into, never re-initialised.
+        Leaf::unpack(unsafe { self.leaves.get(i as usize) }.load(Ordering::Acquire))
     }
 
     /// The stored point records of leaf `i`.
+    ///
+    /// # Safety
+    ///
+    /// As for [`leaf`](Self::leaf); besides, a thread reading the tree while a shared writer
+    /// inserts announces an epoch only when it holds no slice from here (see
+    /// [`insert_shared`](Self::insert_shared)), so the block is not reused while the slice
+    /// lives.
     #[inline(always)]
-    fn leaf_points(&self, i: u32) -> &[[u32; D]] {
-        LeafPool::points(&self.slots, self.leaf(i))
+    #[allow(unsafe_code)]
+    unsafe fn leaf_points(&self, i: u32) -> &[[u32; D]] {
+        // SAFETY: `i` is a reached leaf (the caller's contract), and the record is loaded with
+        // `Acquire`, so it is a published record of this tree's pool whose block stays
+        // unwritten while the slice lives.
+        unsafe { LeafPool::points(&self.slots, self.leaf(i)) }
     }
 
     /// Side of the leaf cells (the variable-precision paper, section 3.1: the last level of the

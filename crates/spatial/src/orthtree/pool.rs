@@ -12,8 +12,8 @@
 
 use super::Leaf;
 use super::arena::{Arena, slow_growth};
+use super::sync::{AtomicU64, load_mut, store_mut};
 use std::collections::VecDeque;
-use std::sync::atomic::AtomicU64;
 
 /// Leaf sizes up to this many points get a block of exactly their size.
 const EXACT_CLASSES: u32 = 16;
@@ -106,24 +106,44 @@ impl LeafPool {
 
     /// A block of `cap` slots of class `class`, from the free list or the end of the pool
     /// (whose capacity the caller has checked).
-    fn alloc<const D: usize>(&mut self, slots: &Arena<[u32; D]>, class: usize, cap: u64) -> u32 {
+    ///
+    /// # Safety
+    ///
+    /// `slots` is the arena this pool carves (its first `self.len` slots are initialised, and
+    /// no reader can reach a block on a free list or beyond `self.len`), and the caller is the
+    /// tree's only writer (its lock held, or exclusive access).
+    unsafe fn alloc<const D: usize>(
+        &mut self,
+        slots: &Arena<[u32; D]>,
+        class: usize,
+        cap: u64,
+    ) -> u32 {
         let head = self.free[class];
         if head != NIL {
-            self.free[class] = slots.get(head as usize)[0];
+            // SAFETY: a free block's first slot holds its list link, written by `free` on this
+            // (the writer's) thread or under the lock a previous writer released.
+            self.free[class] = unsafe { slots.get(head as usize) }[0];
             self.free_slots -= cap as usize;
             head
         } else {
             let start = self.len;
             for i in start..start + cap as usize {
-                slots.init(i, [0; D]);
+                // SAFETY: slots from `self.len` on are in no block, so no reader can reach them.
+                unsafe { slots.init(i, [0; D]) };
             }
             self.len += cap as usize;
             start as u32
         }
     }
 
-    /// Puts the block at `start` (class `class`) on its free list; no reader may be scanning it.
-    fn free<const D: usize>(
+    /// Puts the block at `start` (class `class`) on its free list.
+    ///
+    /// # Safety
+    ///
+    /// As for [`alloc`](Self::alloc); besides, the block is one of this pool's and no reader
+    /// can be scanning it (it was replaced with exclusive access, or retired and then
+    /// reclaimed once every reader had announced a later epoch).
+    unsafe fn free<const D: usize>(
         &mut self,
         slots: &Arena<[u32; D]>,
         start: u32,
@@ -132,7 +152,8 @@ impl LeafPool {
     ) {
         let mut link = [0; D];
         link[0] = self.free[class];
-        slots.init(start as usize, link);
+        // SAFETY: no reader can reach the block (the caller's contract).
+        unsafe { slots.init(start as usize, link) };
         self.free[class] = start;
         self.free_slots += cap as usize;
     }
@@ -142,7 +163,14 @@ impl LeafPool {
     /// with `retire = Some(epoch)` (readers may be scanning it), to the retired blocks. The
     /// caller has checked the slot capacity ([`push_needs`](Self::push_needs)). The new point
     /// is written before the record that makes it visible is returned.
-    pub(super) fn push<const D: usize>(
+    ///
+    /// # Safety
+    ///
+    /// As for [`alloc`](Self::alloc); besides, `leaf` is a record of this pool (its block is
+    /// `leaf.start..` of class `class_of(leaf.len)`, its first `leaf.len` slots written) or
+    /// the empty record, and `retire` is `Some(current epoch)` whenever other threads may be
+    /// reading the tree (with `None` the replaced block is reused at once).
+    pub(super) unsafe fn push<const D: usize>(
         &mut self,
         slots: &Arena<[u32; D]>,
         leaf: Leaf,
@@ -153,17 +181,26 @@ impl LeafPool {
         let mut start = leaf.start;
         if n == 0 {
             let (class, cap) = class_of(1);
-            start = self.alloc(slots, class, cap);
+            // SAFETY: the caller's contract is `alloc`'s.
+            start = unsafe { self.alloc(slots, class, cap) };
         } else {
             let (old_class, old_cap) = class_of(n);
             if u64::from(n) == old_cap {
                 let (new_class, new_cap) = class_of(n + 1);
-                start = self.alloc(slots, new_class, new_cap);
+                // SAFETY: the caller's contract is `alloc`'s.
+                start = unsafe { self.alloc(slots, new_class, new_cap) };
                 for i in 0..n {
-                    slots.init((start + i) as usize, *slots.get((leaf.start + i) as usize));
+                    // SAFETY: the old block's first n slots are written (the caller's
+                    // contract); the new block is fresh or was free, so no reader reaches it
+                    // until the returned record is published.
+                    unsafe {
+                        slots.init((start + i) as usize, *slots.get((leaf.start + i) as usize));
+                    }
                 }
                 match retire {
-                    None => self.free(slots, leaf.start, old_class, old_cap),
+                    // SAFETY: `None` means no other thread reads the tree (the caller's
+                    // contract), so nobody scans the old block.
+                    None => unsafe { self.free(slots, leaf.start, old_class, old_cap) },
                     Some(epoch) => {
                         self.retired.push_back(Retired {
                             epoch,
@@ -176,7 +213,9 @@ impl LeafPool {
                 }
             }
         }
-        slots.init((start + n) as usize, code);
+        // SAFETY: slot n of the block lies beyond the published length n (or the block is
+        // new), so no reader reaches it until the returned record is published.
+        unsafe { slots.init((start + n) as usize, code) };
         Leaf { start, len: n + 1 }
     }
 
@@ -185,16 +224,24 @@ impl LeafPool {
         self.retired.front().map(|r| r.epoch)
     }
 
-    /// Moves the retired blocks of epochs before `safe` (every reader has announced `safe` or
-    /// later since) to the free lists.
-    pub(super) fn reclaim<const D: usize>(&mut self, slots: &Arena<[u32; D]>, safe: u64) {
+    /// Moves the retired blocks of epochs before `safe` to the free lists.
+    ///
+    /// # Safety
+    ///
+    /// As for [`alloc`](Self::alloc); besides, no reader still holds a block retired before
+    /// epoch `safe`: every thread reading the tree has announced `safe` or later since, at a
+    /// point where it held nothing from the tree, and the announcement was read with
+    /// `Acquire` (or there is no reader: exclusive access).
+    pub(super) unsafe fn reclaim<const D: usize>(&mut self, slots: &Arena<[u32; D]>, safe: u64) {
         while let Some(r) = self.retired.front().copied() {
             if r.epoch >= safe {
                 break;
             }
             self.retired.pop_front();
             self.retired_slots -= r.cap as usize;
-            self.free(slots, r.start, r.class as usize, u64::from(r.cap));
+            // SAFETY: retired at an epoch before `safe`, so no reader holds it (the caller's
+            // contract).
+            unsafe { self.free(slots, r.start, r.class as usize, u64::from(r.cap)) };
         }
     }
 
@@ -207,26 +254,32 @@ impl LeafPool {
     /// Slides every leaf's block down over the free blocks, in place (blocks keep their order
     /// and their class capacity), and empties the free lists (exclusive access: no reader, no
     /// retired block). O(slots + leaves log leaves), with a temporary index of 4 bytes per leaf.
-    pub(super) fn compact<const D: usize>(
+    ///
+    /// # Safety
+    ///
+    /// `slots` is the arena this pool carves and `leaves` are the records of its blocks.
+    pub(super) unsafe fn compact<const D: usize>(
         &mut self,
         slots: &mut Arena<[u32; D]>,
         leaves: &mut [AtomicU64],
     ) {
         debug_assert!(self.retired.is_empty());
         let mut order: Vec<u32> = (0..leaves.len() as u32)
-            .filter(|&l| Leaf::unpack(*leaves[l as usize].get_mut()).len > 0)
+            .filter(|&l| Leaf::unpack(load_mut(&mut leaves[l as usize])).len > 0)
             .collect();
-        order.sort_unstable_by_key(|&l| Leaf::unpack(*leaves[l as usize].get_mut()).start);
-        let pool = slots.prefix_mut(self.len);
+        order.sort_unstable_by_key(|&l| Leaf::unpack(load_mut(&mut leaves[l as usize])).start);
+        // SAFETY: the pool's first `self.len` slots are initialised (`alloc` writes every slot
+        // it appends), and `slots` is its arena (the caller's contract).
+        let pool = unsafe { slots.prefix_mut(self.len) };
         let mut cursor = 0usize;
         for l in order {
-            let rec = leaves[l as usize].get_mut();
-            let mut leaf = Leaf::unpack(*rec);
+            let rec = &mut leaves[l as usize];
+            let mut leaf = Leaf::unpack(load_mut(rec));
             let start = leaf.start as usize;
             debug_assert!(cursor <= start);
             pool.copy_within(start..start + leaf.len as usize, cursor);
             leaf.start = cursor as u32;
-            *rec = leaf.pack();
+            store_mut(rec, leaf.pack());
             cursor += class_of(leaf.len).1 as usize;
         }
         self.len = cursor;
@@ -234,11 +287,22 @@ impl LeafPool {
         self.free_slots = 0;
     }
 
-    /// The point records of `leaf` (a published record: its block is not written while the
-    /// slice lives).
+    /// The point records of `leaf`.
+    ///
+    /// # Safety
+    ///
+    /// `leaf` is a record of the pool carving `slots`, read on the writer's thread or loaded
+    /// with `Acquire` after its `Release` store, and its block is not written while the slice
+    /// lives (a shared writer only appends beyond the record's length, and reuses a replaced
+    /// block only after every reader that could hold it has announced a later epoch).
     #[inline(always)]
-    pub(super) fn points<const D: usize>(slots: &Arena<[u32; D]>, leaf: Leaf) -> &[[u32; D]] {
-        slots.slice(leaf.start as usize, leaf.len as usize)
+    pub(super) unsafe fn points<const D: usize>(
+        slots: &Arena<[u32; D]>,
+        leaf: Leaf,
+    ) -> &[[u32; D]] {
+        // SAFETY: the record's first `len` slots were written before it was published, and
+        // are not written while the slice lives (the caller's contract).
+        unsafe { slots.slice(leaf.start as usize, leaf.len as usize) }
     }
 }
 
@@ -276,40 +340,44 @@ mod tests {
         let mut pool = LeafPool::new();
         let mut a = Leaf { start: 0, len: 0 };
         let mut b = Leaf { start: 0, len: 0 };
-        for i in 0..40u32 {
-            pool.reserve(&mut slots, a.len);
-            a = pool.push(&slots, a, [i, 1000 + i], None);
-            if i % 3 == 0 {
-                pool.reserve(&mut slots, b.len);
-                b = pool.push(&slots, b, [i, 7], None);
+        // SAFETY (the pool calls below): one thread, no reader; `slots` is this pool's arena
+        // and every record passed is the empty one or one the pool returned.
+        unsafe {
+            for i in 0..40u32 {
+                pool.reserve(&mut slots, a.len);
+                a = pool.push(&slots, a, [i, 1000 + i], None);
+                if i % 3 == 0 {
+                    pool.reserve(&mut slots, b.len);
+                    b = pool.push(&slots, b, [i, 7], None);
+                }
             }
+            let pa: Vec<_> = LeafPool::points(&slots, a).to_vec();
+            assert_eq!(pa.len(), 40);
+            for (i, p) in pa.iter().enumerate() {
+                assert_eq!(*p, [i as u32, 1000 + i as u32]);
+            }
+            let pb: Vec<_> = LeafPool::points(&slots, b).to_vec();
+            assert_eq!(pb.len(), 14);
+            for (k, p) in pb.iter().enumerate() {
+                assert_eq!(*p, [3 * k as u32, 7]);
+            }
+            // Every block of a's and b's old classes was freed and partly reused by b.
+            let used = (class_of(40).1 + class_of(14).1) as usize;
+            assert_eq!(pool.len, used + pool.free_slots());
+            let mut leaves = [AtomicU64::new(a.pack()), AtomicU64::new(b.pack())];
+            pool.compact(&mut slots, &mut leaves);
+            let [a, b] = leaves.map(|l| Leaf::unpack(l.into_inner()));
+            assert_eq!(pool.len, used);
+            assert_eq!(pool.free_slots(), 0);
+            assert_eq!(LeafPool::points(&slots, a), &pa[..]);
+            assert_eq!(LeafPool::points(&slots, b), &pb[..]);
+            // Growing after compaction works.
+            pool.reserve(&mut slots, b.len);
+            let b = pool.push(&slots, b, [99, 99], None);
+            assert_eq!(LeafPool::points(&slots, b).len(), 15);
+            assert_eq!(LeafPool::points(&slots, b)[14], [99, 99]);
+            assert_eq!(LeafPool::points(&slots, a), &pa[..]);
         }
-        let pa: Vec<_> = LeafPool::points(&slots, a).to_vec();
-        assert_eq!(pa.len(), 40);
-        for (i, p) in pa.iter().enumerate() {
-            assert_eq!(*p, [i as u32, 1000 + i as u32]);
-        }
-        let pb: Vec<_> = LeafPool::points(&slots, b).to_vec();
-        assert_eq!(pb.len(), 14);
-        for (k, p) in pb.iter().enumerate() {
-            assert_eq!(*p, [3 * k as u32, 7]);
-        }
-        // Every block of a's and b's old classes was freed and partly reused by b.
-        let used = (class_of(40).1 + class_of(14).1) as usize;
-        assert_eq!(pool.len, used + pool.free_slots());
-        let mut leaves = [AtomicU64::new(a.pack()), AtomicU64::new(b.pack())];
-        pool.compact(&mut slots, &mut leaves);
-        let [a, b] = leaves.map(|l| Leaf::unpack(l.into_inner()));
-        assert_eq!(pool.len, used);
-        assert_eq!(pool.free_slots(), 0);
-        assert_eq!(LeafPool::points(&slots, a), &pa[..]);
-        assert_eq!(LeafPool::points(&slots, b), &pb[..]);
-        // Growing after compaction works.
-        pool.reserve(&mut slots, b.len);
-        let b = pool.push(&slots, b, [99, 99], None);
-        assert_eq!(LeafPool::points(&slots, b).len(), 15);
-        assert_eq!(LeafPool::points(&slots, b)[14], [99, 99]);
-        assert_eq!(LeafPool::points(&slots, a), &pa[..]);
     }
 
     #[test]
@@ -317,19 +385,24 @@ mod tests {
         let mut slots = Arena::<[u32; 2]>::new();
         let mut pool = LeafPool::new();
         let mut a = Leaf { start: 0, len: 0 };
-        for i in 0..3u32 {
-            pool.reserve(&mut slots, a.len);
-            a = pool.push(&slots, a, [i, i], Some(u64::from(i) + 1));
+        // SAFETY (the pool calls below): one thread, no reader, so no retired block is held;
+        // `slots` is this pool's arena and every record passed is the empty one or one the
+        // pool returned.
+        unsafe {
+            for i in 0..3u32 {
+                pool.reserve(&mut slots, a.len);
+                a = pool.push(&slots, a, [i, i], Some(u64::from(i) + 1));
+            }
+            // Blocks of 1 (epoch 2) and 2 (epoch 3) slots are retired, not free.
+            assert_eq!(pool.free_slots(), 3);
+            assert_eq!(pool.free[0], NIL);
+            pool.reclaim(&slots, 3);
+            assert_ne!(pool.free[0], NIL);
+            assert_eq!(pool.free[1], NIL);
+            pool.reclaim(&slots, u64::MAX);
+            assert_ne!(pool.free[1], NIL);
+            assert_eq!(pool.free_slots(), 3);
+            assert_eq!(LeafPool::points(&slots, a), &[[0, 0], [1, 1], [2, 2]]);
         }
-        // Blocks of 1 (epoch 2) and 2 (epoch 3) slots are retired, not free.
-        assert_eq!(pool.free_slots(), 3);
-        assert_eq!(pool.free[0], NIL);
-        pool.reclaim(&slots, 3);
-        assert_ne!(pool.free[0], NIL);
-        assert_eq!(pool.free[1], NIL);
-        pool.reclaim(&slots, u64::MAX);
-        assert_ne!(pool.free[1], NIL);
-        assert_eq!(pool.free_slots(), 3);
-        assert_eq!(LeafPool::points(&slots, a), &[[0, 0], [1, 1], [2, 2]]);
     }
 }

@@ -154,16 +154,22 @@ impl<const D: usize> Orthtree<D> {
             return;
         }
         let r_sq = r * r;
-        self.for_each_cover_cell(p, r, |tree, node, level, c, half| {
+        let cell = |tree: &Self, node, level, c, half| {
             if box_dist_sq(p, &c, half) > r_sq {
                 return;
             }
-            if level == 0 {
-                tree.range_leaf(p, r_sq, node, c, half, &mut f);
-            } else {
-                tree.range_node(p, r_sq, node, level, c, half, &mut f);
+            // SAFETY: `for_each_cover_cell` passes reached nodes (leaves at level 0) with
+            // their levels.
+            unsafe {
+                if level == 0 {
+                    tree.range_leaf(p, r_sq, node, c, half, &mut f);
+                } else {
+                    tree.range_node(p, r_sq, node, level, c, half, &mut f);
+                }
             }
-        });
+        };
+        // SAFETY: the tree is not empty (checked above).
+        unsafe { self.for_each_cover_cell(p, r, cell) };
     }
 
     /// [`vpdist_detailed`](Self::vpdist_detailed) given an upper bound `upper` of the exact
@@ -209,9 +215,11 @@ impl<const D: usize> Orthtree<D> {
         let s = if !(0.0..f64::INFINITY).contains(&upper) {
             None
         } else if kappa == f64::INFINITY || kappa.is_nan() {
-            self.walk_bounded::<false>(p, f64::INFINITY, upper)
+            // SAFETY: the tree is not empty (checked above).
+            unsafe { self.walk_bounded::<false>(p, f64::INFINITY, upper) }
         } else {
-            self.walk_bounded::<true>(p, far_factor::<D>(kappa), upper)
+            // SAFETY: the tree is not empty (checked above).
+            unsafe { self.walk_bounded::<true>(p, far_factor::<D>(kappa), upper) }
         };
         let s = match s {
             Some(s) => s,
@@ -232,7 +240,11 @@ impl<const D: usize> Orthtree<D> {
 
     /// The walk of [`vpdist_bounded`](Self::vpdist_bounded); `None` if nothing nearer than
     /// `upper` was found.
-    fn walk_bounded<const APPROX: bool>(
+    ///
+    /// # Safety
+    ///
+    /// The tree is not empty.
+    unsafe fn walk_bounded<const APPROX: bool>(
         &self,
         p: &[f64; D],
         far_factor: f64,
@@ -246,16 +258,22 @@ impl<const D: usize> Orthtree<D> {
             source: 0.0,
             point: [f64::NAN; D],
         };
-        self.for_each_cover_cell(p, upper, |tree, node, level, c, half| {
+        let cell = |tree: &Self, node, level, c, half| {
             if box_dist_sq(p, &c, half) >= s.best_sq {
                 return;
             }
-            if level == 0 {
-                tree.visit_leaf::<APPROX, true>(&mut s, node, c, half);
-            } else {
-                tree.visit::<APPROX, true>(&mut s, node, level, c, half);
+            // SAFETY: `for_each_cover_cell` passes reached nodes (leaves at level 0) with
+            // their levels.
+            unsafe {
+                if level == 0 {
+                    tree.visit_leaf::<APPROX, true>(&mut s, node, c, half);
+                } else {
+                    tree.visit::<APPROX, true>(&mut s, node, level, c, half);
+                }
             }
-        });
+        };
+        // SAFETY: the tree is not empty (the caller's contract).
+        unsafe { self.for_each_cover_cell(p, upper, cell) };
         (s.best < upper).then_some(s)
     }
 
@@ -265,8 +283,15 @@ impl<const D: usize> Orthtree<D> {
     /// is at least `2 r`, or the root if that level is not below the root. `level == 0` means
     /// `node` is a leaf index. Finding the nodes costs one descent per node with no distance
     /// computation (the range and bounded queries then start there, not at the root).
+    ///
+    /// Every `node` passed to `f` is a reached node of level `level` (a reached leaf for
+    /// `level == 0`): the root, or read from the slots of reached nodes.
+    ///
+    /// # Safety
+    ///
+    /// The tree is not empty.
     #[inline]
-    fn for_each_cover_cell<F: FnMut(&Self, u32, u32, [f64; D], f64)>(
+    unsafe fn for_each_cover_cell<F: FnMut(&Self, u32, u32, [f64; D], f64)>(
         &self,
         p: &[f64; D],
         r: f64,
@@ -330,7 +355,11 @@ impl<const D: usize> Orthtree<D> {
         let mut top = self.root;
         let mut top_level = self.root_level;
         while top_level > split {
-            let child = self.child(top as usize * Self::FANOUT + self.child_index(&k0, top_level));
+            // SAFETY: `top` is the root (the tree is not empty: the caller's contract) or was
+            // read from its parent's slot at level top_level + 1 >= 2.
+            let child = unsafe {
+                self.child(top as usize * Self::FANOUT + self.child_index(&k0, top_level))
+            };
             if child == EMPTY {
                 return;
             }
@@ -351,7 +380,10 @@ impl<const D: usize> Orthtree<D> {
             let mut node = top;
             let mut l = top_level;
             while l > level {
-                let child = self.child(node as usize * Self::FANOUT + self.child_index(&k, l));
+                // SAFETY: `node` is `top` (reached) or was read from its parent's slot at
+                // level l + 1 >= 2.
+                let child =
+                    unsafe { self.child(node as usize * Self::FANOUT + self.child_index(&k, l)) };
                 if child == EMPTY {
                     continue 'cells;
                 }
@@ -392,7 +424,8 @@ impl<const D: usize> Orthtree<D> {
             point: [f64::NAN; D],
         };
         let (c, half) = self.root_geometry();
-        self.visit::<APPROX, TRACK>(&mut s, self.root, self.root_level, c, half);
+        // SAFETY: the root of a non-empty tree (checked above) at its level.
+        unsafe { self.visit::<APPROX, TRACK>(&mut s, self.root, self.root_level, c, half) };
         Some(s)
     }
 
@@ -422,7 +455,12 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// Listing 1 for an internal node at `level >= 1` with centre `c` and half side `half`.
-    fn visit<const APPROX: bool, const TRACK: bool>(
+    ///
+    /// # Safety
+    ///
+    /// `node` is a reached node (the root, or read from a slot of a reached node) of level
+    /// `level`.
+    unsafe fn visit<const APPROX: bool, const TRACK: bool>(
         &self,
         s: &mut Search<D>,
         node: u32,
@@ -451,7 +489,8 @@ impl<const D: usize> Orthtree<D> {
         let base = node as usize * Self::FANOUT;
         for &m in &CHILD_ORDER[D][..Self::FANOUT] {
             let ci = home ^ m as usize;
-            let child = self.child(base + ci);
+            // SAFETY: `node` is a reached node (the caller's contract), `ci < FANOUT`.
+            let child = unsafe { self.child(base + ci) };
             if child == EMPTY {
                 continue;
             }
@@ -471,17 +510,25 @@ impl<const D: usize> Orthtree<D> {
                     *x -= q;
                 }
             }
-            if level == 1 {
-                self.visit_leaf::<APPROX, TRACK>(s, child, cc, q);
-            } else {
-                self.visit::<APPROX, TRACK>(s, child, level - 1, cc, q);
+            // SAFETY: a non-empty slot of a reached node of level `level`: a reached leaf
+            // if `level == 1`, else a reached node of level `level - 1`.
+            unsafe {
+                if level == 1 {
+                    self.visit_leaf::<APPROX, TRACK>(s, child, cc, q);
+                } else {
+                    self.visit::<APPROX, TRACK>(s, child, level - 1, cc, q);
+                }
             }
         }
     }
 
     /// Listing 1, lines 07-19 for a leaf: far test, then exact scan of its points.
+    ///
+    /// # Safety
+    ///
+    /// `leaf` is a reached leaf (read from a slot of a reached level-1 node).
     #[inline]
-    fn visit_leaf<const APPROX: bool, const TRACK: bool>(
+    unsafe fn visit_leaf<const APPROX: bool, const TRACK: bool>(
         &self,
         s: &mut Search<D>,
         leaf: u32,
@@ -492,7 +539,8 @@ impl<const D: usize> Orthtree<D> {
             return;
         }
         let origin = c.map(|x| x - half);
-        let pts = self.leaf_points(leaf);
+        // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
+        let pts = unsafe { self.leaf_points(leaf) };
         let (best_sq, best_j) = nearest_in_leaf(&s.p, &origin, self.step, pts, s.best_sq);
         if best_j != usize::MAX {
             s.best_sq = best_sq;
@@ -508,8 +556,12 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// Range query below a node (centre `c`, half side `half`) already known to meet the ball.
+    ///
+    /// # Safety
+    ///
+    /// `node` is a reached node of level `level`, as for [`visit`](Self::visit).
     #[allow(clippy::too_many_arguments)]
-    fn range_node<F: FnMut([f64; D])>(
+    unsafe fn range_node<F: FnMut([f64; D])>(
         &self,
         p: &[f64; D],
         r_sq: f64,
@@ -531,7 +583,8 @@ impl<const D: usize> Orthtree<D> {
         }
         let base = node as usize * Self::FANOUT;
         for ci in 0..Self::FANOUT {
-            let child = self.child(base + ci);
+            // SAFETY: `node` is a reached node (the caller's contract), `ci < FANOUT`.
+            let child = unsafe { self.child(base + ci) };
             if child == EMPTY {
                 continue;
             }
@@ -550,10 +603,14 @@ impl<const D: usize> Orthtree<D> {
                     *x -= q;
                 }
             }
-            if level == 1 {
-                self.range_leaf(p, r_sq, child, cc, q, f);
-            } else {
-                self.range_node(p, r_sq, child, level - 1, cc, q, f);
+            // SAFETY: a non-empty slot of a reached node of level `level`: a reached leaf
+            // if `level == 1`, else a reached node of level `level - 1`.
+            unsafe {
+                if level == 1 {
+                    self.range_leaf(p, r_sq, child, cc, q, f);
+                } else {
+                    self.range_node(p, r_sq, child, level - 1, cc, q, f);
+                }
             }
         }
     }
@@ -561,8 +618,12 @@ impl<const D: usize> Orthtree<D> {
 
 impl<const D: usize> Orthtree<D> {
     /// Range query inside a leaf (centre `c`, half side `half`).
+    ///
+    /// # Safety
+    ///
+    /// `leaf` is a reached leaf, as for [`visit_leaf`](Self::visit_leaf).
     #[inline]
-    fn range_leaf<F: FnMut([f64; D])>(
+    unsafe fn range_leaf<F: FnMut([f64; D])>(
         &self,
         p: &[f64; D],
         r_sq: f64,
@@ -572,7 +633,8 @@ impl<const D: usize> Orthtree<D> {
         f: &mut F,
     ) {
         let origin = c.map(|x| x - half);
-        for code in self.leaf_points(leaf) {
+        // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
+        for code in unsafe { self.leaf_points(leaf) } {
             let mut x = [0.0; D];
             let mut d2 = 0.0;
             for i in 0..D {

@@ -80,7 +80,10 @@ fn shared_inserts_while_readers_query() {
                     .min()
                     .unwrap()
             };
-            assert_eq!(t.insert_shared(p, readers).unwrap().0, stored[i]);
+            // SAFETY: each reader announces its epoch between queries only (Release), and
+            // `readers` is the minimum of the announcements (Acquire).
+            let (at, _) = unsafe { t.insert_shared(p, readers) }.unwrap();
+            assert_eq!(at, stored[i]);
             published.store(i + 1, Ordering::Release);
             // Readers are far slower than the writer here (their answers are checked by brute
             // force); let them catch up now and then, as PDLA's walkers do at every birth.
@@ -136,8 +139,9 @@ fn shared_inserts_that_need_exclusive_access_change_nothing() {
     t.insert([0.0, 0.0]).unwrap();
     t.prepare_shared(10, 50.0).unwrap();
     let before = (t.len(), t.stats(), t.root_cell());
+    // SAFETY (here and below): no other thread reads the tree, so `u64::MAX` is truthful.
     assert_eq!(
-        t.insert_shared([1e6, 0.0], || u64::MAX),
+        unsafe { t.insert_shared([1e6, 0.0], || u64::MAX) },
         Err(OrthtreeError::NeedsExclusive)
     );
     assert_eq!((t.len(), t.stats(), t.root_cell()), before);
@@ -149,7 +153,7 @@ fn shared_inserts_that_need_exclusive_access_change_nothing() {
             (i / 20 % 20) as f64 * 4.0 - 40.0 + 0.5,
         ];
         let before = (t.len(), t.stats());
-        match t.insert_shared(p, || u64::MAX) {
+        match unsafe { t.insert_shared(p, || u64::MAX) } {
             Ok(_) => i += 1,
             Err(e) => {
                 assert_eq!((t.len(), t.stats()), before);
@@ -181,10 +185,14 @@ fn shared_inserts_ask_the_readers_once_per_epoch() {
                 (i / 97 % 89) as f64 * 0.3 - 13.0,
             ];
             let announced = if reader_keeps_up { t.epoch() } else { 1 };
-            t.insert_shared(p, || {
-                asked += 1;
-                announced
-            })
+            // SAFETY: no other thread reads the tree; any answer is truthful (a too-small one
+            // only keeps blocks from reuse, which is what this test measures).
+            unsafe {
+                t.insert_shared(p, || {
+                    asked += 1;
+                    announced
+                })
+            }
             .unwrap();
         }
         let slots = t.stats().point_slots;
