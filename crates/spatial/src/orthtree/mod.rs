@@ -93,7 +93,8 @@
 //!   so it is *retired* with the current epoch and reused only once every reader has announced
 //!   a later [`epoch`](Orthtree::epoch) (epoch-based reclamation; a walker announces at birth).
 //! - Compaction never runs while shared.
-//! - Soundness rests on the readers' side of that protocol: `insert_shared` trusts its
+//! - Soundness rests on the readers' side of that protocol: `insert_shared` (an `unsafe fn`)
+//!   trusts its
 //!   `readers_epoch` to answer no more than the smallest epoch announced by a thread still
 //!   reading, and readers announce only while they hold nothing from the tree (see
 //!   [`insert_shared`](Orthtree::insert_shared)). `tests/loom_shared.rs` model-checks the
