@@ -1,20 +1,25 @@
 //! Perception: the neighbour queries the rules ask ("a fox adjacent?", "the nearest rabbit
 //! within vision", "overcrowded?", "enough prey?"). Each is answered from the cell index first
-//! (the cells around the animat, then rings of cells up to `RING_MAX`) and handed to the wide
-//! search over grid boxes (`wide`) when the rings cannot settle it; with the cell search off,
-//! every query goes to the grid boxes ([`spatial::plane::PlaneGrid`]).
+//! (the cells around the animat through [`spatial::cells::near`], then rings of cells up to
+//! `RING_MAX`) and handed to the index's wide search over grid boxes
+//! ([`spatial::cells::wide`]) when the rings cannot settle it; with the cell search off, every
+//! query goes to the paper's grid boxes ([`spatial::plane::PlaneGrid`]).
+//!
+//! Stays in the model: this is the dispatch of the rules' queries (which path answers which
+//! rule, with the model's radii, counters and grid staleness); the searches it calls are
+//! `spatial`'s.
 //!
 //! Invariants: every path gives the exact answer, ties going to the lower id, so the trajectory
 //! does not depend on the path or on the grid-box size; a query that needs the grid while
 //! changes are still logged does not read it but marks the decision stale ([`Tally::stale`]),
 //! and the decision is made again once the grid is up to date.
 
-use super::near::{
+use super::{ADJACENT_R2, Animat, DIRECTIONS, RING_MAX, World, kind_byte};
+use crate::params::Species;
+use spatial::cells::near::{
     NEAR_HALF, Near, RING_CLASSES, byte_sum, count_in, kind_bits, lowest_in, row_cell,
 };
-use super::{ADJACENT_R2, Animat, DIRECTIONS, RING_MAX, World};
-use crate::cells::{FREE, SPECIES, kind_byte};
-use crate::params::Species;
+use spatial::cells::{FREE, KIND_MASK};
 use spatial::plane::Pos;
 
 /// Query and work counters of one decision (added to the world's afterwards).
@@ -50,14 +55,52 @@ impl World {
     /// The cells around `a` for the cell-index fast path (no window when the fast path is
     /// off or `a` is too near the `i64` limits).
     pub(super) fn near(&self, a: &Animat) -> Near<'_> {
-        Near {
-            w: if self.cell_search {
-                self.cells.window(a.pos, RING_MAX)
-            } else {
-                None
-            },
-            rows: None,
-        }
+        Near::new(if self.cell_search {
+            self.cells.window(a.pos, RING_MAX)
+        } else {
+            None
+        })
+    }
+
+    /// The box side of the wide search: the grid-box setting, or (for `none`) one box holding
+    /// the whole plane.
+    fn wide_side(&self) -> i64 {
+        self.grid.box_size().side().unwrap_or(i64::MAX)
+    }
+
+    /// The nearest animat of `kind` within squared distance `r2` of `p`, other than the one
+    /// on `p`, from the cell index's wide search.
+    #[inline]
+    pub(super) fn wide_nearest(
+        &self,
+        p: Pos,
+        kind: Species,
+        r2: u64,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        let kinds = kind_byte(kind == Species::Rabbit);
+        let (found, evals) = self.cells.nearest_within(p, kinds, r2, self.wide_side());
+        t.evals += evals;
+        found
+    }
+
+    /// Whether at least `n` animats (of `kind`, or of either species) lie within squared
+    /// distance `r2` of `p`, the one on `p` not counted, from the cell index's wide search.
+    #[inline]
+    pub(super) fn wide_at_least(
+        &self,
+        p: Pos,
+        kind: Option<Species>,
+        r2: u64,
+        n: usize,
+        t: &mut Tally,
+    ) -> bool {
+        let kinds = kind.map_or(KIND_MASK, |k| kind_byte(k == Species::Rabbit));
+        let (enough, evals) = self
+            .cells
+            .at_least_within(p, kinds, r2, n, self.wide_side());
+        t.evals += evals;
+        enough
     }
 
     /// Whether the grid lags behind the logged changes; if so, notes in `t` that the
@@ -134,7 +177,7 @@ impl World {
         t: &mut Tally,
     ) -> Option<Pos> {
         t.nearest += 1;
-        if near.w.is_some() {
+        if near.window().is_some() {
             let k_max = RING_MAX.min(self.params.vision);
             let kb = kind_byte(kind == Species::Rabbit);
             let [x, y] = a.pos;
@@ -161,7 +204,7 @@ impl World {
                 }
                 k_first = 3;
             }
-            let w = near.w.as_ref().expect("the window is present");
+            let w = near.window().expect("the window is present");
             // Best as (d2, position, id bucket, id once read): a tie of distances goes to
             // the lower bucket, and ids (in a larger array that is rarely in cache) are read
             // only when the buckets are equal too.
@@ -169,7 +212,7 @@ impl World {
             let mut best: Best = None;
             let mut look = |dx: i64, dy: i64, best: &mut Best| {
                 let byte = w.byte(x + dx, y + dy);
-                if byte & SPECIES == kb {
+                if byte & KIND_MASK == kb {
                     evals += 1;
                     let d2 = (dx * dx + dy * dy) as u64;
                     let c = [x + dx, y + dy];
@@ -226,7 +269,7 @@ impl World {
         t.count += 1;
         let n = self.params.crowd_max as usize + 1;
         let r = self.params.crowd_radius;
-        if near.w.is_some() {
+        if near.window().is_some() {
             if r <= NEAR_HALF {
                 // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
                 // the masks keep the cells within the radius.
@@ -241,7 +284,7 @@ impl World {
                 return count >= n;
             }
             if r <= RING_MAX {
-                let w = near.w.as_ref().expect("the window is present");
+                let w = near.window().expect("the window is present");
                 let [x, y] = a.pos;
                 let mut count = 0;
                 for d in &self.crowd_offsets {
@@ -274,7 +317,7 @@ impl World {
     pub(super) fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
         t.count += 1;
         let n = self.params.prey_needed as usize;
-        if let (Some(w), true) = (near.w.as_ref(), n > 0) {
+        if let (Some(w), true) = (near.window(), n > 0) {
             let k_max = RING_MAX.min(self.params.vision);
             let [x, y] = a.pos;
             let v2 = self.vision2;
