@@ -526,7 +526,7 @@ impl CellIndex {
     /// around `p` (cells `x - 2 ..= x + 5` of rows `y - 2 ..= y + 2`), for a prefetch hint:
     /// the caller can ask the CPU to start loading them without waiting (this crate has no
     /// `unsafe` code of its own for it). Only the lines in `p`'s own tile are given
-    /// ([`near_corners`]); the rest are rare and load on use. A line may be given twice.
+    /// (`near_corners`); the rest are rare and load on use. A line may be given twice.
     #[inline]
     pub fn near_lines(&self, p: [i64; 2], mut touch: impl FnMut(&u8)) {
         let (key, _) = split(p);
