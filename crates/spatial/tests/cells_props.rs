@@ -2,7 +2,8 @@
 //!
 //! The cell index is the animat model's hot-path search: after any sequence of puts, clears,
 //! moves and re-bucketings, every cell read (directly, through a window and its row words),
-//! every rectangle scan, the near cache's bit tricks and the wide grid-box queries must equal
+//! every rectangle scan, the near cache's bit tricks, the ring searches of a window and the
+//! wide grid-box queries must equal
 //! an exhaustive scan over an independent model of the items, ties (lower id wins) included,
 //! for every box side of the wide queries.
 //!
@@ -293,5 +294,65 @@ proptest! {
                 }
             }
         }
+    }
+
+    /// The ring searches of a window equal a scan of the rings (and, once settled, of the
+    /// whole plane).
+    #[test]
+    fn ring_searches_match_brute_force(
+        ops in prop::collection::vec(prop_oneof![
+            2 => ((-10i64..=10, -10i64..=10), kind()).prop_map(|((x, y), k)| Op::Put([x, y], k)),
+            1 => op(),
+        ], 0..150),
+        shift in 0u32..8,
+        probes in prop::collection::vec(
+            (any::<Index>(), pos(), any::<bool>(), kind(), radius(), 1i64..=3, 0i64..=WINDOW_MAX, 1usize..8),
+            1..6,
+        ),
+    ) {
+        let (mut c, m) = build(&ops);
+        c.rebucket(0, shift, m.iter().map(|(p, v)| (*p, v.0)));
+        for (i, free, on_item, kb, r2, k_first, k_max, n) in &probes {
+            let p = query_point(&m, i, *free, *on_item);
+            let Some(w) = c.window(p, WINDOW_MAX) else { continue };
+            let cheb = |q: &Pos| p[0].abs_diff(q[0]).max(p[1].abs_diff(q[1])) as i64;
+            let of_kind = |lo: i64, hi: i64| {
+                m.iter()
+                    .filter(move |(q, v)| {
+                        v.1 == *kb && (lo..=hi).contains(&cheb(q)) && dist2(p, **q) <= u128::from(*r2)
+                    })
+                    .map(|(q, v)| (dist2(p, *q), v.0, *q))
+            };
+            let got = w.nearest_in_rings(p, *kb, *r2, *k_first, *k_max);
+            let want = if got.settled {
+                of_kind(*k_first, i64::MAX).min()
+            } else {
+                of_kind(*k_first, *k_max).min()
+            };
+            prop_assert_eq!(got.found, want.map(|t| t.2), "p {:?} r2 {} settled {}", p, r2, got.settled);
+            if !got.settled {
+                // Not settled only when another ring could matter.
+                prop_assert!(*k_max < *k_first || ((*k_max + 1) * (*k_max + 1)) as u64 <= *r2);
+            }
+            let count = of_kind(1, *k_max).count();
+            prop_assert_eq!(w.count_in_rings(p, *kb, *r2, *n, *k_max), (count >= *n, count.min(*n)));
+        }
+    }
+}
+
+/// A tie across rings: (4, 3) in ring 4 and (5, 0) in ring 5 are both at squared distance 25,
+/// so ring 4 cannot settle the search and the lower id, in ring 5, wins.
+#[test]
+fn ring_search_ties_across_rings_go_to_the_lower_id() {
+    for (near_id, far_id) in [(2, 1), (1, 2)] {
+        let mut c = CellIndex::default();
+        c.rebucket(0, 8, std::iter::empty());
+        c.set([4, 3], KIND_B, near_id);
+        c.set([5, 0], KIND_B, far_id);
+        let w = c.window([0, 0], WINDOW_MAX).unwrap();
+        let got = w.nearest_in_rings([0, 0], KIND_B, 100, 1, 8);
+        let want = if far_id < near_id { [5, 0] } else { [4, 3] };
+        assert_eq!(got.found, Some(want));
+        assert!(got.settled);
     }
 }

@@ -1,7 +1,7 @@
 //! Perception: the neighbour queries the rules ask ("a fox adjacent?", "the nearest rabbit
 //! within vision", "overcrowded?", "enough prey?"). Each is answered from the cell index first
 //! (the cells around the animat through [`spatial::cells::near`], then rings of cells up to
-//! `RING_MAX`) and handed to the index's wide search over grid boxes
+//! `RING_MAX` through [`spatial::cells::rings`]) and handed to the index's wide search over grid boxes
 //! ([`spatial::cells::wide`]) when the rings cannot settle it; with the cell search off, every
 //! query goes to the paper's grid boxes ([`spatial::plane::PlaneGrid`]).
 //!
@@ -31,24 +31,6 @@ pub(super) struct Tally {
     pub(super) evals: u64,
     /// A query needed the grid while it lagged behind the logged changes.
     pub(super) stale: bool,
-}
-
-/// Visits the cells of ring `k >= 1` (Chebyshev distance `k`) as offsets `(dx, dy)` in a fixed
-/// order (the bottom and top rows pairwise by `dx`, then the left and right columns pairwise by
-/// `dy`) until `visit` returns `true`; returns whether it did.
-#[inline(always)]
-fn ring_until(k: i64, mut visit: impl FnMut(i64, i64) -> bool) -> bool {
-    for dx in -k..=k {
-        if visit(dx, -k) || visit(dx, k) {
-            return true;
-        }
-    }
-    for dy in (-k + 1)..k {
-        if visit(-k, dy) || visit(k, dy) {
-            return true;
-        }
-    }
-    false
 }
 
 impl World {
@@ -180,9 +162,6 @@ impl World {
         if near.window().is_some() {
             let k_max = RING_MAX.min(self.params.vision);
             let kb = kind_byte(kind == Species::Rabbit);
-            let [x, y] = a.pos;
-            let v2 = self.vision2;
-            let mut evals = 0;
             // Rings 1 and 2 from the row words when they lie within vision.
             let mut k_first = 1;
             if self.params.vision >= 3 {
@@ -205,49 +184,11 @@ impl World {
                 k_first = 3;
             }
             let w = near.window().expect("the window is present");
-            // Best as (d2, position, id bucket, id once read): a tie of distances goes to
-            // the lower bucket, and ids (in a larger array that is rarely in cache) are read
-            // only when the buckets are equal too.
-            type Best = Option<(u64, Pos, u8, Option<u64>)>;
-            let mut best: Best = None;
-            let mut look = |dx: i64, dy: i64, best: &mut Best| {
-                let byte = w.byte(x + dx, y + dy);
-                if byte & KIND_MASK == kb {
-                    evals += 1;
-                    let d2 = (dx * dx + dy * dy) as u64;
-                    let c = [x + dx, y + dy];
-                    let cb = byte >> 2;
-                    match best {
-                        _ if d2 > v2 => {}
-                        None => *best = Some((d2, c, cb, None)),
-                        Some((bd, bp, bb, bid)) => {
-                            if d2 < *bd || (d2 == *bd && cb < *bb) {
-                                *best = Some((d2, c, cb, None));
-                            } else if d2 == *bd && cb == *bb {
-                                let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
-                                let id = w.id(c[0], c[1]);
-                                if id < bi {
-                                    *best = Some((d2, c, cb, Some(id)));
-                                }
-                            }
-                        }
-                    }
-                }
-            };
-            for k in k_first..=k_max {
-                ring_until(k, |dx, dy| {
-                    look(dx, dy, &mut best);
-                    false
-                });
-                // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
-                // than that is final (an equally near one could still win on id).
-                let next = ((k + 1) * (k + 1)) as u64;
-                if best.is_some_and(|(bd, _, _, _)| bd < next) || next > v2 {
-                    t.evals += evals;
-                    return best.map(|(_, p, _, _)| p);
-                }
+            let rings = w.nearest_in_rings(a.pos, kb, self.vision2, k_first, k_max);
+            t.evals += rings.evals;
+            if rings.settled {
+                return rings.found;
             }
-            t.evals += evals;
         }
         if self.cell_search {
             return self.wide_nearest(a.pos, kind, self.vision2, t);
@@ -319,23 +260,7 @@ impl World {
         let n = self.params.prey_needed as usize;
         if let (Some(w), true) = (near.window(), n > 0) {
             let k_max = RING_MAX.min(self.params.vision);
-            let [x, y] = a.pos;
-            let v2 = self.vision2;
-            let kb = kind_byte(true);
-            let mut count = 0usize;
-            let mut look = |dx: i64, dy: i64| -> bool {
-                if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
-                    count += 1;
-                }
-                count >= n
-            };
-            let mut found = false;
-            for k in 1..=k_max {
-                if ring_until(k, &mut look) {
-                    found = true;
-                    break;
-                }
-            }
+            let (found, count) = w.count_in_rings(a.pos, kind_byte(true), self.vision2, n, k_max);
             t.evals += count as u64;
             // Rings 1..=k_max cover the whole vision disc when k_max = vision.
             if found || k_max == self.params.vision {

@@ -2,8 +2,8 @@
 //! per cell, each item an id (`u64`) and one of two kinds. It is the animat model's hot-path
 //! neighbour search (the grid boxes of [`plane`](crate::plane) remain the paper's baseline
 //! setting): the model asks "what stands on this cell", reads the cells around an animat
-//! through a [`Window`] and its row words ([`near`]), and answers the queries beyond them with
-//! rings of grid boxes read from the index ([`wide`]).
+//! through a [`Window`], its row words ([`near`]) and its rings of cells ([`rings`]), and
+//! answers the queries beyond them with rings of grid boxes read from the index ([`wide`]).
 //!
 //! The plane is cut into square tiles of [`TILE`] x [`TILE`] cells; each tile that holds an
 //! item has a cell byte per cell and, in a parallel array, the id of the item on the cell.
@@ -35,6 +35,7 @@
 //! wide queries: `tests/cells_props.rs` checks them against a brute-force scan.
 
 pub mod near;
+pub mod rings;
 pub mod wide;
 
 use rustc_hash::FxHashMap;
