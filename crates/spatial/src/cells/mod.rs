@@ -172,6 +172,7 @@ impl CellIndex {
     }
 
     /// Whether tile coordinates `key` lie in the directory's rectangle.
+    #[inline]
     fn in_dir(&self, key: [i64; 2]) -> Option<usize> {
         let u = key[0].wrapping_sub(self.dx0) as u64;
         let v = key[1].wrapping_sub(self.dy0) as u64;
@@ -566,6 +567,7 @@ impl CellIndex {
 /// The corners of the part of `x - 2 ..= x + 5`, `y - 2 ..= y + 2` around `p = [x, y]` that
 /// lies in `p`'s tile. That part spans at most 2 x 2 blocks of 8 x 8 cells (it is 8 x 5 cells),
 /// so its corners touch every block, hence every cache line of kind bytes, that it covers.
+#[inline]
 fn near_corners(p: [i64; 2]) -> [[i64; 2]; 4] {
     // The tile's cells are `k << SHIFT ..= (k << SHIFT) + TILE - 1` on each axis, with
     // `k = v >> SHIFT` (no overflow: `k << SHIFT <= v`).

@@ -31,6 +31,7 @@ struct Rings {
 }
 
 impl Rings {
+    #[inline]
     fn new(a: i64, p: Pos) -> Self {
         let a = i128::from(a);
         let p = [i128::from(p[0]), i128::from(p[1])];
@@ -45,6 +46,7 @@ impl Rings {
     }
 
     /// Whether ring `k` can hold a cell within squared distance `limit`.
+    #[inline]
     fn reaches(&self, k: i128, limit: u64) -> bool {
         if k == 0 {
             return true;
@@ -54,6 +56,7 @@ impl Rings {
     }
 
     /// The last ring that meets the square of half-side `r` around the point.
+    #[inline]
     fn last(&self, r: i128) -> i128 {
         let lo = [
             (self.p[0] - r).div_euclid(self.a),
@@ -71,6 +74,7 @@ impl Rings {
 
     /// The cells of box `(dx, dy)` (in boxes from the point's) within the square of half-side
     /// `r` around the point, as `i64` ranges, or `None` when they are none.
+    #[inline]
     fn cells(&self, dx: i128, dy: i128, r: i128) -> Option<([i64; 2], [i64; 2])> {
         let axis = |b: i128, p: i128| -> Option<[i64; 2]> {
             let lo = (b * self.a).max(p - r).max(i128::from(i64::MIN));
@@ -84,6 +88,7 @@ impl Rings {
     }
 
     /// Visits the boxes of ring `k` (in a fixed order) until `visit` breaks.
+    #[inline]
     fn ring(
         &self,
         k: i128,
@@ -242,6 +247,7 @@ impl CellIndex {
 }
 
 /// The square of half-side `r` around `p`, clamped to the `i64` plane.
+#[inline]
 fn square(p: Pos, r: i128) -> ([i64; 2], [i64; 2]) {
     let axis = |c: i64| {
         let c = i128::from(c);

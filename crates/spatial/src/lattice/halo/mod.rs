@@ -266,7 +266,6 @@ impl HaloGrid {
     /// writes the clusters then face-adjacent to it to `contacts`, in increasing id: moves the
     /// shape and its region, re-lists the halo's boxes where it crossed a box boundary, and
     /// tests the candidates sharing a box with it. Returns the number of candidates examined.
-    #[inline]
     pub fn try_move(
         &mut self,
         id: ItemId,
