@@ -5,8 +5,10 @@
 //! IV.B), stated precisely in `docs/animat.md`: animats on the unbounded integer plane, one
 //! per cell, each running its species' rule list in priority order and executing the first
 //! rule whose condition holds. Perception is lazy: a rule asks only the neighbour queries its
-//! condition needs. Neighbour searches go through [`spatial::plane::PlaneGrid`]; every grid-box
-//! size, and the exhaustive "no grid" search, gives a bit-identical trajectory.
+//! condition needs. Neighbour searches go through `spatial`: by default the dense per-cell
+//! index [`spatial::cells::CellIndex`] (the hot path), else the paper's grid boxes
+//! [`spatial::plane::PlaneGrid`] (the baseline setting); every path and every grid-box size,
+//! and the exhaustive "no grid" search, gives a bit-identical trajectory.
 //!
 //! ```
 //! use animat::{Params, World};
@@ -18,7 +20,6 @@
 //! ```
 
 pub mod bench;
-mod cells;
 pub mod config;
 mod hint;
 pub mod output;

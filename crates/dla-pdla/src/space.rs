@@ -34,6 +34,12 @@ use core_lattice::rng::{Rng, uniform01};
 /// The dimensions with a [`Space`] implementation, the accepted values of `--dim`.
 pub const DIMENSIONS: &[usize] = &[2, 3, 4, 5];
 
+/// A walker jumps by the distance map's bound `lb` when `lb - 1` exceeds this (diameters);
+/// closer to the cluster the tree's sharper bound pays for its cost. The default of
+/// [`Space::MAP_JUMP_MIN`]; 3D uses its own. (Here rather than in `walker`, which uses this
+/// module, so that the dependency points one way.)
+pub const MAP_JUMP_MIN: f64 = 2.0;
+
 /// The space dimension `D` as a type; see [`Space`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Dim<const D: usize>;
@@ -57,7 +63,7 @@ pub trait Space<const D: usize> {
     /// A walker jumps by a map's bound `lb` (cell not capped) when `lb - 1` exceeds this, in
     /// diameters; closer in it asks the tree or its near cache, whose sharper bound pays for
     /// its cost there.
-    const MAP_JUMP_MIN: f64 = crate::walker::MAP_JUMP_MIN;
+    const MAP_JUMP_MIN: f64 = MAP_JUMP_MIN;
 
     /// Axis names, the header of `positions.csv`.
     const AXES: [&'static str; D];

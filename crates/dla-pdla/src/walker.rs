@@ -19,10 +19,7 @@ use crate::space::{Dim, Space};
 use core_lattice::rng::Rng;
 use spatial::orthtree::{Orthtree, VpEstimate, dist_sq};
 
-/// A walker jumps by the distance map's bound `lb` when `lb - 1` exceeds this (diameters);
-/// closer to the cluster the tree's sharper bound pays for its cost. The default of
-/// [`Space::MAP_JUMP_MIN`]; 3D uses its own.
-pub const MAP_JUMP_MIN: f64 = 2.0;
+pub use crate::space::MAP_JUMP_MIN;
 /// The far field starts at `|p| > r_b * FAR_FIELD_MARGIN`.
 pub const FAR_FIELD_MARGIN: f64 = 1.0 + 1e-9;
 

@@ -1,17 +1,34 @@
-//! Search structures for the aggregation and animat models.
+//! Search structures for the aggregation and animat models, each usable on its own and tested
+//! against a brute-force reference.
+//!
+//! The models' hot paths:
 //!
 //! - [`orthtree`]: quadtree (D = 2), octree (D = 3), 2^D children in general, with an exact
 //!   nearest-distance query and the variable-precision distance search `vpdist` of
-//!   Sosa-Herrera & Rodriguez-Romo (section 3.1, Listing 1).
+//!   Sosa-Herrera & Rodriguez-Romo (section 3.1, Listing 1). DLA and PDLA.
 //! - [`distmap`]: a coarse distance map (Ball & Brady) in front of the orthtree: one byte per
 //!   cell bounding the distance to a growing point set, so DLA walkers far from the cluster
 //!   jump without a tree query.
-//! - [`lattice`]: contact search for items made of lattice sites (the DLCA clusters of Hawick,
-//!   James & Scogings 2006, sections II.A, III, IV.A): the all-pairs baseline, grid boxes
-//!   over a periodic or walled lattice, and an occupancy lattice, all exact and interchangeable.
-//! - [`plane`]: grid boxes hashed over the unbounded integer plane, for the animat model of
-//!   Hawick, James & Scogings (2006, sections II.B and IV.B).
+//! - [`lattice::halo`]: rigid lattice shapes listed in small grid boxes by their halos, with a
+//!   box side tuned as the shapes grow; exact face-contact search. DLCA's default `grid`
+//!   strategy.
+//! - [`cells`]: a dense per-cell index over the unbounded integer plane in tiles, with window
+//!   and row-word reads of a neighbourhood ([`cells::near`]) and grid-box ring queries over it
+//!   ([`cells::wide`]). The animat model's default search.
+//!
+//! The grid-boxing paper's own structures (Hawick, James & Scogings 2006, "Grid-Boxing for
+//! Spatial Simulation Performance Optimisation"), kept as its **baseline settings** for
+//! reproducing its measurements:
+//!
+//! - [`lattice`]: contact search for items made of lattice sites (the DLCA clusters, sections
+//!   II.A, III, IV.A): the all-pairs baseline, the paper's grid boxes over a periodic or walled
+//!   lattice (`LatticeGridBoxes`, DLCA's `grid-doubling`), and an occupancy lattice, all exact
+//!   and interchangeable.
+//! - [`plane`]: the paper's grid boxes hashed over the unbounded integer plane (`PlaneGrid`),
+//!   for the animat model (sections II.B and IV.B): the animats' path with the cell search off
+//!   (`World::set_cell_search`, the grid-box study) and with `--grid-box none`.
 
+pub mod cells;
 pub mod distmap;
 pub mod lattice;
 pub mod orthtree;

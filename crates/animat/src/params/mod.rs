@@ -535,18 +535,18 @@ impl Params {
     }
 
     /// Memory the start population takes, estimated before placing it: a tile of the cell
-    /// index ([`TILE_BYTES`](crate::world::TILE_BYTES), 36 KiB per 64 x 64 cells) for each
+    /// index ([`TILE_BYTES`](spatial::cells::TILE_BYTES), 36 KiB per 64 x 64 cells) for each
     /// square that gets an animat, the expected number when `N` animats fall uniformly on the
     /// `T` tiles meeting the start disc, `T (1 - exp(-N / T))` (so about `N` tiles for a
     /// dilute start), plus [`ANIMAT_BYTES`] per animat.
     pub fn start_memory_bytes(&self) -> u64 {
         let n = self.foxes.saturating_add(self.rabbits) as f64;
-        let tile = crate::world::TILE as f64;
+        let tile = spatial::cells::TILE as f64;
         let tiles = std::f64::consts::PI
             * (self.start_radius as f64 / tile + std::f64::consts::SQRT_2).powi(2);
         let occupied = tiles * -(-n / tiles).exp_m1();
         // Saturates at u64::MAX for absurd populations.
-        (occupied * crate::world::TILE_BYTES as f64 + n * ANIMAT_BYTES as f64) as u64
+        (occupied * spatial::cells::TILE_BYTES as f64 + n * ANIMAT_BYTES as f64) as u64
     }
 
     /// Start radius giving `animats` animats at `density` animats per cell:

@@ -9,8 +9,8 @@
 //!
 //! - `step`: one step (visiting order, turns, ageing and deaths, the id order listed again);
 //! - `rules`: the fox and rabbit rule lists, the action each chooses and how actions apply;
-//! - `perception`: the neighbour queries the rules ask, from the cell index or the grid boxes;
-//! - `near`: the per-turn cache of the cells around the acting animat and its bit tricks;
+//! - `perception`: the neighbour queries the rules ask, from the cell index
+//!   ([`spatial::cells`], with its near cache and wide queries) or the grid boxes;
 //! - `checkpoint`: the [`Snapshot`] of a world between steps and its exact restore;
 //! - `tests`: hand-built scenes.
 //!
@@ -24,21 +24,19 @@
 //! step `grid` may lag behind `cells` by the changes logged in `pending` (see `step`).
 
 mod checkpoint;
-mod near;
 mod perception;
 mod rules;
 mod step;
 #[cfg(test)]
 mod tests;
-mod wide;
 
-use crate::cells::{CellIndex, WINDOW_MAX, kind_byte};
 use crate::params::{ANIMAT_BYTES, FoxRule, MAX_ANIMATS, Params, ParamsError, RabbitRule, Species};
+use spatial::cells::near::{NEAR_ROWS, NEAR_WINDOW_MIN, disc_mask};
+use spatial::cells::{CellIndex, KIND_A, KIND_B, WINDOW_MAX};
 
-pub use crate::cells::{TILE, TILE_BYTES};
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
-use near::{NEAR_ROWS, disc_mask};
 use sim_run::io::StateHasher;
+pub use spatial::cells::{TILE, TILE_BYTES};
 use spatial::plane::{BoxSize, PlaneError, PlaneGrid, Pos};
 
 pub use checkpoint::Snapshot;
@@ -67,7 +65,7 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
 
 /// Largest cell-ring radius the cell-index searches scan before handing a query to the grid.
 const RING_MAX: i64 = 8;
-const _: () = assert!(RING_MAX <= WINDOW_MAX);
+const _: () = assert!(RING_MAX <= WINDOW_MAX && RING_MAX >= NEAR_WINDOW_MIN);
 
 /// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,6 +96,12 @@ struct Rec {
 const RABBIT: u8 = 1;
 /// Flag bit: the animat died in the current step (removed at its end).
 const DEAD: u8 = 2;
+
+/// The cell index's kind byte of a species: foxes are [`KIND_A`], rabbits [`KIND_B`].
+#[inline]
+fn kind_byte(rabbit: bool) -> u8 {
+    if rabbit { KIND_B } else { KIND_A }
+}
 
 fn species_of(flags: u8) -> Species {
     if flags & RABBIT != 0 {
@@ -183,7 +187,7 @@ pub struct World {
     /// Cell offsets within `crowd_radius` (origin excluded), when `crowd_radius <= RING_MAX`.
     crowd_offsets: Vec<[i64; 2]>,
     /// The same offsets as bit 0 of byte `dx + 2` of row `dy + 2` (see
-    /// [`Near::rows`](near::Near::rows)), when `crowd_radius <= 2`.
+    /// [`Near::rows`](spatial::cells::near::Near::rows)), when `crowd_radius <= 2`.
     crowd_masks: [u64; NEAR_ROWS],
     /// The animats' records in the order of the last step's turns, then the animats born in
     /// it (in id order); during a step, in the order of its turns, then its newborns. Records

@@ -1,20 +1,25 @@
 //! Perception: the neighbour queries the rules ask ("a fox adjacent?", "the nearest rabbit
 //! within vision", "overcrowded?", "enough prey?"). Each is answered from the cell index first
-//! (the cells around the animat, then rings of cells up to `RING_MAX`) and handed to the wide
-//! search over grid boxes (`wide`) when the rings cannot settle it; with the cell search off,
-//! every query goes to the grid boxes ([`spatial::plane::PlaneGrid`]).
+//! (the cells around the animat through [`spatial::cells::near`], then rings of cells up to
+//! `RING_MAX` through [`spatial::cells::rings`]) and handed to the index's wide search over grid boxes
+//! ([`spatial::cells::wide`]) when the rings cannot settle it; with the cell search off, every
+//! query goes to the paper's grid boxes ([`spatial::plane::PlaneGrid`]).
+//!
+//! Stays in the model: this is the dispatch of the rules' queries (which path answers which
+//! rule, with the model's radii, counters and grid staleness); the searches it calls are
+//! `spatial`'s.
 //!
 //! Invariants: every path gives the exact answer, ties going to the lower id, so the trajectory
 //! does not depend on the path or on the grid-box size; a query that needs the grid while
 //! changes are still logged does not read it but marks the decision stale ([`Tally::stale`]),
 //! and the decision is made again once the grid is up to date.
 
-use super::near::{
+use super::{ADJACENT_R2, Animat, DIRECTIONS, RING_MAX, World, kind_byte};
+use crate::params::Species;
+use spatial::cells::near::{
     NEAR_HALF, Near, RING_CLASSES, byte_sum, count_in, kind_bits, lowest_in, row_cell,
 };
-use super::{ADJACENT_R2, Animat, DIRECTIONS, RING_MAX, World};
-use crate::cells::{FREE, SPECIES, kind_byte};
-use crate::params::Species;
+use spatial::cells::{FREE, KIND_MASK};
 use spatial::plane::Pos;
 
 /// Query and work counters of one decision (added to the world's afterwards).
@@ -28,36 +33,56 @@ pub(super) struct Tally {
     pub(super) stale: bool,
 }
 
-/// Visits the cells of ring `k >= 1` (Chebyshev distance `k`) as offsets `(dx, dy)` in a fixed
-/// order (the bottom and top rows pairwise by `dx`, then the left and right columns pairwise by
-/// `dy`) until `visit` returns `true`; returns whether it did.
-#[inline(always)]
-fn ring_until(k: i64, mut visit: impl FnMut(i64, i64) -> bool) -> bool {
-    for dx in -k..=k {
-        if visit(dx, -k) || visit(dx, k) {
-            return true;
-        }
-    }
-    for dy in (-k + 1)..k {
-        if visit(-k, dy) || visit(k, dy) {
-            return true;
-        }
-    }
-    false
-}
-
 impl World {
     /// The cells around `a` for the cell-index fast path (no window when the fast path is
     /// off or `a` is too near the `i64` limits).
     pub(super) fn near(&self, a: &Animat) -> Near<'_> {
-        Near {
-            w: if self.cell_search {
-                self.cells.window(a.pos, RING_MAX)
-            } else {
-                None
-            },
-            rows: None,
-        }
+        Near::new(if self.cell_search {
+            self.cells.window(a.pos, RING_MAX)
+        } else {
+            None
+        })
+    }
+
+    /// The box side of the wide search: the grid-box setting, or (for `none`) one box holding
+    /// the whole plane.
+    fn wide_side(&self) -> i64 {
+        self.grid.box_size().side().unwrap_or(i64::MAX)
+    }
+
+    /// The nearest animat of `kind` within squared distance `r2` of `p`, other than the one
+    /// on `p`, from the cell index's wide search.
+    #[inline]
+    pub(super) fn wide_nearest(
+        &self,
+        p: Pos,
+        kind: Species,
+        r2: u64,
+        t: &mut Tally,
+    ) -> Option<Pos> {
+        let kinds = kind_byte(kind == Species::Rabbit);
+        let (found, evals) = self.cells.nearest_within(p, kinds, r2, self.wide_side());
+        t.evals += evals;
+        found
+    }
+
+    /// Whether at least `n` animats (of `kind`, or of either species) lie within squared
+    /// distance `r2` of `p`, the one on `p` not counted, from the cell index's wide search.
+    #[inline]
+    pub(super) fn wide_at_least(
+        &self,
+        p: Pos,
+        kind: Option<Species>,
+        r2: u64,
+        n: usize,
+        t: &mut Tally,
+    ) -> bool {
+        let kinds = kind.map_or(KIND_MASK, |k| kind_byte(k == Species::Rabbit));
+        let (enough, evals) = self
+            .cells
+            .at_least_within(p, kinds, r2, n, self.wide_side());
+        t.evals += evals;
+        enough
     }
 
     /// Whether the grid lags behind the logged changes; if so, notes in `t` that the
@@ -134,12 +159,9 @@ impl World {
         t: &mut Tally,
     ) -> Option<Pos> {
         t.nearest += 1;
-        if near.w.is_some() {
+        if near.window().is_some() {
             let k_max = RING_MAX.min(self.params.vision);
             let kb = kind_byte(kind == Species::Rabbit);
-            let [x, y] = a.pos;
-            let v2 = self.vision2;
-            let mut evals = 0;
             // Rings 1 and 2 from the row words when they lie within vision.
             let mut k_first = 1;
             if self.params.vision >= 3 {
@@ -161,50 +183,12 @@ impl World {
                 }
                 k_first = 3;
             }
-            let w = near.w.as_ref().expect("the window is present");
-            // Best as (d2, position, id bucket, id once read): a tie of distances goes to
-            // the lower bucket, and ids (in a larger array that is rarely in cache) are read
-            // only when the buckets are equal too.
-            type Best = Option<(u64, Pos, u8, Option<u64>)>;
-            let mut best: Best = None;
-            let mut look = |dx: i64, dy: i64, best: &mut Best| {
-                let byte = w.byte(x + dx, y + dy);
-                if byte & SPECIES == kb {
-                    evals += 1;
-                    let d2 = (dx * dx + dy * dy) as u64;
-                    let c = [x + dx, y + dy];
-                    let cb = byte >> 2;
-                    match best {
-                        _ if d2 > v2 => {}
-                        None => *best = Some((d2, c, cb, None)),
-                        Some((bd, bp, bb, bid)) => {
-                            if d2 < *bd || (d2 == *bd && cb < *bb) {
-                                *best = Some((d2, c, cb, None));
-                            } else if d2 == *bd && cb == *bb {
-                                let bi = *bid.get_or_insert_with(|| w.id(bp[0], bp[1]));
-                                let id = w.id(c[0], c[1]);
-                                if id < bi {
-                                    *best = Some((d2, c, cb, Some(id)));
-                                }
-                            }
-                        }
-                    }
-                }
-            };
-            for k in k_first..=k_max {
-                ring_until(k, |dx, dy| {
-                    look(dx, dy, &mut best);
-                    false
-                });
-                // Every cell beyond ring k is at least k + 1 away: a best strictly nearer
-                // than that is final (an equally near one could still win on id).
-                let next = ((k + 1) * (k + 1)) as u64;
-                if best.is_some_and(|(bd, _, _, _)| bd < next) || next > v2 {
-                    t.evals += evals;
-                    return best.map(|(_, p, _, _)| p);
-                }
+            let w = near.window().expect("the window is present");
+            let rings = w.nearest_in_rings(a.pos, kb, self.vision2, k_first, k_max);
+            t.evals += rings.evals;
+            if rings.settled {
+                return rings.found;
             }
-            t.evals += evals;
         }
         if self.cell_search {
             return self.wide_nearest(a.pos, kind, self.vision2, t);
@@ -226,7 +210,7 @@ impl World {
         t.count += 1;
         let n = self.params.crowd_max as usize + 1;
         let r = self.params.crowd_radius;
-        if near.w.is_some() {
+        if near.window().is_some() {
             if r <= NEAR_HALF {
                 // Kind bytes are 0, 1 or 2: bit 0 or'ed with bit 1 marks an occupied cell;
                 // the masks keep the cells within the radius.
@@ -241,7 +225,7 @@ impl World {
                 return count >= n;
             }
             if r <= RING_MAX {
-                let w = near.w.as_ref().expect("the window is present");
+                let w = near.window().expect("the window is present");
                 let [x, y] = a.pos;
                 let mut count = 0;
                 for d in &self.crowd_offsets {
@@ -274,25 +258,9 @@ impl World {
     pub(super) fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
         t.count += 1;
         let n = self.params.prey_needed as usize;
-        if let (Some(w), true) = (near.w.as_ref(), n > 0) {
+        if let (Some(w), true) = (near.window(), n > 0) {
             let k_max = RING_MAX.min(self.params.vision);
-            let [x, y] = a.pos;
-            let v2 = self.vision2;
-            let kb = kind_byte(true);
-            let mut count = 0usize;
-            let mut look = |dx: i64, dy: i64| -> bool {
-                if w.at(x + dx, y + dy) == kb && (dx * dx + dy * dy) as u64 <= v2 {
-                    count += 1;
-                }
-                count >= n
-            };
-            let mut found = false;
-            for k in 1..=k_max {
-                if ring_until(k, &mut look) {
-                    found = true;
-                    break;
-                }
-            }
+            let (found, count) = w.count_in_rings(a.pos, kind_byte(true), self.vision2, n, k_max);
             t.evals += count as u64;
             // Rings 1..=k_max cover the whole vision disc when k_max = vision.
             if found || k_max == self.params.vision {

@@ -8,12 +8,12 @@
 //! brought up to date); applying an action keeps one animat per cell and logs every grid
 //! change in `pending`.
 
-use super::near::{NEAR_ROWS, Near, row_cell};
 use super::perception::Tally;
 use super::{Animat, DIRECTIONS, GridOp, World};
-use crate::cells::FREE;
 use crate::params::{FoxRule, RabbitRule, Species};
 use core_lattice::rng::{RngExt, uniform01};
+use spatial::cells::FREE;
+use spatial::cells::near::{NEAR_ROWS, Near, row_cell};
 use spatial::plane::Pos;
 use std::time::Instant;
 
@@ -82,7 +82,7 @@ impl World {
                 continue;
             }
             let rows = match act {
-                Action::Step(_) | Action::Wander | Action::Breed if near.w.is_some() => {
+                Action::Step(_) | Action::Wander | Action::Breed if near.window().is_some() => {
                     Some(*near.rows(a.pos))
                 }
                 _ => None,

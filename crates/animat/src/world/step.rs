@@ -63,14 +63,14 @@ impl World {
                 let flushed = self.flush_seconds;
                 let t = Instant::now();
                 if let Some(p) = ahead {
-                    self.cells.prefetch_near(p);
+                    self.cells.near_lines(p, crate::hint::prefetch);
                 }
                 let act = self.decide_near(&a);
                 self.search_seconds += t.elapsed().as_secs_f64() - (self.flush_seconds - flushed);
                 act
             } else {
                 if let Some(p) = ahead {
-                    self.cells.prefetch_near(p);
+                    self.cells.near_lines(p, crate::hint::prefetch);
                 }
                 self.decide_near(&a)
             };
@@ -159,7 +159,7 @@ impl World {
     }
 
     /// Spreads the id buckets of the cell bytes
-    /// ([`CellIndex::bucket`](crate::cells::CellIndex::bucket)) over the ids that can be alive
+    /// ([`CellIndex::bucket`](spatial::cells::CellIndex::bucket)) over the ids that can be alive
     /// during the next step (the live ones, sorted in `ids`, and at most `n` newborns) when the
     /// top bucket could overflow or the lower half of the buckets has gone unused. Buckets only
     /// speed up tie-breaks; any non-decreasing map gives the same answers.

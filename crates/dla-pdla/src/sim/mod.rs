@@ -26,7 +26,8 @@ pub use self::growth::{GROWTH_COLUMNS, SAMPLES_PER_DECADE, Sample};
 pub use self::pdla::{DiscardGuard, MAX_CONSECUTIVE_DISCARDS, OVERLAP_DISTANCE, PURPOSE_PDLA};
 pub use self::serial::PURPOSE_WALK;
 pub use crate::error::SimError;
-pub use crate::walker::{FAR_FIELD_MARGIN, MAP_JUMP_MIN, Walker, direction, first_contact};
+pub use crate::space::MAP_JUMP_MIN;
+pub use crate::walker::{FAR_FIELD_MARGIN, Walker, direction, first_contact};
 
 use self::growth::{Growth, Streams};
 use self::pdla::PdlaStats;

@@ -6,7 +6,7 @@
 
 use crate::params::{ParamError, Params, Search};
 use crate::rigid::{RigidError, RigidStore};
-use crate::store::{ClusterArrays, DoublingGrid, Engine, HaloGrid, Indexed, RigidClusters};
+use crate::store::{ClusterArrays, DoublingGrid, Engine, HaloStore, Indexed, RigidClusters};
 use core_lattice::Lattice;
 use spatial::lattice::Occupancy;
 
@@ -59,7 +59,7 @@ pub(super) fn choose(params: &Params, lattice: &Lattice, particles: u64) -> (Sea
 }
 
 /// Install strategy `kind` over the clusters `arrays`, with grid box side `grid_box` for the
-/// grids (see [`HaloGrid::new`] and [`DoublingGrid::new`]), pushing what happened to `notes`. Fails only for the
+/// grids (see [`HaloStore::new`] and [`DoublingGrid::new`]), pushing what happened to `notes`. Fails only for the
 /// `lattice` strategy when its occupancy lattice does not fit `params.max_memory` (or a side is
 /// beyond the rigid-cluster store's reach).
 pub(super) fn install(
@@ -93,7 +93,7 @@ pub(super) fn install(
             }
         }
         Search::AllPairs | Search::Auto => Engine::all_pairs(arrays),
-        Search::Grid => Engine::Grid(Box::new(HaloGrid::new(arrays, grid_box, notes))),
+        Search::Grid => Engine::Grid(Box::new(HaloStore::new(arrays, grid_box, notes))),
         Search::GridDoubling => match DoublingGrid::new(arrays, grid_box, notes) {
             Ok(grid) => Engine::GridDoubling(Box::new(grid)),
             Err(arrays) => Engine::all_pairs(arrays),

@@ -20,7 +20,7 @@ mod strategy;
 
 pub(crate) use arrays::ClusterArrays;
 pub(crate) use doubling::DoublingGrid;
-pub(crate) use halo::HaloGrid;
+pub(crate) use halo::HaloStore;
 pub(crate) use indexed::Indexed;
 pub(crate) use rigid::RigidClusters;
 pub(crate) use strategy::{ClusterStore, Merged};
@@ -36,7 +36,7 @@ pub(crate) enum Engine {
     /// All-pairs.
     AllPairs(Indexed<AllPairs>),
     /// Grid boxes with a halo per cluster.
-    Grid(Box<HaloGrid>),
+    Grid(Box<HaloStore>),
     /// The paper's grid boxes, doubling with the largest cluster.
     GridDoubling(Box<DoublingGrid>),
     /// The `lattice` strategy where rigid clusters do not pay (4 and 5 dimensions).

@@ -1,4 +1,6 @@
-//! Grid boxes over a lattice (the grid-boxing paper, section II, Fig. 1; section IV.A).
+//! Grid boxes over a lattice (the grid-boxing paper, section II, Fig. 1; section IV.A): the
+//! paper's own structure, kept as its **baseline setting** (DLCA's `grid-doubling` strategy);
+//! DLCA's default `grid` strategy runs [`HaloGrid`](super::HaloGrid) instead.
 
 use super::{ContactSearch, ItemId, SiteSets, StampSet, coords_of, touches};
 use core_lattice::{Boundary, Direction, Lattice, MAX_DIM};

@@ -19,15 +19,22 @@
 //! Every strategy implements [`ContactSearch`]; a model keeps one [`SiteSets`] and one
 //! strategy and calls the strategy's `insert`, `moved`, `merge`, `remove` alongside its own
 //! updates. Contacts come back sorted by id, so a model's trajectory never depends on the
-//! strategy.
+//! strategy. These three are the paper's settings, the baseline its measurements use (DLCA's
+//! `all-pairs` and `grid-doubling` strategies, and `lattice` in 4 and 5 dimensions).
+//!
+//! [`HaloGrid`] ([`halo`]) is the structure DLCA runs by default (its `grid` strategy): it
+//! keeps the clusters itself, as rigid shapes listed in small grid boxes by their halos, with
+//! a self-tuned box side, and gives the same contacts.
 
 mod all_pairs;
 mod grid;
+pub mod halo;
 mod occupancy;
 mod sets;
 
 pub use all_pairs::AllPairs;
 pub use grid::{GridError, LatticeGridBoxes};
+pub use halo::HaloGrid;
 pub use occupancy::{Occupancy, OccupancyError};
 pub use sets::SiteSets;
 

@@ -1,4 +1,6 @@
-//! Grid boxes hashed over the unbounded 2D integer plane, for the animat model.
+//! Grid boxes hashed over the unbounded 2D integer plane, for the animat model: the grid-boxing
+//! paper's own structure, kept as its **baseline setting** (the model runs it with the cell
+//! search off and in the exhaustive `none` mode; its default search is [`crate::cells`]).
 //!
 //! This module serves Hawick, James & Scogings, *Grid-Boxing for Spatial Simulation Performance
 //! Optimisation* (2006): the animat predator-prey model of section II.B lives on an unbounded

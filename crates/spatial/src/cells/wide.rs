@@ -1,29 +1,22 @@
-//! Wide queries: the neighbour queries that the cell rings around the animat cannot settle
-//! (a radius beyond the rings, few animats of the wanted kind nearby, or an animat too near
-//! the `i64` limits for a window), answered exactly from the cell index with the grid-box
-//! search of Hawick, James & Scogings (2006), section II.B: the boxes of side `A` in rings
-//! outward from the query's box, stopping once no nearer animat can exist. A box's animats
-//! are read from the cell index ([`CellIndex::scan_rect`](crate::cells::CellIndex::scan_rect)),
-//! which skips empty tiles and blocks, so no list per box has to be kept up to date as the
-//! animats move: with the cell search on, the world maintains no other structure.
+//! Wide queries over the cell index: the nearest item of a kind within a squared radius, and
+//! whether at least `n` items lie within one, answered exactly with the grid-box search of
+//! Hawick, James & Scogings (2006), "Grid-Boxing for Spatial Simulation Performance
+//! Optimisation", section II.B: the boxes of side `A` in rings outward from the query's box,
+//! stopping once no nearer item can exist. A box's items are read from the index
+//! ([`CellIndex::scan_rect`]), which skips empty tiles and blocks, so no list per box has to
+//! be kept up to date as the items move: the box side is a parameter of the query, not of the
+//! index. The animat model asks these when the cells around an animat cannot settle a query
+//! (a radius beyond its window, few animats of the wanted kind nearby, or an animat too near
+//! the `i64` limits for a window).
 //!
 //! Invariants: every cell within the radius is examined unless the answer is already known
 //! (a count reached, or every remaining cell farther than the best found), the query's own
 //! cell is never counted, and the nearest is the minimum of `(squared distance, id)`, so the
-//! answers equal the grid boxes' and the exhaustive scan's for every box size.
+//! answers equal the exhaustive scan's for every box side (`tests/cells_props.rs`).
 
-use super::World;
-use super::perception::Tally;
-use crate::cells::{SPECIES, kind_byte};
-use crate::params::Species;
-use spatial::plane::Pos;
+use super::CellIndex;
+use crate::plane::Pos;
 use std::ops::ControlFlow;
-
-/// The species bits of [`CellIndex::scan_rect`](crate::cells::CellIndex::scan_rect) for a
-/// query of `kind` (`None`: both).
-fn kind_bits(kind: Option<Species>) -> u8 {
-    kind.map_or(SPECIES, |k| kind_byte(k == Species::Rabbit))
-}
 
 /// The rings of grid boxes around a query point, as the search visits them.
 struct Rings {
@@ -38,6 +31,7 @@ struct Rings {
 }
 
 impl Rings {
+    #[inline]
     fn new(a: i64, p: Pos) -> Self {
         let a = i128::from(a);
         let p = [i128::from(p[0]), i128::from(p[1])];
@@ -52,6 +46,7 @@ impl Rings {
     }
 
     /// Whether ring `k` can hold a cell within squared distance `limit`.
+    #[inline]
     fn reaches(&self, k: i128, limit: u64) -> bool {
         if k == 0 {
             return true;
@@ -61,6 +56,7 @@ impl Rings {
     }
 
     /// The last ring that meets the square of half-side `r` around the point.
+    #[inline]
     fn last(&self, r: i128) -> i128 {
         let lo = [
             (self.p[0] - r).div_euclid(self.a),
@@ -78,6 +74,7 @@ impl Rings {
 
     /// The cells of box `(dx, dy)` (in boxes from the point's) within the square of half-side
     /// `r` around the point, as `i64` ranges, or `None` when they are none.
+    #[inline]
     fn cells(&self, dx: i128, dy: i128, r: i128) -> Option<([i64; 2], [i64; 2])> {
         let axis = |b: i128, p: i128| -> Option<[i64; 2]> {
             let lo = (b * self.a).max(p - r).max(i128::from(i64::MIN));
@@ -91,6 +88,7 @@ impl Rings {
     }
 
     /// Visits the boxes of ring `k` (in a fixed order) until `visit` breaks.
+    #[inline]
     fn ring(
         &self,
         k: i128,
@@ -119,36 +117,27 @@ fn dist2(p: Pos, x: i64, y: i64) -> u128 {
     dx * dx + dy * dy
 }
 
-impl World {
-    /// The box side of the wide search: the grid-box setting, or (for `none`) one box holding
-    /// the whole plane.
-    fn wide_side(&self) -> i64 {
-        self.grid.box_size().side().unwrap_or(i64::MAX)
-    }
-
+impl CellIndex {
     /// Whether visiting the boxes ring by ring up to ring `last` would take more box visits
     /// than scanning the square once through the tiles in use.
     fn rings_too_many(&self, last: i128) -> bool {
         let boxes = (2 * last + 1).saturating_mul(2 * last + 1);
-        boxes > 4 * (self.cells.tiles_in_use() as i128 + 1)
+        boxes > 4 * (self.tiles_in_use() as i128 + 1)
     }
 
-    /// The position of the nearest animat of `kind` within squared distance `r2` of `p`,
-    /// other than the one on `p`: the minimum of `(squared distance, id)`.
-    pub(super) fn wide_nearest(
-        &self,
-        p: Pos,
-        kind: Species,
-        r2: u64,
-        t: &mut Tally,
-    ) -> Option<Pos> {
-        let rings = Rings::new(self.wide_side(), p);
-        let kinds = kind_bits(Some(kind));
+    /// The cell of the nearest item whose kind meets `kinds` (bit 0 [`KIND_A`](super::KIND_A),
+    /// bit 1 [`KIND_B`](super::KIND_B)) within squared distance `r2` of `p`, other than the
+    /// one on `p`: the minimum of `(squared distance, id)`. The search visits grid boxes of
+    /// side `side` (`>= 1`; `i64::MAX` for one box holding the plane), which changes its
+    /// speed only. Also returns the number of cells examined (a work counter).
+    #[inline]
+    pub fn nearest_within(&self, p: Pos, kinds: u8, r2: u64, side: i64) -> (Option<Pos>, u64) {
+        let rings = Rings::new(side, p);
         // Best as (d2, cell, id bucket, id once read); buckets settle most ties without ids.
         let mut best: Option<(u64, Pos, u8, Option<u64>)> = None;
         let mut limit = r2;
         let mut evals = 0;
-        let cells = &self.cells;
+        let cells = self;
         let mut look = |x: i64, y: i64, byte: u8, limit: &mut u64| {
             if [x, y] == p {
                 return;
@@ -193,7 +182,7 @@ impl World {
                 break;
             }
             let _ = rings.ring(k, |dx, dy| {
-                // The square shrinks as better animats are found.
+                // The square shrinks as better items are found.
                 let r = i128::from(limit.isqrt());
                 if let Some((xs, ys)) = rings.cells(dx, dy, r) {
                     let _ = cells.scan_rect(xs, ys, kinds, |x, y, b| {
@@ -205,25 +194,19 @@ impl World {
             });
             k += 1;
         }
-        t.evals += evals;
-        best.map(|(_, c, _, _)| c)
+        (best.map(|(_, c, _, _)| c), evals)
     }
 
-    /// Whether at least `n` animats (of `kind`, or of either species) lie within squared
-    /// distance `r2` of `p`, the one on `p` not counted.
-    pub(super) fn wide_at_least(
-        &self,
-        p: Pos,
-        kind: Option<Species>,
-        r2: u64,
-        n: usize,
-        t: &mut Tally,
-    ) -> bool {
+    /// Whether at least `n` items whose kind meets `kinds` lie within squared distance `r2` of
+    /// `p`, the one on `p` not counted; grid boxes of side `side` as for
+    /// [`CellIndex::nearest_within`]. Stops as soon as `n` are found. Also returns the number
+    /// of cells examined.
+    #[inline]
+    pub fn at_least_within(&self, p: Pos, kinds: u8, r2: u64, n: usize, side: i64) -> (bool, u64) {
         if n == 0 {
-            return true;
+            return (true, 0);
         }
-        let rings = Rings::new(self.wide_side(), p);
-        let kinds = kind_bits(kind);
+        let rings = Rings::new(side, p);
         let r = i128::from(r2.isqrt());
         let last = rings.last(r);
         let mut count = 0;
@@ -242,7 +225,7 @@ impl World {
         };
         let _ = if self.rings_too_many(last) {
             let (xs, ys) = square(p, r);
-            self.cells.scan_rect(xs, ys, kinds, &mut look)
+            self.scan_rect(xs, ys, kinds, &mut look)
         } else {
             let mut k = 0;
             loop {
@@ -250,7 +233,7 @@ impl World {
                     break ControlFlow::Continue(());
                 }
                 let done = rings.ring(k, |dx, dy| match rings.cells(dx, dy, r) {
-                    Some((xs, ys)) => self.cells.scan_rect(xs, ys, kinds, &mut look),
+                    Some((xs, ys)) => self.scan_rect(xs, ys, kinds, &mut look),
                     None => ControlFlow::Continue(()),
                 });
                 if done.is_break() {
@@ -259,12 +242,12 @@ impl World {
                 k += 1;
             }
         };
-        t.evals += evals;
-        count >= n
+        (count >= n, evals)
     }
 }
 
 /// The square of half-side `r` around `p`, clamped to the `i64` plane.
+#[inline]
 fn square(p: Pos, r: i128) -> ([i64; 2], [i64; 2]) {
     let axis = |c: i64| {
         let c = i128::from(c);
@@ -274,94 +257,4 @@ fn square(p: Pos, r: i128) -> ([i64; 2], [i64; 2]) {
         ]
     };
     (axis(p[0]), axis(p[1]))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::params::{GridBox, Params};
-    use core_lattice::rng::{RngExt, stream};
-
-    /// A world with clustered, scattered and far-flung animats (some at the `i64` limits).
-    fn scene(side: i64) -> World {
-        let p = Params {
-            foxes: 0,
-            rabbits: 0,
-            grid_box: GridBox::Side(side),
-            ..Params::default()
-        };
-        let mut w = World::empty(p, 1).unwrap();
-        let mut rng = stream(11, 0);
-        for i in 0..1500u32 {
-            let pos = match i % 20 {
-                0 => [rng.random_range(-3000..3000), rng.random_range(-3000..3000)],
-                1 if i < 200 => [
-                    i64::MAX - rng.random_range(0..40),
-                    i64::MIN + rng.random_range(0..40),
-                ],
-                _ => [rng.random_range(-60..60), rng.random_range(-60..60)],
-            };
-            let species = if i % 4 == 0 {
-                Species::Fox
-            } else {
-                Species::Rabbit
-            };
-            let _ = w.add(species, pos, 0, 0);
-        }
-        assert!(w.cell_search());
-        w
-    }
-
-    #[test]
-    fn wide_queries_equal_the_exhaustive_answers() {
-        for side in [1, 7, 60, 1 << 30] {
-            let w = scene(side);
-            let all: Vec<_> = w.animats().collect();
-            let mut rng = stream(12, side as u64);
-            for q in 0..400 {
-                // Query points on animats (their own cell is excluded) and on free cells.
-                let p = if q % 3 == 0 {
-                    [rng.random_range(-200..200), rng.random_range(-200..200)]
-                } else {
-                    all[rng.random_range(0..all.len())].pos
-                };
-                let r2: u64 = match q % 5 {
-                    0 => 2,
-                    1 => 81,
-                    2 => 3600,
-                    3 => rng.random_range(0..20_000),
-                    _ => u64::MAX,
-                };
-                let kind = if q % 2 == 0 {
-                    Species::Fox
-                } else {
-                    Species::Rabbit
-                };
-                let within = |k: Option<Species>| {
-                    all.iter()
-                        .filter(move |a| a.pos != p && k.is_none_or(|k| a.species == k))
-                        .filter(move |a| dist2(p, a.pos[0], a.pos[1]) <= u128::from(r2))
-                };
-                let want = within(Some(kind))
-                    .min_by_key(|a| (dist2(p, a.pos[0], a.pos[1]), a.id))
-                    .map(|a| a.pos);
-                let mut t = Tally::default();
-                assert_eq!(
-                    w.wide_nearest(p, kind, r2, &mut t),
-                    want,
-                    "side {side} p {p:?} r2 {r2}"
-                );
-                for k in [Some(kind), None] {
-                    let count = within(k).count();
-                    for n in [0, 1, 3, count, count + 1] {
-                        assert_eq!(
-                            w.wide_at_least(p, k, r2, n, &mut t),
-                            count >= n,
-                            "side {side} p {p:?} r2 {r2} n {n}"
-                        );
-                    }
-                }
-            }
-        }
-    }
 }

@@ -5,9 +5,8 @@
 //! grown by one site) overlaps `b`, and not at all otherwise.
 
 use super::region::{Region, Span};
+use crate::lattice::{ItemId, StampSet};
 use core_lattice::{Lattice, MAX_DIM};
-use spatial::lattice::ItemId;
-use spatial::lattice::StampSet;
 
 /// The boxes a span of coordinates overlaps along one axis: `first, first + 1, ...` (`n` of
 /// them), modulo the number of boxes on the axis.

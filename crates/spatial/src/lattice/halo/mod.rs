@@ -1,42 +1,43 @@
-//! The `grid` strategy: small grid boxes with a halo per cluster, and a box side tuned at run
-//! time (Hawick, James & Scogings 2006, section V: keep boxes "ostensibly too small" for the
-//! largest cluster, "construct halos on an individual basis", and "build in self-tuning of the
-//! grid-boxing ... to adjust this at runtime").
+//! Rigid lattice shapes listed in small grid boxes by their halos, with a box side tuned at
+//! run time ([`HaloGrid`]): exact face-contact search for moving, merging clusters of lattice
+//! sites. DLCA's default `grid` strategy; the grid-boxing paper's own boxes are
+//! [`LatticeGridBoxes`](super::LatticeGridBoxes), its baseline setting. It follows the
+//! paper's closing advice (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
+//! Performance Optimisation", section V): keep boxes "ostensibly too small" for the largest
+//! cluster, "construct halos on an individual basis", and "build in self-tuning of the
+//! grid-boxing ... to adjust this at runtime".
 //!
-//! - Each cluster is a rigid [`Shape`] (origin plus sorted relative positions): a move changes
-//!   its origin and its bounding [`Region`] in O(1).
+//! - Each cluster is a rigid `Shape` (origin plus sorted relative positions): a move changes
+//!   its origin and its bounding `Region` in O(1).
 //! - Its *halo* is its bounding region grown by one site: every site face-adjacent to it. The
-//!   cluster is listed in every grid box its halo overlaps ([`HaloBoxes`]); a move re-lists it
+//!   cluster is listed in every grid box its halo overlaps (`HaloBoxes`); a move re-lists it
 //!   only in the slab of boxes its halo enters or leaves.
 //! - The candidates of a move are the clusters listed in the mover's boxes: two clusters in
 //!   contact have a site in both halos, so they share that site's box. A candidate whose
 //!   bounding region misses the mover's halo is dropped at once; the others get the exact
-//!   particle test ([`touches`]).
-//! - The box side is the power of two with the least [`predicted_cost`] (boxes per cluster
-//!   against clusters per box). It is re-tuned each time the number of clusters falls past a
-//!   step of a geometric scale (about 16% apart), and the boxes are rebuilt when another side
-//!   is predicted at most [`RETUNE_GAIN`] times as costly.
+//!   particle test (`touches`).
+//! - The box side is the power of two with the least predicted cost (`predicted_cost`: boxes
+//!   per cluster against clusters per box). It is re-tuned each time the number of clusters
+//!   falls past a step of a geometric scale (about 16% apart), and the boxes are rebuilt when
+//!   another side is predicted at most [`RETUNE_GAIN`] times as costly.
 //!
-//! Invariant: as every strategy, the contacts of a move are exactly the clusters touching the
-//! mover, in increasing id, so the trajectory does not depend on the boxes or their side.
+//! Invariant: the contacts of a move are exactly the clusters touching the mover, in
+//! increasing id, whatever the boxes and their side (so a model's trajectory cannot depend on
+//! them); `tests/halo_props.rs` checks this against a brute-force scan.
 
 mod boxes;
 mod region;
 mod shape;
 
-use super::arrays::ClusterArrays;
-use super::strategy::{ClusterStore, Merged};
-use crate::params::Search;
+use super::{ItemId, SiteSets};
 use boxes::{HaloBoxes, box_count, predicted_cost};
 use core_lattice::{Blocked, Direction, Lattice};
 use region::Region;
 use shape::{Shape, touches};
-use spatial::lattice::{ItemId, SiteSets};
-use std::sync::OnceLock;
 
 /// Rebuild the boxes when another side is predicted to cost at most this fraction of the
 /// current one (hysteresis: re-tuning costs a rebuild).
-const RETUNE_GAIN: f64 = 0.6;
+pub const RETUNE_GAIN: f64 = 0.6;
 
 /// Re-tune when `floor(RETUNE_STEPS * log2(clusters))` changes.
 const RETUNE_STEPS: f64 = 4.0;
@@ -49,9 +50,45 @@ const BOX_ALLOWANCE: u64 = 1 << 16;
 /// Position of a cluster id in the live list, or this for a retired id.
 const DEAD: u32 = u32::MAX;
 
-/// The clusters as rigid shapes, listed in grid boxes by their halos.
-#[derive(Debug)]
-pub(crate) struct HaloGrid {
+/// A re-tuning of the box side during a merge, for the caller's log.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Retuned {
+    /// Live clusters after the merge.
+    pub clusters: usize,
+    /// The box side before and after.
+    pub from: u64,
+    /// The new box side.
+    pub to: u64,
+    /// Predicted cost of a sweep (box-list entries) with the old side.
+    pub cost_before: f64,
+    /// Predicted cost of a sweep with the new side.
+    pub cost_after: f64,
+}
+
+/// The clusters as rigid shapes, listed in grid boxes by their halos; see the module
+/// documentation.
+///
+/// Clusters are numbered by [`ItemId`] as in the [`SiteSets`] it is built from; a merge keeps
+/// the survivor's id and retires the others'. The caller keeps clusters apart: between two
+/// calls no two clusters are face-adjacent (DLCA merges them as soon as they touch).
+///
+/// ```
+/// use core_lattice::{Boundary, Direction, Lattice};
+/// use spatial::lattice::{HaloGrid, SiteSets};
+/// let lattice = Lattice::with_boundary(&[16, 16], Boundary::Periodic).unwrap();
+/// let mut sets = SiteSets::new(lattice.clone());
+/// sets.push(vec![lattice.encode(&[2, 2]).unwrap()]);
+/// sets.push(vec![lattice.encode(&[4, 2]).unwrap()]);
+/// let mut grid = HaloGrid::new(&sets, None);
+/// let mut contacts = Vec::new();
+/// // Cluster 0 steps towards cluster 1 and touches it.
+/// grid.try_move(0, Direction::new(0, true), &mut contacts).unwrap();
+/// assert_eq!(contacts, [1]);
+/// let (size, _) = grid.merge(0, &[1]);
+/// assert_eq!((size, grid.live()), (2, &[0][..]));
+/// ```
+#[derive(Debug, Clone)]
+pub struct HaloGrid {
     lattice: Lattice,
     /// Every cluster id ever handed out: its shape (empty once retired) and bounding region.
     shapes: Vec<Shape>,
@@ -62,9 +99,6 @@ pub(crate) struct HaloGrid {
     boxes: HaloBoxes,
     /// The step of the cluster count's geometric scale at the last tuning.
     tuned_at: i64,
-    /// The clusters as k-index arrays, built by [`ClusterStore::sets`] and dropped by
-    /// [`ClusterStore::forget_views`].
-    materialized: OnceLock<SiteSets>,
     candidates: Vec<ItemId>,
     scratch: Vec<u64>,
 }
@@ -75,14 +109,10 @@ fn tuning_step(clusters: usize) -> i64 {
 }
 
 impl HaloGrid {
-    /// The clusters of `arrays`, in grid boxes of side `requested` (a power of two) or, by
-    /// default, of the side with the least predicted cost. Pushes the side chosen to `notes`.
-    pub(crate) fn new(
-        arrays: ClusterArrays,
-        requested: Option<u64>,
-        notes: &mut Vec<String>,
-    ) -> Self {
-        let sets = arrays.sets();
+    /// The live clusters of `sets` (with their ids; none may be face-adjacent to another), in
+    /// grid boxes of side `requested` (a power of two) or, by default, of the side with the
+    /// least predicted cost. [`HaloGrid::side`] tells the side chosen.
+    pub fn new(sets: &SiteSets, requested: Option<u64>) -> Self {
         let lattice = sets.lattice().clone();
         let mut shapes = vec![Shape::default(); sets.id_bound()];
         let mut regions = vec![Region::default(); sets.id_bound()];
@@ -104,19 +134,40 @@ impl HaloGrid {
             position,
             particles: sets.total_sites(),
             tuned_at: tuning_step(sets.len()),
-            materialized: OnceLock::new(),
             candidates: Vec::new(),
             scratch: Vec::new(),
         };
         let side = requested.unwrap_or_else(|| grid.best_side().0);
         grid.rebuild(side);
-        notes.push(match requested {
-            Some(_) => format!("grid box side {side} (halo per cluster, re-tuned as clusters grow)"),
-            None => format!(
-                "grid box side {side} (halo per cluster, least predicted cost; re-tuned as clusters grow)"
-            ),
-        });
         grid
+    }
+
+    /// The lattice.
+    pub fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+
+    /// The box side `A`.
+    pub fn side(&self) -> u64 {
+        self.boxes.side()
+    }
+
+    /// Live cluster ids, in no particular order.
+    #[inline]
+    pub fn live(&self) -> &[ItemId] {
+        &self.live
+    }
+
+    /// Whether cluster `id` is live.
+    #[inline]
+    pub fn contains(&self, id: ItemId) -> bool {
+        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+    }
+
+    /// Number of particles of live cluster `id`.
+    #[inline]
+    pub fn len_of(&self, id: ItemId) -> usize {
+        self.shapes[id as usize].len()
     }
 
     /// The halo of cluster `id`.
@@ -158,10 +209,10 @@ impl HaloGrid {
 
     /// Re-tune the box side if the cluster count has passed a step of its scale since the last
     /// tuning and another side is predicted to be enough cheaper.
-    fn maybe_retune(&mut self, notes: &mut Vec<String>) {
+    fn maybe_retune(&mut self) -> Option<Retuned> {
         let step = tuning_step(self.live.len());
         if step == self.tuned_at {
-            return;
+            return None;
         }
         self.tuned_at = step;
         let side = self.boxes.side();
@@ -170,11 +221,15 @@ impl HaloGrid {
         let (best, cost) = self.best_side();
         if best != side && cost <= RETUNE_GAIN * now {
             self.rebuild(best);
-            notes.push(format!(
-                "{} clusters: grid box side re-tuned from {side} to {best} (predicted cost per sweep {now:.0} -> {cost:.0})",
-                self.live.len()
-            ));
+            return Some(Retuned {
+                clusters: self.live.len(),
+                from: side,
+                to: best,
+                cost_before: now,
+                cost_after: cost,
+            });
         }
+        None
     }
 
     /// Retire cluster `id` from the live list.
@@ -187,8 +242,8 @@ impl HaloGrid {
         self.position[id as usize] = DEAD;
     }
 
-    /// The clusters as k-index arrays, with the same ids.
-    fn to_sets(&self) -> SiteSets {
+    /// The clusters as k-index arrays, with the same ids (retired ids removed). O(N).
+    pub fn to_sets(&self) -> SiteSets {
         let mut sets = SiteSets::new(self.lattice.clone());
         for id in 0..self.shapes.len() as ItemId {
             sets.push(if self.contains(id) {
@@ -206,34 +261,12 @@ impl HaloGrid {
     }
 }
 
-impl ClusterStore for HaloGrid {
-    fn kind(&self) -> Search {
-        Search::Grid
-    }
-
-    fn grid_side(&self) -> Option<u64> {
-        Some(self.boxes.side())
-    }
-
-    #[inline]
-    fn live(&self) -> &[ItemId] {
-        &self.live
-    }
-
-    #[inline]
-    fn contains(&self, id: ItemId) -> bool {
-        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
-    }
-
-    #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
-        self.shapes[id as usize].len()
-    }
-
-    /// Moves the shape and its region, re-lists the halo's boxes where it crossed a box
-    /// boundary, and tests the candidates sharing a box with it. Returns the number of
-    /// candidates.
-    fn try_move(
+impl HaloGrid {
+    /// Moves cluster `id` by `dir`, all or nothing (a wall blocks the whole cluster), and
+    /// writes the clusters then face-adjacent to it to `contacts`, in increasing id: moves the
+    /// shape and its region, re-lists the halo's boxes where it crossed a box boundary, and
+    /// tests the candidates sharing a box with it. Returns the number of candidates examined.
+    pub fn try_move(
         &mut self,
         id: ItemId,
         dir: Direction,
@@ -268,7 +301,11 @@ impl ClusterStore for HaloGrid {
         Ok(examined)
     }
 
-    fn merge(&mut self, survivor: ItemId, others: &[ItemId], notes: &mut Vec<String>) -> Merged {
+    /// Merges every cluster of `others` (live, distinct, other than `survivor`) into
+    /// `survivor`, which keeps its id; the others' ids are retired. Returns the survivor's
+    /// size and, when the cluster count passed a step of its scale and another box side was
+    /// predicted to be enough cheaper, the re-tuning done.
+    pub fn merge(&mut self, survivor: ItemId, others: &[ItemId]) -> (usize, Option<Retuned>) {
         let s = survivor as usize;
         let halo = self.halo(survivor);
         self.boxes.unregister(survivor, &halo);
@@ -288,24 +325,12 @@ impl ClusterStore for HaloGrid {
         let halo = self.halo(survivor);
         self.boxes.register(survivor, &halo);
         let size = self.shapes[s].len();
-        self.maybe_retune(notes);
-        Merged {
-            size,
-            to_all_pairs: false,
-        }
+        (size, self.maybe_retune())
     }
 
-    fn sets(&self) -> &SiteSets {
-        self.materialized.get_or_init(|| self.to_sets())
-    }
-
-    fn forget_views(&mut self) {
-        self.materialized.take();
-    }
-
-    /// Every shape sorted and inside its region, and every box listing exactly the clusters
-    /// whose halo overlaps it.
-    fn check(&self) {
+    /// Panics unless every shape is sorted and inside its region, and every box lists exactly
+    /// the clusters whose halo overlaps it. For tests.
+    pub fn check(&self) {
         let mut halos = Vec::with_capacity(self.live.len());
         for &id in &self.live {
             let shape = &self.shapes[id as usize];
@@ -323,9 +348,5 @@ impl ClusterStore for HaloGrid {
             halos.push((id, self.halo(id)));
         }
         self.boxes.check(&halos);
-    }
-
-    fn take_arrays(&mut self) -> ClusterArrays {
-        ClusterArrays::new(self.to_sets())
     }
 }

@@ -1,31 +1,42 @@
-//! A dense per-cell index of the animats over the unbounded plane: which animat (id and
-//! species) stands on each cell.
+//! A dense per-cell index over the unbounded integer plane ([`CellIndex`]): at most one item
+//! per cell, each item an id (`u64`) and one of two kinds. It is the animat model's hot-path
+//! neighbour search (the grid boxes of [`plane`](crate::plane) remain the paper's baseline
+//! setting): the model asks "what stands on this cell", reads the cells around an animat
+//! through a [`Window`], its row words ([`near`]) and its rings of cells ([`rings`]), and
+//! answers the queries beyond them with rings of grid boxes read from the index ([`wide`]).
 //!
 //! The plane is cut into square tiles of [`TILE`] x [`TILE`] cells; each tile that holds an
-//! animat has a cell byte per cell and, in a parallel array, the id of the animat on the cell.
-//! A cell byte holds the kind in its low two bits ([`SPECIES`]: 0 free, 1 fox, 2 rabbit) and
-//! the occupant's id bucket in the other six ([`CellIndex::bucket`]), which settles most id
-//! comparisons without the ids. Cell bytes are stored in 8 x 8 blocks of 64 bytes, so a
-//! cell's whole 5 x 5 neighbourhood lies in at most four cache lines. Tiles are kept in a
-//! vector; a dense directory over the rectangle of tile coordinates in use (grown with a
-//! margin, at most 2^18 entries) and, beyond it, a hash map (rustc-hash, already used
-//! by `spatial`) go from tile coordinates to the tile's slot. A tile that empties returns to a
-//! free list, so memory follows the occupied area, not the area the animats ever roamed.
+//! item has a cell byte per cell and, in a parallel array, the id of the item on the cell.
+//! A cell byte holds the kind in its low two bits ([`KIND_MASK`]: [`FREE`], [`KIND_A`] or
+//! [`KIND_B`]) and the occupant's id bucket in the other six ([`CellIndex::bucket`]), which
+//! settles most id comparisons without the ids. Cell bytes are stored in 8 x 8 blocks of 64
+//! bytes, so a cell's whole 5 x 5 neighbourhood lies in at most four cache lines. Tiles are
+//! kept in a vector; a dense directory over the rectangle of tile coordinates in use (grown
+//! with a margin, at most 2^18 entries) and, beyond it, a hash map (rustc-hash) go from tile
+//! coordinates to the tile's slot. A tile that empties returns to a free list, so memory
+//! follows the occupied area, not the area the items ever roamed.
 //!
-//! Perception reads cells through a [`Window`]: the at most 2 x 2 tiles covering a square of
-//! half-side up to [`WINDOW_MAX`] around the query point, fetched with at most four directory
-//! lookups; every cell read after that is an array index, and [`Window::rows`] reads 8 cells
-//! of a row as one word. Wide queries read rectangles ([`CellIndex::scan_rect`]): each tile
-//! keeps, per species, a count and a bit per 8 x 8 block of the animats in it, so empty tiles
-//! and blocks are skipped without reading their cells.
+//! Reads go through a [`Window`]: the at most 2 x 2 tiles covering a square of half-side up
+//! to [`WINDOW_MAX`] around the query point, fetched with at most four directory lookups;
+//! every cell read after that is an array index, and [`Window::rows`] reads 8 cells of a row
+//! as one word. Wide queries read rectangles ([`CellIndex::scan_rect`]): each tile keeps, per
+//! kind, a count and a bit per 8 x 8 block of the items in it, so empty tiles and blocks are
+//! skipped without reading their cells.
 //!
-//! Invariants: a cell byte is [`FREE`] exactly when no animat stands on the cell, and then its
+//! Invariants: a cell byte is [`FREE`] exactly when no item stands on the cell, and then its
 //! id slot is unused; an occupied cell's byte holds its occupant's kind and the bucket of its
 //! id under the current bucket map, which is non-decreasing in the id; a tile is in use
-//! exactly while it holds an animat (`count` is its number of occupied cells); a tile's block
-//! counts are the occupied cells of each species in each block, and its block masks have a bit
+//! exactly while it holds an item (`count` is its number of occupied cells); a tile's block
+//! counts are the occupied cells of each kind in each block, and its block masks have a bit
 //! set exactly for the blocks with a nonzero count; the dense directory agrees with the map for
 //! every tile coordinate in its rectangle.
+//!
+//! Every answer is exact and independent of the tiles, the directory and the box side of the
+//! wide queries: `tests/cells_props.rs` checks them against a brute-force scan.
+
+pub mod near;
+pub mod rings;
+pub mod wide;
 
 use rustc_hash::FxHashMap;
 use std::ops::ControlFlow;
@@ -36,32 +47,33 @@ const SHIFT: u32 = 6;
 pub const TILE: i64 = 1 << SHIFT;
 /// Largest half-side of a [`Window`] (so that a window spans at most two tiles per axis).
 pub const WINDOW_MAX: i64 = TILE / 2;
-/// Positions farther than this from the `i64` limits are served by windows; the rest (never
-/// reached by a real run) fall back to the grid search.
+/// Positions farther than this from the `i64` limits are served by windows; for the rest
+/// [`CellIndex::window`] returns `None` and the caller uses the wide queries.
 const EDGE_GUARD: i64 = 4 * TILE;
 
 /// The kind byte of a free cell.
 pub const FREE: u8 = 0;
 
-/// The species bits of a cell byte: [`FREE`], 1 fox or 2 rabbit. The other six bits hold the
-/// occupant's id bucket (see [`CellIndex::bucket`]).
-pub const SPECIES: u8 = 3;
+/// The first kind of item (kind byte 1; the animat model's foxes).
+pub const KIND_A: u8 = 1;
 
-/// Kind byte of an occupant: 1 fox, 2 rabbit (never [`FREE`]).
-#[inline]
-pub fn kind_byte(rabbit: bool) -> u8 {
-    1 + u8::from(rabbit)
-}
+/// The second kind of item (kind byte 2; the animat model's rabbits).
+pub const KIND_B: u8 = 2;
+
+/// The kind bits of a cell byte: [`FREE`], [`KIND_A`] or [`KIND_B`]. The other six bits hold
+/// the occupant's id bucket (see [`CellIndex::bucket`]). As a set of kinds (in
+/// [`CellIndex::scan_rect`] and the wide queries) it means both.
+pub const KIND_MASK: u8 = 3;
 
 #[derive(Debug, Clone)]
 struct Tile {
     kinds: Box<[u8; CELLS]>,
     ids: Box<[u64; CELLS]>,
     count: u32,
-    /// Occupied cells of each 8 x 8 block, by species (index `kind - 1`); boxed, so that the
-    /// tile records that every turn reads stay small.
+    /// Occupied cells of each 8 x 8 block, by kind (index `kind - 1`); boxed, so that the
+    /// tile records that every query reads stay small.
     block_counts: Box<[[u8; BLOCKS]; 2]>,
-    /// Bit `b` set when block `b` holds an animat of the species (same index).
+    /// Bit `b` set when block `b` holds an item of the kind (same index).
     block_masks: [u64; 2],
 }
 
@@ -72,7 +84,7 @@ impl Tile {
     /// Counts an occupant of kind byte `k` (not [`FREE`]) in the block of cell offset `off`.
     #[inline]
     fn enter(&mut self, k: u8, off: usize) {
-        let (s, b) = (usize::from(k & SPECIES) - 1, off >> 6);
+        let (s, b) = (usize::from(k & KIND_MASK) - 1, off >> 6);
         self.block_counts[s][b] += 1;
         self.block_masks[s] |= 1 << b;
     }
@@ -80,7 +92,7 @@ impl Tile {
     /// Uncounts an occupant of kind byte `k` (not [`FREE`]) in the block of cell offset `off`.
     #[inline]
     fn leave(&mut self, k: u8, off: usize) {
-        let (s, b) = (usize::from(k & SPECIES) - 1, off >> 6);
+        let (s, b) = (usize::from(k & KIND_MASK) - 1, off >> 6);
         self.block_counts[s][b] -= 1;
         if self.block_counts[s][b] == 0 {
             self.block_masks[s] &= !(1 << b);
@@ -89,6 +101,20 @@ impl Tile {
 }
 
 /// The cell index; see the module documentation.
+///
+/// ```
+/// use spatial::cells::{CellIndex, FREE, KIND_A, KIND_B};
+/// let mut c = CellIndex::default();
+/// c.set([3, -4], KIND_A, 7);
+/// c.set([70, 0], KIND_B, 9);
+/// assert_eq!((c.kind([3, -4]), c.id([3, -4])), (KIND_A, 7));
+/// c.relocate([3, -4], [4, -4]);
+/// assert_eq!(c.kind([3, -4]), FREE);
+/// let w = c.window([5, -5], 8).unwrap();
+/// assert_eq!(w.at(4, -4), KIND_A);
+/// // The nearest item of kind B within squared distance 5000 of [4, -4], with boxes of side 60.
+/// assert_eq!(c.nearest_within([4, -4], KIND_B, 5000, 60).0, Some([70, 0]));
+/// ```
 #[derive(Debug, Clone, Default)]
 pub struct CellIndex {
     /// Every tile's slot by tile coordinates.
@@ -115,8 +141,8 @@ const DIR_MAX: u64 = 1 << 18;
 const CELLS: usize = (TILE * TILE) as usize;
 
 /// Bytes of one tile: a cell byte and an 8-byte id per cell (36 KiB). A tile is allocated for
-/// each 64 x 64 square holding an animat, so in a dilute world, with animats farther apart than
-/// a tile, this is the memory of each animat.
+/// each 64 x 64 square holding an item, so in a dilute set, with items farther apart than a
+/// tile, this is the memory of each item.
 pub const TILE_BYTES: u64 = (CELLS * (1 + size_of::<u64>())) as u64;
 
 /// Offset of a cell inside its tile: 8 x 8 blocks of cells, each block 64 consecutive bytes
@@ -146,6 +172,7 @@ impl CellIndex {
     }
 
     /// Whether tile coordinates `key` lie in the directory's rectangle.
+    #[inline]
     fn in_dir(&self, key: [i64; 2]) -> Option<usize> {
         let u = key[0].wrapping_sub(self.dx0) as u64;
         let v = key[1].wrapping_sub(self.dy0) as u64;
@@ -196,13 +223,13 @@ impl CellIndex {
     pub fn kind(&self, p: [i64; 2]) -> u8 {
         let (key, off) = split(p);
         match self.slot(key) {
-            Some(t) => self.tiles[t as usize].kinds[off] & SPECIES,
+            Some(t) => self.tiles[t as usize].kinds[off] & KIND_MASK,
             None => FREE,
         }
     }
 
     /// The bucket of an id, kept in the top six bits of its cell byte: non-decreasing in the
-    /// id, so between two animats the one with the lower bucket has the lower id, and only
+    /// id, so between two items the one with the lower bucket has the lower id, and only
     /// equal buckets need the ids themselves.
     #[inline]
     pub fn bucket(&self, id: u64) -> u8 {
@@ -211,32 +238,34 @@ impl CellIndex {
     }
 
     /// Whether the bucket of `id` would exceed 63 (and be capped).
+    #[inline]
     pub fn bucket_capped(&self, id: u64) -> bool {
         id.saturating_sub(self.bucket_base) >> self.bucket_shift > 63
     }
 
     /// The lowest id bucket 0 stands for, and the bucket width (log2).
+    #[inline]
     pub fn bucket_range(&self) -> (u64, u32) {
         (self.bucket_base, self.bucket_shift)
     }
 
     /// Maps ids to buckets afresh (`base`, `shift < 64`) and rewrites the bucket of every
-    /// animat, given as (cell, id).
+    /// item, given as (cell, id).
     pub fn rebucket(
         &mut self,
         base: u64,
         shift: u32,
-        animats: impl Iterator<Item = ([i64; 2], u64)>,
+        items: impl Iterator<Item = ([i64; 2], u64)>,
     ) {
         debug_assert!(shift < 64);
         self.bucket_base = base;
         self.bucket_shift = shift;
-        for (p, id) in animats {
+        for (p, id) in items {
             let b = self.bucket(id) << 2;
             let (key, off) = split(p);
             if let Some(t) = self.slot(key) {
                 let k = &mut self.tiles[t as usize].kinds[off];
-                *k = (*k & SPECIES) | b;
+                *k = (*k & KIND_MASK) | b;
             }
         }
     }
@@ -247,9 +276,10 @@ impl CellIndex {
         self.kind(p) != FREE
     }
 
-    /// Puts animat `id` of kind byte `k != FREE` on the free cell `p`.
+    /// Puts item `id` of kind byte `k` ([`KIND_A`] or [`KIND_B`]) on the free cell `p`.
+    #[inline]
     pub fn set(&mut self, p: [i64; 2], k: u8, id: u64) {
-        debug_assert!(k != FREE && k & SPECIES == k);
+        debug_assert!(k != FREE && k & KIND_MASK == k);
         let b = self.bucket(id) << 2;
         let (key, off) = split(p);
         let t = match self.slot(key) {
@@ -287,6 +317,7 @@ impl CellIndex {
     }
 
     /// Frees cell `p` (which must be occupied).
+    #[inline]
     pub fn clear(&mut self, p: [i64; 2]) {
         let (key, off) = split(p);
         let Some(t) = self.slot(key) else {
@@ -309,6 +340,7 @@ impl CellIndex {
     }
 
     /// Moves the occupant of `from` to the free cell `to`.
+    #[inline]
     pub fn relocate(&mut self, from: [i64; 2], to: [i64; 2]) {
         let (kf, of) = split(from);
         let (kt, ot) = split(to);
@@ -332,7 +364,8 @@ impl CellIndex {
         self.set(to, k, id);
     }
 
-    /// Id of the animat on the occupied cell `p`.
+    /// Id of the item on the occupied cell `p`.
+    #[inline]
     pub fn id(&self, p: [i64; 2]) -> u64 {
         let (key, off) = split(p);
         self.slot(key)
@@ -378,15 +411,16 @@ impl CellIndex {
         })
     }
 
-    /// Tiles in use (each holds at least one animat).
+    /// Tiles in use (each holds at least one item).
+    #[inline]
     pub fn tiles_in_use(&self) -> usize {
         self.map.len()
     }
 
     /// Calls `f(x, y, byte)` for every occupied cell `(x, y)` of the rectangle `x0..=x1`,
-    /// `y0..=y1` whose species meets `kinds` (bit 0 foxes, bit 1 rabbits: the kind bytes'
-    /// own bits), with its whole cell byte, in no particular order, until `f` breaks. Tiles
-    /// and 8 x 8 blocks without such an animat are skipped without reading their cells, so
+    /// `y0..=y1` whose kind meets `kinds` (bit 0 [`KIND_A`], bit 1 [`KIND_B`]: the kind
+    /// bytes' own bits), with its whole cell byte, in no particular order, until `f` breaks. Tiles
+    /// and 8 x 8 blocks without such an item are skipped without reading their cells, so
     /// the cost follows the occupied blocks rather than the area; a rectangle covering more
     /// tile positions than there are tiles in use goes through the tiles in use instead.
     pub fn scan_rect(
@@ -396,7 +430,7 @@ impl CellIndex {
         kinds: u8,
         mut f: impl FnMut(i64, i64, u8) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        if x0 > x1 || y0 > y1 || kinds & SPECIES == 0 {
+        if x0 > x1 || y0 > y1 || kinds & KIND_MASK == 0 {
             return ControlFlow::Continue(());
         }
         let (tx0, tx1, ty0, ty1) = (x0 >> SHIFT, x1 >> SHIFT, y0 >> SHIFT, y1 >> SHIFT);
@@ -474,7 +508,7 @@ impl CellIndex {
                         .try_into()
                         .expect("a block row is 8 bytes"),
                 );
-                let sel = match r.kinds & SPECIES {
+                let sel = match r.kinds & KIND_MASK {
                     1 => w,
                     2 => w >> 1,
                     _ => w | w >> 1,
@@ -490,18 +524,19 @@ impl CellIndex {
         ControlFlow::Continue(())
     }
 
-    /// Asks the CPU to start loading the cell bytes [`Window::rows`] reads first around `p`
-    /// (cells `x - 2 ..= x + 5` of rows `y - 2 ..= y + 2`), without waiting for them. Only the
-    /// lines in `p`'s own tile are asked for ([`near_corners`]); the rest are rare and load on
-    /// use.
+    /// Calls `touch` with one cell byte in each cache line that [`Window::rows`] reads first
+    /// around `p` (cells `x - 2 ..= x + 5` of rows `y - 2 ..= y + 2`), for a prefetch hint:
+    /// the caller can ask the CPU to start loading them without waiting (this crate has no
+    /// `unsafe` code of its own for it). Only the lines in `p`'s own tile are given
+    /// (`near_corners`); the rest are rare and load on use. A line may be given twice.
     #[inline]
-    pub fn prefetch_near(&self, p: [i64; 2]) {
+    pub fn near_lines(&self, p: [i64; 2], mut touch: impl FnMut(&u8)) {
         let (key, _) = split(p);
         if let Some(t) = self.slot(key) {
             let kinds = &self.tiles[t as usize].kinds;
-            // One line per 8 x 8 block of cells; a repeated line costs only an issue slot.
+            // One line per 8 x 8 block of cells.
             for [x, y] in near_corners(p) {
-                crate::hint::prefetch(&kinds[offset(x, y)]);
+                touch(&kinds[offset(x, y)]);
             }
         }
     }
@@ -515,8 +550,7 @@ impl CellIndex {
         self.tiles.len() as u64 * TILE_BYTES + slots as u64
     }
 
-    /// Occupied cells (for consistency checks).
-    #[cfg(test)]
+    /// Occupied cells (O(tiles in use); for consistency checks).
     pub fn len(&self) -> usize {
         self.map
             .values()
@@ -525,7 +559,6 @@ impl CellIndex {
     }
 
     /// Whether no cell is occupied.
-    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.map.is_empty()
     }
@@ -534,6 +567,7 @@ impl CellIndex {
 /// The corners of the part of `x - 2 ..= x + 5`, `y - 2 ..= y + 2` around `p = [x, y]` that
 /// lies in `p`'s tile. That part spans at most 2 x 2 blocks of 8 x 8 cells (it is 8 x 5 cells),
 /// so its corners touch every block, hence every cache line of kind bytes, that it covers.
+#[inline]
 fn near_corners(p: [i64; 2]) -> [[i64; 2]; 4] {
     // The tile's cells are `k << SHIFT ..= (k << SHIFT) + TILE - 1` on each axis, with
     // `k = v >> SHIFT` (no overflow: `k << SHIFT <= v`).
@@ -552,7 +586,7 @@ fn near_corners(p: [i64; 2]) -> [[i64; 2]; 4] {
     [[x0, y0], [x1, y0], [x0, y1], [x1, y1]]
 }
 
-/// The rectangle and species of a [`CellIndex::scan_rect`].
+/// The rectangle and kinds of a [`CellIndex::scan_rect`].
 struct Rect {
     x0: i64,
     x1: i64,
@@ -586,7 +620,7 @@ impl Window<'_> {
     /// The kind byte on cell `(x, y)`, which must lie within the window's square.
     #[inline(always)]
     pub fn at(&self, x: i64, y: i64) -> u8 {
-        self.byte(x, y) & SPECIES
+        self.byte(x, y) & KIND_MASK
     }
 
     /// The whole cell byte on `(x, y)`: kind and id bucket (within the window's square).
@@ -630,7 +664,7 @@ impl Window<'_> {
         out
     }
 
-    /// The id of the animat on the occupied cell `(x, y)` (within the window's square).
+    /// The id of the item on the occupied cell `(x, y)` (within the window's square).
     #[inline(always)]
     pub fn id(&self, x: i64, y: i64) -> u64 {
         let (t, off) = self.locate(x, y);

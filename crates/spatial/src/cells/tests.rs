@@ -2,6 +2,11 @@
 
 use super::*;
 
+/// The kind byte of the test items: [`KIND_B`] for `second`, else [`KIND_A`].
+fn kind_byte(second: bool) -> u8 {
+    if second { KIND_B } else { KIND_A }
+}
+
 #[test]
 fn prefetched_lines_cover_the_rows_lines_in_the_tile() {
     // Every 8-byte row word `Window::rows` reads around p, where it lies in p's tile, is
@@ -49,7 +54,7 @@ fn scan_rect_visits_exactly_the_occupied_cells_of_the_kinds_in_the_rectangle() {
     let mut rng = stream(5, 0);
     let mut c = CellIndex::default();
     let mut occ = std::collections::BTreeMap::new();
-    // Clustered and scattered animats across tile and block edges, some far away.
+    // Clustered and scattered items across tile and block edges, some far away.
     for i in 0..3000u64 {
         let p = if i % 10 == 0 {
             [rng.random_range(-5000..5000), rng.random_range(-5000..5000)]
