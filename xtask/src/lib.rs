@@ -6,6 +6,7 @@
 
 pub mod bench;
 pub mod ci;
+pub mod codemap;
 pub mod plot;
 pub mod probe;
 pub mod report;
