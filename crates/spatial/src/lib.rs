@@ -27,6 +27,22 @@
 //! - [`plane`]: the paper's grid boxes hashed over the unbounded integer plane (`PlaneGrid`),
 //!   for the animat model (sections II.B and IV.B): the animats' path with the cell search off
 //!   (`World::set_cell_search`, the grid-box study) and with `--grid-box none`.
+//!
+//! ```
+//! use spatial::orthtree::Orthtree;
+//!
+//! // A quadtree of unit-diameter particles, as DLA stores its cluster.
+//! let mut tree = Orthtree::<2>::new();
+//! for p in [[0.0, 0.0], [1.0, 0.0], [1.5, 0.8660254]] {
+//!     tree.insert(p).unwrap();
+//! }
+//! let walker = [30.0, 40.0];
+//! let exact = tree.nearest_distance(&walker).unwrap();
+//! // vpdist with the paper's precision kappa = 2: never above the exact distance, so a walker
+//! // may jump that far without touching the cluster, and cheaper to compute far away.
+//! let bound = tree.vpdist(&walker, 2.0).unwrap();
+//! assert!(bound <= exact && bound > 0.5 * exact);
+//! ```
 
 pub mod cells;
 pub mod distmap;
