@@ -10,6 +10,8 @@
 //! - [`stats`]: Welford mean/variance, integer and logarithmic histograms, least-squares and
 //!   log-log fits with standard errors, and radius-of-gyration accumulators that stay accurate
 //!   far from the origin.
+//! - [`spec`]: descriptions of model parameters (name, flag, unit, range), one table per model
+//!   that the front ends are derived from or checked against.
 //! - [`cpu`]: the processor features the build was compiled for, checked at start.
 //! - [`io`]: atomic file writes, the run manifest `run.json`, the checkpoint envelope, PNG and
 //!   CSV writers, and the stable state hash.
@@ -30,6 +32,7 @@ pub mod lattice;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod rng;
+pub mod spec;
 pub mod stats;
 #[cfg(feature = "test-support")]
 pub mod testing;

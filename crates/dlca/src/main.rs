@@ -27,7 +27,7 @@ use std::process::ExitCode;
 #[derive(Parser, Debug)]
 #[command(name = "dlca", version, allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
 struct Cli {
-    /// Lattice dimension, 1 to 5. With a single --size value, every axis gets that length.
+    /// Lattice dimension, 1..=5. With a single --size value, every axis gets that length.
     #[arg(long, default_value_t = 2)]
     dim: usize,
 
@@ -77,12 +77,12 @@ struct Cli {
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
     gravity: f64,
 
-    /// Mobility exponent gamma >= 0: a cluster of s particles moves with probability
+    /// Mobility exponent gamma in [0, inf): a cluster of s particles moves with probability
     /// temperature * s^-gamma (0: all clusters equally mobile, as in the paper).
     #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
     mobility_exponent: f64,
 
-    /// Stop when at most this many clusters remain (>= 1; the paper stops at 100 to 1000).
+    /// Stop when at most this many clusters remain, 1.. (the paper stops at 100 to 1000).
     #[arg(long, default_value_t = 100)]
     target_clusters: u64,
 
@@ -128,7 +128,7 @@ struct Cli {
     #[arg(long)]
     gyration: bool,
 
-    /// Smallest cluster size used in the fractal-dimension fit.
+    /// Smallest cluster size used in the fractal-dimension fit, 2..
     #[arg(long, default_value_t = 10)]
     fit_min_size: u64,
 
@@ -367,3 +367,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "cli_spec_tests.rs"]
+mod cli_spec_tests;
