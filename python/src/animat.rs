@@ -645,13 +645,13 @@ pub fn animat(
     run.result(py)
 }
 
-/// The `animat` binary's defaults, from the library.
+/// The `animat` binary's defaults, from the library's parameter table (`density`: none, the
+/// start radius is the default's).
 pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    let mut v = serde_json::to_value(Params::default()).map_err(run_error)?;
-    if let Some(o) = v.as_object_mut() {
-        o.insert("steps".into(), DEFAULT_STEPS.into());
-        o.insert("seed".into(), 1.into());
-        o.insert("timing".into(), false.into());
-    }
-    crate::convert::json(py, &v)
+    let mut o = ::animat::params::defaults();
+    o.remove("density");
+    o.insert("steps".into(), DEFAULT_STEPS.into());
+    o.insert("seed".into(), 1.into());
+    o.insert("timing".into(), false.into());
+    crate::convert::json(py, &serde_json::Value::Object(o))
 }

@@ -20,18 +20,6 @@ fn defaults() -> Params {
 /// cluster of a second or so, large enough for a fractal-dimension fit.
 const PARTICLES: u64 = 100_000;
 
-/// `--far-field` by its name.
-fn far_field(name: &str) -> PyResult<FarField> {
-    [FarField::Return, FarField::Jump]
-        .into_iter()
-        .find(|f| f.name() == name)
-        .ok_or_else(|| {
-            value_error(format!(
-                "invalid value '{name}' for '--far-field': possible values are return, jump"
-            ))
-        })
-}
-
 /// The result of :func:`aggsim.dla`: the cluster, its growth and every result of the ``dla``
 /// binary's ``run.json``.
 ///
@@ -191,7 +179,7 @@ pub fn dla(
         dim,
         particles: count("--particles", particles)?,
         birth_gap,
-        far_field: self::far_field(far_field)?,
+        far_field: far_field.parse::<FarField>().map_err(value_error)?,
         death_ratio: death_ratio.unwrap_or(defaults().death_ratio),
         step_min,
         precision,
@@ -205,19 +193,21 @@ pub fn dla(
         near_cache,
     };
     let params = if paper_settings {
+        // The library's rule, as the binary's: the fields it sets may not be given beside it.
+        // A keyword left at its default counts as not given (Python cannot tell them apart).
         let d = defaults();
-        if params.far_field != d.far_field
-            || death_ratio.is_some()
-            || params.step_min != d.step_min
-            || params.precision != d.precision
-            || params.distance_map != d.distance_map
-        {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "paper_settings=True sets far_field, death_ratio, step_min, precision and \
-                 distance_map; leave them at their defaults",
-            ));
-        }
-        params.paper_settings()
+        let given = |name: &str| match name {
+            "far_field" => params.far_field != d.far_field,
+            "death_ratio" => death_ratio.is_some(),
+            "step_min" => params.step_min != d.step_min,
+            "precision" => params.precision != d.precision,
+            "distance_map" => params.distance_map != d.distance_map,
+            _ => false,
+        };
+        params
+            .clone()
+            .with_paper_settings(given)
+            .map_err(value_error)?
     } else {
         params
     };
@@ -225,14 +215,10 @@ pub fn dla(
         .validate_given(death_ratio.is_some())
         .map_err(value_error)?;
     let progress = Progress::from_arg(progress, "dla", "particles")?;
-    // The one run-time dimension dispatch, as in the binary.
-    match params.dim {
-        2 => grow::<2>(py, params, seed, &progress, &clock),
-        3 => grow::<3>(py, params, seed, &progress, &clock),
-        4 => grow::<4>(py, params, seed, &progress, &clock),
-        5 => grow::<5>(py, params, seed, &progress, &clock),
-        d => Err(value_error(dla_pdla::ParamsError::Dim(d))),
-    }
+    // The library's one run-time dimension dispatch, as in the binary.
+    dla_pdla::with_dim!(params.dim, D => grow::<D>(py, params, seed, &progress, &clock), d => {
+        Err(value_error(dla_pdla::ParamsError::Dim(d)))
+    })
 }
 
 fn grow<const D: usize>(
@@ -281,13 +267,11 @@ where
     Ok(out.unbind())
 }
 
-/// The `dla` binary's defaults, from the library.
+/// The `dla` binary's defaults, from the library's parameter table (`particles`: this
+/// module's, as the binary has none).
 pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    let mut v = serde_json::to_value(defaults()).map_err(run_error)?;
-    if let Some(o) = v.as_object_mut() {
-        o.remove("keep_positions");
-        o.insert("particles".into(), PARTICLES.into());
-        o.insert("seed".into(), 1.into());
-    }
-    crate::convert::json(py, &v)
+    let mut o = dla_pdla::params::defaults();
+    o.insert("particles".into(), PARTICLES.into());
+    o.insert("seed".into(), 1.into());
+    crate::convert::json(py, &serde_json::Value::Object(o))
 }
