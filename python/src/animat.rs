@@ -522,22 +522,23 @@ impl AnimatWorld {
 /// foxes, rabbits : int
 ///     Start populations (default 300 and 2000).
 /// start_radius : int
-///     Radius of the start disc around the origin, in cells (default 60).
+///     Radius of the start disc around the origin, in cells, 0..=1073741824 (default 60).
 /// density : float
 ///     Start density in animats per cell, in (0, 0.5]: sets ``start_radius`` instead.
 /// vision : int
-///     Vision radius in cells, >= 1 (default 60, the paper's).
+///     Vision radius in cells, 1..=1073741824 (default 60, the paper's).
 /// grid_box : int or str
 ///     Grid-box side, ``"vision"`` (default) or ``"none"`` (exhaustive search): speed only.
 /// hungry_at, starve, fox_max_age, rabbit_max_age : int
-///     A fox is hungry at this hunger and starves above ``starve``; each species dies older
-///     than its maximum age.
+///     A fox is hungry at this hunger (0..=``starve``) and starves above ``starve``
+///     (1..=4294967295); each species dies older than its maximum age (1..=4294967295).
 /// fox_breed_p, rabbit_breed_p : float
-///     Probabilities that a breed rule whose condition holds produces an animat.
+///     Probabilities that a breed rule whose condition holds produces an animat, in [0, 1].
 /// prey_needed : int
 ///     Rabbits within vision a fox needs to breed.
 /// crowd_max, crowd_radius : int
-///     More than ``crowd_max`` animats within ``crowd_radius`` forbid breeding.
+///     More than ``crowd_max`` (0..=4294967294) animats within ``crowd_radius``
+///     (1..=1073741824) forbid breeding.
 /// fox_rules, rabbit_rules : list of str
 ///     Rule lists in priority order (fox: eat, breed, hunt, seek_mate, wander; rabbit: flee,
 ///     breed, herd, wander).

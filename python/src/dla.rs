@@ -79,31 +79,32 @@ impl DlaResult {
 /// Parameters
 /// ----------
 /// dim : int
-///     Space dimension, 2, 3, 4 or 5 (default 2).
+///     Space dimension, one of {2, 3, 4, 5} (default 2).
 /// particles : int
-///     Particles in the final cluster, seed particle included (default 100000).
+///     Particles in the final cluster, seed particle included, 1..=3000000000 in 2D and 3D,
+///     1..=2500000000 in 4D and 5D (default 100000).
 /// seed : int
 ///     Seed of every random stream (default 1).
 /// threads : int
-///     Walkers moving at once (PDLA; default 1, which is DLA and deterministic).
+///     Walkers moving at once (PDLA), 1..=1024 (default 1, which is DLA and deterministic).
 /// birth_gap : float
-///     R_b - R_ext in diameters, >= 1 (default 5).
+///     R_b - R_ext in diameters, in [1, 1e4] (default 5).
 /// far_field : str
 ///     ``"return"`` (default): a walker outside the birth sphere returns to it exactly where
 ///     Brownian motion would first hit it; ``"jump"``: the paper's jump with relaunch beyond
 ///     the death radius.
 /// death_ratio : float or None
-///     R_d / R_b for ``far_field="jump"`` (> 1; default None: 100). Refused with
+///     R_d / R_b for ``far_field="jump"``, in (1, 1e100] (default None: 100). Refused with
 ///     ``"return"``, as by the binary.
 /// step_min : float
 ///     Near-field step in diameters, in [1e-6, 1e3] (default 0.1; the paper's 0.5 biases
 ///     the R_g prefactor about 5 % low).
 /// precision : float
-///     kappa of the variable-precision distance, > 0.5 (default 2; ``math.inf`` is the
+///     kappa of the variable-precision distance, in (0.5, inf] (default 2; ``math.inf`` is the
 ///     exact search).
 /// leaf_side : float
-///     Side of the orthtree's leaves, a power of two in [1, 64] (default 8): speed and memory
-///     only.
+///     Side of the orthtree's leaves, a power of two in {1, 2, 4, 8, 16, 32, 64} (default 8):
+///     speed and memory only.
 /// distance_map : bool
 ///     The coarse distance maps in front of the orthtree (default True, the binary's
 ///     ``--distance-map on``): speed only, but another trajectory.
@@ -116,7 +117,7 @@ impl DlaResult {
 /// serial_until : int
 ///     With threads > 1: grow with one walker up to this many particles (default 0).
 /// fit_from : int
-///     Smallest N of the fractal-dimension fit log N = D log R_g + c (default 1000).
+///     Smallest N of the fractal-dimension fit log N = D log R_g + c, in 2.. (default 1000).
 /// progress : bool or callable
 ///     True prints progress to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).

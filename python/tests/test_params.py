@@ -128,6 +128,30 @@ def test_every_choice_is_accepted_and_named_in_the_error(call, name):
     assert str(e.value).endswith(", ".join(row["choices"]))
 
 
+def parameter_docs(doc):
+    """``{name: paragraph}`` of a numpydoc Parameters section (``a, b : type`` names several)."""
+    section = doc.split("Parameters\n----------\n", 1)[1].split("\n\n", 1)[0]
+    out, names = {}, []
+    for line in section.splitlines():
+        if " : " in line and not line.startswith(" "):
+            names = [n.strip() for n in line.split(" : ")[0].split(",")]
+            for n in names:
+                out[n] = line
+        else:
+            for n in names:
+                out[n] += " " + line.strip()
+    return out
+
+
+@pytest.mark.parametrize("model", ENTRY_POINTS)
+def test_the_docstrings_state_each_range(model):
+    docs = parameter_docs(getattr(aggsim, model).__doc__)
+    for r in table(model):
+        if r["range"] == "any" or r["choices"] or "`" in r["range"]:
+            continue
+        assert r["range"] in docs[r["name"]], (model, r["name"], r["range"], docs[r["name"]])
+
+
 def test_the_tables_state_units_ranges_and_docs():
     for model in ENTRY_POINTS:
         for r in table(model):

@@ -334,7 +334,7 @@ impl DlcaResult {
 /// particles : int
 ///     Number of particles at the start, 1 to the number of sites.
 /// dim : int or None
-///     Lattice dimension, 1 to 5 (default: the number of lengths in ``size``, or 2 for one
+///     Lattice dimension, 1..=5 (default: the number of lengths in ``size``, or 2 for one
 ///     length, as the binary).
 /// seed : int
 ///     Seed of every random stream (default 1).
@@ -346,10 +346,10 @@ impl DlcaResult {
 /// gravity : float
 ///     g in [0, 1): moves down the last axis have weight 1+g, up 1-g (default 0).
 /// mobility_exponent : float
-///     gamma >= 0: a cluster of s particles moves with probability temperature * s^-gamma
+///     gamma in [0, inf): a cluster of s particles moves with probability temperature * s^-gamma
 ///     (default 0).
 /// target_clusters : int
-///     Stop when at most this many clusters remain, >= 1 (default 100).
+///     Stop when at most this many clusters remain, 1.. (default 100).
 /// max_sweeps : int or None
 ///     Stop after this many sweeps at the latest (default None: no limit).
 /// search : str
@@ -370,7 +370,7 @@ impl DlcaResult {
 ///     Measure every final cluster's radius of gyration and fit the fractal dimension
 ///     (default False).
 /// fit_min_size : int
-///     Smallest cluster size in that fit, >= 2 (default 10).
+///     Smallest cluster size in that fit, 2.. (default 10).
 /// progress : bool or callable
 ///     True prints progress (merges) to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
