@@ -19,11 +19,13 @@ use std::process::ExitCode;
 /// radius R_b = R_ext + birth-gap, jump by the variable-precision distance to the cluster when
 /// far from it, take steps of step-min near it, and stick at exact contact. Outputs go into
 /// --out DIR (see docs/dla.md).
+// Defaults come from the library (`Params::default()`); `cli_spec_tests` checks the rest
+// (flags, choices, ranges in the help) against `dla_pdla::params::PARAMS`.
 #[derive(Parser, Debug)]
 #[command(name = "dla", version, allow_negative_numbers = true)]
 struct Cli {
     /// Space dimension, one of {2, 3, 4, 5}.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = Params::default().dim)]
     dim: usize,
 
     /// Particles in the final cluster, seed particle included: 1..=3000000000 in 2D and 3D,
@@ -44,13 +46,13 @@ struct Cli {
     // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
     // clap would read `-inf` as an unknown short flag.
     /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters, in [1, 1e4].
-    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().birth_gap)]
     birth_gap: f64,
 
     /// Far field (|p| > R_b): `return` puts the walker exactly where Brownian motion would first
     /// hit the birth sphere (harmonic measure; see docs/dla.md); `jump` is the paper's jump of
     /// |p| - R_ext - 1 with relaunch beyond the death radius.
-    #[arg(long, value_enum, default_value_t = FarField::Return)]
+    #[arg(long, value_enum, default_value_t = Params::default().far_field)]
     far_field: FarField,
 
     /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in (1, 1e100]
@@ -62,17 +64,17 @@ struct Cli {
     /// one is at most this. Smaller is closer to Brownian motion. The default is where the
     /// accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor about 5 %
     /// low (docs/dla.md, "Accuracy").
-    #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DEFAULT_STEP_MIN)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().step_min)]
     step_min: f64,
 
     /// Precision kappa of the variable-precision distance, in (0.5, inf] (the paper uses 2;
     /// `inf` is the exact search). Larger is more exact and slower.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 2.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().precision)]
     precision: f64,
 
     /// Side of the orthtree's leaf cells in diameters, a power of two in
     /// {1, 2, 4, 8, 16, 32, 64}: speed and memory only, not the physics.
-    #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DLA_LEAF_SIDE)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().leaf_side)]
     leaf_side: f64,
 
     /// The distance maps in front of the orthtree (one byte per cell of side 8 diameters plus a
@@ -80,7 +82,7 @@ struct Cli {
     /// 2-diameter cells near the cluster, about 6 bytes per particle at 1e6): walkers away from
     /// the cluster jump by their bound without a tree query. Speed and memory only, not the
     /// physics (but another trajectory and state hash); `off` is the paper's tree-only walk.
-    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    #[arg(long, value_enum, default_value_t = Toggle::from(Params::default().distance_map))]
     distance_map: Toggle,
 
     /// Each walker copies the particles within 5 diameters out of the tree and answers its
@@ -88,7 +90,7 @@ struct Cli {
     /// so the same trajectory and state hash on or off; speed only. Used when the tree is
     /// exact at those distances anyway ((precision - 1/2) leaf diagonals >= 5, as by
     /// default).
-    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    #[arg(long, value_enum, default_value_t = Toggle::from(Params::default().near_cache))]
     near_cache: Toggle,
 
     /// The variable-precision paper's walk, to reproduce its numbers: --far-field jump
@@ -99,15 +101,15 @@ struct Cli {
 
     /// Walkers moving at once on the shared cluster (PDLA), 1..=1024; 1 is exactly DLA and
     /// deterministic.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = Params::default().threads)]
     threads: usize,
 
     /// With --threads > 1: grow with one walker until the cluster has this many particles.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = Params::default().serial_until)]
     serial_until: u64,
 
     /// Smallest N used in the fractal-dimension fit log N = D log R_g + c, in 2..
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = Params::default().fit_from)]
     fit_from: u64,
 
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
@@ -160,6 +162,12 @@ struct Cli {
 enum Toggle {
     On,
     Off,
+}
+
+impl From<bool> for Toggle {
+    fn from(on: bool) -> Self {
+        if on { Toggle::On } else { Toggle::Off }
+    }
 }
 
 fn params(cli: &Cli) -> Result<Params, String> {
