@@ -45,6 +45,7 @@ fn show(v: &Value) -> String {
 #[test]
 fn every_flagged_parameter_is_a_flag_stating_its_range() {
     let cmd = Cli::command();
+    let mut unitless = Vec::new();
     for s in PARAMS {
         let Some(flag) = s.flag else { continue };
         let arg = cmd
@@ -57,6 +58,9 @@ fn every_flagged_parameter_is_a_flag_stating_its_range() {
             "--{flag} has a default"
         );
         let help = arg.get_long_help().or(arg.get_help()).unwrap().to_string();
+        if !help.to_lowercase().contains(s.unit) {
+            unitless.push(format!("--{flag} ({})", s.unit));
+        }
         if !matches!(s.range, Range::Any) {
             assert!(
                 help.contains(&s.range.to_string()),
@@ -65,6 +69,10 @@ fn every_flagged_parameter_is_a_flag_stating_its_range() {
             );
         }
     }
+    assert!(
+        unitless.is_empty(),
+        "help texts without their unit: {unitless:?}"
+    );
     for arg in cmd.get_arguments() {
         let Some(long) = arg.get_long() else { continue };
         assert!(

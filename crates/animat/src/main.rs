@@ -67,7 +67,7 @@ struct Cli {
     #[arg(long)]
     vision: Option<i64>,
 
-    /// Grid-box side: a positive integer, `vision` or `none` (exhaustive search); by default
+    /// Grid-box side in cells: a positive integer, `vision` or `none` (exhaustive search); by default
     /// `vision`. Changes only the speed, never the result.
     #[arg(long)]
     grid_box: Option<String>,

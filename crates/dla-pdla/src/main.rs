@@ -55,7 +55,7 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Params::default().far_field)]
     far_field: FarField,
 
-    /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in (1, 1e100]
+    /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in birth radii, in (1, 1e100]
     /// [default: 100].
     #[arg(long, allow_hyphen_values = true)]
     death_ratio: Option<f64>,
@@ -108,7 +108,7 @@ struct Cli {
     #[arg(long, default_value_t = Params::default().serial_until)]
     serial_until: u64,
 
-    /// Smallest N used in the fractal-dimension fit log N = D log R_g + c, in 2..
+    /// Smallest N (particles) used in the fractal-dimension fit log N = D log R_g + c, in 2..
     #[arg(long, default_value_t = Params::default().fit_from)]
     fit_from: u64,
 

@@ -43,6 +43,7 @@ fn show(v: &Value) -> String {
 fn every_parameter_is_a_flag_with_the_library_default_and_choices() {
     let cmd = Cli::command();
     let defaults = defaults();
+    let mut unitless = Vec::new();
     for s in PARAMS {
         let flag = s.flag.expect("every DLCA parameter has a flag");
         let arg = cmd
@@ -71,6 +72,9 @@ fn every_parameter_is_a_flag_with_the_library_default_and_choices() {
             ),
             many => panic!("--{flag}: defaults {many:?}"),
         }
+        if !help.to_lowercase().contains(s.unit) {
+            unitless.push(format!("--{flag} ({})", s.unit));
+        }
         if !matches!(s.range, Range::Any | Range::Choices(_)) {
             assert!(
                 help.contains(&s.range.to_string()),
@@ -94,6 +98,10 @@ fn every_parameter_is_a_flag_with_the_library_default_and_choices() {
             }
         }
     }
+    assert!(
+        unitless.is_empty(),
+        "help texts without their unit: {unitless:?}"
+    );
     for arg in cmd.get_arguments() {
         let Some(long) = arg.get_long() else { continue };
         assert!(

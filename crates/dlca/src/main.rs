@@ -34,7 +34,7 @@ struct Cli {
     #[arg(long, default_value_t = Params::default().dim())]
     dim: usize,
 
-    /// Side lengths: one number for every axis (`1024`) or one per axis (`1024x512`).
+    /// Side lengths in sites: one number for every axis (`1024`) or one per axis (`1024x512`).
     #[arg(long, value_parser = parse_size)]
     size: Option<Sizes>,
 
@@ -97,7 +97,7 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Params::default().search)]
     search: Search,
 
-    /// Initial grid-box side for `--search grid` or `grid-doubling`, a power of two (default:
+    /// Initial grid-box side in sites for `--search grid` or `grid-doubling`, a power of two (default:
     /// `grid` takes the side of least predicted cost and re-tunes it as clusters grow;
     /// `grid-doubling` starts from the cluster spacing and doubles with the largest cluster).
     #[arg(long)]
@@ -131,7 +131,7 @@ struct Cli {
     #[arg(long)]
     gyration: bool,
 
-    /// Smallest cluster size used in the fractal-dimension fit, 2..
+    /// Smallest cluster size (particles) used in the fractal-dimension fit, 2..
     #[arg(long, default_value_t = Params::default().fit_min_size)]
     fit_min_size: u64,
 

@@ -29,14 +29,14 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "foxes",
         flag: Some("foxes"),
-        unit: "animats",
+        unit: "foxes",
         doc: "Foxes at the start.",
         range: Range::Any,
     },
     ParamSpec {
         name: "rabbits",
         flag: Some("rabbits"),
-        unit: "animats",
+        unit: "rabbits",
         doc: "Rabbits at the start.",
         range: Range::Any,
     },
