@@ -85,7 +85,8 @@ def test_every_parameter_is_a_keyword_with_the_library_default(model):
                 # None takes the library's default, which aggsim.defaults() reports.
                 assert same(defaults[name], expected), (name, defaults[name], expected)
             else:
-                assert same(shown, expected), f"{obj.__name__}({name}={shown!r}), library {expected!r}"
+                where = f"{obj.__name__}({name}={shown!r})"
+                assert same(shown, expected), f"{where}, library {expected!r}"
         extra = set(sig) - names - PYTHON_ONLY
         assert not extra, f"{obj.__name__}: {extra} not in the library's table"
 

@@ -55,15 +55,15 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = Params::default().far_field)]
     far_field: FarField,
 
-    /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in birth radii, in (1, 1e100]
-    /// [default: 100].
+    /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in birth radii, in
+    /// (1, 1e100] [default: 100].
     #[arg(long, allow_hyphen_values = true)]
     death_ratio: Option<f64>,
 
-    /// Near-field step length in diameters, in [1e-6, 1e3]: used when the distance to the cluster minus
-    /// one is at most this. Smaller is closer to Brownian motion. The default is where the
-    /// accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor about 5 %
-    /// low (docs/dla.md, "Accuracy").
+    /// Near-field step length in diameters, in [1e-6, 1e3]: used when the distance to the
+    /// cluster minus one is at most this. Smaller is closer to Brownian motion. The default is
+    /// where the accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor
+    /// about 5 % low (docs/dla.md, "Accuracy").
     #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().step_min)]
     step_min: f64,
 
