@@ -18,12 +18,15 @@ use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
 /// A `u32` parameter (set in config files, not by a flag of its own): out of range is the
-/// library's wording of a range error.
+/// library's wording of a range error, with the range of the library's table.
 fn u32_arg(name: &str, v: i64) -> PyResult<u32> {
     u32::try_from(v).map_err(|_| {
+        let range = ::animat::params::PARAMS
+            .iter()
+            .find(|s| s.name == name)
+            .map_or_else(|| format!("0..={}", u32::MAX), |s| s.range.to_string());
         value_error(format!(
-            "{name} = {v} is outside the accepted range 0..={}",
-            u32::MAX
+            "{name} = {v} is outside the accepted range {range}"
         ))
     })
 }
@@ -535,7 +538,7 @@ impl AnimatWorld {
 /// fox_breed_p, rabbit_breed_p : float
 ///     Probabilities that a breed rule whose condition holds produces an animat, in [0, 1].
 /// prey_needed : int
-///     Rabbits within vision a fox needs to breed.
+///     Rabbits within vision a fox needs to breed, 0..=4294967295.
 /// crowd_max, crowd_radius : int
 ///     More than ``crowd_max`` (0..=4294967294) animats within ``crowd_radius``
 ///     (1..=1073741824) forbid breeding.

@@ -160,3 +160,13 @@ def test_the_tables_state_units_ranges_and_docs():
             assert r["range"], r
     with pytest.raises(ValueError, match="unknown model"):
         aggsim._params("ising")
+
+
+@pytest.mark.parametrize(
+    "name", ["hungry_at", "starve", "fox_max_age", "rabbit_max_age", "prey_needed", "crowd_max"]
+)
+def test_a_negative_count_names_the_tables_range(name):
+    row = next(r for r in table("animat") if r["name"] == name)
+    with pytest.raises(ValueError) as e:
+        aggsim.AnimatWorld(**{name: -1})
+    assert str(e.value) == f"{name} = -1 is outside the accepted range {row['range']}"

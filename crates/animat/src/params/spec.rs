@@ -115,7 +115,7 @@ pub const PARAMS: &[ParamSpec] = &[
         flag: None,
         unit: "rabbits",
         doc: "Rabbits needed within vision for a fox to breed.",
-        range: Range::Any,
+        range: int(0, U32),
     },
     ParamSpec {
         name: "crowd_max",
