@@ -32,6 +32,7 @@ from ._aggsim import (
     DlcaLattice,
     DlcaResult,
     __version__,
+    _params,
     defaults,
 )
 

@@ -20,6 +20,10 @@ Progress = Union[None, bool, Callable[[int, int], Any]]
 def defaults(model: Literal["dla", "dlca", "animat"]) -> Dict[str, Any]:
     """The defaults of ``model``'s keyword arguments: the binary's, from the library."""
 
+def _params(model: Literal["dla", "dlca", "animat"]) -> List[Dict[str, Any]]:
+    """The library's parameter table of ``model``: name, flag, unit, doc, range, choices and
+    default of each parameter (the consistency tests check the keywords against it)."""
+
 class DlaResult:
     """A grown DLA/PDLA cluster: :func:`dla`'s result."""
 
@@ -141,7 +145,7 @@ class DlcaLattice:
         mobility_exponent: float = ...,
         target_clusters: int = ...,
         max_sweeps: Optional[int] = None,
-        search: Literal["auto", "all-pairs", "grid", "lattice"] = ...,
+        search: Literal["auto", "all-pairs", "grid", "grid-doubling", "lattice"] = ...,
         grid_box: Optional[int] = None,
         max_memory: Union[None, int, str] = None,
         timing: bool = False,
@@ -196,7 +200,7 @@ def dlca(
     mobility_exponent: float = ...,
     target_clusters: int = ...,
     max_sweeps: Optional[int] = None,
-    search: Literal["auto", "all-pairs", "grid", "lattice"] = ...,
+    search: Literal["auto", "all-pairs", "grid", "grid-doubling", "lattice"] = ...,
     grid_box: Optional[int] = None,
     max_memory: Union[None, int, str] = None,
     timing: bool = False,

@@ -18,12 +18,15 @@ use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
 /// A `u32` parameter (set in config files, not by a flag of its own): out of range is the
-/// library's wording of a range error.
+/// library's wording of a range error, with the range of the library's table.
 fn u32_arg(name: &str, v: i64) -> PyResult<u32> {
     u32::try_from(v).map_err(|_| {
+        let range = ::animat::params::PARAMS
+            .iter()
+            .find(|s| s.name == name)
+            .map_or_else(|| format!("0..={}", u32::MAX), |s| s.range.to_string());
         value_error(format!(
-            "{name} = {v} is outside the accepted range 0..={}",
-            u32::MAX
+            "{name} = {v} is outside the accepted range {range}"
         ))
     })
 }
@@ -522,22 +525,23 @@ impl AnimatWorld {
 /// foxes, rabbits : int
 ///     Start populations (default 300 and 2000).
 /// start_radius : int
-///     Radius of the start disc around the origin, in cells (default 60).
+///     Radius of the start disc around the origin, in cells, 0..=1073741824 (default 60).
 /// density : float
 ///     Start density in animats per cell, in (0, 0.5]: sets ``start_radius`` instead.
 /// vision : int
-///     Vision radius in cells, >= 1 (default 60, the paper's).
+///     Vision radius in cells, 1..=1073741824 (default 60, the paper's).
 /// grid_box : int or str
 ///     Grid-box side, ``"vision"`` (default) or ``"none"`` (exhaustive search): speed only.
 /// hungry_at, starve, fox_max_age, rabbit_max_age : int
-///     A fox is hungry at this hunger and starves above ``starve``; each species dies older
-///     than its maximum age.
+///     A fox is hungry at this hunger (0..=``starve``) and starves above ``starve``
+///     (1..=4294967295); each species dies older than its maximum age (1..=4294967295).
 /// fox_breed_p, rabbit_breed_p : float
-///     Probabilities that a breed rule whose condition holds produces an animat.
+///     Probabilities that a breed rule whose condition holds produces an animat, in [0, 1].
 /// prey_needed : int
-///     Rabbits within vision a fox needs to breed.
+///     Rabbits within vision a fox needs to breed, 0..=4294967295.
 /// crowd_max, crowd_radius : int
-///     More than ``crowd_max`` animats within ``crowd_radius`` forbid breeding.
+///     More than ``crowd_max`` (0..=4294967294) animats within ``crowd_radius``
+///     (1..=1073741824) forbid breeding.
 /// fox_rules, rabbit_rules : list of str
 ///     Rule lists in priority order (fox: eat, breed, hunt, seek_mate, wander; rabbit: flee,
 ///     breed, herd, wander).
@@ -645,13 +649,13 @@ pub fn animat(
     run.result(py)
 }
 
-/// The `animat` binary's defaults, from the library.
+/// The `animat` binary's defaults, from the library's parameter table (`density`: none, the
+/// start radius is the default's).
 pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    let mut v = serde_json::to_value(Params::default()).map_err(run_error)?;
-    if let Some(o) = v.as_object_mut() {
-        o.insert("steps".into(), DEFAULT_STEPS.into());
-        o.insert("seed".into(), 1.into());
-        o.insert("timing".into(), false.into());
-    }
-    crate::convert::json(py, &v)
+    let mut o = ::animat::params::defaults();
+    o.remove("density");
+    o.insert("steps".into(), DEFAULT_STEPS.into());
+    o.insert("seed".into(), 1.into());
+    o.insert("timing".into(), false.into());
+    crate::convert::json(py, &serde_json::Value::Object(o))
 }

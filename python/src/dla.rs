@@ -20,18 +20,6 @@ fn defaults() -> Params {
 /// cluster of a second or so, large enough for a fractal-dimension fit.
 const PARTICLES: u64 = 100_000;
 
-/// `--far-field` by its name.
-fn far_field(name: &str) -> PyResult<FarField> {
-    [FarField::Return, FarField::Jump]
-        .into_iter()
-        .find(|f| f.name() == name)
-        .ok_or_else(|| {
-            value_error(format!(
-                "invalid value '{name}' for '--far-field': possible values are return, jump"
-            ))
-        })
-}
-
 /// The result of :func:`aggsim.dla`: the cluster, its growth and every result of the ``dla``
 /// binary's ``run.json``.
 ///
@@ -91,31 +79,32 @@ impl DlaResult {
 /// Parameters
 /// ----------
 /// dim : int
-///     Space dimension, 2, 3, 4 or 5 (default 2).
+///     Space dimension, one of {2, 3, 4, 5} (default 2).
 /// particles : int
-///     Particles in the final cluster, seed particle included (default 100000).
+///     Particles in the final cluster, seed particle included, 1..=3000000000 in 2D and 3D,
+///     1..=2500000000 in 4D and 5D (default 100000).
 /// seed : int
 ///     Seed of every random stream (default 1).
 /// threads : int
-///     Walkers moving at once (PDLA; default 1, which is DLA and deterministic).
+///     Walkers moving at once (PDLA), 1..=1024 (default 1, which is DLA and deterministic).
 /// birth_gap : float
-///     R_b - R_ext in diameters, >= 1 (default 5).
+///     R_b - R_ext in diameters, in [1, 1e4] (default 5).
 /// far_field : str
 ///     ``"return"`` (default): a walker outside the birth sphere returns to it exactly where
 ///     Brownian motion would first hit it; ``"jump"``: the paper's jump with relaunch beyond
 ///     the death radius.
 /// death_ratio : float or None
-///     R_d / R_b for ``far_field="jump"`` (> 1; default None: 100). Refused with
+///     R_d / R_b for ``far_field="jump"``, in (1, 1e100] (default None: 100). Refused with
 ///     ``"return"``, as by the binary.
 /// step_min : float
 ///     Near-field step in diameters, in [1e-6, 1e3] (default 0.1; the paper's 0.5 biases
 ///     the R_g prefactor about 5 % low).
 /// precision : float
-///     kappa of the variable-precision distance, > 0.5 (default 2; ``math.inf`` is the
+///     kappa of the variable-precision distance, in (0.5, inf] (default 2; ``math.inf`` is the
 ///     exact search).
 /// leaf_side : float
-///     Side of the orthtree's leaves, a power of two in [1, 64] (default 8): speed and memory
-///     only.
+///     Side of the orthtree's leaves, a power of two in {1, 2, 4, 8, 16, 32, 64} (default 8):
+///     speed and memory only.
 /// distance_map : bool
 ///     The coarse distance maps in front of the orthtree (default True, the binary's
 ///     ``--distance-map on``): speed only, but another trajectory.
@@ -128,7 +117,7 @@ impl DlaResult {
 /// serial_until : int
 ///     With threads > 1: grow with one walker up to this many particles (default 0).
 /// fit_from : int
-///     Smallest N of the fractal-dimension fit log N = D log R_g + c (default 1000).
+///     Smallest N of the fractal-dimension fit log N = D log R_g + c, in 2.. (default 1000).
 /// progress : bool or callable
 ///     True prints progress to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
@@ -191,7 +180,7 @@ pub fn dla(
         dim,
         particles: count("--particles", particles)?,
         birth_gap,
-        far_field: self::far_field(far_field)?,
+        far_field: far_field.parse::<FarField>().map_err(value_error)?,
         death_ratio: death_ratio.unwrap_or(defaults().death_ratio),
         step_min,
         precision,
@@ -205,19 +194,21 @@ pub fn dla(
         near_cache,
     };
     let params = if paper_settings {
+        // The library's rule, as the binary's: the fields it sets may not be given beside it.
+        // A keyword left at its default counts as not given (Python cannot tell them apart).
         let d = defaults();
-        if params.far_field != d.far_field
-            || death_ratio.is_some()
-            || params.step_min != d.step_min
-            || params.precision != d.precision
-            || params.distance_map != d.distance_map
-        {
-            return Err(pyo3::exceptions::PyValueError::new_err(
-                "paper_settings=True sets far_field, death_ratio, step_min, precision and \
-                 distance_map; leave them at their defaults",
-            ));
-        }
-        params.paper_settings()
+        let given = |name: &str| match name {
+            "far_field" => params.far_field != d.far_field,
+            "death_ratio" => death_ratio.is_some(),
+            "step_min" => params.step_min != d.step_min,
+            "precision" => params.precision != d.precision,
+            "distance_map" => params.distance_map != d.distance_map,
+            _ => false,
+        };
+        params
+            .clone()
+            .with_paper_settings(given)
+            .map_err(value_error)?
     } else {
         params
     };
@@ -225,14 +216,10 @@ pub fn dla(
         .validate_given(death_ratio.is_some())
         .map_err(value_error)?;
     let progress = Progress::from_arg(progress, "dla", "particles")?;
-    // The one run-time dimension dispatch, as in the binary.
-    match params.dim {
-        2 => grow::<2>(py, params, seed, &progress, &clock),
-        3 => grow::<3>(py, params, seed, &progress, &clock),
-        4 => grow::<4>(py, params, seed, &progress, &clock),
-        5 => grow::<5>(py, params, seed, &progress, &clock),
-        d => Err(value_error(dla_pdla::ParamsError::Dim(d))),
-    }
+    // The library's one run-time dimension dispatch, as in the binary.
+    dla_pdla::with_dim!(params.dim, D => grow::<D>(py, params, seed, &progress, &clock), d => {
+        Err(value_error(dla_pdla::ParamsError::Dim(d)))
+    })
 }
 
 fn grow<const D: usize>(
@@ -281,13 +268,11 @@ where
     Ok(out.unbind())
 }
 
-/// The `dla` binary's defaults, from the library.
+/// The `dla` binary's defaults, from the library's parameter table (`particles`: this
+/// module's, as the binary has none).
 pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    let mut v = serde_json::to_value(defaults()).map_err(run_error)?;
-    if let Some(o) = v.as_object_mut() {
-        o.remove("keep_positions");
-        o.insert("particles".into(), PARTICLES.into());
-        o.insert("seed".into(), 1.into());
-    }
-    crate::convert::json(py, &v)
+    let mut o = dla_pdla::params::defaults();
+    o.insert("particles".into(), PARTICLES.into());
+    o.insert("seed".into(), 1.into());
+    crate::convert::json(py, &serde_json::Value::Object(o))
 }

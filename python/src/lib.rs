@@ -32,6 +32,40 @@ fn defaults<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
     }
 }
 
+/// The parameter table of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``), from the library:
+/// a list of dicts with ``name``, ``flag`` (None: config files only), ``unit``, ``doc``,
+/// ``range`` (as the error messages write it), ``choices`` and ``default``. The consistency
+/// tests check the keyword arguments and stubs against it.
+#[pyfunction]
+#[pyo3(name = "_params")]
+fn params_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
+    let (table, defaults) = match model {
+        "dla" => (dla_pdla::params::PARAMS, dla_pdla::params::defaults()),
+        "dlca" => (::dlca::params::PARAMS, ::dlca::params::defaults()),
+        "animat" => (::animat::params::PARAMS, ::animat::params::defaults()),
+        other => {
+            return Err(convert::value_error(format!(
+                "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
+            )));
+        }
+    };
+    let rows = table
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "name": s.name,
+                "flag": s.flag,
+                "unit": s.unit,
+                "doc": s.doc,
+                "range": s.range.to_string(),
+                "choices": s.range.choices(),
+                "default": defaults.get(s.name),
+            })
+        })
+        .collect();
+    convert::json(py, &serde_json::Value::Array(rows))
+}
+
 /// The aggsim models (DLA/PDLA, DLCA, animats) at native speed, results as NumPy arrays.
 #[pymodule]
 fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -46,6 +80,7 @@ fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dlca::dlca, m)?)?;
     m.add_function(wrap_pyfunction!(animat::animat, m)?)?;
     m.add_function(wrap_pyfunction!(defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(params_table, m)?)?;
     m.add_class::<dla::DlaResult>()?;
     m.add_class::<dlca::DlcaResult>()?;
     m.add_class::<dlca::DlcaLattice>()?;

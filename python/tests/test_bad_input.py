@@ -98,7 +98,7 @@ def test_values_the_command_line_cannot_spell():
     cases = [
         (lambda: aggsim.dla(particles=-5), "--particles -5"),
         (lambda: aggsim.dla(particles=10, far_field="bounce"), "'--far-field'"),
-        (lambda: aggsim.dla(particles=10, paper_settings=True, step_min=0.2), "paper_settings"),
+        (lambda: aggsim.dla(particles=10, paper_settings=True, step_min=0.2), "--paper-settings"),
         (lambda: aggsim.dlca(size=64, fill=0.1, particles=10), "exactly one of --fill"),
         (lambda: aggsim.dlca(size=64), "exactly one of --fill"),
         (lambda: aggsim.dlca(size=64, fill=0.1, search="kd"), "'--search'"),

@@ -53,7 +53,7 @@ struct Cli {
     #[arg(long)]
     rabbits: Option<u64>,
 
-    /// Radius of the start disc around the origin, in cells.
+    /// Radius of the start disc around the origin, in cells, 0..=1073741824.
     #[arg(long, conflicts_with = "density")]
     start_radius: Option<i64>,
 
@@ -63,12 +63,12 @@ struct Cli {
     #[arg(long, allow_hyphen_values = true)]
     density: Option<f64>,
 
-    /// Vision radius in cells (>= 1).
+    /// Vision radius in cells, 1..=1073741824.
     #[arg(long)]
     vision: Option<i64>,
 
-    /// Grid-box side: a positive integer, `vision` (the default) or `none` (exhaustive).
-    /// Changes only the speed, never the result.
+    /// Grid-box side in cells: a positive integer, `vision` or `none` (exhaustive search); by default
+    /// `vision`. Changes only the speed, never the result.
     #[arg(long)]
     grid_box: Option<String>,
 
@@ -407,3 +407,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "cli_spec_tests.rs"]
+mod cli_spec_tests;

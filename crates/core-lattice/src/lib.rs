@@ -10,6 +10,8 @@
 //! - [`stats`]: Welford mean/variance, integer and logarithmic histograms, least-squares and
 //!   log-log fits with standard errors, and radius-of-gyration accumulators that stay accurate
 //!   far from the origin.
+//! - [`spec`]: descriptions of model parameters (name, flag, unit, range), one table per model
+//!   that the front ends are derived from or checked against.
 //! - [`cpu`]: the processor features the build was compiled for, checked at start.
 //!
 //! Feature `serde` (default) makes lattices, random streams and statistics serialisable, for
@@ -41,6 +43,7 @@
 pub mod cpu;
 pub mod lattice;
 pub mod rng;
+pub mod spec;
 pub mod stats;
 
 pub use lattice::{Blocked, Boundary, Coords, Direction, Lattice, LatticeError, MAX_DIM, Offset};

@@ -12,7 +12,7 @@
 //! |---|---|
 //! | [`farfield`] | the exact far-field return samplers |
 //! | [`space`] | everything dimension-specific ([`Dim`], [`Space`]) |
-//! | [`params`] | the run's parameters and their validation |
+//! | [`params`] | the run's parameters, their table ([`params::PARAMS`]) and validation |
 //! | [`error`] | [`SimError`] |
 //! | [`cluster`] | the stored particles: orthtree and distance maps |
 //! | `near` | a walker's near cache (private) |
@@ -22,7 +22,7 @@
 //!
 //! Each module uses only modules above it in this list (no import cycles).
 //!
-//! With the default feature `cli` the parameter enums derive `clap::ValueEnum` and the `dla`
+//! With the default feature `cli` the parameter enums implement `clap::ValueEnum` and the `dla`
 //! binary is built; without it the library does not depend on clap.
 //!
 //! ```
@@ -50,6 +50,46 @@ pub use params::{FarField, Params, ParamsError};
 pub use sim::{Sample, Simulation};
 pub use space::{Dim, Space};
 pub use walker::Walker;
+
+/// The one run-time dimension dispatch, shared by every front end (the `dla` binary, Python,
+/// xtask): evaluates `$body` with the constant `$D` set to `$dim` when it is one of
+/// [`space::DIMENSIONS`], else `$fallback` with `$other` matched against the value.
+///
+/// ```
+/// use dla_pdla::{Params, Simulation};
+/// let params = Params { dim: 3, particles: 50, ..Params::default() };
+/// let n = dla_pdla::with_dim!(params.dim, D => {
+///     let mut sim = Simulation::<D>::new(params.clone(), 1)?;
+///     sim.run()?;
+///     sim.particles()
+/// }, d => panic!("no {d}D"));
+/// assert_eq!(n, 50);
+/// # Ok::<(), dla_pdla::SimError>(())
+/// ```
+#[macro_export]
+macro_rules! with_dim {
+    ($dim:expr, $D:ident => $body:expr, $other:pat => $fallback:expr $(,)?) => {
+        match $dim {
+            2 => {
+                const $D: usize = 2;
+                $body
+            }
+            3 => {
+                const $D: usize = 3;
+                $body
+            }
+            4 => {
+                const $D: usize = 4;
+                $body
+            }
+            5 => {
+                const $D: usize = 5;
+                $body
+            }
+            $other => $fallback,
+        }
+    };
+}
 
 /// The README's examples, compiled and run as doctests so that they stay true.
 #[cfg(doctest)]

@@ -19,15 +19,17 @@ use std::process::ExitCode;
 /// radius R_b = R_ext + birth-gap, jump by the variable-precision distance to the cluster when
 /// far from it, take steps of step-min near it, and stick at exact contact. Outputs go into
 /// --out DIR (see docs/dla.md).
+// Defaults come from the library (`Params::default()`); `cli_spec_tests` checks the rest
+// (flags, choices, ranges in the help) against `dla_pdla::params::PARAMS`.
 #[derive(Parser, Debug)]
 #[command(name = "dla", version, allow_negative_numbers = true)]
 struct Cli {
-    /// Space dimension: 2, 3, 4 or 5.
-    #[arg(long, default_value_t = 2)]
+    /// Space dimension, one of {2, 3, 4, 5}.
+    #[arg(long, default_value_t = Params::default().dim)]
     dim: usize,
 
-    /// Particles in the final cluster, seed particle included: 1 to 3000000000 in 2D and 3D,
-    /// 2500000000 in 4D and 5D (the orthtree's 32-bit indices). Memory: about 11 bytes per
+    /// Particles in the final cluster, seed particle included: 1..=3000000000 in 2D and 3D,
+    /// 1..=2500000000 in 4D and 5D (the orthtree's 32-bit indices). Memory: about 11 bytes per
     /// particle in 2D and 15 in 3D at 1e7; the tree and distance map take about 25 in 4D at
     /// 1e5 and 300 in 5D at 3e4 (mostly the map).
     #[arg(long)]
@@ -43,36 +45,36 @@ struct Cli {
 
     // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
     // clap would read `-inf` as an unknown short flag.
-    /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters (1 to 1e4).
-    #[arg(long, allow_hyphen_values = true, default_value_t = 5.0)]
+    /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters, in [1, 1e4].
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().birth_gap)]
     birth_gap: f64,
 
     /// Far field (|p| > R_b): `return` puts the walker exactly where Brownian motion would first
     /// hit the birth sphere (harmonic measure; see docs/dla.md); `jump` is the paper's jump of
     /// |p| - R_ext - 1 with relaunch beyond the death radius.
-    #[arg(long, value_enum, default_value_t = FarField::Return)]
+    #[arg(long, value_enum, default_value_t = Params::default().far_field)]
     far_field: FarField,
 
-    /// Death radius R_d = death-ratio * R_b for `--far-field jump` (> 1, at most 1e100)
-    /// [default: 100].
+    /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in birth radii, in
+    /// (1, 1e100] [default: 100].
     #[arg(long, allow_hyphen_values = true)]
     death_ratio: Option<f64>,
 
-    /// Near-field step length in diameters (> 0): used when the distance to the cluster minus
-    /// one is at most this. Smaller is closer to Brownian motion. The default is where the
-    /// accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor about 5 %
-    /// low (docs/dla.md, "Accuracy").
-    #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DEFAULT_STEP_MIN)]
+    /// Near-field step length in diameters, in [1e-6, 1e3]: used when the distance to the
+    /// cluster minus one is at most this. Smaller is closer to Brownian motion. The default is
+    /// where the accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor
+    /// about 5 % low (docs/dla.md, "Accuracy").
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().step_min)]
     step_min: f64,
 
-    /// Precision kappa of the variable-precision distance (> 0.5; the paper uses 2; `inf` is
-    /// the exact search). Larger is more exact and slower.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 2.0)]
+    /// Precision kappa of the variable-precision distance, in (0.5, inf] (the paper uses 2;
+    /// `inf` is the exact search). Larger is more exact and slower.
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().precision)]
     precision: f64,
 
-    /// Side of the orthtree's leaf cells in diameters (power of two, 1 to 64): speed and
-    /// memory only, not the physics.
-    #[arg(long, allow_hyphen_values = true, default_value_t = dla_pdla::params::DLA_LEAF_SIDE)]
+    /// Side of the orthtree's leaf cells in diameters, a power of two in
+    /// {1, 2, 4, 8, 16, 32, 64}: speed and memory only, not the physics.
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().leaf_side)]
     leaf_side: f64,
 
     /// The distance maps in front of the orthtree (one byte per cell of side 8 diameters plus a
@@ -80,7 +82,7 @@ struct Cli {
     /// 2-diameter cells near the cluster, about 6 bytes per particle at 1e6): walkers away from
     /// the cluster jump by their bound without a tree query. Speed and memory only, not the
     /// physics (but another trajectory and state hash); `off` is the paper's tree-only walk.
-    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    #[arg(long, value_enum, default_value_t = Toggle::from(Params::default().distance_map))]
     distance_map: Toggle,
 
     /// Each walker copies the particles within 5 diameters out of the tree and answers its
@@ -88,25 +90,26 @@ struct Cli {
     /// so the same trajectory and state hash on or off; speed only. Used when the tree is
     /// exact at those distances anyway ((precision - 1/2) leaf diagonals >= 5, as by
     /// default).
-    #[arg(long, value_enum, default_value_t = Toggle::On)]
+    #[arg(long, value_enum, default_value_t = Toggle::from(Params::default().near_cache))]
     near_cache: Toggle,
 
     /// The variable-precision paper's walk, to reproduce its numbers: --far-field jump
     /// --death-ratio 100 --step-min 0.5 --precision 2 --distance-map off (the step of 0.5
     /// biases the R_g prefactor about 5 % low against the default; docs/dla.md, "Accuracy").
-    #[arg(long, conflicts_with_all = ["far_field", "death_ratio", "step_min", "precision", "distance_map"])]
+    #[arg(long, conflicts_with_all = dla_pdla::params::PAPER_SETTINGS)]
     paper_settings: bool,
 
-    /// Walkers moving at once on the shared cluster (PDLA); 1 is exactly DLA and deterministic.
-    #[arg(long, default_value_t = 1)]
+    /// Walkers moving at once on the shared cluster (PDLA), 1..=1024; 1 is exactly DLA and
+    /// deterministic.
+    #[arg(long, default_value_t = Params::default().threads)]
     threads: usize,
 
     /// With --threads > 1: grow with one walker until the cluster has this many particles.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = Params::default().serial_until)]
     serial_until: u64,
 
-    /// Smallest N used in the fractal-dimension fit log N = D log R_g + c.
-    #[arg(long, default_value_t = 1000)]
+    /// Smallest N (particles) used in the fractal-dimension fit log N = D log R_g + c, in 2..
+    #[arg(long, default_value_t = Params::default().fit_from)]
     fit_from: u64,
 
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
@@ -161,6 +164,12 @@ enum Toggle {
     Off,
 }
 
+impl From<bool> for Toggle {
+    fn from(on: bool) -> Self {
+        if on { Toggle::On } else { Toggle::Off }
+    }
+}
+
 fn params(cli: &Cli) -> Result<Params, String> {
     let p = Params {
         dim: cli.dim,
@@ -180,7 +189,9 @@ fn params(cli: &Cli) -> Result<Params, String> {
         near_cache: cli.near_cache == Toggle::On,
     };
     let p = if cli.paper_settings {
-        p.paper_settings()
+        // clap has refused the flags it sets (`conflicts_with_all`, the same list).
+        p.with_paper_settings(|_| false)
+            .map_err(|e| e.to_string())?
     } else {
         p
     };
@@ -257,18 +268,13 @@ fn main() -> ExitCode {
         "dla",
         |c: &Cli| c.log,
         params,
-        // The one run-time dimension dispatch: adding a dimension is one arm here (and its
-        // `Space` implementation).
+        // The one run-time dimension dispatch (`with_dim!`, shared with Python and xtask).
         |cli, params: Params| {
             let ensemble = cli
                 .ensemble
                 .run("dla", params.threads, &cli.out, CURVES, &cli.log);
-            ensemble.unwrap_or_else(|| match params.dim {
-                2 => run::<2>(cli, params),
-                3 => run::<3>(cli, params),
-                4 => run::<4>(cli, params),
-                5 => run::<5>(cli, params),
-                d => Err(ParamsError::Dim(d).into()),
+            ensemble.unwrap_or_else(|| {
+                dla_pdla::with_dim!(params.dim, D => run::<D>(cli, params), d => Err(ParamsError::Dim(d).into()))
             })
         },
     )
@@ -362,3 +368,7 @@ where
     }
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "cli_spec_tests.rs"]
+mod cli_spec_tests;

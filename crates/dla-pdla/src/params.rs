@@ -7,9 +7,11 @@
 use crate::space::DIMENSIONS;
 use serde::{Deserialize, Serialize};
 
+mod spec;
+pub use spec::{PARAMS, defaults};
+
 /// What happens to a walker outside the birth sphere (`|p| > R_b`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum FarField {
     /// Exact return to the birth circle/sphere at the harmonic-measure hit point
@@ -21,12 +23,68 @@ pub enum FarField {
 }
 
 impl FarField {
+    /// Every far field, in declaration order.
+    pub const ALL: [FarField; 2] = [FarField::Return, FarField::Jump];
+
+    /// The flag values of [`ALL`](Self::ALL), in the same order: the one spelling the command
+    /// line, config files, Python and `run.json` use.
+    pub const NAMES: [&'static str; 2] = ["return", "jump"];
+
     /// The flag value.
     pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// One line of plain text for the command line's help.
+    pub fn help(self) -> &'static str {
         match self {
-            FarField::Return => "return",
-            FarField::Jump => "jump",
+            FarField::Return => {
+                "exact return to the birth sphere at the harmonic-measure hit point; no walker is ever killed"
+            }
+            FarField::Jump => {
+                "the paper's jump of |p| - R_ext - 1 in a random direction, relaunch beyond the death radius"
+            }
         }
+    }
+}
+
+impl std::str::FromStr for FarField {
+    type Err = String;
+
+    /// A flag value of [`FarField::NAMES`]; the error is the command line's.
+    fn from_str(s: &str) -> Result<Self, String> {
+        parse_choice("--far-field", s, &Self::ALL, Self::name)
+    }
+}
+
+/// `value` as one of `all` by `name`; otherwise the command line's wording of the error.
+fn parse_choice<T: Copy>(
+    flag: &str,
+    value: &str,
+    all: &[T],
+    name: fn(T) -> &'static str,
+) -> Result<T, String> {
+    all.iter()
+        .copied()
+        .find(|&x| name(x) == value)
+        .ok_or_else(|| {
+            let names: Vec<&str> = all.iter().map(|&x| name(x)).collect();
+            format!(
+                "invalid value '{value}' for '{flag}': possible values are {}",
+                names.join(", ")
+            )
+        })
+}
+
+/// The command line parses `--far-field` through [`FarField::ALL`] and [`FarField::name`].
+#[cfg(feature = "cli")]
+impl clap::ValueEnum for FarField {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Self::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.help()))
     }
 }
 
@@ -97,6 +155,16 @@ pub const DLA_LEAF_SIDE: f64 = 8.0;
 /// the same (2D 1e6: 0.98 times that of 0.5; 3D 2e5: 0.85 times, since shorter steps near a
 /// branch stick sooner). `--step-min 0.5` is the paper's setting.
 pub const DEFAULT_STEP_MIN: f64 = 0.1;
+
+/// The fields [`Params::paper_settings`] sets; as flags (dashes for underscores) they cannot be
+/// given beside `--paper-settings`.
+pub const PAPER_SETTINGS: [&str; 5] = [
+    "far_field",
+    "death_ratio",
+    "step_min",
+    "precision",
+    "distance_map",
+];
 
 /// The variable-precision paper's near-field step, in diameters ([`Params::paper_settings`]).
 pub const PAPER_STEP_MIN: f64 = 0.5;
@@ -263,6 +331,12 @@ pub enum ParamsError {
         "--death-ratio is used by --far-field jump only (the default `return` has no death radius)"
     )]
     DeathRatioUnused,
+    /// A field of [`PAPER_SETTINGS`] given beside `--paper-settings`, which sets it.
+    #[error(
+        "--{} cannot be given with --paper-settings, which sets --far-field, --death-ratio, --step-min, --precision and --distance-map",
+        .0.replace('_', "-")
+    )]
+    PaperSettingsConflict(&'static str),
     /// `serial_until` given with one thread, which is serial throughout.
     #[error("--serial-until {0} is used with --threads > 1 only (one thread is serial throughout)")]
     SerialUntilUnused(u64),
@@ -274,7 +348,7 @@ impl Params {
     /// near-field step 0.5, precision 2, and no distance maps (the paper's walk asks the tree
     /// only). Every other field is kept. The step of 0.5 biases the R_g prefactor about 5 % low
     /// against the converged default (`docs/results/accuracy.md`); the `dla` binary's
-    /// `--paper-settings`.
+    /// `--paper-settings`. The fields it sets are [`PAPER_SETTINGS`].
     pub fn paper_settings(self) -> Self {
         Params {
             far_field: FarField::Jump,
@@ -283,6 +357,17 @@ impl Params {
             precision: PAPER_PRECISION,
             distance_map: false,
             ..self
+        }
+    }
+
+    /// [`paper_settings`](Self::paper_settings) for a front end, refusing a field of
+    /// [`PAPER_SETTINGS`] that was also given (`given(name)`), since `--paper-settings` would
+    /// override it silently. Every front end applies the rule with this: the `dla` binary
+    /// (whose clap declaration refuses the same flags from [`PAPER_SETTINGS`]) and Python.
+    pub fn with_paper_settings(self, given: impl Fn(&str) -> bool) -> Result<Self, ParamsError> {
+        match PAPER_SETTINGS.iter().find(|name| given(name)) {
+            Some(name) => Err(ParamsError::PaperSettingsConflict(name)),
+            None => Ok(self.paper_settings()),
         }
     }
 

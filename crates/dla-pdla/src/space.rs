@@ -7,8 +7,8 @@
 //! `where Dim<D>: Space<D>` bound, so a dimension without an implementation does not compile,
 //! and no code path branches on the dimension at run time. The one run-time choice is the
 //! command line's `--dim`: it is checked against [`DIMENSIONS`] by
-//! [`Params::validate`](crate::Params::validate) and turned into a type by one `match` in the
-//! `dla` binary.
+//! [`Params::validate`](crate::Params::validate) and turned into a type by
+//! [`with_dim!`](crate::with_dim), which every front end uses.
 //!
 //! Invariants: the trait's methods are `#[inline]` and statically dispatched (no trait
 //! objects), so a kernel compiles to the same code as if written for its dimension; the
@@ -23,9 +23,8 @@
 //!    measured for that dimension, an `expected_r_ext` and axis names (the orthtree takes up
 //!    to 8 dimensions);
 //! 2. add the dimension to [`DIMENSIONS`];
-//! 3. add one arm to each dispatch on the dimension: `main.rs` (`6 => run::<6>(cli, params)`),
-//!    the Python bindings (`python/src/dla.rs`) and `cargo xtask scaling`
-//!    (`xtask/src/scaling/dla.rs`);
+//! 3. add one arm to [`with_dim!`](crate::with_dim), the one dispatch on the dimension (the
+//!    binary, the Python bindings and `cargo xtask scaling` use it);
 //! 4. check the orthtree's index limits against [`max_particles`](crate::params::max_particles).
 
 use crate::farfield::{return_to_circle, return_to_sphere_3d, return_to_sphere_nd};

@@ -24,14 +24,17 @@ use std::process::ExitCode;
 /// sweep visits every cluster in a fresh random order; a cluster moves one site in a random
 /// direction and merges with every cluster it then touches. Stops at --target-clusters or
 /// --max-sweeps. Outputs go into --out DIR (see docs/dlca.md).
+// Defaults come from the library (`Params::default()`) where clap takes a value; the others
+// (`--boundary`, `--max-memory`) and the flags, choices and ranges in the help are checked
+// against `dlca::params::PARAMS` by `cli_spec_tests`.
 #[derive(Parser, Debug)]
 #[command(name = "dlca", version, allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
 struct Cli {
-    /// Lattice dimension, 1 to 5. With a single --size value, every axis gets that length.
-    #[arg(long, default_value_t = 2)]
+    /// Lattice dimension, 1..=5. With a single --size value, every axis gets that length.
+    #[arg(long, default_value_t = Params::default().dim())]
     dim: usize,
 
-    /// Side lengths: one number for every axis (`1024`) or one per axis (`1024x512`).
+    /// Side lengths in sites: one number for every axis (`1024`) or one per axis (`1024x512`).
     #[arg(long, value_parser = parse_size)]
     size: Option<Sizes>,
 
@@ -70,20 +73,20 @@ struct Cli {
     boundary: String,
 
     /// Overall move probability of a cluster per sweep, in (0, 1].
-    #[arg(long, allow_hyphen_values = true, default_value_t = 1.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().temperature)]
     temperature: f64,
 
     /// Gravity g in [0, 1): the move down the last axis has weight 1+g, up 1-g, others 1.
-    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().gravity)]
     gravity: f64,
 
-    /// Mobility exponent gamma >= 0: a cluster of s particles moves with probability
+    /// Mobility exponent gamma in [0, inf): a cluster of s particles moves with probability
     /// temperature * s^-gamma (0: all clusters equally mobile, as in the paper).
-    #[arg(long, allow_hyphen_values = true, default_value_t = 0.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().mobility_exponent)]
     mobility_exponent: f64,
 
-    /// Stop when at most this many clusters remain (>= 1; the paper stops at 100 to 1000).
-    #[arg(long, default_value_t = 100)]
+    /// Stop when at most this many clusters remain, 1.. (the paper stops at 100 to 1000).
+    #[arg(long, default_value_t = Params::default().target_clusters)]
     target_clusters: u64,
 
     /// Stop after this many sweeps at the latest (default: no limit).
@@ -91,10 +94,10 @@ struct Cli {
     max_sweeps: Option<u64>,
 
     /// Contact search. All give the same trajectory; `auto` picks by regime and logs why.
-    #[arg(long, value_enum, default_value_t = Search::Auto)]
+    #[arg(long, value_enum, default_value_t = Params::default().search)]
     search: Search,
 
-    /// Initial grid-box side for `--search grid` or `grid-doubling`, a power of two (default:
+    /// Initial grid-box side in sites for `--search grid` or `grid-doubling`, a power of two (default:
     /// `grid` takes the side of least predicted cost and re-tunes it as clusters grow;
     /// `grid-doubling` starts from the cluster spacing and doubles with the largest cluster).
     #[arg(long)]
@@ -128,8 +131,8 @@ struct Cli {
     #[arg(long)]
     gyration: bool,
 
-    /// Smallest cluster size used in the fractal-dimension fit.
-    #[arg(long, default_value_t = 10)]
+    /// Smallest cluster size (particles) used in the fractal-dimension fit, 2..
+    #[arg(long, default_value_t = Params::default().fit_min_size)]
     fit_min_size: u64,
 
     /// Write dlca.png: the final state, one colour per cluster (first two axes).
@@ -365,3 +368,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+#[path = "cli_spec_tests.rs"]
+mod cli_spec_tests;

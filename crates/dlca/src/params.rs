@@ -6,6 +6,9 @@
 use core_lattice::{Boundary, Lattice, LatticeError};
 use serde::{Deserialize, Serialize};
 
+mod spec;
+pub use spec::{PARAMS, defaults};
+
 /// Largest dimension the model accepts (Hawick, James & Scogings 2006 run 2 to 5; 1 is
 /// included for tests and teaching).
 pub const MAX_MODEL_DIM: usize = 5;
@@ -34,7 +37,6 @@ pub enum Init {
 /// The contact search (docs/dlca.md, "The search strategies"). All give bit-identical
 /// trajectories; they differ only in speed and memory.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Search {
     /// Pick by regime (memory, dimension, density) and log why.
@@ -53,15 +55,67 @@ pub enum Search {
 }
 
 impl Search {
+    /// Every strategy, in declaration order.
+    pub const ALL: [Search; 5] = [
+        Search::Auto,
+        Search::AllPairs,
+        Search::Grid,
+        Search::GridDoubling,
+        Search::Lattice,
+    ];
+
+    /// The names of [`ALL`](Self::ALL), in the same order: the one spelling the command line,
+    /// config files, Python and the outputs use.
+    pub const NAMES: [&'static str; 5] = ["auto", "all-pairs", "grid", "grid-doubling", "lattice"];
+
     /// The name used on the command line and in outputs.
     pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// One line of plain text for the command line's help.
+    pub fn help(self) -> &'static str {
         match self {
-            Search::Auto => "auto",
-            Search::AllPairs => "all-pairs",
-            Search::Grid => "grid",
-            Search::GridDoubling => "grid-doubling",
-            Search::Lattice => "lattice",
+            Search::Auto => "Pick by regime (memory, dimension, density) and log why",
+            Search::AllPairs => "The all-pairs baseline of Hawick, James & Scogings 2006",
+            Search::Grid => {
+                "Grid boxes (Hawick, James & Scogings 2006) with a halo per cluster: small boxes, each cluster listed in every box its bounding region grown by one site overlaps, the box side re-tuned at run time by a cost model"
+            }
+            Search::GridDoubling => {
+                "The paper's grid boxes (Hawick, James & Scogings 2006), doubling with the largest cluster, falling back to all-pairs once 3A >= L on some axis (the Fig. 6 rule)"
+            }
+            Search::Lattice => "Occupancy lattice: a cluster id per site",
         }
+    }
+}
+
+impl std::str::FromStr for Search {
+    type Err = String;
+
+    /// A name of [`Search::NAMES`]; the error is the command line's.
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|x| x.name() == s)
+            .ok_or_else(|| {
+                format!(
+                    "invalid value '{s}' for '--search': possible values are {}",
+                    Self::NAMES.join(", ")
+                )
+            })
+    }
+}
+
+/// The command line parses `--search` through [`Search::ALL`] and [`Search::name`].
+#[cfg(feature = "cli")]
+impl clap::ValueEnum for Search {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Self::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.help()))
     }
 }
 

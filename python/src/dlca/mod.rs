@@ -55,21 +55,6 @@ fn bytes(arg: &Bound<'_, PyAny>) -> PyResult<u64> {
     count("--max-memory", arg.extract()?)
 }
 
-/// `--search` by its name.
-fn search(name: &str) -> PyResult<Search> {
-    let all = [
-        Search::Auto,
-        Search::AllPairs,
-        Search::Grid,
-        Search::Lattice,
-    ];
-    all.into_iter().find(|s| s.name() == name).ok_or_else(|| {
-        value_error(format!(
-            "invalid value '{name}' for '--search': possible values are auto, all-pairs, grid, lattice"
-        ))
-    })
-}
-
 /// The parameters of the keyword arguments, checked as the binary checks its flags.
 #[allow(clippy::too_many_arguments)]
 fn params(
@@ -123,7 +108,7 @@ fn params(
         mobility_exponent,
         target_clusters: count("--target-clusters", target_clusters)?,
         max_sweeps: max_sweeps.map(|n| count("--max-sweeps", n)).transpose()?,
-        search: self::search(search)?,
+        search: search.parse::<Search>().map_err(value_error)?,
         grid_box: grid_box.map(|n| count("--grid-box", n)).transpose()?,
         max_memory: bytes(max_memory)?,
         timing,
@@ -349,7 +334,7 @@ impl DlcaResult {
 /// particles : int
 ///     Number of particles at the start, 1 to the number of sites.
 /// dim : int or None
-///     Lattice dimension, 1 to 5 (default: the number of lengths in ``size``, or 2 for one
+///     Lattice dimension, 1..=5 (default: the number of lengths in ``size``, or 2 for one
 ///     length, as the binary).
 /// seed : int
 ///     Seed of every random stream (default 1).
@@ -361,17 +346,18 @@ impl DlcaResult {
 /// gravity : float
 ///     g in [0, 1): moves down the last axis have weight 1+g, up 1-g (default 0).
 /// mobility_exponent : float
-///     gamma >= 0: a cluster of s particles moves with probability temperature * s^-gamma
+///     gamma in [0, inf): a cluster of s particles moves with probability temperature * s^-gamma
 ///     (default 0).
 /// target_clusters : int
-///     Stop when at most this many clusters remain, >= 1 (default 100).
+///     Stop when at most this many clusters remain, 1.. (default 100).
 /// max_sweeps : int or None
 ///     Stop after this many sweeps at the latest (default None: no limit).
 /// search : str
-///     Contact search, ``"auto"`` (default), ``"all-pairs"``, ``"grid"`` or ``"lattice"``:
-///     all give the same trajectory.
+///     Contact search, ``"auto"`` (default), ``"all-pairs"``, ``"grid"``,
+///     ``"grid-doubling"`` or ``"lattice"``: all give the same trajectory.
 /// grid_box : int or None
-///     Initial grid-box side for ``search="grid"``, a power of two (default: chosen).
+///     Initial grid-box side for ``search="grid"`` or ``"grid-doubling"``, a power of two
+///     (default: chosen).
 /// max_memory : int or str
 ///     Memory the occupancy lattice may take, bytes or ``"4G"`` (default 4 GiB).
 /// timing : bool
@@ -384,7 +370,7 @@ impl DlcaResult {
 ///     Measure every final cluster's radius of gyration and fit the fractal dimension
 ///     (default False).
 /// fit_min_size : int
-///     Smallest cluster size in that fit, >= 2 (default 10).
+///     Smallest cluster size in that fit, 2.. (default 10).
 /// progress : bool or callable
 ///     True prints progress (merges) to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
@@ -478,29 +464,13 @@ pub fn dlca(
     run.result(py)
 }
 
-/// The `dlca` binary's defaults, from the library (`size` and `fill`/`particles` have none on
-/// the command line).
+/// The `dlca` binary's defaults, from the library's parameter table (`size` and
+/// `fill`/`particles` have none).
 pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
-    let p = defaults();
-    let v = serde_json::json!({
-        "seed": 1,
-        "boundary": p.boundary[0].to_string(),
-        "temperature": p.temperature,
-        "gravity": p.gravity,
-        "mobility_exponent": p.mobility_exponent,
-        "target_clusters": p.target_clusters,
-        "max_sweeps": p.max_sweeps,
-        "search": p.search.name(),
-        "grid_box": p.grid_box,
-        "max_memory": p.max_memory,
-        "timing": p.timing,
-        "histogram": false,
-        "histogram_sweeps": DEFAULT_HISTOGRAM_SWEEPS
-            .split(',')
-            .filter_map(|s| s.parse::<u64>().ok())
-            .collect::<Vec<_>>(),
-        "gyration": p.gyration,
-        "fit_min_size": p.fit_min_size,
-    });
-    crate::convert::json(py, &v)
+    let mut o = ::dlca::params::defaults();
+    for required in ["size", "fill", "particles"] {
+        o.remove(required);
+    }
+    o.insert("seed".into(), 1.into());
+    crate::convert::json(py, &serde_json::Value::Object(o))
 }

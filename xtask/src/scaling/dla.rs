@@ -46,19 +46,15 @@ where
 
 /// Grow one cluster with `params` (2D to 5D).
 pub fn grow(params: &Params, seed: u64) -> Result<Grown> {
-    match params.dim {
-        2 => grow_d::<2>(params, seed),
-        3 => grow_d::<3>(params, seed),
-        4 => grow_d::<4>(params, seed),
-        5 => grow_d::<5>(params, seed),
-        d => anyhow::bail!("DLA runs in 2 to 5 dimensions, not {d}"),
-    }
+    dla_pdla::with_dim!(params.dim, D => grow_d::<D>(params, seed), d => {
+        Err(dla_pdla::ParamsError::Dim(d).into())
+    })
 }
 
 /// Fit-from size used for an ensemble of `n`-particle clusters: the library default (1000),
 /// lowered for the tiny harness test so the fit still has a decade of data.
 pub fn fit_from(n: u64) -> u64 {
-    1000.min(n / 10).max(10)
+    Params::default().fit_from.min(n / 10).max(10)
 }
 
 /// One dimension's ensemble of serial DLA clusters for the "D_f by dimension" table.

@@ -9,6 +9,9 @@ use serde::{Deserialize, Serialize};
 use spatial::plane::BoxSize;
 use std::fmt;
 
+mod spec;
+pub use spec::{PARAMS, defaults};
+
 /// The two species of the model (Hawick, James & Scogings 2006, section II.B).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -63,15 +66,12 @@ impl FoxRule {
         FoxRule::Wander,
     ];
 
+    /// The names of [`ALL`](Self::ALL), in the same order.
+    pub const NAMES: [&'static str; 5] = ["eat", "breed", "hunt", "seek_mate", "wander"];
+
     /// The rule's name in config files.
     pub fn name(self) -> &'static str {
-        match self {
-            FoxRule::Eat => "eat",
-            FoxRule::Breed => "breed",
-            FoxRule::Hunt => "hunt",
-            FoxRule::SeekMate => "seek_mate",
-            FoxRule::Wander => "wander",
-        }
+        Self::NAMES[self as usize]
     }
 }
 
@@ -98,14 +98,12 @@ impl RabbitRule {
         RabbitRule::Wander,
     ];
 
+    /// The names of [`ALL`](Self::ALL), in the same order.
+    pub const NAMES: [&'static str; 4] = ["flee", "breed", "herd", "wander"];
+
     /// The rule's name in config files.
     pub fn name(self) -> &'static str {
-        match self {
-            RabbitRule::Flee => "flee",
-            RabbitRule::Breed => "breed",
-            RabbitRule::Herd => "herd",
-            RabbitRule::Wander => "wander",
-        }
+        Self::NAMES[self as usize]
     }
 }
 

@@ -1,0 +1,172 @@
+"""The keyword arguments, their defaults and the stubs against the libraries' parameter tables
+(``aggsim._params(model)``, from ``PARAMS`` and ``Params::default()`` of each model crate): a
+parameter missing from a signature or stub, another default or other choices fail here."""
+
+import ast
+import inspect
+import math
+from pathlib import Path
+
+import pytest
+
+import aggsim
+
+STUBS = ast.parse((Path(aggsim.__file__).parent / "__init__.pyi").read_text())
+
+# The entry points of each model: (object, stub function, stub class or None).
+ENTRY_POINTS = {
+    "dla": [(aggsim.dla, "dla", None)],
+    "dlca": [(aggsim.dlca, "dlca", None), (aggsim.DlcaLattice, "__init__", "DlcaLattice")],
+    "animat": [(aggsim.animat, "animat", None), (aggsim.AnimatWorld, "__init__", "AnimatWorld")],
+}
+
+# Keyword arguments that are not model parameters.
+PYTHON_ONLY = {"seed", "progress", "paper_settings", "config", "steps", "timing"}
+
+# Documented differences from the library default: ``aggsim.dla`` grows 1e5 particles when
+# none are given (the binary requires ``--particles``); ``aggsim.dlca``'s ``dim`` defaults to
+# the number of lengths given.
+DIFFER = {("dla", "particles"): 100_000, ("dlca", "dim"): None}
+
+
+def stub(name, within=None):
+    body = STUBS.body
+    if within:
+        body = next(n for n in body if isinstance(n, ast.ClassDef) and n.name == within).body
+    return next(n for n in body if isinstance(n, ast.FunctionDef) and n.name == name)
+
+
+def stub_defaults(fn):
+    """``{name: (default node or None, annotation node)}`` of a stub function."""
+    a = fn.args
+    positional = a.posonlyargs + a.args
+    pos_defaults = [None] * (len(positional) - len(a.defaults)) + list(a.defaults)
+    out = {x.arg: (d, x.annotation) for x, d in zip(positional, pos_defaults)}
+    out.update({x.arg: (d, x.annotation) for x, d in zip(a.kwonlyargs, a.kw_defaults)})
+    out.pop("self", None)
+    return out
+
+
+def literals(annotation):
+    """The strings of every ``Literal[...]`` in an annotation."""
+    found = []
+    for node in ast.walk(annotation):
+        if isinstance(node, ast.Subscript) and getattr(node.value, "id", "") == "Literal":
+            found += [c.value for c in ast.walk(node.slice) if isinstance(c, ast.Constant)]
+    return found
+
+
+def same(a, b):
+    if isinstance(a, float) or isinstance(b, float):
+        return a == b or (math.isinf(a) and math.isinf(b))
+    return a == b
+
+
+def table(model):
+    return aggsim._params(model)
+
+
+@pytest.mark.parametrize("model", ENTRY_POINTS)
+def test_every_parameter_is_a_keyword_with_the_library_default(model):
+    rows = table(model)
+    names = {r["name"] for r in rows}
+    defaults = aggsim.defaults(model)
+    for obj, _, _ in ENTRY_POINTS[model]:
+        sig = inspect.signature(obj).parameters
+        for r in rows:
+            name = r["name"]
+            assert name in sig, f"{obj.__name__} has no keyword {name}"
+            shown = sig[name].default
+            expected = DIFFER.get((model, name), r["default"])
+            if shown is inspect.Parameter.empty:
+                # Required, as the library has no default (`size`).
+                assert expected is None, f"{obj.__name__}: {name} required, library {expected!r}"
+            elif shown is None and expected is not None:
+                # None takes the library's default, which aggsim.defaults() reports.
+                assert same(defaults[name], expected), (name, defaults[name], expected)
+            else:
+                where = f"{obj.__name__}({name}={shown!r})"
+                assert same(shown, expected), f"{where}, library {expected!r}"
+        extra = set(sig) - names - PYTHON_ONLY
+        assert not extra, f"{obj.__name__}: {extra} not in the library's table"
+
+
+@pytest.mark.parametrize("model", ENTRY_POINTS)
+def test_the_stubs_name_every_parameter_its_default_and_choices(model):
+    rows = table(model)
+    for _, fn, cls in ENTRY_POINTS[model]:
+        args = stub_defaults(stub(fn, cls))
+        for r in rows:
+            name = r["name"]
+            assert name in args, f"the stub of {cls or fn} has no {name}"
+            default, annotation = args[name]
+            expected = DIFFER.get((model, name), r["default"])
+            if default is None:
+                assert expected is None, f"{fn}: {name} required in the stub, library {expected!r}"
+                continue
+            value = default.value if isinstance(default, ast.Constant) else default
+            # `...` stands for the library's default; None for "the library's" too.
+            assert value is Ellipsis or value is None or same(value, expected), (fn, name, value)
+            shown = literals(annotation)
+            if shown and r["choices"]:
+                assert shown == r["choices"], (fn, name, shown, r["choices"])
+
+
+@pytest.mark.parametrize(
+    "call, name",
+    [
+        (lambda v: aggsim.dla(particles=10, far_field=v), ("dla", "far_field")),
+        (lambda v: aggsim.dlca(size=16, fill=0.1, search=v), ("dlca", "search")),
+    ],
+)
+def test_every_choice_is_accepted_and_named_in_the_error(call, name):
+    row = next(r for r in table(name[0]) if r["name"] == name[1])
+    assert row["choices"]
+    for choice in row["choices"]:
+        call(choice)
+    with pytest.raises(ValueError) as e:
+        call("nonsense")
+    assert str(e.value).endswith(", ".join(row["choices"]))
+
+
+def parameter_docs(doc):
+    """``{name: paragraph}`` of a numpydoc Parameters section (``a, b : type`` names several)."""
+    section = doc.split("Parameters\n----------\n", 1)[1].split("\n\n", 1)[0]
+    out, names = {}, []
+    for line in section.splitlines():
+        if " : " in line and not line.startswith(" "):
+            names = [n.strip() for n in line.split(" : ")[0].split(",")]
+            for n in names:
+                out[n] = line
+        else:
+            for n in names:
+                out[n] += " " + line.strip()
+    return out
+
+
+@pytest.mark.parametrize("model", ENTRY_POINTS)
+def test_the_docstrings_state_each_range(model):
+    docs = parameter_docs(getattr(aggsim, model).__doc__)
+    for r in table(model):
+        if r["range"] == "any" or r["choices"] or "`" in r["range"]:
+            continue
+        assert r["range"] in docs[r["name"]], (model, r["name"], r["range"], docs[r["name"]])
+
+
+def test_the_tables_state_units_ranges_and_docs():
+    for model in ENTRY_POINTS:
+        for r in table(model):
+            assert r["doc"] and "[`" not in r["doc"], r
+            assert r["range"], r
+    with pytest.raises(ValueError, match="unknown model"):
+        aggsim._params("ising")
+
+
+@pytest.mark.parametrize(
+    "name", ["hungry_at", "starve", "fox_max_age", "rabbit_max_age", "prey_needed", "crowd_max"]
+)
+def test_a_negative_count_names_the_tables_range(name):
+    row = next(r for r in table("animat") if r["name"] == name)
+    with pytest.raises(ValueError) as e:
+        aggsim.AnimatWorld(**{name: -1})
+    assert str(e.value) == f"{name} = -1 is outside the accepted range {row['range']}"
