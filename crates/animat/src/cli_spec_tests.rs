@@ -5,8 +5,8 @@
 use super::Cli;
 use animat::params::{PARAMS, defaults};
 use clap::CommandFactory;
-use core_lattice::spec::{Range, markdown_table, same_default};
-use serde_json::Value;
+use core_lattice::spec::markdown_table;
+use sim_run::spec_check::{CliSpec, DocColumns};
 
 /// Flags of the binary that are not model parameters (run, output and logging flags).
 const NOT_PARAMS: &[&str] = &[
@@ -32,60 +32,20 @@ const NOT_PARAMS: &[&str] = &[
     "version",
 ];
 
-/// A library default as the front ends spell it.
-fn show(v: &Value) -> String {
-    match v {
-        Value::String(s) => s.clone(),
-        Value::Array(a) => a.iter().map(show).collect::<Vec<_>>().join(","),
-        Value::Null => "none".into(),
-        other => other.to_string(),
+fn spec() -> CliSpec<'static> {
+    CliSpec {
+        program: "animat",
+        params: PARAMS,
+        defaults: defaults(),
+        run_flags: NOT_PARAMS,
     }
 }
 
+/// The flags have no defaults: the value comes from the config file or the library unless
+/// the flag is given.
 #[test]
 fn every_flagged_parameter_is_a_flag_stating_its_range() {
-    let cmd = Cli::command();
-    let mut unitless = Vec::new();
-    for s in PARAMS {
-        let Some(flag) = s.flag else { continue };
-        let arg = cmd
-            .get_arguments()
-            .find(|a| a.get_long() == Some(flag))
-            .unwrap_or_else(|| panic!("`animat` has no --{flag} ({})", s.name));
-        // The value comes from the config file or the library unless the flag is given.
-        assert!(
-            arg.get_default_values().is_empty(),
-            "--{flag} has a default"
-        );
-        let help = arg.get_long_help().or(arg.get_help()).unwrap().to_string();
-        if !help.to_lowercase().contains(s.unit) {
-            unitless.push(format!("--{flag} ({})", s.unit));
-        }
-        if !matches!(s.range, Range::Any) {
-            assert!(
-                help.contains(&s.range.to_string()),
-                "--{flag}: the help does not state the range {}: {help}",
-                s.range
-            );
-        }
-    }
-    assert!(
-        unitless.is_empty(),
-        "help texts without their unit: {unitless:?}"
-    );
-    for arg in cmd.get_arguments() {
-        let Some(long) = arg.get_long() else { continue };
-        assert!(
-            NOT_PARAMS.contains(&long) || PARAMS.iter().any(|s| s.flag == Some(long)),
-            "--{long} is neither in animat::params::PARAMS nor a run flag"
-        );
-    }
-}
-
-#[test]
-fn help_has_no_rustdoc_markup() {
-    let help = Cli::command().render_long_help().to_string();
-    assert!(!help.contains("[`"), "{help}");
+    spec().check_flags(&Cli::command(), false);
 }
 
 /// The config file the repository ships spells out every parameter with its default.
@@ -107,48 +67,27 @@ fn the_docs_table_states_each_default_and_range() {
     let md = include_str!("../../../docs/animat.md");
     let rows = markdown_table(md, "## Parameters and defaults");
     assert_eq!(rows[0], ["parameter", "flag", "default", "accepted"]);
-    let defaults = defaults();
+    let columns = DocColumns {
+        flags: 1,
+        default: 2,
+        range: 3,
+    };
+    let row_of = |s: &core_lattice::spec::ParamSpec, r: &[String]| {
+        r[0] == format!("`{}`", s.name) || s.flag.is_some_and(|f| r[1] == format!("`--{f}`"))
+    };
+    spec().check_docs_table("docs/animat.md", &rows, columns, &Cli::command(), row_of);
     for s in PARAMS {
-        let name = format!("`{}`", s.name);
+        let row = rows.iter().find(|r| row_of(s, r)).unwrap();
         let flag = s.flag.map(|f| format!("`--{f}`")).unwrap_or_default();
-        let row = rows
-            .iter()
-            .find(|r| r[0] == name || (s.flag.is_some() && r[1] == flag))
-            .unwrap_or_else(|| panic!("docs/animat.md has no row for {}", s.name));
         assert_eq!(row[1], flag, "{}: the flag", s.name);
-        let library = &defaults[s.name];
-        if !library.is_null() {
-            assert!(
-                same_default(&row[2], &show(library)),
-                "{}: default {} in docs/animat.md, {library} in the library",
-                s.name,
-                row[2]
-            );
-        }
-        match s.range {
-            Range::Any => {}
-            Range::Choices(c) => {
-                for n in c {
-                    assert!(row.join(" ").contains(n), "{}: {n}", s.name);
-                }
-            }
-            r => assert!(
-                row[3].contains(&r.to_string()),
-                "{}: docs/animat.md does not state the range {r}: {}",
-                s.name,
-                row[3]
-            ),
-        }
     }
     // Every row is a parameter of the table.
     for r in &rows[1..] {
-        let known = PARAMS.iter().any(|s| {
-            r[0] == format!("`{}`", s.name) || s.flag.is_some_and(|f| r[1] == format!("`--{f}`"))
-        });
         assert!(
-            known,
+            PARAMS.iter().any(|s| row_of(s, r)),
             "docs/animat.md lists {} {}, not a parameter",
-            r[0], r[1]
+            r[0],
+            r[1]
         );
     }
 }

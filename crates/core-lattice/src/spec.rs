@@ -255,6 +255,34 @@ fn number(s: &str) -> Option<f64> {
     digits.parse::<f64>().ok().map(|v| v * scale)
 }
 
+/// Checks that validation accepts each closed bound of every range in `params` and refuses the
+/// nearest value outside it, naming the range as the table writes it (`accepted range ...`),
+/// with the probes of [`Range::probes`]. `validate(name, value)` sets parameter `name` to the
+/// JSON text `value` on top of the defaults and validates: `Err` with the message when the
+/// value does not parse (a message containing `invalid`) or is refused.
+///
+/// # Panics
+/// On the first probe whose answer is wrong, naming the parameter, the value and the message.
+pub fn check_range_probes(
+    params: &[ParamSpec],
+    validate: impl Fn(&str, &str) -> Result<(), String>,
+) {
+    for s in params {
+        for (value, accept) in s.range.probes() {
+            match (accept, validate(s.name, &value)) {
+                (true, Err(e)) => panic!("{} {value} refused: {e}", s.name),
+                (false, Ok(())) => panic!("{} {value} accepted, outside {}", s.name, s.range),
+                (false, Err(e)) if !e.contains("invalid") => assert!(
+                    e.contains(&format!("accepted range {}", s.range)),
+                    "{} {value}: {e}",
+                    s.name
+                ),
+                _ => {}
+            }
+        }
+    }
+}
+
 /// Parameter names that occur more than once in `specs`, and flags likewise.
 pub fn duplicates(specs: &[ParamSpec]) -> Vec<String> {
     let mut seen = std::collections::BTreeSet::new();

@@ -13,7 +13,9 @@
 //! - `ensemble` (feature `cli`): `--seeds` for every binary, members as child processes or over
 //!   the ranks of an MPI job (feature `mpi`), restart, and the merged statistics.
 //! - `plot` (feature `plot`): PNG charts with error bands.
-//! - `testing` (feature `test-support`): the bad-input harness of the binaries' tests.
+//! - `testing` (feature `test-support`): the bad-input harness of the binaries' tests;
+//!   `spec_check` (with `cli` too): a binary's flags and its docs table against the model's
+//!   parameter table.
 //!
 //! Conventions: a run is a pure function of its parameters and seed; bad input is a typed
 //! error, never a panic; every output file is written atomically (a reader never sees half a
@@ -42,6 +44,8 @@ pub mod ensemble;
 pub mod io;
 #[cfg(feature = "plot")]
 pub mod plot;
+#[cfg(all(feature = "test-support", feature = "cli"))]
+pub mod spec_check;
 #[cfg(feature = "test-support")]
 pub mod testing;
 

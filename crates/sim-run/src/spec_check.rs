@@ -1,0 +1,207 @@
+//! Checks that a front end agrees with a model's parameter table (features `test-support` and
+//! `cli`, for the binaries' tests): the command line (every parameter a flag with the
+//! library's default, unit, range and choices; every other flag a known run flag; no rustdoc
+//! markup in the help) and the flag table of the model's document. One implementation for the
+//! three binaries, each of which states only what differs: its run flags and its table's
+//! columns.
+
+use clap::Command;
+use core_lattice::spec::{ParamSpec, Range, same_default};
+use serde_json::{Map, Value};
+
+/// A library default as the front ends spell it (lists joined by `, `, `none` for null).
+pub fn show(v: &Value) -> String {
+    match v {
+        Value::String(s) => s.clone(),
+        Value::Array(a) => a.iter().map(show).collect::<Vec<_>>().join(", "),
+        Value::Null => "none".into(),
+        other => other.to_string(),
+    }
+}
+
+/// One binary against its model's parameter table.
+pub struct CliSpec<'a> {
+    /// The binary's name, for messages.
+    pub program: &'a str,
+    /// The model's parameter table.
+    pub params: &'a [ParamSpec],
+    /// The library's defaults by parameter name.
+    pub defaults: Map<String, Value>,
+    /// Long flags that are not model parameters (run, output and logging flags).
+    pub run_flags: &'a [&'a str],
+}
+
+impl CliSpec<'_> {
+    /// The parameter spec of a long flag, if it is a parameter's.
+    fn param_of(&self, long: &str) -> Option<&ParamSpec> {
+        self.params.iter().find(|s| s.flag == Some(long))
+    }
+
+    /// Every parameter with a flag is a flag of `cmd` whose help states its unit and range and
+    /// whose possible values are its choices; its default is the library's (or, with
+    /// `defaults_in_cli` false, the flag has none: the value then comes from a config file or
+    /// the library); every other long flag of `cmd` is a run flag.
+    pub fn check_flags(&self, cmd: &Command, defaults_in_cli: bool) {
+        let mut unitless = Vec::new();
+        for s in self.params {
+            let Some(flag) = s.flag else { continue };
+            let program = self.program;
+            let arg = cmd
+                .get_arguments()
+                .find(|a| a.get_long() == Some(flag))
+                .unwrap_or_else(|| panic!("`{program}` has no --{flag} ({})", s.name));
+            let help = arg.get_long_help().or(arg.get_help()).unwrap().to_string();
+            let library = &self.defaults[s.name];
+            match arg.get_default_values() {
+                [] if !defaults_in_cli => {}
+                [v] if defaults_in_cli => assert!(
+                    same_default(&v.to_string_lossy(), &show(library)),
+                    "--{flag}: default {v:?} in the CLI, {library} in the library"
+                ),
+                [] if defaults_in_cli => {
+                    // A switch is off unless given; a required flag or a library without a
+                    // default has none; an optional flag refused where unused states the
+                    // library's default in its help.
+                    let stated = help
+                        .split("[default: ")
+                        .nth(1)
+                        .and_then(|t| t.split(']').next());
+                    let ok = (matches!(arg.get_action(), clap::ArgAction::SetTrue)
+                        && library == &Value::Bool(false))
+                        || arg.is_required_set()
+                        || library.is_null()
+                        || stated.is_some_and(|d| same_default(d, &show(library)));
+                    assert!(
+                        ok,
+                        "--{flag}: no default in the CLI, {library} in the library"
+                    );
+                }
+                other => panic!("--{flag}: defaults {other:?} in the CLI"),
+            }
+            if !help.to_lowercase().contains(s.unit) {
+                unitless.push(format!("--{flag} ({})", s.unit));
+            }
+            match s.range {
+                Range::Any => {}
+                Range::Choices(choices) => {
+                    let shown: Vec<String> = arg
+                        .get_possible_values()
+                        .iter()
+                        .map(|p| p.get_name().to_string())
+                        .collect();
+                    // A free-form list (`--boundary periodic,wall`) names its choices in the
+                    // help instead.
+                    if shown.is_empty() {
+                        for c in choices {
+                            assert!(help.contains(c), "--{flag}: {c} not in the help: {help}");
+                        }
+                    } else {
+                        assert_eq!(shown, choices, "--{flag}: possible values");
+                    }
+                }
+                r => assert!(
+                    help.contains(&r.to_string()),
+                    "--{flag}: the help does not state the range {r}: {help}"
+                ),
+            }
+        }
+        assert!(
+            unitless.is_empty(),
+            "help texts without their unit: {unitless:?}"
+        );
+        for arg in cmd.get_arguments() {
+            let Some(long) = arg.get_long() else { continue };
+            assert!(
+                self.run_flags.contains(&long) || self.param_of(long).is_some(),
+                "--{long} of `{}` is neither a parameter of the library's table nor a run flag",
+                self.program
+            );
+        }
+        let help = cmd.clone().render_long_help().to_string();
+        assert!(!help.contains("[`"), "rustdoc markup in the help: {help}");
+    }
+
+    /// A docs table (`rows`, header first, as `core_lattice::spec::markdown_table` reads it)
+    /// against the table: for each parameter, the row `find_row` picks states the library's
+    /// default in column `default` (unless the row names several flags or the library has no
+    /// default) and the range or choices in column `range`; every flag the column `flags`
+    /// names exists in `cmd` (or is `--merge`, read before the parser). `doc` names the file
+    /// in messages.
+    pub fn check_docs_table(
+        &self,
+        doc: &str,
+        rows: &[Vec<String>],
+        columns: DocColumns,
+        cmd: &Command,
+        find_row: impl Fn(&ParamSpec, &[String]) -> bool,
+    ) {
+        for s in self.params {
+            let row = rows[1..]
+                .iter()
+                .find(|r| find_row(s, r))
+                .unwrap_or_else(|| panic!("{doc} has no row for {}", s.name));
+            let library = &self.defaults[s.name];
+            let one_flag = flags_of(&row[columns.flags]).len() <= 1;
+            let cell = &row[columns.default];
+            if one_flag && !library.is_null() && cell != "(required)" {
+                assert!(
+                    same_default(cell, &show(library)),
+                    "{}: default {cell} in {doc}, {library} in the library",
+                    s.name
+                );
+            }
+            match s.range {
+                Range::Any => {}
+                Range::Choices(c) => {
+                    let line = row.join(" ");
+                    for name in c {
+                        assert!(line.contains(name), "{}: {name} not in {doc}", s.name);
+                    }
+                }
+                r => assert!(
+                    row[columns.range].contains(&r.to_string()),
+                    "{}: {doc} does not state the range {r}: {}",
+                    s.name,
+                    row[columns.range]
+                ),
+            }
+        }
+        for r in &rows[1..] {
+            for f in flags_of(&r[columns.flags]) {
+                if let Some(long) = f.strip_prefix("--") {
+                    assert!(
+                        long == "merge" || cmd.get_arguments().any(|a| a.get_long() == Some(long)),
+                        "{doc} lists {f}, which `{}` does not have",
+                        self.program
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Which columns of a docs table hold the flags, the default and the accepted range.
+#[derive(Debug, Clone, Copy)]
+pub struct DocColumns {
+    /// The flag or flags (`--fill` or `--particles`).
+    pub flags: usize,
+    /// The default.
+    pub default: usize,
+    /// The meaning or accepted range, which states the range.
+    pub range: usize,
+}
+
+/// The flags a docs table cell names: "`--fill` or `--particles`", "`--config FILE`".
+pub fn flags_of(cell: &str) -> Vec<String> {
+    cell.split(", ")
+        .flat_map(|c| c.split(" or "))
+        .map(|f| {
+            f.trim_matches('`')
+                .split(' ')
+                .next()
+                .unwrap_or_default()
+                .to_string()
+        })
+        .filter(|f| !f.is_empty())
+        .collect()
+}
