@@ -6,31 +6,11 @@ use super::Cli;
 use animat::params::{PARAMS, defaults};
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
-use sim_run::spec_check::{CliSpec, DocColumns};
+use sim_run::spec_check::{CliSpec, DocColumns, SHARED_RUN_FLAGS};
 
-/// Flags of the binary that are not model parameters (run, output and logging flags).
-const NOT_PARAMS: &[&str] = &[
-    "steps",
-    "seed",
-    "out",
-    "config",
-    "dump-config",
-    "timing",
-    "max-memory",
-    "snapshot-every",
-    "positions",
-    "checkpoint-every",
-    "resume",
-    "quiet",
-    "verbose",
-    "heartbeat",
-    "color",
-    "seeds",
-    "jobs",
-    "merge",
-    "help",
-    "version",
-];
+/// Flags of `animat` beyond the run flags every binary has ([`SHARED_RUN_FLAGS`]) that are not
+/// model parameters.
+const NOT_PARAMS: &[&str] = &["steps", "timing", "max-memory", "snapshot-every"];
 
 fn spec() -> CliSpec<'static> {
     CliSpec {

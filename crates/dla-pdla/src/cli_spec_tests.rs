@@ -6,30 +6,11 @@ use super::Cli;
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
 use dla_pdla::params::{PARAMS, defaults};
-use sim_run::spec_check::{CliSpec, DocColumns};
+use sim_run::spec_check::{CliSpec, DocColumns, SHARED_RUN_FLAGS};
 
-/// Flags of the binary that are not model parameters (run, output and logging flags).
-const NOT_PARAMS: &[&str] = &[
-    "seed",
-    "out",
-    "paper-settings",
-    "positions",
-    "checkpoint-every",
-    "resume",
-    "png",
-    "png-size",
-    "config",
-    "dump-config",
-    "quiet",
-    "verbose",
-    "heartbeat",
-    "color",
-    "seeds",
-    "jobs",
-    "merge",
-    "help",
-    "version",
-];
+/// Flags of `dla` beyond the run flags every binary has ([`SHARED_RUN_FLAGS`]) that are not
+/// model parameters.
+const NOT_PARAMS: &[&str] = &["paper-settings", "png", "png-size"];
 
 fn spec() -> CliSpec<'static> {
     CliSpec {

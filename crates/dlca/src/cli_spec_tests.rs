@@ -6,28 +6,11 @@ use super::Cli;
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
 use dlca::params::{PARAMS, defaults};
-use sim_run::spec_check::{CliSpec, DocColumns, flags_of};
+use sim_run::spec_check::{CliSpec, DocColumns, SHARED_RUN_FLAGS, flags_of};
 
-/// Flags of the binary that are not model parameters (run, output and logging flags).
-const NOT_PARAMS: &[&str] = &[
-    "seed",
-    "out",
-    "positions",
-    "checkpoint-every",
-    "resume",
-    "png",
-    "config",
-    "dump-config",
-    "quiet",
-    "verbose",
-    "heartbeat",
-    "color",
-    "seeds",
-    "jobs",
-    "merge",
-    "help",
-    "version",
-];
+/// Flags of `dlca` beyond the run flags every binary has ([`SHARED_RUN_FLAGS`]) that are not
+/// model parameters.
+const NOT_PARAMS: &[&str] = &["png"];
 
 fn spec() -> CliSpec<'static> {
     CliSpec {

@@ -9,6 +9,27 @@ use clap::Command;
 use core_lattice::spec::{ParamSpec, Range, same_default};
 use serde_json::{Map, Value};
 
+/// The flags every binary has that are not model parameters: the run, output, config,
+/// logging and ensemble flags of [`crate::cli`] and [`crate::ensemble`], and clap's own.
+pub const SHARED_RUN_FLAGS: &[&str] = &[
+    "seed",
+    "out",
+    "positions",
+    "checkpoint-every",
+    "resume",
+    "config",
+    "dump-config",
+    "quiet",
+    "verbose",
+    "heartbeat",
+    "color",
+    "seeds",
+    "jobs",
+    "merge",
+    "help",
+    "version",
+];
+
 /// A library default as the front ends spell it (lists joined by `, `, `none` for null).
 pub fn show(v: &Value) -> String {
     match v {
@@ -27,7 +48,7 @@ pub struct CliSpec<'a> {
     pub params: &'a [ParamSpec],
     /// The library's defaults by parameter name.
     pub defaults: Map<String, Value>,
-    /// Long flags that are not model parameters (run, output and logging flags).
+    /// Long flags of this binary that are not model parameters, beyond [`SHARED_RUN_FLAGS`].
     pub run_flags: &'a [&'a str],
 }
 
@@ -112,7 +133,9 @@ impl CliSpec<'_> {
         for arg in cmd.get_arguments() {
             let Some(long) = arg.get_long() else { continue };
             assert!(
-                self.run_flags.contains(&long) || self.param_of(long).is_some(),
+                SHARED_RUN_FLAGS.contains(&long)
+                    || self.run_flags.contains(&long)
+                    || self.param_of(long).is_some(),
                 "--{long} of `{}` is neither a parameter of the library's table nor a run flag",
                 self.program
             );
