@@ -6,9 +6,9 @@ use super::Cli;
 use animat::params::{PARAMS, defaults};
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
-use sim_run::spec_check::{CliSpec, DocColumns, SHARED_RUN_FLAGS};
+use sim_run::spec_check::{CliSpec, DocColumns};
 
-/// Flags of `animat` beyond the run flags every binary has ([`SHARED_RUN_FLAGS`]) that are not
+/// Flags of `animat` beyond the run flags every binary has (`sim_run::spec_check::SHARED_RUN_FLAGS`) that are not
 /// model parameters.
 const NOT_PARAMS: &[&str] = &["steps", "timing", "max-memory", "snapshot-every"];
 
