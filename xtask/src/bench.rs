@@ -276,25 +276,13 @@ pub fn target_dir(root: &Path) -> PathBuf {
 /// Build the release binaries the workloads need.
 pub fn build(root: &Path, cargo: &str) -> Result<()> {
     eprintln!("==> building release binaries");
-    let status = Command::new(cargo)
-        .args([
-            "build",
-            "--release",
-            "-p",
-            "dla-pdla",
-            "-p",
-            "dlca",
-            "-p",
-            "animat",
-            "--bins",
-        ])
-        .current_dir(root)
-        .status()
-        .context("could not start cargo build")?;
-    if !status.success() {
-        bail!("cargo build failed ({status})");
-    }
-    Ok(())
+    crate::run_checked(
+        Command::new(cargo)
+            .args(["build", "--release", "--bins"])
+            .args(["-p", "dla-pdla", "-p", "dlca", "-p", "animat"])
+            .current_dir(root),
+        "cargo build",
+    )
 }
 
 /// Items the rate counts, from the run's outputs.

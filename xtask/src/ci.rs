@@ -26,11 +26,8 @@ pub enum Needs {
 /// How a step runs.
 #[derive(Debug, Clone, Copy)]
 pub enum Run {
-    /// `cargo ARGS` with extra environment variables.
-    Cargo(
-        &'static [&'static str],
-        &'static [(&'static str, &'static str)],
-    ),
+    /// `cargo ARGS` (words separated by spaces) with extra environment variables.
+    Cargo(&'static str, &'static [(&'static str, &'static str)]),
     /// `pip install` of the Python package and its test tools into the CI virtual environment.
     PythonInstall,
     /// `pytest` on `python/tests` against the debug binaries the test step built.
@@ -49,29 +46,19 @@ pub struct Step {
 }
 
 /// The README's test command (the `tests` step), kept in one place.
-pub const TEST_ARGS: &[&str] = &["test", "--workspace"];
+pub const TEST_ARGS: &str = "test --workspace";
 
 /// Every CI step, in order.
 pub const STEPS: &[Step] = &[
     Step {
         name: "format",
         needs: Needs::Rust,
-        run: Run::Cargo(&["fmt", "--all", "--", "--check"], &[]),
+        run: Run::Cargo("fmt --all -- --check", &[]),
     },
     Step {
         name: "clippy",
         needs: Needs::Rust,
-        run: Run::Cargo(
-            &[
-                "clippy",
-                "--workspace",
-                "--all-targets",
-                "--",
-                "-D",
-                "warnings",
-            ],
-            &[],
-        ),
+        run: Run::Cargo("clippy --workspace --all-targets -- -D warnings", &[]),
     },
     // The model libraries build without the command line (feature `cli`), as the Python
     // bindings use them; core-lattice builds without serde, as spatial uses it.
@@ -79,23 +66,10 @@ pub const STEPS: &[Step] = &[
         name: "libraries-alone",
         needs: Needs::Rust,
         run: Run::Cargo(
-            &[
-                "clippy",
-                "-p",
-                "dlca",
-                "-p",
-                "dla-pdla",
-                "-p",
-                "animat",
-                "-p",
-                "spatial",
-                "-p",
-                "core-lattice",
-                "--no-default-features",
-                "--",
-                "-D",
-                "warnings",
-            ],
+            concat!(
+                "clippy -p dlca -p dla-pdla -p animat -p spatial -p core-lattice",
+                " --no-default-features -- -D warnings"
+            ),
             &[],
         ),
     },
@@ -103,7 +77,7 @@ pub const STEPS: &[Step] = &[
         name: "rustdoc",
         needs: Needs::Rust,
         run: Run::Cargo(
-            &["doc", "--workspace", "--no-deps"],
+            "doc --workspace --no-deps",
             &[("RUSTDOCFLAGS", "-D warnings")],
         ),
     },
@@ -118,14 +92,7 @@ pub const STEPS: &[Step] = &[
         name: "loom",
         needs: Needs::Rust,
         run: Run::Cargo(
-            &[
-                "test",
-                "-p",
-                "spatial",
-                "--test",
-                "loom_shared",
-                "--release",
-            ],
+            "test -p spatial --test loom_shared --release",
             &[
                 ("RUSTFLAGS", "--cfg loom"),
                 ("CARGO_TARGET_DIR", "target/loom"),
@@ -138,16 +105,7 @@ pub const STEPS: &[Step] = &[
     Step {
         name: "package",
         needs: Needs::Rust,
-        run: Run::Cargo(
-            &[
-                "package",
-                "--workspace",
-                "--exclude",
-                "xtask",
-                "--allow-dirty",
-            ],
-            &[],
-        ),
+        run: Run::Cargo("package --workspace --exclude xtask --allow-dirty", &[]),
     },
     // The Python package (python/, its own Cargo workspace): formatted, linted, built and
     // installed by pip (maturin, release) into a fresh virtual environment, and its tests run
@@ -155,30 +113,13 @@ pub const STEPS: &[Step] = &[
     Step {
         name: "python-format",
         needs: Needs::Rust,
-        run: Run::Cargo(
-            &[
-                "fmt",
-                "--manifest-path",
-                "python/Cargo.toml",
-                "--",
-                "--check",
-            ],
-            &[],
-        ),
+        run: Run::Cargo("fmt --manifest-path python/Cargo.toml -- --check", &[]),
     },
     Step {
         name: "python-clippy",
         needs: Needs::Rust,
         run: Run::Cargo(
-            &[
-                "clippy",
-                "--manifest-path",
-                "python/Cargo.toml",
-                "--all-targets",
-                "--",
-                "-D",
-                "warnings",
-            ],
+            "clippy --manifest-path python/Cargo.toml --all-targets -- -D warnings",
             &[],
         ),
     },
@@ -198,39 +139,14 @@ pub const STEPS: &[Step] = &[
         name: "mpi-clippy",
         needs: Needs::Mpi,
         run: Run::Cargo(
-            &[
-                "clippy",
-                "-p",
-                "dla-pdla",
-                "-p",
-                "dlca",
-                "-p",
-                "animat",
-                "--features",
-                "mpi",
-                "--all-targets",
-                "--",
-                "-D",
-                "warnings",
-            ],
+            "clippy -p dla-pdla -p dlca -p animat --features mpi --all-targets -- -D warnings",
             &[],
         ),
     },
     Step {
         name: "mpi-tests",
         needs: Needs::Mpi,
-        run: Run::Cargo(
-            &[
-                "test",
-                "-p",
-                "dla-pdla",
-                "--features",
-                "mpi",
-                "--test",
-                "ensemble",
-            ],
-            &[],
-        ),
+        run: Run::Cargo("test -p dla-pdla --features mpi --test ensemble", &[]),
     },
 ];
 
@@ -282,23 +198,18 @@ fn venv_python() -> PathBuf {
 }
 
 fn status(cmd: &mut Command, what: &str) -> Result<()> {
-    let st = cmd
-        .current_dir(workspace_root())
-        .status()
-        .with_context(|| format!("could not start {what}"))?;
-    if !st.success() {
-        bail!("{what} failed ({st})");
-    }
-    Ok(())
+    crate::run_checked(cmd.current_dir(workspace_root()), what)
 }
 
 fn run_step(step: &Step) -> Result<()> {
     match step.run {
         Run::Cargo(args, env) => {
-            eprintln!("==> {}: cargo {}", step.name, args.join(" "));
+            eprintln!("==> {}: cargo {args}", step.name);
             status(
-                Command::new(cargo()).args(args).envs(env.iter().copied()),
-                &format!("cargo {}", args.join(" ")),
+                Command::new(cargo())
+                    .args(args.split_whitespace())
+                    .envs(env.iter().copied()),
+                &format!("cargo {args}"),
             )
         }
         Run::PythonInstall => {
@@ -393,7 +304,7 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), STEPS.len());
         let readme = std::fs::read_to_string(workspace_root().join("README.md")).unwrap();
-        let command = format!("cargo {}", TEST_ARGS.join(" "));
+        let command = format!("cargo {TEST_ARGS}");
         assert!(
             readme.contains(&format!("{command} ")) || readme.contains(&format!("{command}\n")),
             "README does not give `{command}` as its test command"

@@ -23,6 +23,18 @@ pub fn workspace_root() -> PathBuf {
         .to_path_buf()
 }
 
+/// Runs `cmd` to its end; an error names `what` when it cannot start or exits unsuccessfully.
+pub fn run_checked(cmd: &mut std::process::Command, what: &str) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let status = cmd
+        .status()
+        .with_context(|| format!("could not start {what}"))?;
+    if !status.success() {
+        anyhow::bail!("{what} failed ({status})");
+    }
+    Ok(())
+}
+
 /// The cargo that runs us (`$CARGO`), or `cargo` from the path.
 pub fn cargo() -> String {
     std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string())

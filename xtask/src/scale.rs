@@ -95,15 +95,13 @@ fn measure(
     }
     let command = format!("target/release/dla {} -q --out DIR", args.join(" "));
     eprintln!("==> {command}");
-    let o = Command::new(bin)
-        .args(&args)
-        .args(["-q", "--heartbeat", "60", "--out"])
-        .arg(&out)
-        .status()
-        .with_context(|| format!("running {}", bin.display()))?;
-    if !o.success() {
-        bail!("{command} failed ({o})");
-    }
+    crate::run_checked(
+        Command::new(bin)
+            .args(&args)
+            .args(["-q", "--heartbeat", "60", "--out"])
+            .arg(&out),
+        &command,
+    )?;
     let m = RunManifest::read(out.join("run.json")).context("reading run.json")?;
     let num = |k: &str| m.results.get(k).and_then(|v| v.as_f64());
     let mut times = Vec::new();

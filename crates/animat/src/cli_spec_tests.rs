@@ -8,17 +8,12 @@ use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
 use sim_run::spec_check::{CliSpec, DocColumns};
 
-/// Flags of `animat` beyond the run flags every binary has (`sim_run::spec_check::SHARED_RUN_FLAGS`) that are not
-/// model parameters.
+/// Flags of `animat` that are not model parameters, beyond the run flags every binary has
+/// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
 const NOT_PARAMS: &[&str] = &["steps", "timing", "max-memory", "snapshot-every"];
 
 fn spec() -> CliSpec<'static> {
-    CliSpec {
-        program: "animat",
-        params: PARAMS,
-        defaults: defaults(),
-        run_flags: NOT_PARAMS,
-    }
+    CliSpec::new("animat", PARAMS, defaults(), NOT_PARAMS)
 }
 
 /// The flags have no defaults: the value comes from the config file or the library unless
@@ -47,11 +42,7 @@ fn the_docs_table_states_each_default_and_range() {
     let md = include_str!("../../../docs/animat.md");
     let rows = markdown_table(md, "## Parameters and defaults");
     assert_eq!(rows[0], ["parameter", "flag", "default", "accepted"]);
-    let columns = DocColumns {
-        flags: 1,
-        default: 2,
-        range: 3,
-    };
+    let columns = DocColumns::new(1, 2, 3);
     let row_of = |s: &core_lattice::spec::ParamSpec, r: &[String]| {
         r[0] == format!("`{}`", s.name) || s.flag.is_some_and(|f| r[1] == format!("`--{f}`"))
     };

@@ -8,17 +8,12 @@ use core_lattice::spec::markdown_table;
 use dla_pdla::params::{PARAMS, defaults};
 use sim_run::spec_check::{CliSpec, DocColumns};
 
-/// Flags of `dla` beyond the run flags every binary has (`sim_run::spec_check::SHARED_RUN_FLAGS`) that are not
-/// model parameters.
+/// Flags of `dla` that are not model parameters, beyond the run flags every binary has
+/// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
 const NOT_PARAMS: &[&str] = &["paper-settings", "png", "png-size"];
 
 fn spec() -> CliSpec<'static> {
-    CliSpec {
-        program: "dla",
-        params: PARAMS,
-        defaults: defaults(),
-        run_flags: NOT_PARAMS,
-    }
+    CliSpec::new("dla", PARAMS, defaults(), NOT_PARAMS)
 }
 
 #[test]
@@ -31,11 +26,7 @@ fn the_docs_flag_table_states_each_default_and_range() {
     let md = include_str!("../../../docs/dla.md");
     let rows = markdown_table(md, "## Parameters (flags; `Params` fields)");
     assert_eq!(rows[0], ["flag", "default", "meaning"]);
-    let columns = DocColumns {
-        flags: 0,
-        default: 1,
-        range: 2,
-    };
+    let columns = DocColumns::new(0, 1, 2);
     spec().check_docs_table("docs/dla.md", &rows, columns, &Cli::command(), |s, r| {
         r[0] == format!("`--{}`", s.flag.unwrap())
     });

@@ -8,17 +8,12 @@ use core_lattice::spec::markdown_table;
 use dlca::params::{PARAMS, defaults};
 use sim_run::spec_check::{CliSpec, DocColumns, flags_of};
 
-/// Flags of `dlca` beyond the run flags every binary has (`sim_run::spec_check::SHARED_RUN_FLAGS`) that are not
-/// model parameters.
+/// Flags of `dlca` that are not model parameters, beyond the run flags every binary has
+/// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
 const NOT_PARAMS: &[&str] = &["png"];
 
 fn spec() -> CliSpec<'static> {
-    CliSpec {
-        program: "dlca",
-        params: PARAMS,
-        defaults: defaults(),
-        run_flags: NOT_PARAMS,
-    }
+    CliSpec::new("dlca", PARAMS, defaults(), NOT_PARAMS)
 }
 
 #[test]
@@ -31,11 +26,7 @@ fn the_docs_flag_table_states_each_default_and_range() {
     let md = include_str!("../../../docs/dlca.md");
     let rows = markdown_table(md, "## Flags by purpose");
     assert_eq!(rows[0], ["purpose", "flag", "default", "meaning"]);
-    let columns = DocColumns {
-        flags: 1,
-        default: 2,
-        range: 3,
-    };
+    let columns = DocColumns::new(1, 2, 3);
     spec().check_docs_table("docs/dlca.md", &rows, columns, &Cli::command(), |s, r| {
         flags_of(&r[1]).contains(&format!("--{}", s.flag.unwrap()))
     });

@@ -185,21 +185,9 @@ pub fn manifest(
 /// The first error of `f`.
 pub fn each_particle<E>(
     sim: &Simulation,
-    mut f: impl FnMut(ItemId, u64) -> Result<(), E>,
+    f: impl FnMut(ItemId, u64) -> Result<(), E>,
 ) -> Result<(), E> {
-    let sets = sim.sets();
-    let mut ids = sets.live().to_vec();
-    ids.sort_unstable();
-    let mut sites = Vec::new();
-    for id in ids {
-        sites.clear();
-        sites.extend_from_slice(sets.sites(id));
-        sites.sort_unstable();
-        for &k in &sites {
-            f(id, k)?;
-        }
-    }
-    Ok(())
+    sim.try_for_each_particle(f)
 }
 
 fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputError> {

@@ -52,7 +52,22 @@ pub struct CliSpec<'a> {
     pub run_flags: &'a [&'a str],
 }
 
-impl CliSpec<'_> {
+impl<'a> CliSpec<'a> {
+    /// A binary's name, its model's parameter table and defaults, and its own run flags.
+    pub fn new(
+        program: &'a str,
+        params: &'a [ParamSpec],
+        defaults: Map<String, Value>,
+        run_flags: &'a [&'a str],
+    ) -> Self {
+        CliSpec {
+            program,
+            params,
+            defaults,
+            run_flags,
+        }
+    }
+
     /// The parameter spec of a long flag, if it is a parameter's.
     fn param_of(&self, long: &str) -> Option<&ParamSpec> {
         self.params.iter().find(|s| s.flag == Some(long))
@@ -212,6 +227,17 @@ pub struct DocColumns {
     pub default: usize,
     /// The meaning or accepted range, which states the range.
     pub range: usize,
+}
+
+impl DocColumns {
+    /// The columns of the flags, the default and the range, in that order.
+    pub const fn new(flags: usize, default: usize, range: usize) -> Self {
+        DocColumns {
+            flags,
+            default,
+            range,
+        }
+    }
 }
 
 /// The flags a docs table cell names: "`--fill` or `--particles`", "`--config FILE`".

@@ -473,22 +473,39 @@ impl Simulation {
         &self.records
     }
 
-    /// Hash of every particle's site and cluster id: clusters in increasing id, each cluster's
-    /// sites in increasing k-index, fed as `(id, k)` little-endian `u64` pairs into XXH3-64.
-    pub fn state_hash(&self) -> String {
+    /// Calls `f(cluster id, site k-index)` for every particle in a canonical order: clusters
+    /// in increasing id, each cluster's sites in increasing k-index (the order of
+    /// `particles.csv` and of the state hash).
+    ///
+    /// # Errors
+    /// The first error of `f`.
+    pub fn try_for_each_particle<E>(
+        &self,
+        mut f: impl FnMut(ItemId, u64) -> Result<(), E>,
+    ) -> Result<(), E> {
         let sets = self.sets();
         let mut ids: Vec<ItemId> = sets.live().to_vec();
         ids.sort_unstable();
-        let mut h = StateHasher::new();
         let mut sites = Vec::new();
         for id in ids {
             sites.clear();
             sites.extend_from_slice(sets.sites(id));
             sites.sort_unstable();
             for &k in &sites {
-                h.u64(u64::from(id)).u64(k);
+                f(id, k)?;
             }
         }
+        Ok(())
+    }
+
+    /// Hash of every particle's site and cluster id: clusters in increasing id, each cluster's
+    /// sites in increasing k-index, fed as `(id, k)` little-endian `u64` pairs into XXH3-64.
+    pub fn state_hash(&self) -> String {
+        let mut h = StateHasher::new();
+        let _ = self.try_for_each_particle(|id, k| {
+            h.u64(u64::from(id)).u64(k);
+            Ok::<(), std::convert::Infallible>(())
+        });
         h.finish_hex()
     }
 }

@@ -15,13 +15,56 @@ use core_lattice::{Blocked, Boundary, Direction, Lattice};
 pub struct SiteSets {
     lattice: Lattice,
     sets: Vec<Vec<u64>>,
-    live: Vec<ItemId>,
-    /// Position of each id in `live`, or `DEAD`.
-    position: Vec<u32>,
+    live: LiveList,
     total_sites: u64,
 }
 
 const DEAD: u32 = u32::MAX;
+
+/// The live ids among `0..bound` as a dense list with each id's position in it: O(1)
+/// membership, iteration over the live ids only, O(1) retirement (the last live id takes the
+/// retired one's place). Shared by [`SiteSets`] and the halo grid, which starts from a copy.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LiveList {
+    live: Vec<ItemId>,
+    /// Position of each id in `live`, or `DEAD`.
+    position: Vec<u32>,
+}
+
+impl LiveList {
+    /// Hands out the next id (`bound()`) as live.
+    fn push_next(&mut self) -> ItemId {
+        let id = ItemId::try_from(self.position.len())
+            .ok()
+            .filter(|&i| i != DEAD)
+            .expect("too many items");
+        self.position.push(self.live.len() as u32);
+        self.live.push(id);
+        id
+    }
+
+    /// Whether `id` is live.
+    #[inline]
+    pub(crate) fn contains(&self, id: ItemId) -> bool {
+        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+    }
+
+    /// The live ids.
+    #[inline]
+    pub(crate) fn ids(&self) -> &[ItemId] {
+        &self.live
+    }
+
+    /// Retires live id `id`.
+    pub(crate) fn unlink(&mut self, id: ItemId) {
+        let p = self.position[id as usize] as usize;
+        self.live.swap_remove(p);
+        if let Some(&moved) = self.live.get(p) {
+            self.position[moved as usize] = p as u32;
+        }
+        self.position[id as usize] = DEAD;
+    }
+}
 
 impl SiteSets {
     /// No items on `lattice`.
@@ -29,8 +72,7 @@ impl SiteSets {
         SiteSets {
             lattice,
             sets: Vec::new(),
-            live: Vec::new(),
-            position: Vec::new(),
+            live: LiveList::default(),
             total_sites: 0,
         }
     }
@@ -50,20 +92,15 @@ impl SiteSets {
             sites.iter().all(|&k| k < self.lattice.volume()),
             "site outside the lattice"
         );
-        let id = ItemId::try_from(self.sets.len())
-            .ok()
-            .filter(|&i| i != DEAD)
-            .expect("too many items");
+        let id = self.live.push_next();
         self.total_sites += sites.len() as u64;
         self.sets.push(sites);
-        self.position.push(self.live.len() as u32);
-        self.live.push(id);
         id
     }
 
     /// Whether `id` is a live item.
     pub fn contains(&self, id: ItemId) -> bool {
-        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+        self.live.contains(id)
     }
 
     /// The sites of item `id` (empty for a removed item).
@@ -74,17 +111,22 @@ impl SiteSets {
 
     /// Live item ids (see the type docs for their order).
     pub fn live(&self) -> &[ItemId] {
+        self.live.ids()
+    }
+
+    /// The live list itself, for a structure that starts from the same ids.
+    pub(crate) fn live_list(&self) -> &LiveList {
         &self.live
     }
 
     /// Number of live items.
     pub fn len(&self) -> usize {
-        self.live.len()
+        self.live.ids().len()
     }
 
     /// Whether there are no live items.
     pub fn is_empty(&self) -> bool {
-        self.live.is_empty()
+        self.live.ids().is_empty()
     }
 
     /// One more than the largest id ever handed out: the size of arrays indexed by id.
@@ -139,7 +181,7 @@ impl SiteSets {
             std::mem::swap(target, &mut moved);
         }
         target.extend_from_slice(&moved);
-        self.unlink(from);
+        self.live.unlink(from);
         from_len
     }
 
@@ -172,16 +214,7 @@ impl SiteSets {
         assert!(self.contains(id));
         let sites = std::mem::take(&mut self.sets[id as usize]);
         self.total_sites -= sites.len() as u64;
-        self.unlink(id);
+        self.live.unlink(id);
         sites
-    }
-
-    fn unlink(&mut self, id: ItemId) {
-        let p = self.position[id as usize] as usize;
-        self.live.swap_remove(p);
-        if let Some(&moved) = self.live.get(p) {
-            self.position[moved as usize] = p as u32;
-        }
-        self.position[id as usize] = DEAD;
     }
 }

@@ -29,6 +29,7 @@ mod boxes;
 mod region;
 mod shape;
 
+use super::sets::LiveList;
 use super::{ItemId, SiteSets};
 use boxes::{HaloBoxes, box_count, predicted_cost};
 use core_lattice::{Blocked, Direction, Lattice};
@@ -46,9 +47,6 @@ const RETUNE_STEPS: f64 = 4.0;
 /// the box count follows the particles, not the sites.
 const BOXES_PER_PARTICLE: u64 = 8;
 const BOX_ALLOWANCE: u64 = 1 << 16;
-
-/// Position of a cluster id in the live list, or this for a retired id.
-const DEAD: u32 = u32::MAX;
 
 /// A re-tuning of the box side during a merge, for the caller's log.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,8 +91,8 @@ pub struct HaloGrid {
     /// Every cluster id ever handed out: its shape (empty once retired) and bounding region.
     shapes: Vec<Shape>,
     regions: Vec<Region>,
-    live: Vec<ItemId>,
-    position: Vec<u32>,
+    /// The live cluster ids (a copy of the sets' list at the start, then retired on merges).
+    live: LiveList,
     particles: u64,
     boxes: HaloBoxes,
     /// The step of the cluster count's geometric scale at the last tuning.
@@ -116,22 +114,17 @@ impl HaloGrid {
         let lattice = sets.lattice().clone();
         let mut shapes = vec![Shape::default(); sets.id_bound()];
         let mut regions = vec![Region::default(); sets.id_bound()];
-        let mut position = vec![DEAD; sets.id_bound()];
-        let mut live = Vec::with_capacity(sets.len());
         for &id in sets.live() {
             let sites = sets.sites(id);
             shapes[id as usize] = Shape::of(&lattice, sites);
             regions[id as usize] = Region::of(&lattice, sites);
-            position[id as usize] = live.len() as u32;
-            live.push(id);
         }
         let mut grid = HaloGrid {
             boxes: HaloBoxes::new(&lattice, 1 << 62),
             lattice,
             shapes,
             regions,
-            live,
-            position,
+            live: sets.live_list().clone(),
             particles: sets.total_sites(),
             tuned_at: tuning_step(sets.len()),
             candidates: Vec::new(),
@@ -155,13 +148,13 @@ impl HaloGrid {
     /// Live cluster ids, in no particular order.
     #[inline]
     pub fn live(&self) -> &[ItemId] {
-        &self.live
+        self.live.ids()
     }
 
     /// Whether cluster `id` is live.
     #[inline]
     pub fn contains(&self, id: ItemId) -> bool {
-        self.position.get(id as usize).is_some_and(|&p| p != DEAD)
+        self.live.contains(id)
     }
 
     /// Number of particles of live cluster `id`.
@@ -180,7 +173,7 @@ impl HaloGrid {
     /// those giving at most [`BOXES_PER_PARTICLE`] boxes per particle (plus an allowance), and
     /// that cost.
     fn best_side(&self) -> (u64, f64) {
-        let halos: Vec<Region> = self.live.iter().map(|&id| self.halo(id)).collect();
+        let halos: Vec<Region> = self.live.ids().iter().map(|&id| self.halo(id)).collect();
         let longest = self.lattice.sizes().iter().copied().max().unwrap_or(1);
         let most_boxes = self.particles.saturating_mul(BOXES_PER_PARTICLE) + BOX_ALLOWANCE;
         let mut best = (longest.next_power_of_two(), f64::INFINITY);
@@ -200,8 +193,8 @@ impl HaloGrid {
     /// Boxes of side `side`, listing every live cluster.
     fn rebuild(&mut self, side: u64) {
         self.boxes = HaloBoxes::new(&self.lattice, side);
-        for i in 0..self.live.len() {
-            let id = self.live[i];
+        for i in 0..self.live.ids().len() {
+            let id = self.live.ids()[i];
             let halo = self.halo(id);
             self.boxes.register(id, &halo);
         }
@@ -210,19 +203,19 @@ impl HaloGrid {
     /// Re-tune the box side if the cluster count has passed a step of its scale since the last
     /// tuning and another side is predicted to be enough cheaper.
     fn maybe_retune(&mut self) -> Option<Retuned> {
-        let step = tuning_step(self.live.len());
+        let step = tuning_step(self.live.ids().len());
         if step == self.tuned_at {
             return None;
         }
         self.tuned_at = step;
         let side = self.boxes.side();
-        let halos: Vec<Region> = self.live.iter().map(|&id| self.halo(id)).collect();
+        let halos: Vec<Region> = self.live.ids().iter().map(|&id| self.halo(id)).collect();
         let now = predicted_cost(&self.lattice, side, halos.iter());
         let (best, cost) = self.best_side();
         if best != side && cost <= RETUNE_GAIN * now {
             self.rebuild(best);
             return Some(Retuned {
-                clusters: self.live.len(),
+                clusters: self.live.ids().len(),
                 from: side,
                 to: best,
                 cost_before: now,
@@ -230,16 +223,6 @@ impl HaloGrid {
             });
         }
         None
-    }
-
-    /// Retire cluster `id` from the live list.
-    fn unlink(&mut self, id: ItemId) {
-        let p = self.position[id as usize] as usize;
-        self.live.swap_remove(p);
-        if let Some(&moved) = self.live.get(p) {
-            self.position[moved as usize] = p as u32;
-        }
-        self.position[id as usize] = DEAD;
     }
 
     /// The clusters as k-index arrays, with the same ids (retired ids removed). O(N).
@@ -320,7 +303,7 @@ impl HaloGrid {
             }
             self.shapes[s].absorb(&self.lattice, &from, &mut self.scratch);
             self.regions[s] = self.regions[s].union(&self.regions[o], &self.lattice);
-            self.unlink(other);
+            self.live.unlink(other);
         }
         let halo = self.halo(survivor);
         self.boxes.register(survivor, &halo);
@@ -331,8 +314,8 @@ impl HaloGrid {
     /// Panics unless every shape is sorted and inside its region, and every box lists exactly
     /// the clusters whose halo overlaps it. For tests.
     pub fn check(&self) {
-        let mut halos = Vec::with_capacity(self.live.len());
-        for &id in &self.live {
+        let mut halos = Vec::with_capacity(self.live.ids().len());
+        for &id in self.live.ids() {
             let shape = &self.shapes[id as usize];
             assert!(
                 shape.is_consistent(),
