@@ -28,6 +28,9 @@ pub enum Needs {
 pub enum Run {
     /// `cargo ARGS` (words separated by spaces) with extra environment variables.
     Cargo(&'static str, &'static [(&'static str, &'static str)]),
+    /// `cargo package` of the library crates, after removing cargo's unpacked copies of them
+    /// from the last packaging (see [`forget_packaged_sources`]).
+    Package,
     /// `pip install` of the Python package and its test tools into the CI virtual environment.
     PythonInstall,
     /// `pytest` on `python/tests` against the debug binaries the test step built.
@@ -105,7 +108,7 @@ pub const STEPS: &[Step] = &[
     Step {
         name: "package",
         needs: Needs::Rust,
-        run: Run::Cargo("package --workspace --exclude xtask --allow-dirty", &[]),
+        run: Run::Package,
     },
     // The Python package (python/, its own Cargo workspace): formatted, linted, built and
     // installed by pip (maturin, release) into a fresh virtual environment, and its tests run
@@ -197,6 +200,41 @@ fn venv_python() -> PathBuf {
     workspace_root().join("target/ci-venv/bin/python")
 }
 
+/// Removes cargo's unpacked copies of the workspace's own crates from the local registries
+/// `cargo package` made before (`$CARGO_HOME/registry/src/-<hash>/<crate>-<version>`): cargo
+/// unpacks a package of the same name and version only once, so a second packaging would
+/// verify a crate against the first one's dependencies (seen here: `animat` verified against a
+/// `spatial` from before `spatial::cells` existed). Crates from crates.io are not touched:
+/// their registry directories are named after the index, never starting with `-`.
+fn forget_packaged_sources() -> Result<()> {
+    let home = std::env::var_os("CARGO_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")));
+    let Some(src) = home.map(|h| h.join("registry/src")) else {
+        return Ok(());
+    };
+    let ours: Vec<String> = crate::codemap::workspace_crates(&workspace_root())
+        .into_iter()
+        .map(|(name, _)| format!("{name}-"))
+        .collect();
+    let Ok(registries) = std::fs::read_dir(&src) else {
+        return Ok(());
+    };
+    for reg in registries.flatten() {
+        if !reg.file_name().to_string_lossy().starts_with('-') {
+            continue;
+        }
+        for entry in std::fs::read_dir(reg.path())?.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if ours.iter().any(|o| name.starts_with(o.as_str())) {
+                std::fs::remove_dir_all(entry.path())
+                    .with_context(|| format!("removing {}", entry.path().display()))?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn status(cmd: &mut Command, what: &str) -> Result<()> {
     crate::run_checked(cmd.current_dir(workspace_root()), what)
 }
@@ -209,6 +247,15 @@ fn run_step(step: &Step) -> Result<()> {
                 Command::new(cargo())
                     .args(args.split_whitespace())
                     .envs(env.iter().copied()),
+                &format!("cargo {args}"),
+            )
+        }
+        Run::Package => {
+            forget_packaged_sources()?;
+            let args = "package --workspace --exclude xtask --allow-dirty";
+            eprintln!("==> {}: cargo {args}", step.name);
+            status(
+                Command::new(cargo()).args(args.split_whitespace()),
                 &format!("cargo {args}"),
             )
         }
