@@ -280,9 +280,10 @@ fn run_step(step: &Step) -> Result<()> {
                 "pip install --upgrade pip",
             )?;
             status(
-                Command::new(&py)
-                    .args(["-m", "pip", "install", "-q", "./python", "pytest", "numpy"]),
-                "pip install ./python pytest numpy",
+                Command::new(&py).args([
+                    "-m", "pip", "install", "-q", "./python", "pytest", "numpy", "meshio",
+                ]),
+                "pip install ./python pytest numpy meshio",
             )
         }
         Run::PythonTests => {

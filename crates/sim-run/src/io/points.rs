@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | `csv` | `STEM.csv`: the coordinates, then one column per attribute | pandas, R, spreadsheets |
 //! | `npy` | `STEM.npy`: float64 `(N, D)`; `STEM_<attribute>.npy`: int64 `(N,)` each | `numpy.load` (memory-mapped) |
-//! | `vtk` | `STEM.vtk`: legacy VTK, binary `POLYDATA`, one vertex per point, the attributes as point scalars | ParaView, VisIt |
+//! | `vtk` | `STEM.vtk`: legacy VTK, binary `UNSTRUCTURED_GRID`, one vertex cell per point, the attributes as point scalars | ParaView, VisIt, pyvista, meshio |
 //! | `xyz` | `STEM.xyz`: extended XYZ (count, a `Properties=` comment line, one line per point) | OVITO, VMD, ASE |
 //!
 //! Points come from a visitor the writer may call more than once (VTK stores each attribute in
@@ -26,7 +26,8 @@ pub enum PointFormat {
     Csv,
     /// NumPy `.npy`: coordinates float64 `(N, D)`, each attribute int64 `(N,)` in its own file.
     Npy,
-    /// Legacy VTK (binary `POLYDATA` with vertices and point scalars) for ParaView and VisIt.
+    /// Legacy VTK (binary `UNSTRUCTURED_GRID` with vertex cells and point scalars) for
+    /// ParaView, VisIt, pyvista and meshio.
     Vtk,
     /// Extended XYZ for OVITO, VMD and ASE.
     Xyz,
@@ -55,7 +56,8 @@ pub enum Positions {
     Csv,
     /// NumPy `.npy`: coordinates float64 `(N, D)`, each attribute int64 `(N,)` in its own file.
     Npy,
-    /// Legacy VTK (binary `POLYDATA` with vertices and point scalars) for ParaView and VisIt.
+    /// Legacy VTK (binary `UNSTRUCTURED_GRID` with vertex cells and point scalars) for
+    /// ParaView, VisIt, pyvista and meshio.
     Vtk,
     /// Extended XYZ for OVITO, VMD and ASE.
     Xyz,
@@ -288,9 +290,11 @@ impl NpyFile {
     }
 }
 
-/// Legacy VTK 3.0, binary (big-endian): `POINTS` (float64, z = 0 in the plane; only the first
-/// three axes of a higher-dimensional set), one `VERTICES` cell per point so that every viewer
-/// draws them, and the index and the attributes as `POINT_DATA` scalars.
+/// Legacy VTK 3.0, binary (big-endian): an `UNSTRUCTURED_GRID` of `POINTS` (float64, z = 0 in
+/// the plane; only the first three axes of a higher-dimensional set) with one vertex cell
+/// (`CELL_TYPES` 1) per point, so that every viewer draws them, and the index and the
+/// attributes as `POINT_DATA` scalars. An unstructured grid rather than `POLYDATA`: the light
+/// readers (meshio) read only unstructured grids.
 fn write_vtk(path: &Path, set: &PointSet<'_>, visit: &mut Visitor<'_>) -> Result<(), OutputError> {
     let n = set.n;
     // VTK's legacy cells and scalars are 32-bit.
@@ -309,7 +313,8 @@ fn write_vtk(path: &Path, set: &PointSet<'_>, visit: &mut Visitor<'_>) -> Result
         let title: String = set.title.chars().filter(|c| *c != '\n').take(255).collect();
         write!(
             b,
-            "# vtk DataFile Version 3.0\n{title}\nBINARY\nDATASET POLYDATA\nPOINTS {n} double\n"
+            "# vtk DataFile Version 3.0\n{title}\nBINARY\nDATASET UNSTRUCTURED_GRID\n\
+             POINTS {n} double\n"
         )?;
         let mut count = 0u64;
         visit(&mut |p, _| {
@@ -326,10 +331,15 @@ fn write_vtk(path: &Path, set: &PointSet<'_>, visit: &mut Visitor<'_>) -> Result
             )
             .into());
         }
-        write!(b, "\nVERTICES {n} {}\n", 2 * n)?;
+        // Each cell: its point count (1) and its point; then each cell's type, VTK_VERTEX (1).
+        write!(b, "\nCELLS {n} {}\n", 2 * n)?;
         for i in 0..n32 {
             b.write_all(&1i32.to_be_bytes())?;
             b.write_all(&i.to_be_bytes())?;
+        }
+        write!(b, "\nCELL_TYPES {n}\n")?;
+        for _ in 0..n32 {
+            b.write_all(&1i32.to_be_bytes())?;
         }
         write!(b, "\nPOINT_DATA {n}\n")?;
         if let Some(name) = set.index {
@@ -445,12 +455,12 @@ mod tests {
     }
 
     #[test]
-    fn vtk_has_points_vertices_and_scalars() {
+    fn vtk_has_points_vertex_cells_and_scalars() {
         let dir = tempfile::tempdir().unwrap();
         write(PointFormat::Vtk, dir.path());
         let bytes = std::fs::read(dir.path().join("positions.vtk")).unwrap();
-        let head =
-            "# vtk DataFile Version 3.0\nthree points\nBINARY\nDATASET POLYDATA\nPOINTS 3 double\n";
+        let head = "# vtk DataFile Version 3.0\nthree points\nBINARY\nDATASET UNSTRUCTURED_GRID\n\
+             POINTS 3 double\n";
         assert!(bytes.starts_with(head.as_bytes()));
         let at = head.len();
         let xyz: Vec<f64> = bytes[at..at + 72]
@@ -464,8 +474,10 @@ mod tests {
                 .position(|w| w == s.as_bytes())
                 .unwrap_or_else(|| panic!("{s:?} missing"))
         };
-        let v = find("VERTICES 3 6\n") + "VERTICES 3 6\n".len();
+        let v = find("CELLS 3 6\n") + "CELLS 3 6\n".len();
         assert_eq!(&rest[v..v + 8], &[0, 0, 0, 1, 0, 0, 0, 0]);
+        let t = find("CELL_TYPES 3\n") + "CELL_TYPES 3\n".len();
+        assert_eq!(&rest[t..t + 12], &[0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]);
         find("POINT_DATA 3\n");
         let c = find("SCALARS cluster int 1\nLOOKUP_TABLE default\n")
             + "SCALARS cluster int 1\nLOOKUP_TABLE default\n".len();
