@@ -16,11 +16,13 @@
 //!   `-qq` silences it ([`LogArgs`], [`Progress`]).
 
 pub mod config;
+mod count;
 mod out_dir;
 mod progress;
 mod resume;
 
 pub use config::ConfigArgs;
+pub use count::count;
 pub use out_dir::{check_out_dir, prepare_out_dir};
 pub use progress::Progress;
 pub use resume::{flag_differences, labelled_differences};
