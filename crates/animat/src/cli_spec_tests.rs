@@ -28,6 +28,7 @@ const NOT_PARAMS: &[&str] = &[
     "seeds",
     "jobs",
     "merge",
+    "overwrite",
     "help",
     "version",
 ];

@@ -110,6 +110,9 @@ struct Cli {
 
     #[command(flatten)]
     ensemble: EnsembleArgs,
+
+    #[command(flatten)]
+    overwrite: sim_run::cli::OverwriteArgs,
 }
 
 impl Cli {
@@ -183,6 +186,15 @@ fn culprit(cli: &Cli, e: &ParamsError) -> String {
     animat::params::error_message(e, by_flag, cli.config.as_deref())
 }
 
+/// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
+/// earlier run's and what --overwrite deletes.
+const RUN_FILES: &[&str] = &[
+    "populations.csv",
+    "snapshot_*.png",
+    "positions.*",
+    "positions_*",
+];
+
 /// What an ensemble (`--seeds`) averages over its members.
 const CURVES: &[Curve] = &[Curve {
     file: "populations.csv",
@@ -211,8 +223,19 @@ fn main() -> ExitCode {
                 print!("{}", animat::config::to_toml(&params)?);
                 return Ok(());
             }
+            let owner = sim_run::ensemble::Owner {
+                run_files: RUN_FILES,
+                params: serde_json::to_value(&params)?,
+                config: Some(animat::config::to_toml(&params)?),
+                run_flags: vec![(
+                    "--steps",
+                    cli.steps.to_string(),
+                    animat::params::DEFAULT_STEPS.to_string(),
+                )],
+                overwrite: cli.overwrite.overwrite,
+            };
             cli.ensemble
-                .run("animat", 1, cli.out(), CURVES, &cli.log)
+                .run("animat", 1, cli.out(), CURVES, &cli.log, &owner)
                 .unwrap_or_else(|| run(cli, params))
         },
     )
@@ -288,8 +311,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     };
     world.set_timing(cli.timing);
-    sim_run::cli::prepare_out_dir(cli.out())
-        .with_context(|| format!("creating output directory {}", cli.out().display()))?;
+    // Ours until the run ends: refused if another run holds it or it holds an earlier run.
+    let _lock = sim_run::cli::own_out_dir(&sim_run::cli::Claim {
+        out: cli.out(),
+        run_files: RUN_FILES,
+        resume: cli.resume.as_deref(),
+        overwrite: cli.overwrite.overwrite,
+        ensemble: false,
+    })?;
     // The effective parameters, so that `--config OUT/config.toml` repeats the run.
     sim_run::io::write_atomic(
         cli.out().join("config.toml"),

@@ -27,6 +27,7 @@ const NOT_PARAMS: &[&str] = &[
     "seeds",
     "jobs",
     "merge",
+    "overwrite",
     "help",
     "version",
 ];

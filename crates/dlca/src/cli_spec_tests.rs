@@ -25,6 +25,7 @@ const NOT_PARAMS: &[&str] = &[
     "seeds",
     "jobs",
     "merge",
+    "overwrite",
     "help",
     "version",
 ];
