@@ -497,7 +497,8 @@ pub struct Ownership<'a> {
     /// Flags of a small, fast run, without `--out`, `--seed` (ensembles are run with them) and
     /// `change`'s flag.
     pub flags: &'a [&'a str],
-    /// A flag that changes the result and two values of it: `("--particles", "200", "300")`.
+    /// A parameter flag (saved in `config.toml`) and two values of it:
+    /// `("--particles", "200", "300")`.
     pub change: (&'a str, &'a str, &'a str),
     /// Flags of a run that takes a few seconds at least (caught running), without `--out`.
     pub long: &'a [&'a str],
@@ -565,7 +566,8 @@ fn command_line(dir: &Path) -> Vec<String> {
 /// - a run killed by SIGKILL after its first checkpoint is refused with `--resume DIR` offered,
 ///   and `--resume DIR --out DIR` takes over the stale lock and finishes;
 /// - an ensemble rerun with another value of `change` is refused, naming each member and the
-///   flag with both values, nothing changed; the same rerun with `--overwrite` starts over;
+///   flag with both values, nothing changed (a finished member compared by its `run.json`, an
+///   unfinished one by its `config.toml`); the same rerun with `--overwrite` starts over;
 /// - no finished run leaves its `run.lock`.
 pub fn ownership_contract(o: &Ownership<'_>) {
     let (flag, a, b) = o.change;
@@ -642,8 +644,10 @@ pub fn ownership_contract(o: &Ownership<'_>) {
         .spawn()
         .expect("the binary starts");
     let holder = loop {
+        // The lock, and the first file the run writes (so that it leaves partial outputs).
         if let Ok(text) = std::fs::read_to_string(busy.join(lock))
             && !text.is_empty()
+            && busy.join("config.toml").exists()
         {
             break text;
         }
@@ -758,6 +762,19 @@ pub fn ownership_contract(o: &Ownership<'_>) {
         assert!(!ens.join(seed).join(lock).exists());
     }
     assert!(!ens.join(lock).exists());
+    // An unfinished member (no run.json) is compared by its config.toml.
+    std::fs::remove_file(ens.join("seed-0002/run.json")).expect("unfinishing a member");
+    let before = files_with_mtimes(&ens);
+    let differ = format!("seed-0001, seed-0002: {flag} {b} there, {a} given");
+    refuse(
+        &with(&["--seeds", "1..=2", flag, a, "--out", "ens"]),
+        &["--out ens", "other parameters", &differ],
+    );
+    assert_eq!(
+        files_with_mtimes(&ens),
+        before,
+        "a refused ensemble changed ens"
+    );
     // A single run into the ensemble's directory is refused.
     refuse(
         &with(&[flag, b, "--out", "ens"]),

@@ -448,6 +448,117 @@ mod tests {
         assert_eq!(names, vec![std::ffi::OsString::from("f")]);
     }
 
+    fn claim(out: &Path, overwrite: bool) -> Result<OutDirLock, ClaimError> {
+        claim_out_dir(&Claim {
+            out,
+            run_files: &["growth.csv", "positions.*"],
+            resume: None,
+            overwrite,
+            ensemble: false,
+        })
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut n: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        n.sort();
+        n
+    }
+
+    #[test]
+    fn earlier_runs_are_found_by_their_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let find = |d: &Path| EarlierRun::find(d, &["growth.csv", "positions.*"]).unwrap();
+        assert_eq!(find(&d.join("missing")), None);
+        std::fs::write(d.join("notes.txt"), b"x").unwrap();
+        std::fs::write(d.join("seed-0001"), b"a file, not a member").unwrap();
+        assert_eq!(find(d), None, "unrelated files");
+        std::fs::write(d.join("positions.npy"), b"x").unwrap();
+        let e = find(d).unwrap();
+        assert!(!e.finished && !e.checkpoint && !e.ensemble, "{e:?}");
+        assert_eq!(e.files, ["positions.npy"]);
+        std::fs::write(d.join("checkpoint.bin"), b"x").unwrap();
+        assert!(
+            find(d)
+                .unwrap()
+                .describe()
+                .starts_with("an interrupted run with a checkpoint")
+        );
+        std::fs::write(d.join("run.json"), b"{}").unwrap();
+        assert!(find(d).unwrap().describe().starts_with("a finished run ("));
+        let ens = d.join("ens");
+        std::fs::create_dir_all(ens.join("seed-0002")).unwrap();
+        let e = find(&ens).unwrap();
+        assert!(e.ensemble && e.files == ["seed-0002/"], "{e:?}");
+    }
+
+    #[test]
+    fn a_held_directory_is_refused_naming_the_holder_and_released_on_drop() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("a/b");
+        let first = claim(&out, false).unwrap();
+        let holder = LockHolder::read(&out.join(LOCK_FILE)).unwrap();
+        assert_eq!(holder.pid, std::process::id());
+        // flock locks belong to an open file: a second open in this process conflicts too.
+        match claim(&out, false) {
+            Err(ClaimError::Refused(m)) => {
+                assert!(
+                    m.contains("in use by another run") && m.contains(&holder.to_string()),
+                    "{m}"
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        drop(first);
+        assert!(names(&out).is_empty(), "the lock file stays after the run");
+        drop(claim(&out, false).unwrap());
+    }
+
+    #[test]
+    fn an_earlier_run_is_refused_unchanged_or_overwritten_and_a_stale_lock_taken_over() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        std::fs::create_dir(&out).unwrap();
+        let stale = r#"{"pid":4000000,"host":"gone","since":"2020-01-01T00:00:00Z"}"#;
+        for (name, text) in [
+            ("run.json", "{}"),
+            ("growth.csv", "n\n"),
+            ("config.toml", ""),
+            ("notes.txt", "mine"),
+            (LOCK_FILE, stale),
+        ] {
+            std::fs::write(out.join(name), text).unwrap();
+        }
+        match claim(&out, false) {
+            Err(ClaimError::Refused(m)) => assert!(
+                m.contains("a finished run (config.toml, growth.csv, run.json)")
+                    && m.contains("--overwrite")
+                    && !m.contains("--resume"),
+                "{m}"
+            ),
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(
+            std::fs::read_to_string(out.join(LOCK_FILE)).unwrap(),
+            stale,
+            "a refusal changed the stale lock"
+        );
+        let lock = claim(&out, true).unwrap();
+        assert_eq!(names(&out), ["notes.txt", LOCK_FILE]);
+        assert_eq!(
+            LockHolder::read(&out.join(LOCK_FILE)).unwrap().pid,
+            std::process::id()
+        );
+        drop(lock);
+        // A new directory is created, and one refused is removed again.
+        let fresh = dir.path().join("x/y");
+        drop(claim(&fresh, false).unwrap());
+        assert!(fresh.is_dir());
+    }
+
     #[test]
     fn prepare_creates_the_directory_and_clears_stale_temporaries() {
         let dir = tempfile::tempdir().unwrap();

@@ -587,6 +587,29 @@ mod tests {
     }
 
     #[test]
+    fn recorded_flags_and_saved_configurations_are_compared_as_flags() {
+        let line: Vec<String> = ["animat", "--steps", "40", "--seed=3"]
+            .map(str::to_owned)
+            .to_vec();
+        assert_eq!(flag_value(&line, "--steps").as_deref(), Some("40"));
+        assert_eq!(flag_value(&line, "--seed").as_deref(), Some("3"));
+        assert_eq!(flag_value(&line, "--vision"), None);
+        let saved: toml::Table = "particles = 200\nseed = 1\nfar-field = \"return\""
+            .parse()
+            .unwrap();
+        let given: toml::Table = "particles = 300\nseed = 2\nfar-field = \"jump\""
+            .parse()
+            .unwrap();
+        assert_eq!(
+            config_differences(&saved, &given, "there"),
+            [
+                "--far-field return there, jump given",
+                "--particles 200 there, 300 given"
+            ]
+        );
+    }
+
+    #[test]
     fn members_get_the_run_flags_only() {
         let got = member_args(os(&[
             "--seeds",
