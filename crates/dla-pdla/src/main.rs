@@ -39,7 +39,10 @@ struct Cli {
     #[arg(long, default_value_t = 1)]
     seed: u64,
 
-    /// Output directory (created if missing; nothing is written on bad input).
+    /// Output directory (created if missing; nothing is written on bad input). It is this run's
+    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
+    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
+    /// or replace it with --overwrite.
     #[arg(long)]
     out: PathBuf,
 

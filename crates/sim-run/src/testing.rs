@@ -568,7 +568,7 @@ fn command_line(dir: &Path) -> Vec<String> {
 /// - an ensemble rerun with another value of `change` is refused, naming each member and the
 ///   flag with both values, nothing changed (a finished member compared by its `run.json`, an
 ///   unfinished one by its `config.toml`); the same rerun with `--overwrite` starts over;
-/// - no finished run leaves its `run.lock`.
+/// - no finished run, nor one stopped by SIGTERM after a checkpoint, leaves its `run.lock`.
 pub fn ownership_contract(o: &Ownership<'_>) {
     let (flag, a, b) = o.change;
     let with = |extra: &[&str]| -> Vec<String> {
@@ -728,6 +728,18 @@ pub fn ownership_contract(o: &Ownership<'_>) {
         "{log}"
     );
     assert!(ck.join("run.json").is_file() && !ck.join(lock).exists());
+
+    // Stopped by SIGTERM (exit code 130 after a checkpoint): the lock file goes with the run.
+    let term = o.dir.join("term");
+    let mut cmd = Command::new(o.binary);
+    cmd.args(o.checkpointed)
+        .args(["-qq", "--out", "term"])
+        .current_dir(o.dir)
+        .stdin(Stdio::null());
+    let (running, code) = terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+    assert!(running, "the checkpointed run ended before SIGTERM");
+    assert_eq!(code, Some(130));
+    assert!(!term.join(lock).exists(), "SIGTERM left the lock file");
 
     // An ensemble rerun with another parameter value.
     succeed(&with(&["--seeds", "1..=2", flag, a, "--out", "ens"]));
