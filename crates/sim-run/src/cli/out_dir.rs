@@ -42,7 +42,41 @@ pub fn check_out_dir(out: &Path) -> Result<(), String> {
     // An anonymous temporary file: proves a file can be created there and leaves nothing.
     tempfile::tempfile_in(existing)
         .map(drop)
-        .map_err(|e| format!("--out {shown}: cannot write in {}: {e}", existing.display()))
+        .map_err(|e| format!("--out {shown}: cannot write in {}: {e}", existing.display()))?;
+    // Another run holding it is named now, before a checkpoint it is writing is read.
+    match held(out) {
+        Some(holder) => Err(in_use(out, holder)),
+        None => Ok(()),
+    }
+}
+
+/// Whether a live run holds `dir/run.lock` (`Some(its details, if written)`), found without
+/// creating or changing anything.
+#[cfg(unix)]
+fn held(dir: &Path) -> Option<Option<LockHolder>> {
+    use nix::fcntl::{Flock, FlockArg};
+    let path = dir.join(LOCK_FILE);
+    let file = std::fs::File::open(&path).ok()?;
+    match Flock::lock(file, FlockArg::LockSharedNonblock) {
+        Ok(_) => None,
+        Err((_, nix::errno::Errno::EWOULDBLOCK)) => Some(LockHolder::read(&path)),
+        Err(_) => None,
+    }
+}
+
+#[cfg(not(unix))]
+fn held(_dir: &Path) -> Option<Option<LockHolder>> {
+    None
+}
+
+/// The refusal of a directory another run holds.
+fn in_use(out: &Path, holder: Option<LockHolder>) -> String {
+    let who = holder.map_or_else(|| "a run that is starting".to_string(), |h| h.to_string());
+    format!(
+        "--out {} is in use by another run ({who}; lock {}); wait for it to end or use another --out",
+        out.display(),
+        out.join(LOCK_FILE).display()
+    )
 }
 
 /// Create `--out DIR` (checked by [`check_out_dir`]) and delete the temporary files an
@@ -262,12 +296,23 @@ fn lock(dir: &Path) -> Result<(OutDirLock, Option<LockHolder>, bool), Locking> {
             .truncate(false)
             .open(&path)
             .map_err(Locking::Io)?;
-        let file = match Flock::lock(file, FlockArg::LockExclusiveNonblock) {
-            Ok(f) => f,
-            Err((_, nix::errno::Errno::EWOULDBLOCK)) => {
-                return Err(Locking::Held(LockHolder::read(&path)));
+        // A few quick retries: another process's `check_out_dir` holds a shared lock for an
+        // instant, which is not a run.
+        let mut file = file;
+        let mut tries = 0;
+        let file = loop {
+            match Flock::lock(file, FlockArg::LockExclusiveNonblock) {
+                Ok(f) => break f,
+                Err((f, nix::errno::Errno::EWOULDBLOCK)) if tries < 5 => {
+                    tries += 1;
+                    file = f;
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                }
+                Err((_, nix::errno::Errno::EWOULDBLOCK)) => {
+                    return Err(Locking::Held(LockHolder::read(&path)));
+                }
+                Err((_, e)) => return Err(Locking::Io(e.into())),
             }
-            Err((_, e)) => return Err(Locking::Io(e.into())),
         };
         let same = match (file.metadata(), std::fs::metadata(&path)) {
             (Ok(a), Ok(b)) => a.ino() == b.ino() && a.dev() == b.dev(),
@@ -358,14 +403,7 @@ pub fn claim_out_dir(c: &Claim<'_>) -> Result<OutDirLock, ClaimError> {
     };
     let (lock, stale, new_file) = match lock(c.out) {
         Ok(l) => l,
-        Err(Locking::Held(holder)) => {
-            let who =
-                holder.map_or_else(|| "a run that is starting".to_string(), |h| h.to_string());
-            return Err(ClaimError::Refused(format!(
-                "--out {shown} is in use by another run ({who}; lock {}); wait for it to end or use another --out",
-                c.out.join(LOCK_FILE).display()
-            )));
-        }
+        Err(Locking::Held(holder)) => return Err(ClaimError::Refused(in_use(c.out, holder))),
         Err(Locking::Io(e)) => {
             undo(None, false);
             return Err(io("locking", e));

@@ -44,7 +44,8 @@ pub struct EnsembleArgs {
     /// run.json and outputs, combined into DIR/ensemble.json and ensemble.md (mean, standard
     /// deviation and standard error of every result) and averaged curves. LIST: 1..=80, 1..81,
     /// 3,5,9 or a mix. Rerunning the command skips finished members and resumes checkpointed
-    /// ones. `--merge DIR` alone rebuilds the combined result from the members in DIR.
+    /// ones, if they were made with the same parameters (else it is refused; --overwrite starts
+    /// over). `--merge DIR` alone rebuilds the combined result from the members in DIR.
     #[arg(long, value_name = "LIST", value_parser = seeds::parse_seeds_arg, conflicts_with_all = ["seed", "resume"])]
     pub seeds: Option<Seeds>,
 
