@@ -227,22 +227,13 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
         }
     }
     // Rank 0 (or the only process) owns the directory; members lock their own.
-    let _lock = crate::cli::own_out_dir(&crate::cli::Claim {
-        out: e.out,
-        run_files: e.owner.run_files,
-        resume: None,
-        overwrite: e.owner.overwrite,
-        ensemble: true,
-    })?;
-    let differ = foreign_members(e.out, e.program, e.owner)
-        .with_context(|| format!("reading the members in {}", e.out.display()))?;
-    if !differ.is_empty() {
-        return Err(crate::cli::usage(format!(
-            "--out {} holds members made with other parameters ({}); rerun with their flags, use another --out, or add --overwrite to start the ensemble over",
-            e.out.display(),
-            differ.join("; ")
-        )));
+    let owned = own(e);
+    // Refused under mpirun: the other ranks are told there is nothing to run, so they end.
+    #[cfg(feature = "mpi")]
+    if let (Err(_), Some(w)) = (&owned, &world) {
+        ranks::dispatch(w, e.out, &[], &stop, &crate::cli::Progress::silent());
     }
+    let _lock = owned?;
     let work: Vec<(u64, Todo)> = e
         .seeds
         .iter()
@@ -325,6 +316,28 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
         ));
     }
     report.map(drop)
+}
+
+/// Takes the ensemble's directory: locks it, refuses it if it holds a single run or members
+/// made with other parameters (unless `--overwrite`, which starts over).
+fn own(e: &Ensemble<'_>) -> anyhow::Result<crate::cli::OutDirLock> {
+    let lock = crate::cli::own_out_dir(&crate::cli::Claim {
+        out: e.out,
+        run_files: e.owner.run_files,
+        resume: None,
+        overwrite: e.owner.overwrite,
+        ensemble: true,
+    })?;
+    let differ = foreign_members(e.out, e.program, e.owner)
+        .with_context(|| format!("reading the members in {}", e.out.display()))?;
+    if !differ.is_empty() {
+        return Err(crate::cli::usage(format!(
+            "--out {} holds members made with other parameters ({}); rerun with their flags, use another --out, or add --overwrite to start the ensemble over",
+            e.out.display(),
+            differ.join("; ")
+        )));
+    }
+    Ok(lock)
 }
 
 /// Runs one member to its end, passing SIGTERM on once `stop` is set.
