@@ -568,6 +568,8 @@ fn command_line(dir: &Path) -> Vec<String> {
 /// - an ensemble rerun with another value of `change` is refused, naming each member and the
 ///   flag with both values, nothing changed (a finished member compared by its `run.json`, an
 ///   unfinished one by its `config.toml`); the same rerun with `--overwrite` starts over;
+/// - a second ensemble into a running ensemble's directory is refused naming the first, and
+///   so is a run into the directory of a member that is running;
 /// - no finished run, nor one stopped by SIGTERM after a checkpoint, leaves its `run.lock`.
 pub fn ownership_contract(o: &Ownership<'_>) {
     let (flag, a, b) = o.change;
@@ -787,6 +789,43 @@ pub fn ownership_contract(o: &Ownership<'_>) {
         before,
         "a refused ensemble changed ens"
     );
+    // Two ensembles at once: the second is refused, naming the first; so is a run into a
+    // member's directory that member holds.
+    let mut cmd = Command::new(o.binary);
+    cmd.args(["--seeds", "1..=2", "--jobs", "1"])
+        .args(o.long)
+        .args(["-qq", "--out", "ens-busy"])
+        .current_dir(o.dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
+    let mut first = cmd.spawn().expect("the binary starts");
+    let member_lock = o.dir.join("ens-busy/seed-0001").join(lock);
+    while !std::fs::read(&member_lock).is_ok_and(|b| !b.is_empty()) {
+        assert!(
+            first.try_wait().expect("waiting").is_none(),
+            "the long ensemble ended before its first member locked its directory"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    let pid = format!("pid {}", first.id());
+    refuse(
+        &with(&["--seeds", "1..=2", flag, a, "--out", "ens-busy"]),
+        &["--out ens-busy", "in use by another run", &pid],
+    );
+    refuse(
+        &with(&[flag, a, "--out", "ens-busy/seed-0001"]),
+        &["--out ens-busy/seed-0001", "in use by another run"],
+    );
+    #[cfg(unix)]
+    if let Ok(id) = i32::try_from(first.id()) {
+        use nix::sys::signal::{Signal, killpg};
+        let _ = killpg(nix::unistd::Pid::from_raw(id), Signal::SIGKILL);
+    }
+    let _ = first.kill();
+    let _ = first.wait();
     // A single run into the ensemble's directory is refused.
     refuse(
         &with(&[flag, b, "--out", "ens"]),
