@@ -30,7 +30,10 @@ struct Cli {
     #[arg(long, default_value_t = 1)]
     seed: u64,
 
-    /// Output directory (created if missing; nothing is written on bad input).
+    /// Output directory (created if missing; nothing is written on bad input). It is this run's
+    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
+    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
+    /// or replace it with --overwrite.
     #[arg(long, required_unless_present = "dump_config")]
     out: Option<PathBuf>,
 
@@ -110,6 +113,9 @@ struct Cli {
 
     #[command(flatten)]
     ensemble: EnsembleArgs,
+
+    #[command(flatten)]
+    overwrite: sim_run::cli::OverwriteArgs,
 }
 
 impl Cli {
@@ -183,6 +189,15 @@ fn culprit(cli: &Cli, e: &ParamsError) -> String {
     animat::params::error_message(e, by_flag, cli.config.as_deref())
 }
 
+/// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
+/// earlier run's and what --overwrite deletes.
+const RUN_FILES: &[&str] = &[
+    "populations.csv",
+    "snapshot_*.png",
+    "positions.*",
+    "positions_*",
+];
+
 /// What an ensemble (`--seeds`) averages over its members.
 const CURVES: &[Curve] = &[Curve {
     file: "populations.csv",
@@ -211,8 +226,19 @@ fn main() -> ExitCode {
                 print!("{}", animat::config::to_toml(&params)?);
                 return Ok(());
             }
+            let owner = sim_run::ensemble::Owner {
+                run_files: RUN_FILES,
+                params: serde_json::to_value(&params)?,
+                config: Some(animat::config::to_toml(&params)?),
+                run_flags: vec![(
+                    "--steps",
+                    cli.steps.to_string(),
+                    animat::params::DEFAULT_STEPS.to_string(),
+                )],
+                overwrite: cli.overwrite.overwrite,
+            };
             cli.ensemble
-                .run("animat", 1, cli.out(), CURVES, &cli.log)
+                .run("animat", 1, cli.out(), CURVES, &cli.log, &owner)
                 .unwrap_or_else(|| run(cli, params))
         },
     )
@@ -288,8 +314,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
     };
     world.set_timing(cli.timing);
-    sim_run::cli::prepare_out_dir(cli.out())
-        .with_context(|| format!("creating output directory {}", cli.out().display()))?;
+    // Ours until the run ends: refused if another run holds it or it holds an earlier run.
+    let _lock = sim_run::cli::own_out_dir(&sim_run::cli::Claim {
+        out: cli.out(),
+        run_files: RUN_FILES,
+        resume: cli.resume.as_deref(),
+        overwrite: cli.overwrite.overwrite,
+        ensemble: false,
+    })?;
     // The effective parameters, so that `--config OUT/config.toml` repeats the run.
     sim_run::io::write_atomic(
         cli.out().join("config.toml"),

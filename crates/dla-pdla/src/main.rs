@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
-use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
+use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, OverwriteArgs, flag_differences, usage};
 use sim_run::ensemble::{Curve, EnsembleArgs};
 use sim_run::io::RunClock;
 use std::path::{Path, PathBuf};
@@ -39,7 +39,10 @@ struct Cli {
     #[arg(long, default_value_t = 1)]
     seed: u64,
 
-    /// Output directory (created if missing; nothing is written on bad input).
+    /// Output directory (created if missing; nothing is written on bad input). It is this run's
+    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
+    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
+    /// or replace it with --overwrite.
     #[arg(long)]
     out: PathBuf,
 
@@ -155,6 +158,9 @@ struct Cli {
 
     #[command(flatten)]
     ensemble: EnsembleArgs,
+
+    #[command(flatten)]
+    overwrite: OverwriteArgs,
 }
 
 /// An on/off switch.
@@ -245,6 +251,10 @@ where
     Ok(sim)
 }
 
+/// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
+/// earlier run's and what --overwrite deletes.
+const RUN_FILES: &[&str] = &["growth.csv", "positions.*", "dla.png"];
+
 /// What an ensemble (`--seeds`) averages over its members.
 const CURVES: &[Curve] = &[Curve {
     file: "growth.csv",
@@ -270,9 +280,16 @@ fn main() -> ExitCode {
         params,
         // The one run-time dimension dispatch (`with_dim!`, shared with Python and xtask).
         |cli, params: Params| {
-            let ensemble = cli
-                .ensemble
-                .run("dla", params.threads, &cli.out, CURVES, &cli.log);
+            let owner = sim_run::ensemble::Owner {
+                run_files: RUN_FILES,
+                params: serde_json::to_value(&params)?,
+                config: sim_run::cli::config::effective_text().map(str::to_owned),
+                run_flags: Vec::new(),
+                overwrite: cli.overwrite.overwrite,
+            };
+            let ensemble =
+                cli.ensemble
+                    .run("dla", params.threads, &cli.out, CURVES, &cli.log, &owner);
             ensemble.unwrap_or_else(|| {
                 dla_pdla::with_dim!(params.dim, D => run::<D>(cli, params), d => Err(ParamsError::Dim(d).into()))
             })
@@ -302,8 +319,14 @@ where
         })?,
         Some(dir) => resume::<D>(dir, &params, cli.seed)?,
     };
-    sim_run::cli::prepare_out_dir(&cli.out)
-        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    // Ours until the run ends: refused if another run holds it or it holds an earlier run.
+    let _lock = sim_run::cli::own_out_dir(&sim_run::cli::Claim {
+        out: &cli.out,
+        run_files: RUN_FILES,
+        resume: cli.resume.as_deref(),
+        overwrite: cli.overwrite.overwrite,
+        ensemble: false,
+    })?;
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
     sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;

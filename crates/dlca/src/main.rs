@@ -52,7 +52,10 @@ struct Cli {
     #[arg(long, default_value_t = 1)]
     seed: u64,
 
-    /// Output directory (created if missing; nothing is written on bad input).
+    /// Output directory (created if missing; nothing is written on bad input). It is this run's
+    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
+    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
+    /// or replace it with --overwrite.
     #[arg(long)]
     out: PathBuf,
 
@@ -153,6 +156,9 @@ struct Cli {
 
     #[command(flatten)]
     ensemble: EnsembleArgs,
+
+    #[command(flatten)]
+    overwrite: sim_run::cli::OverwriteArgs,
 }
 
 /// Side lengths as given to `--size`.
@@ -255,6 +261,18 @@ const CURVES: &[Curve] = &[
     },
 ];
 
+/// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
+/// earlier run's and what --overwrite deletes.
+const RUN_FILES: &[&str] = &[
+    "sweeps.csv",
+    "sizes.csv",
+    "clusters.csv",
+    "histogram.csv",
+    "positions.*",
+    "positions_*",
+    "dlca.png",
+];
+
 fn main() -> ExitCode {
     if let Some(code) = sim_run::cli::refuse_unsupported_cpu("dlca") {
         return code;
@@ -267,8 +285,15 @@ fn main() -> ExitCode {
         |c: &Cli| c.log,
         params,
         |cli, params| {
+            let owner = sim_run::ensemble::Owner {
+                run_files: RUN_FILES,
+                params: serde_json::to_value(&params)?,
+                config: sim_run::cli::config::effective_text().map(str::to_owned),
+                run_flags: Vec::new(),
+                overwrite: cli.overwrite.overwrite,
+            };
             cli.ensemble
-                .run("dlca", 1, &cli.out, CURVES, &cli.log)
+                .run("dlca", 1, &cli.out, CURVES, &cli.log, &owner)
                 .unwrap_or_else(|| run(cli, params))
         },
     )
@@ -284,8 +309,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         None => Simulation::new(params, cli.seed).map_err(|e| usage(e.to_string()))?,
     };
     // Created before the run so a long run cannot end with nowhere to write.
-    sim_run::cli::prepare_out_dir(&cli.out)
-        .with_context(|| format!("creating output directory {}", cli.out.display()))?;
+    // Ours until the run ends: refused if another run holds it or it holds an earlier run.
+    let _lock = sim_run::cli::own_out_dir(&sim_run::cli::Claim {
+        out: &cli.out,
+        run_files: RUN_FILES,
+        resume: cli.resume.as_deref(),
+        overwrite: cli.overwrite.overwrite,
+        ensemble: false,
+    })?;
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
     sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;

@@ -26,6 +26,7 @@ pub const SHARED_RUN_FLAGS: &[&str] = &[
     "seeds",
     "jobs",
     "merge",
+    "overwrite",
     "help",
     "version",
 ];

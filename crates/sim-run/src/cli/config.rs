@@ -30,8 +30,9 @@ pub struct ConfigArgs {
 
 /// Argument ids that are never config keys: where and how the process runs, not what it
 /// computes.
-const NOT_CONFIG: [&str; 13] = [
+const NOT_CONFIG: [&str; 14] = [
     "help",
+    "overwrite",
     "version",
     "out",
     "resume",
@@ -285,6 +286,11 @@ pub fn parse_with_config<C: clap::Parser>(program: &str) -> Result<C, std::proce
     };
     let _ = EFFECTIVE.set(text);
     Ok(cli)
+}
+
+/// The effective configuration of this run (from [`parse_with_config`]), as saved by [`save`].
+pub fn effective_text() -> Option<&'static str> {
+    EFFECTIVE.get().map(String::as_str)
 }
 
 /// Writes the effective configuration of this run (from [`parse_with_config`]) as

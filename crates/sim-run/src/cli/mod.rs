@@ -23,7 +23,10 @@ mod resume;
 
 pub use config::ConfigArgs;
 pub use count::count;
-pub use out_dir::{check_out_dir, prepare_out_dir};
+pub use out_dir::{
+    Claim, ClaimError, ENSEMBLE_FILES, EarlierRun, LOCK_FILE, LockHolder, OutDirLock,
+    check_out_dir, claim_out_dir, prepare_out_dir,
+};
 pub use progress::Progress;
 pub use resume::{flag_differences, labelled_differences};
 
@@ -122,6 +125,25 @@ impl LogArgs {
             Progress::silent()
         }
     }
+}
+
+/// The flag `--overwrite`, flattened into every model binary's flags.
+#[derive(Debug, Clone, Copy, Default, clap::Args)]
+pub struct OverwriteArgs {
+    /// Replace the run already in --out instead of refusing the directory: deletes its run.json,
+    /// checkpoint.bin, config.toml and output files (with --seeds: the ensemble's members
+    /// seed-NNNN/ and its ensemble.* files), keeping any other file. Not with --resume.
+    #[arg(long, conflicts_with = "resume")]
+    pub overwrite: bool,
+}
+
+/// [`claim_out_dir`] for a binary's `run` step: a refusal is a [`UsageError`] (exit code 2),
+/// anything else a failed run.
+pub fn own_out_dir(claim: &Claim<'_>) -> anyhow::Result<OutDirLock> {
+    claim_out_dir(claim).map_err(|e| match e {
+        ClaimError::Refused(m) => usage(m),
+        ClaimError::Io(m) => anyhow::anyhow!(m),
+    })
 }
 
 /// A usage error found by a binary's `run` step before it has created anything (a checkpoint

@@ -6,7 +6,13 @@
 //! processes, `--jobs` at a time: a member that fails or crashes cannot take the others down.
 //!
 //! - **Restartable.** Rerunning the same command skips members with a `run.json`, resumes those
-//!   with a `checkpoint.bin` (`--resume`), and runs the rest.
+//!   with a `checkpoint.bin` (`--resume`), and runs the rest. Only members made with the same
+//!   parameters are continued: a member made with others (its `run.json`, or the `config.toml`
+//!   of an unfinished one) refuses the whole rerun as a usage error naming each differing flag
+//!   with both values; `--overwrite` starts the ensemble over.
+//! - **Owned.** The ensemble locks its directory and each member its own
+//!   ([`claim_out_dir`](crate::cli::claim_out_dir)), so two ensembles (or a run) cannot share
+//!   one.
 //! - **Failures.** A failed member is reported with its seed and the last line it printed
 //!   (kept in `DIR/seed-NNNN/member.log`); the others go on; the exit code is 1 if any failed.
 //! - **Signals.** SIGINT or SIGTERM stop launching members and pass SIGTERM on to the running
@@ -38,7 +44,8 @@ pub struct EnsembleArgs {
     /// run.json and outputs, combined into DIR/ensemble.json and ensemble.md (mean, standard
     /// deviation and standard error of every result) and averaged curves. LIST: 1..=80, 1..81,
     /// 3,5,9 or a mix. Rerunning the command skips finished members and resumes checkpointed
-    /// ones. `--merge DIR` alone rebuilds the combined result from the members in DIR.
+    /// ones, if they were made with the same parameters (else it is refused; --overwrite starts
+    /// over). `--merge DIR` alone rebuilds the combined result from the members in DIR.
     #[arg(long, value_name = "LIST", value_parser = seeds::parse_seeds_arg, conflicts_with_all = ["seed", "resume"])]
     pub seeds: Option<Seeds>,
 
@@ -57,6 +64,7 @@ impl EnsembleArgs {
         out: &Path,
         curves: &[Curve],
         log: &LogArgs,
+        owner: &Owner<'_>,
     ) -> Option<anyhow::Result<()>> {
         let seeds = self.seeds.as_ref()?;
         Some(run(&Ensemble {
@@ -67,6 +75,7 @@ impl EnsembleArgs {
             out,
             curves,
             log,
+            owner,
         }))
     }
 }
@@ -88,6 +97,39 @@ pub struct Ensemble<'a> {
     pub curves: &'a [Curve],
     /// The logging flags.
     pub log: &'a LogArgs,
+    /// What the members must agree on, and `--overwrite`.
+    pub owner: &'a Owner<'a>,
+}
+
+/// What makes an ensemble's members its own: the parameters they must have been made with.
+#[derive(Debug, Clone)]
+pub struct Owner<'a> {
+    /// The model's output files (as [`Claim::run_files`](crate::cli::Claim::run_files)).
+    pub run_files: &'a [&'a str],
+    /// The model's parameters as `run.json` records them (`params`), compared with each
+    /// finished member's.
+    pub params: serde_json::Value,
+    /// The configuration a member saves as `config.toml` (less its `seed`), compared with each
+    /// unfinished member's; `None` to skip that comparison.
+    pub config: Option<String>,
+    /// Run flags that change the result but are not parameters (animat's `--steps`), as
+    /// `(flag, value given, default)`: compared with the flag on each finished member's
+    /// recorded command line (`provenance.command_line` of its `run.json`).
+    pub run_flags: Vec<(&'a str, String, String)>,
+    /// `--overwrite`: start the ensemble over.
+    pub overwrite: bool,
+}
+
+/// The value of `flag` on a recorded command line (`--flag V` or `--flag=V`), if given.
+fn flag_value(line: &[String], flag: &str) -> Option<String> {
+    let eq = format!("{flag}=");
+    line.iter().enumerate().find_map(|(i, a)| {
+        if a == flag {
+            line.get(i + 1).cloned()
+        } else {
+            a.strip_prefix(&eq).map(str::to_owned)
+        }
+    })
 }
 
 /// Subdirectory of member `seed`.
@@ -101,7 +143,7 @@ pub const MEMBER_LOG: &str = "member.log";
 /// Flags of the ensemble's command line that a member does not get (with a value).
 const DROPPED_WITH_VALUE: [&str; 5] = ["--seeds", "--jobs", "--out", "--seed", "--heartbeat"];
 /// Flags without a value that a member does not get (members run with `-qq`).
-const DROPPED_BARE: [&str; 2] = ["--quiet", "--verbose"];
+const DROPPED_BARE: [&str; 3] = ["--quiet", "--verbose", "--overwrite"];
 
 /// The member's flags: the ensemble's, less the ensemble and logging flags.
 fn member_args(args: impl IntoIterator<Item = OsString>) -> Vec<OsString> {
@@ -163,8 +205,6 @@ enum Ended {
 pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     let exe = std::env::current_exe().context("locating the model's binary for the members")?;
     let args = member_args(std::env::args_os().skip(1));
-    crate::cli::prepare_out_dir(e.out)
-        .with_context(|| format!("creating output directory {}", e.out.display()))?;
     let stop = crate::cli::stop_on_signals().context("installing signal handlers")?;
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let default_jobs = (cores / e.member_threads.max(1)).max(1);
@@ -186,6 +226,14 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
             return Ok(());
         }
     }
+    // Rank 0 (or the only process) owns the directory; members lock their own.
+    let owned = own(e);
+    // Refused under mpirun: the other ranks are told there is nothing to run, so they end.
+    #[cfg(feature = "mpi")]
+    if let (Err(_), Some(w)) = (&owned, &world) {
+        ranks::dispatch(w, e.out, &[], &stop, &crate::cli::Progress::silent());
+    }
+    let _lock = owned?;
     let work: Vec<(u64, Todo)> = e
         .seeds
         .iter()
@@ -270,6 +318,28 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     report.map(drop)
 }
 
+/// Takes the ensemble's directory: locks it, refuses it if it holds a single run or members
+/// made with other parameters (unless `--overwrite`, which starts over).
+fn own(e: &Ensemble<'_>) -> anyhow::Result<crate::cli::OutDirLock> {
+    let lock = crate::cli::own_out_dir(&crate::cli::Claim {
+        out: e.out,
+        run_files: e.owner.run_files,
+        resume: None,
+        overwrite: e.owner.overwrite,
+        ensemble: true,
+    })?;
+    let differ = foreign_members(e.out, e.program, e.owner)
+        .with_context(|| format!("reading the members in {}", e.out.display()))?;
+    if !differ.is_empty() {
+        return Err(crate::cli::usage(format!(
+            "--out {} holds members made with other parameters ({}); rerun with their flags, use another --out, or add --overwrite to start the ensemble over",
+            e.out.display(),
+            differ.join("; ")
+        )));
+    }
+    Ok(lock)
+}
+
 /// Runs one member to its end, passing SIGTERM on once `stop` is set.
 fn run_member(
     exe: &Path,
@@ -298,9 +368,12 @@ fn run_member(
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(log);
-    if todo == Todo::Resume {
-        cmd.arg("--resume").arg(&dir);
-    }
+    match todo {
+        Todo::Resume => cmd.arg("--resume").arg(&dir),
+        // Partial outputs of a member killed before its first checkpoint (checked to be this
+        // ensemble's by `foreign_members`) are replaced.
+        _ => cmd.arg("--overwrite"),
+    };
     let mut child = match cmd.spawn() {
         Ok(c) => c,
         Err(e) => return Ended::Failed(format!("starting {}: {e}", exe.display())),
@@ -330,6 +403,95 @@ fn run_member(
     } else {
         last
     })
+}
+
+/// The members in `dir` made with parameters other than `owner`'s, each as `seed-NNNN:` and
+/// the differing flags with both values (empty when all agree). A finished member is compared
+/// by its `run.json`, an unfinished one by its `config.toml` (where it has one).
+fn foreign_members(dir: &Path, program: &str, owner: &Owner<'_>) -> anyhow::Result<Vec<String>> {
+    let mut out = Vec::new();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(out);
+    };
+    let mut members: Vec<(String, PathBuf)> = Vec::new();
+    for entry in entries {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name.starts_with("seed-") && entry.file_type()?.is_dir() {
+            members.push((name, entry.path()));
+        }
+    }
+    members.sort();
+    let config: Option<toml::Table> = owner.config.as_deref().and_then(|c| c.parse().ok());
+    // Members that differ alike are named together.
+    let mut groups: Vec<(Vec<String>, String)> = Vec::new();
+    for (name, path) in members {
+        let there = "there".to_string();
+        let differ = match crate::io::RunManifest::read(path.join("run.json")) {
+            Ok(m) if m.model != program => vec![format!("a {} run, not {program}", m.model)],
+            Ok(m) => {
+                let mut d = crate::cli::labelled_differences(
+                    &m.params,
+                    &owner.params,
+                    (&there, "given"),
+                    &[],
+                );
+                let line = m
+                    .provenance
+                    .as_ref()
+                    .map_or(&[][..], |p| &p.command_line[..]);
+                for (flag, given, default) in &owner.run_flags {
+                    let was = flag_value(line, flag).unwrap_or_else(|| default.clone());
+                    if was != *given {
+                        d.push(format!("{flag} {was} {there}, {given} given"));
+                    }
+                }
+                d
+            }
+            Err(_) => match (&config, std::fs::read_to_string(path.join("config.toml"))) {
+                (Some(given), Ok(text)) => match text.parse::<toml::Table>() {
+                    Ok(saved) => config_differences(&saved, given, &there),
+                    Err(e) => vec![format!("{}/config.toml: {e}", path.display())],
+                },
+                _ => Vec::new(),
+            },
+        };
+        if differ.is_empty() {
+            continue;
+        }
+        let differ = differ.join(", ");
+        match groups.iter_mut().find(|(_, d)| *d == differ) {
+            Some((names, _)) => names.push(name),
+            None => groups.push((vec![name], differ)),
+        }
+    }
+    for (names, differ) in groups {
+        out.push(format!("{}: {differ}", names.join(", ")));
+    }
+    Ok(out)
+}
+
+/// The keys of two saved configurations that differ, less `seed`, as flags with both values.
+fn config_differences(saved: &toml::Table, given: &toml::Table, label: &str) -> Vec<String> {
+    let mut keys: Vec<&String> = saved.keys().chain(given.keys()).collect();
+    keys.sort();
+    keys.dedup();
+    let show = |v: Option<&toml::Value>| match v {
+        None => "none".to_string(),
+        Some(toml::Value::String(s)) => s.clone(),
+        Some(v) => v.to_string(),
+    };
+    keys.into_iter()
+        .filter(|k| k.as_str() != "seed" && saved.get(*k) != given.get(*k))
+        .map(|k| {
+            format!(
+                "--{} {} {label}, {} given",
+                k.replace('_', "-"),
+                show(saved.get(k)),
+                show(given.get(k))
+            )
+        })
+        .collect()
 }
 
 /// The last non-empty line of a member's log (empty if none or unreadable).
@@ -436,6 +598,29 @@ mod tests {
 
     fn os(v: &[&str]) -> Vec<OsString> {
         v.iter().map(OsString::from).collect()
+    }
+
+    #[test]
+    fn recorded_flags_and_saved_configurations_are_compared_as_flags() {
+        let line: Vec<String> = ["animat", "--steps", "40", "--seed=3"]
+            .map(str::to_owned)
+            .to_vec();
+        assert_eq!(flag_value(&line, "--steps").as_deref(), Some("40"));
+        assert_eq!(flag_value(&line, "--seed").as_deref(), Some("3"));
+        assert_eq!(flag_value(&line, "--vision"), None);
+        let saved: toml::Table = "particles = 200\nseed = 1\nfar-field = \"return\""
+            .parse()
+            .unwrap();
+        let given: toml::Table = "particles = 300\nseed = 2\nfar-field = \"jump\""
+            .parse()
+            .unwrap();
+        assert_eq!(
+            config_differences(&saved, &given, "there"),
+            [
+                "--far-field return there, jump given",
+                "--particles 200 there, 300 given"
+            ]
+        );
     }
 
     #[test]
