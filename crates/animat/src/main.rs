@@ -23,7 +23,7 @@ use std::sync::atomic::Ordering;
 #[command(name = "animat", version, allow_negative_numbers = true)]
 struct Cli {
     /// Steps to run.
-    #[arg(long, default_value_t = animat::params::DEFAULT_STEPS)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = animat::params::DEFAULT_STEPS)]
     steps: u64,
 
     /// Seed of every random stream of the run: same seed and parameters, same run.
@@ -49,11 +49,11 @@ struct Cli {
     dump_config: bool,
 
     /// Foxes at the start.
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     foxes: Option<u64>,
 
     /// Rabbits at the start.
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     rabbits: Option<u64>,
 
     /// Radius of the start disc around the origin, in cells, 0..=1073741824.
@@ -87,7 +87,7 @@ struct Cli {
     max_memory: u64,
 
     /// Write a PNG snapshot every K steps (and of the start and the end).
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     snapshot_every: Option<u64>,
 
     /// Write every live animat at the end (id, species, x, y, age, hunger): positions.csv

@@ -32,7 +32,7 @@ struct Cli {
     /// 1..=2500000000 in 4D and 5D (the orthtree's 32-bit indices). Memory: about 11 bytes per
     /// particle in 2D and 15 in 3D at 1e7; the tree and distance map take about 25 in 4D at
     /// 1e5 and 300 in 5D at 3e4 (mostly the map).
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     particles: u64,
 
     /// Seed of every random stream of the run: same seed and flags, same run (one thread).
@@ -104,15 +104,15 @@ struct Cli {
 
     /// Walkers moving at once on the shared cluster (PDLA), 1..=1024; 1 is exactly DLA and
     /// deterministic.
-    #[arg(long, default_value_t = Params::default().threads)]
+    #[arg(long, value_parser = sim_run::cli::count::<usize>, default_value_t = Params::default().threads)]
     threads: usize,
 
     /// With --threads > 1: grow with one walker until the cluster has this many particles.
-    #[arg(long, default_value_t = Params::default().serial_until)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().serial_until)]
     serial_until: u64,
 
     /// Smallest N (particles) used in the fractal-dimension fit log N = D log R_g + c, in 2..
-    #[arg(long, default_value_t = Params::default().fit_from)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().fit_from)]
     fit_from: u64,
 
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
@@ -129,7 +129,7 @@ struct Cli {
     /// continued with --resume ends with the same state_hash; with more (PDLA), every N
     /// particles is a parallel phase ending at a quiescent point, and a resumed run is a valid
     /// PDLA cluster.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>, value_name = "N")]
     checkpoint_every: Option<u64>,
 
     /// Continue the run checkpointed in DIR (checkpoint.bin and positions.npy). The run flags

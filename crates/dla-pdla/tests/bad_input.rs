@@ -107,6 +107,27 @@ fn bad_inputs_are_refused_before_any_work() {
         (vec!["--particles", "0", "--out", "out"], "--particles 0"),
         (vec!["--particles", "abc", "--out", "out"], "abc"),
         (vec!["--particles", "-5", "--out", "out"], "-5"),
+        // Counts as physicists write them are exact whole numbers or nothing.
+        (
+            vec!["--particles", "1.5", "--out", "out"],
+            "1.5 is not a whole number",
+        ),
+        (
+            vec!["--particles", "2.5e-1", "--out", "out"],
+            "not a whole number",
+        ),
+        (
+            vec!["--particles", "1e30", "--out", "out"],
+            "1e30 is too large",
+        ),
+        (
+            vec!["--particles", "1__000", "--out", "out"],
+            "1__000 is not a count",
+        ),
+        (
+            vec!["--threads", "2.5", "--particles", "300", "--out", "out"],
+            "--threads",
+        ),
         (with(&["--dim", "6"]), "--dim 6"),
         (
             with(&["--dim", "4", "--positions", "vtk"]),

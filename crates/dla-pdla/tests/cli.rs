@@ -322,3 +322,33 @@ fn paper_settings_run_the_papers_walk() {
         "{config}"
     );
 }
+
+/// Counts as physicists write them: `1e3`, `1_000`, `1.0e3` and `1000` are the same run.
+#[test]
+fn counts_in_every_notation_are_the_same_run() {
+    let hash = |particles: &str| {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let st = dla()
+            .args([
+                "--particles",
+                particles,
+                "--fit-from",
+                "1e2",
+                "-qq",
+                "--out",
+            ])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(st.success(), "--particles {particles}");
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+        assert_eq!(m["results"]["particles"], 1000, "--particles {particles}");
+        m["results"]["state_hash"].as_str().unwrap().to_string()
+    };
+    let plain = hash("1000");
+    for notation in ["1e3", "1E3", "1_000", "1.0e3", "0.1e4"] {
+        assert_eq!(hash(notation), plain, "--particles {notation}");
+    }
+}

@@ -45,7 +45,7 @@ struct Cli {
     fill: Option<f64>,
 
     /// Number of particles at the start, 1 to the number of sites.
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     particles: Option<u64>,
 
     /// Seed of every random stream of the run: same seed and flags, same run.
@@ -89,11 +89,11 @@ struct Cli {
     mobility_exponent: f64,
 
     /// Stop when at most this many clusters remain, 1.. (the paper stops at 100 to 1000).
-    #[arg(long, default_value_t = Params::default().target_clusters)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().target_clusters)]
     target_clusters: u64,
 
     /// Stop after this many sweeps at the latest (default: no limit).
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     max_sweeps: Option<u64>,
 
     /// Contact search. All give the same trajectory; `auto` picks by regime and logs why.
@@ -135,7 +135,7 @@ struct Cli {
     gyration: bool,
 
     /// Smallest cluster size (particles) used in the fractal-dimension fit, 2..
-    #[arg(long, default_value_t = Params::default().fit_min_size)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().fit_min_size)]
     fit_min_size: u64,
 
     /// Write dlca.png: the final state, one colour per cluster (first two axes).
