@@ -29,6 +29,7 @@ const NOT_PARAMS: &[&str] = &[
     "merge",
     "help",
     "version",
+    "max-memory",
 ];
 
 /// A library default as the front ends spell it.

@@ -17,6 +17,20 @@ mod checkpoint;
 mod placement;
 mod strategy;
 
+/// The contact search a run of `params` on `lattice` with `particles` uses (`auto` resolved).
+pub(crate) fn chosen_search(params: &Params, lattice: &Lattice, particles: u64) -> Search {
+    strategy::choose(params, lattice, particles).0
+}
+
+/// The name of the contact search a run of valid `params` uses (`auto` resolved), for
+/// messages.
+pub fn chosen_search_name(params: &Params) -> &'static str {
+    match (params.lattice(), params.particles()) {
+        (Ok(lattice), Ok(n)) => chosen_search(params, &lattice, n).name(),
+        _ => params.search.name(),
+    }
+}
+
 pub use checkpoint::Snapshot;
 pub use strategy::SearchEvent;
 
@@ -127,9 +141,9 @@ impl Simulation {
             &lattice,
             n,
             &mut stream(seed, stream_id(STREAM_PLACEMENT, 0)),
-        );
+        )?;
         let mut sets = SiteSets::new(lattice.clone());
-        for cluster in initial_clusters(&lattice, &sites) {
+        for cluster in initial_clusters(&lattice, &sites)? {
             sets.push(cluster);
         }
         let largest = sets
@@ -192,6 +206,7 @@ impl Simulation {
         let s = snapshot;
         s.params.validate()?;
         let lattice = s.params.lattice()?;
+        s.check(&lattice).map_err(ParamError::Checkpoint)?;
         let directions =
             DirectionSampler::gravity(lattice.dim(), s.params.gravity).expect("gravity validated");
         let mut sets = SiteSets::new(lattice.clone());
