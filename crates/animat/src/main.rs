@@ -159,8 +159,10 @@ fn params(cli: &Cli) -> Result<Params, String> {
             p.foxes.saturating_add(p.rabbits),
             p.start_radius
         );
+        // The world's memory, as the cap on a growing world counts it (the program's own
+        // few MiB, in `peak_memory_bytes`, aside).
         memory_limit(cli).check(
-            p.peak_memory_bytes(),
+            p.start_memory_bytes(),
             &what,
             "raise --density (or lower --start-radius)",
         )?;

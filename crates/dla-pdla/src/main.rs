@@ -215,6 +215,15 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }
+    if cli.positions == PositionsFormat::Vtk && p.particles > sim_run::io::points::VTK_MAX_POINTS {
+        return Err(format!(
+            "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
+             use --positions npy",
+            sim_run::io::points::VTK_MAX_POINTS,
+            p.particles
+        ));
+    }
+    // After every other check of the flags, so that a bad flag is named first.
     check_memory(cli, &p)?;
     sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
@@ -317,13 +326,6 @@ where
 {
     let clock = RunClock::start();
     let total = params.particles;
-    if cli.positions == PositionsFormat::Vtk && total > sim_run::io::points::VTK_MAX_POINTS {
-        return Err(usage(format!(
-            "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {total}; \
-             use --positions npy",
-            sim_run::io::points::VTK_MAX_POINTS
-        )));
-    }
     tracing::info!(?params, seed = cli.seed, "starting growth");
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {

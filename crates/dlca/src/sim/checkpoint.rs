@@ -55,8 +55,8 @@ impl Snapshot {
     /// a panic or an allocation sized by a corrupted count): every site on the lattice and
     /// taken once, the particle count and the largest cluster those of the clusters, ids
     /// increasing below `id_bound`, which the particles bound; every cluster connected and no
-    /// two clusters face-adjacent (they would have merged); a grid box side as `--grid-box`
-    /// accepts.
+    /// two clusters face-adjacent (they would have merged); a grid box side that is a power of
+    /// two no longer than the lattice.
     pub(super) fn check(&self, lattice: &core_lattice::Lattice) -> Result<(), String> {
         let volume = lattice.volume();
         let total: u64 = self.clusters.iter().map(|(_, s)| s.len() as u64).sum();
@@ -121,8 +121,9 @@ impl Snapshot {
             }
         }
         if let Some(a) = self.grid_side {
-            let shortest = lattice.sizes().iter().copied().min().unwrap_or(0);
-            if !a.is_power_of_two() || a.saturating_mul(3) >= shortest {
+            // Tuned at run time, a side may exceed what `--grid-box` accepts, not the lattice.
+            let longest = lattice.sizes().iter().copied().max().unwrap_or(1);
+            if !a.is_power_of_two() || a > longest.next_power_of_two() {
                 return Err(format!("grid box side {a}"));
             }
         }
