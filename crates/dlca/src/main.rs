@@ -201,7 +201,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     let given = sim_run::cli::config::given("max_memory").then_some(cli.max_memory);
     let n = p.particles().unwrap_or(0);
     sim_run::memory::Limit::from_flag(given).check(
-        p.peak_memory_bytes(),
+        dlca::sim::peak_memory_bytes(&p),
         &format!(
             "{n} particles on {} sites with the {} search",
             p.size.iter().product::<u64>(),

@@ -21,20 +21,20 @@ pub const MAX_SIDE: u64 = 1 << 62;
 pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
 /// Peak memory that does not grow with the run (the binary and its libraries); see
-/// [`Params::peak_memory_bytes`].
+/// `sim::peak_memory_bytes`.
 pub const PEAK_FIXED_BYTES: u64 = 10 << 20;
 /// Peak memory per particle and dimension with the occupancy lattice: a particle takes
 /// `(d + 1)` times this (its site, its cluster's records, the initial grouping); see
-/// [`Params::peak_memory_bytes`].
+/// `sim::peak_memory_bytes`.
 pub const PEAK_BYTES_PER_PARTICLE_AXIS: u64 = 80;
 /// Peak memory per particle and dimension with the other searches (grid boxes and their halo
-/// lists, all-pairs); see [`Params::peak_memory_bytes`].
+/// lists, all-pairs); see `sim::peak_memory_bytes`.
 pub const PEAK_BYTES_PER_PARTICLE_AXIS_GRID: u64 = 240;
 /// Peak memory per lattice site with the occupancy lattice (its 4-byte cell and occupancy bit,
-/// the placement's bitset); see [`Params::peak_memory_bytes`].
+/// the placement's bitset); see `sim::peak_memory_bytes`.
 pub const PEAK_BYTES_PER_SITE_LATTICE: f64 = 4.5;
 /// Peak memory per lattice site without it (the placement's bitset, one bit per site, and the
-/// grid's boxes); see [`Params::peak_memory_bytes`].
+/// grid's boxes); see `sim::peak_memory_bytes`.
 pub const PEAK_BYTES_PER_SITE: f64 = 0.25;
 
 /// Default sweeps at which `--histogram` records (`--histogram-sweeps`): about three per
@@ -340,28 +340,6 @@ impl Params {
                 Ok(n)
             }
         }
-    }
-
-    /// Peak memory of a run of these parameters, estimated before it starts, in bytes:
-    /// [`PEAK_FIXED_BYTES`], then per particle `(d + 1)` [`PEAK_BYTES_PER_PARTICLE_AXIS`] and
-    /// per site [`PEAK_BYTES_PER_SITE_LATTICE`] when the run uses the occupancy lattice
-    /// (`--search lattice`, or `auto` where it fits), else `(d + 1)`
-    /// [`PEAK_BYTES_PER_PARTICLE_AXIS_GRID`] and [`PEAK_BYTES_PER_SITE`] (the placement's
-    /// bitset). An upper bound of
-    /// the measured peak RSS (docs/dlca.md, "Memory", has the calibration table). 0 for
-    /// parameters that do not validate.
-    pub fn peak_memory_bytes(&self) -> u64 {
-        let (Ok(lattice), Ok(n)) = (self.lattice(), self.particles()) else {
-            return 0;
-        };
-        let (per_particle, per_site) = match crate::sim::chosen_search(self, &lattice, n) {
-            Search::Lattice => (PEAK_BYTES_PER_PARTICLE_AXIS, PEAK_BYTES_PER_SITE_LATTICE),
-            _ => (PEAK_BYTES_PER_PARTICLE_AXIS_GRID, PEAK_BYTES_PER_SITE),
-        };
-        let sites = (lattice.volume() as f64 * per_site) as u64;
-        PEAK_FIXED_BYTES
-            .saturating_add(n.saturating_mul(per_particle * (self.dim() as u64 + 1)))
-            .saturating_add(sites)
     }
 
     /// Check every parameter; the first problem found is returned.

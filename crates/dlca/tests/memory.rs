@@ -25,7 +25,7 @@ fn a_run_that_cannot_fit_is_refused_and_the_estimate_bounds_the_peak() {
         "dlca",
         tmp.path(),
         &["--size", "1024", "--fill", "0.05", "--max-sweeps", "3"],
-        p.peak_memory_bytes(),
+        dlca::sim::peak_memory_bytes(&p),
         2.0,
     );
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));

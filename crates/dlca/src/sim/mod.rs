@@ -22,6 +22,26 @@ pub(crate) fn chosen_search(params: &Params, lattice: &Lattice, particles: u64) 
     strategy::choose(params, lattice, particles).0
 }
 
+/// Peak memory of a run of `params`, estimated before it starts, in bytes:
+/// [`PEAK_FIXED_BYTES`], then per particle `(d + 1)` [`PEAK_BYTES_PER_PARTICLE_AXIS`] and per
+/// site [`PEAK_BYTES_PER_SITE_LATTICE`] when the run uses the occupancy lattice (`--search
+/// lattice`, or `auto` where it fits), else `(d + 1)` [`PEAK_BYTES_PER_PARTICLE_AXIS_GRID`] and
+/// [`PEAK_BYTES_PER_SITE`] (the placement's bitset). An upper bound of the measured peak RSS
+/// (docs/dlca.md, "Memory", has the calibration table). 0 for parameters that do not validate.
+pub fn peak_memory_bytes(params: &Params) -> u64 {
+    let (Ok(lattice), Ok(n)) = (params.lattice(), params.particles()) else {
+        return 0;
+    };
+    let (per_particle, per_site) = match chosen_search(params, &lattice, n) {
+        Search::Lattice => (PEAK_BYTES_PER_PARTICLE_AXIS, PEAK_BYTES_PER_SITE_LATTICE),
+        _ => (PEAK_BYTES_PER_PARTICLE_AXIS_GRID, PEAK_BYTES_PER_SITE),
+    };
+    let sites = (lattice.volume() as f64 * per_site) as u64;
+    PEAK_FIXED_BYTES
+        .saturating_add(n.saturating_mul(per_particle * (params.dim() as u64 + 1)))
+        .saturating_add(sites)
+}
+
 /// The name of the contact search a run of valid `params` uses (`auto` resolved), for
 /// messages.
 pub fn chosen_search_name(params: &Params) -> &'static str {
@@ -34,7 +54,10 @@ pub fn chosen_search_name(params: &Params) -> &'static str {
 pub use checkpoint::Snapshot;
 pub use strategy::SearchEvent;
 
-use crate::params::{ParamError, Params, Search};
+use crate::params::{
+    PEAK_BYTES_PER_PARTICLE_AXIS, PEAK_BYTES_PER_PARTICLE_AXIS_GRID, PEAK_BYTES_PER_SITE,
+    PEAK_BYTES_PER_SITE_LATTICE, PEAK_FIXED_BYTES, ParamError, Params, Search,
+};
 use crate::record::Records;
 use crate::store::{ClusterArrays, ClusterStore, Engine};
 use core_lattice::Lattice;
