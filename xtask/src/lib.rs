@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod ci;
 pub mod codemap;
+pub mod fuzz;
 pub mod plot;
 pub mod probe;
 pub mod report;

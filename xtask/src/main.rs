@@ -7,6 +7,8 @@
 //!   and figures from our own runs (see `docs/results/README.md`).
 //! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and
 //!   memory figures as JSON, and their ratios to a saved baseline.
+//! - `cargo xtask fuzz [--cases N] [--only TEXT]`: every reader of user files fuzzed with N
+//!   cases (default 1e5; `xtask::fuzz`).
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -92,6 +94,17 @@ enum Cmd {
         #[arg(long, default_value_t = 1)]
         repeat: usize,
     },
+    /// Fuzz every reader of a file a user can hand the programs (checkpoints, positions.npy,
+    /// config files, ensemble members for --merge) with many cases of arbitrary bytes and
+    /// mutated valid files; prints cases and seconds per reader (xtask/src/fuzz.rs).
+    Fuzz {
+        /// Cases per reader.
+        #[arg(long, default_value_t = 100_000)]
+        cases: u64,
+        /// Only readers (or tests) whose name contains this text.
+        #[arg(long)]
+        only: Option<String>,
+    },
 }
 
 fn main() -> Result<()> {
@@ -161,6 +174,9 @@ fn main() -> Result<()> {
             against.as_deref(),
         )
         .map(|_| ()),
+        Cmd::Fuzz { cases, only } => {
+            xtask::fuzz::run(&workspace_root(), &cargo(), cases, only.as_deref())
+        }
     }
 }
 

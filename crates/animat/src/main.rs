@@ -79,12 +79,13 @@ struct Cli {
     #[arg(long)]
     timing: bool,
 
-    /// Memory the world may take, estimated as 256 bytes per animat plus 36 KiB for each
-    /// 64 x 64 square of cells holding one (a dilute world takes 36 KiB per animat): a start
-    /// that needs more is refused, a run that grows past it stops with an error. Suffixes K,
-    /// M, G, T (powers of 1024).
-    #[arg(long, default_value = "4G", value_parser = sim_run::io::parse_bytes)]
-    max_memory: u64,
+    /// Memory the run may take, in bytes; suffixes K, M, G, T (powers of 1024). The world is
+    /// estimated as 256 bytes per animat plus 36 KiB for each 64 x 64 square of cells holding
+    /// one (a dilute world takes 36 KiB per animat): a start that needs more is refused, a run
+    /// that grows past it stops with an error. Default: 4 GiB, or the memory available
+    /// (MemAvailable, or a lower cgroup limit) if less.
+    #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
+    max_memory: Option<u64>,
 
     /// Write a PNG snapshot every K steps (and of the start and the end).
     #[arg(long, value_parser = sim_run::cli::count::<u64>)]
@@ -157,22 +158,33 @@ fn params(cli: &Cli) -> Result<Params, String> {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
     p.validate().map_err(|e| culprit(cli, &e))?;
-    let need = p.start_memory_bytes();
-    if cli.resume.is_none() && need > cli.max_memory {
-        return Err(format!(
-            "the start population needs about {} ({} animats in a disc of radius {}: a 36 KiB tile \
-             of the cell index for each 64 x 64 square holding an animat, 256 bytes per animat), \
-             over --max-memory {}; raise --density (or lower --start-radius) or --max-memory",
-            show_bytes(need),
+    if cli.resume.is_none() {
+        let what = format!(
+            "{} animats in a disc of radius {}: a 36 KiB tile of the cell index for each 64 x 64 \
+             square holding an animat, 256 bytes per animat",
             p.foxes.saturating_add(p.rabbits),
-            p.start_radius,
-            show_bytes(cli.max_memory)
-        ));
+            p.start_radius
+        );
+        // The world's memory, as the cap on a growing world counts it (the program's own
+        // few MiB, in `peak_memory_bytes`, aside).
+        memory_limit(cli).check(
+            p.start_memory_bytes(),
+            &what,
+            "raise --density (or lower --start-radius)",
+        )?;
     }
     if let Some(out) = &cli.out {
         sim_run::cli::check_out_dir(out)?;
     }
     Ok(p)
+}
+
+/// The default cap of `--max-memory` on the world.
+const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
+
+/// The memory the run may take: `--max-memory`, else 4 GiB or the memory available if less.
+fn memory_limit(cli: &Cli) -> sim_run::memory::Limit {
+    sim_run::memory::Limit::with_default_cap(cli.max_memory, DEFAULT_MAX_MEMORY)
 }
 
 /// The message of a parameter error, naming where the value came from: a flag
@@ -303,6 +315,7 @@ fn resume(
 
 fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     let clock = RunClock::start();
+    let limit = memory_limit(cli);
     // Everything that can refuse the run happens before --out is created.
     let (mut world, mut rows) = match &cli.resume {
         Some(dir) => resume(dir, &params, cli.seed, cli.steps)?,
@@ -380,15 +393,15 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             break;
         }
         let s = world.step();
-        if world.memory_bytes() > cli.max_memory {
+        if world.memory_bytes() > limit.bytes {
             progress.finish();
             anyhow::bail!(
-                "after step {} the world holds {} animats and takes about {}, over --max-memory {}; \
+                "after step {} the world holds {} animats and takes about {}, over {}; \
                  raise --max-memory (with --checkpoint-every, --resume continues from the last checkpoint)",
                 world.steps(),
                 world.foxes() + world.rabbits(),
                 show_bytes(world.memory_bytes()),
-                show_bytes(cli.max_memory)
+                limit.describe()
             );
         }
         rows.push(PopulationRow::of(&world, s));

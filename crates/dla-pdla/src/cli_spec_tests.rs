@@ -10,7 +10,7 @@ use sim_run::spec_check::{CliSpec, DocColumns};
 
 /// Flags of `dla` that are not model parameters, beyond the run flags every binary has
 /// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
-const NOT_PARAMS: &[&str] = &["paper-settings", "png", "png-size"];
+const NOT_PARAMS: &[&str] = &["paper-settings", "png", "png-size", "max-memory"];
 
 fn spec() -> CliSpec<'static> {
     CliSpec::new("dla", PARAMS, defaults(), NOT_PARAMS)

@@ -150,6 +150,12 @@ struct Cli {
     #[arg(long, value_name = "PX", requires = "png", value_parser = clap::value_parser!(u32).range(16..=65536))]
     png_size: Option<u32>,
 
+    /// Memory the run may take, in bytes; suffixes K, M, G, T (powers of 1024). A run whose
+    /// estimated peak (docs/dla.md, "Memory") is larger is refused before it starts. Default:
+    /// the memory available (MemAvailable, or a lower cgroup limit).
+    #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
+    max_memory: Option<u64>,
+
     #[command(flatten)]
     config: ConfigArgs,
 
@@ -215,8 +221,42 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }
+    if cli.positions == PositionsFormat::Vtk && p.particles > sim_run::io::points::VTK_MAX_POINTS {
+        return Err(format!(
+            "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
+             use --positions npy",
+            sim_run::io::points::VTK_MAX_POINTS,
+            p.particles
+        ));
+    }
+    // After every other check of the flags, so that a bad flag is named first.
+    check_memory(cli, &p)?;
     sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
+}
+
+/// Refuses a run whose estimated peak memory (the cluster, and the picture's buffers with
+/// `--png`) does not fit `--max-memory` or the memory available. An ensemble runs its members
+/// one per job, so each member must fit.
+fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
+    let side = u64::from(cli.png_size.unwrap_or(dla_pdla::output::PNG_MAX_SIDE));
+    let png = if cli.png {
+        dla_pdla::output::png_memory_bytes(side)
+    } else {
+        0
+    };
+    let what = format!(
+        "{} particles in {}D at {} bytes each{}",
+        p.particles,
+        p.dim,
+        dla_pdla::params::PEAK_BYTES_PER_PARTICLE[p.dim.clamp(2, 5) - 2],
+        if cli.png { " and the picture" } else { "" }
+    );
+    sim_run::memory::Limit::from_flag(cli.max_memory).check(
+        p.peak_memory_bytes().saturating_add(png),
+        &what,
+        "lower --particles",
+    )
 }
 
 /// The progress bar of a run on a terminal.
@@ -303,13 +343,6 @@ where
 {
     let clock = RunClock::start();
     let total = params.particles;
-    if cli.positions == PositionsFormat::Vtk && total > sim_run::io::points::VTK_MAX_POINTS {
-        return Err(usage(format!(
-            "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {total}; \
-             use --positions npy",
-            sim_run::io::points::VTK_MAX_POINTS
-        )));
-    }
     tracing::info!(?params, seed = cli.seed, "starting growth");
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {

@@ -253,6 +253,12 @@ pub fn default_png_side(r_ext: f64) -> u32 {
     ((2.0 * (r_ext + 1.0)).ceil() as u32).clamp(PNG_MIN_SIDE, PNG_MAX_SIDE)
 }
 
+/// Memory the buffers of a `side` x `side` `dla.png` take while it is drawn (a depth, a count
+/// and a grey value per pixel, at most).
+pub fn png_memory_bytes(side: u64) -> u64 {
+    side.saturating_mul(side).saturating_mul(13)
+}
+
 /// Smallest default side of `dla.png`.
 pub const PNG_MIN_SIDE: u32 = 512;
 /// Largest default side of `dla.png` (any side up to 65536 may be asked for).

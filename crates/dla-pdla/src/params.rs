@@ -342,7 +342,26 @@ pub enum ParamsError {
     SerialUntilUnused(u64),
 }
 
+/// Peak memory of a run, bytes per particle by dimension (2 to 5): an upper bound of the peak
+/// RSS per particle measured at 1e5 to 3e6 particles (docs/dla.md, "Memory", has the
+/// calibration table), tree, distance maps and walkers included; the positions stream to disk.
+pub const PEAK_BYTES_PER_PARTICLE: [u64; 4] = [13, 26, 40, 450];
+
+/// Peak memory of a run that does not grow with it: the binary, its libraries and the
+/// distance maps' smallest size.
+pub const PEAK_FIXED_BYTES: u64 = 8 << 20;
+
 impl Params {
+    /// Peak memory of this run, estimated before it starts: [`PEAK_FIXED_BYTES`] plus
+    /// [`PEAK_BYTES_PER_PARTICLE`] of the dimension per particle. An upper bound of the
+    /// measured peak RSS, within about 1.5 times of it for 1e5 particles and more
+    /// (docs/dla.md, "Memory"). The binaries refuse a run whose estimate does not fit the
+    /// memory available or `--max-memory`.
+    pub fn peak_memory_bytes(&self) -> u64 {
+        let per = PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2];
+        PEAK_FIXED_BYTES.saturating_add(self.particles.saturating_mul(per))
+    }
+
     /// The variable-precision paper's walk (Sosa-Herrera & Rodriguez-Romo, section 3.2), for
     /// reproducing its numbers: far field `jump` with the death radius at 100 birth radii,
     /// near-field step 0.5, precision 2, and no distance maps (the paper's walk asks the tree

@@ -106,8 +106,11 @@ struct Cli {
     #[arg(long)]
     grid_box: Option<u64>,
 
-    /// Memory the occupancy lattice (`--search lattice`) may take, in bytes; suffixes K, M, G
-    /// (powers of 1024) are accepted.
+    /// Memory in bytes; suffixes K, M, G, T (powers of 1024). The occupancy lattice
+    /// (`--search lattice`, or `auto`) must fit in it; given explicitly, it is also the limit
+    /// of the whole run: a run whose estimated peak (docs/dlca.md, "Memory") is larger is
+    /// refused before it starts. Not given, that limit is the memory available (MemAvailable,
+    /// or a lower cgroup limit).
     #[arg(long, default_value = "4G", value_parser = flags::parse_bytes)]
     max_memory: u64,
 
@@ -199,6 +202,19 @@ fn params(cli: &Cli) -> Result<Params, String> {
         fit_min_size: cli.fit_min_size,
     };
     p.validate().map_err(|e| e.to_string())?;
+    // The default 4G is the occupancy lattice's budget only; the run's limit is then the memory
+    // available.
+    let given = sim_run::cli::config::given("max_memory").then_some(cli.max_memory);
+    let n = p.particles().unwrap_or(0);
+    sim_run::memory::Limit::from_flag(given).check(
+        dlca::sim::peak_memory_bytes(&p),
+        &format!(
+            "{n} particles on {} sites with the {} search",
+            p.size.iter().product::<u64>(),
+            dlca::sim::chosen_search_name(&p)
+        ),
+        "lower --size or --fill/--particles",
+    )?;
     sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
@@ -305,8 +321,12 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
         Some(dir) => resume(dir, params, cli.seed)?,
-        // Every error of the set-up is a parameter the run cannot take.
-        None => Simulation::new(params, cli.seed).map_err(|e| usage(e.to_string()))?,
+        // Every error of the set-up is a parameter the run cannot take, except an allocation
+        // the system refused: a failed run.
+        None => Simulation::new(params, cli.seed).map_err(|e| match e {
+            dlca::params::ParamError::Alloc(a) => anyhow::Error::from(a),
+            other => usage(other.to_string()),
+        })?,
     };
     // Created before the run so a long run cannot end with nowhere to write.
     // Ours until the run ends: refused if another run holds it or it holds an earlier run.

@@ -20,6 +20,23 @@ pub const MAX_SIDE: u64 = 1 << 62;
 /// Default memory budget for the occupancy lattice: 4 GiB.
 pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
+/// Peak memory that does not grow with the run (the binary and its libraries); see
+/// `sim::peak_memory_bytes`.
+pub const PEAK_FIXED_BYTES: u64 = 10 << 20;
+/// Peak memory per particle and dimension with the occupancy lattice: a particle takes
+/// `(d + 1)` times this (its site, its cluster's records, the initial grouping); see
+/// `sim::peak_memory_bytes`.
+pub const PEAK_BYTES_PER_PARTICLE_AXIS: u64 = 80;
+/// Peak memory per particle and dimension with the other searches (grid boxes and their halo
+/// lists, all-pairs); see `sim::peak_memory_bytes`.
+pub const PEAK_BYTES_PER_PARTICLE_AXIS_GRID: u64 = 240;
+/// Peak memory per lattice site with the occupancy lattice (its 4-byte cell and occupancy bit,
+/// the placement's bitset); see `sim::peak_memory_bytes`.
+pub const PEAK_BYTES_PER_SITE_LATTICE: f64 = 4.5;
+/// Peak memory per lattice site without it (the placement's bitset, one bit per site, and the
+/// grid's boxes); see `sim::peak_memory_bytes`.
+pub const PEAK_BYTES_PER_SITE: f64 = 0.25;
+
 /// Default sweeps at which `--histogram` records (`--histogram-sweeps`): about three per
 /// decade up to 10^4, as in Figs. 4, 7, 8 of Hawick, James & Scogings 2006.
 pub const DEFAULT_HISTOGRAM_SWEEPS: &str = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000";
@@ -185,6 +202,13 @@ impl Default for Params {
 /// A parameter outside its accepted range. The message names the value and the range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamError {
+    /// A large allocation of the set-up (the particles' sites, the occupancy lattice) was
+    /// refused by the system: not bad input, a run that failed (the binary exits with code 1).
+    #[error(transparent)]
+    Alloc(#[from] sim_run::memory::AllocError),
+    /// A checkpoint whose state no run can be in (damaged, or made by hand).
+    #[error("the saved state is inconsistent: {0}")]
+    Checkpoint(String),
     /// Dimension outside 1..=5.
     #[error("--dim {0} is outside the accepted range 1..={MAX_MODEL_DIM}")]
     Dimension(usize),

@@ -41,7 +41,10 @@
 pub mod cli;
 #[cfg(feature = "cli")]
 pub mod ensemble;
+#[cfg(any(test, feature = "test-support"))]
+pub mod fuzz;
 pub mod io;
+pub mod memory;
 #[cfg(feature = "plot")]
 pub mod plot;
 #[cfg(all(feature = "test-support", feature = "cli"))]

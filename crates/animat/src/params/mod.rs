@@ -313,6 +313,10 @@ pub const MAX_ANIMATS: u64 = u32::MAX as u64;
 /// it in tiles.
 pub const ANIMAT_BYTES: u64 = 256;
 
+/// Peak memory of a run that does not grow with the population (the binary, its libraries,
+/// the step's scratch); see [`Params::peak_memory_bytes`].
+pub const PEAK_FIXED_BYTES: u64 = 8 << 20;
+
 /// Every parameter of the model (`docs/animat.md`, "Parameters and defaults"). Build one (or
 /// start from
 /// [`Params::default`]), call [`Params::validate`] (the [`World`](crate::World) does), run.
@@ -545,6 +549,15 @@ impl Params {
         let occupied = tiles * -(-n / tiles).exp_m1();
         // Saturates at u64::MAX for absurd populations.
         (occupied * spatial::cells::TILE_BYTES as f64 + n * ANIMAT_BYTES as f64) as u64
+    }
+
+    /// Peak memory of a run of these parameters, estimated before it starts:
+    /// [`start_memory_bytes`](Self::start_memory_bytes) plus [`PEAK_FIXED_BYTES`] (the
+    /// binary, its libraries, the step's scratch). An upper bound of the measured peak RSS of
+    /// a run whose population does not grow much (docs/animat.md, "Memory"); a world that
+    /// grows past the limit is stopped by the binary as it steps.
+    pub fn peak_memory_bytes(&self) -> u64 {
+        self.start_memory_bytes().saturating_add(PEAK_FIXED_BYTES)
     }
 
     /// Start radius giving `animats` animats at `density` animats per cell:

@@ -201,9 +201,9 @@ where
         growth.samples.pop();
         growth.last_off_schedule = false;
     }
-    if let Some(t) =
-        Instant::now().checked_sub(Duration::from_secs_f64(snap.seconds.clamp(0.0, 1e9)))
-    {
+    // A NaN (a damaged checkpoint) counts as no time rather than a panic.
+    let seconds = Duration::try_from_secs_f64(snap.seconds.clamp(0.0, 1e9)).unwrap_or_default();
+    if let Some(t) = Instant::now().checked_sub(seconds) {
         growth.started = t;
     }
     Ok(Restored {

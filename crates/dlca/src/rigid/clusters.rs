@@ -150,14 +150,21 @@ const DEAD: u32 = u32::MAX;
 impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     /// The store for the clusters of `sets` (ids kept), with their occupancy lattice, in frame
     /// `frame` over `geo` (the geometry of the sets' lattice).
-    pub(super) fn new(sets: &SiteSets, geo: Geometry<D>, frame: F) -> Self {
+    /// The lattice's cells (4 bytes a site) are allocated fallibly.
+    pub(super) fn new(
+        sets: &SiteSets,
+        geo: Geometry<D>,
+        frame: F,
+    ) -> Result<Self, sim_run::memory::AllocError> {
         let lattice = sets.lattice().clone();
         let n = sets.id_bound();
+        let cells =
+            sim_run::memory::try_vec(lattice.volume() as usize, EMPTY, "the occupancy lattice")?;
         let mut r = Rigid {
             frame,
             single: None,
             occupied: Bits::new(lattice.volume() as usize),
-            cells: vec![EMPTY; lattice.volume() as usize],
+            cells,
             id_of: (0..n as ItemId).collect(),
             clusters: vec![Cluster::default(); n],
             cold: vec![Cold::default(); n],
@@ -197,7 +204,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             let id = r.live[i];
             r.finish(id);
         }
-        r
+        Ok(r)
     }
 
     #[inline]

@@ -49,7 +49,7 @@ use geometry::Geometry;
 use spatial::lattice::{ItemId, SiteSets};
 
 /// Why the rigid-cluster store does not take a lattice.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub(crate) enum RigidError {
     /// No rigid kernel for this dimension (see the module documentation).
     #[error("no rigid-cluster kernel in {0} dimensions")]
@@ -57,6 +57,9 @@ pub(crate) enum RigidError {
     /// A side longer than the store's relative coordinates reach.
     #[error("side {0} is longer than the rigid-cluster store handles ({MAX_SIDE})")]
     Side(u64),
+    /// The occupancy lattice could not be allocated.
+    #[error(transparent)]
+    Alloc(#[from] sim_run::memory::AllocError),
 }
 
 /// Defines [`RigidStore`] with one pair of variants (general frame, power-of-two frame) per
@@ -100,8 +103,8 @@ macro_rules! rigid_store {
                         $dim => {
                             let geo = Geometry::<$dim>::new(l);
                             Ok(match Pow2Frame::new(&geo) {
-                                Some(frame) => RigidStore::$pow2(Rigid::new(sets, geo, frame)),
-                                None => RigidStore::$any(Rigid::new(sets, geo, AnyFrame)),
+                                Some(frame) => RigidStore::$pow2(Rigid::new(sets, geo, frame)?),
+                                None => RigidStore::$any(Rigid::new(sets, geo, AnyFrame)?),
                             })
                         }
                     )+

@@ -17,10 +17,47 @@ mod checkpoint;
 mod placement;
 mod strategy;
 
+/// The contact search a run of `params` on `lattice` with `particles` uses (`auto` resolved).
+pub(crate) fn chosen_search(params: &Params, lattice: &Lattice, particles: u64) -> Search {
+    strategy::choose(params, lattice, particles).0
+}
+
+/// Peak memory of a run of `params`, estimated before it starts, in bytes:
+/// [`PEAK_FIXED_BYTES`], then per particle `(d + 1)` [`PEAK_BYTES_PER_PARTICLE_AXIS`] and per
+/// site [`PEAK_BYTES_PER_SITE_LATTICE`] when the run uses the occupancy lattice (`--search
+/// lattice`, or `auto` where it fits), else `(d + 1)` [`PEAK_BYTES_PER_PARTICLE_AXIS_GRID`] and
+/// [`PEAK_BYTES_PER_SITE`] (the placement's bitset). An upper bound of the measured peak RSS
+/// (docs/dlca.md, "Memory", has the calibration table). 0 for parameters that do not validate.
+pub fn peak_memory_bytes(params: &Params) -> u64 {
+    let (Ok(lattice), Ok(n)) = (params.lattice(), params.particles()) else {
+        return 0;
+    };
+    let (per_particle, per_site) = match chosen_search(params, &lattice, n) {
+        Search::Lattice => (PEAK_BYTES_PER_PARTICLE_AXIS, PEAK_BYTES_PER_SITE_LATTICE),
+        _ => (PEAK_BYTES_PER_PARTICLE_AXIS_GRID, PEAK_BYTES_PER_SITE),
+    };
+    let sites = (lattice.volume() as f64 * per_site) as u64;
+    PEAK_FIXED_BYTES
+        .saturating_add(n.saturating_mul(per_particle * (params.dim() as u64 + 1)))
+        .saturating_add(sites)
+}
+
+/// The name of the contact search a run of valid `params` uses (`auto` resolved), for
+/// messages.
+pub fn chosen_search_name(params: &Params) -> &'static str {
+    match (params.lattice(), params.particles()) {
+        (Ok(lattice), Ok(n)) => chosen_search(params, &lattice, n).name(),
+        _ => params.search.name(),
+    }
+}
+
 pub use checkpoint::Snapshot;
 pub use strategy::SearchEvent;
 
-use crate::params::{ParamError, Params, Search};
+use crate::params::{
+    PEAK_BYTES_PER_PARTICLE_AXIS, PEAK_BYTES_PER_PARTICLE_AXIS_GRID, PEAK_BYTES_PER_SITE,
+    PEAK_BYTES_PER_SITE_LATTICE, PEAK_FIXED_BYTES, ParamError, Params, Search,
+};
 use crate::record::Records;
 use crate::store::{ClusterArrays, ClusterStore, Engine};
 use core_lattice::Lattice;
@@ -127,9 +164,9 @@ impl Simulation {
             &lattice,
             n,
             &mut stream(seed, stream_id(STREAM_PLACEMENT, 0)),
-        );
+        )?;
         let mut sets = SiteSets::new(lattice.clone());
-        for cluster in initial_clusters(&lattice, &sites) {
+        for cluster in initial_clusters(&lattice, &sites)? {
             sets.push(cluster);
         }
         let largest = sets
@@ -192,6 +229,7 @@ impl Simulation {
         let s = snapshot;
         s.params.validate()?;
         let lattice = s.params.lattice()?;
+        s.check(&lattice).map_err(ParamError::Checkpoint)?;
         let directions =
             DirectionSampler::gravity(lattice.dim(), s.params.gravity).expect("gravity validated");
         let mut sets = SiteSets::new(lattice.clone());

@@ -90,6 +90,7 @@ pub(super) fn install(
                     Engine::Occupancy(Indexed::new(arrays, occupancy))
                 }
                 Err(RigidError::Side(_)) => return Err(too_large),
+                Err(RigidError::Alloc(e)) => return Err(e.into()),
             }
         }
         Search::AllPairs | Search::Auto => Engine::all_pairs(arrays),

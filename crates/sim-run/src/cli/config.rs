@@ -50,6 +50,17 @@ const NOT_CONFIG: [&str; 14] = [
 /// The effective configuration of the run being parsed, kept for [`save`].
 static EFFECTIVE: OnceLock<String> = OnceLock::new();
 
+/// Argument ids given on the command line or by the config file (not defaults), kept for
+/// [`given`].
+static GIVEN: OnceLock<Vec<String>> = OnceLock::new();
+
+/// Whether the flag with argument id `id` (`max_memory`) was given, on the command line or in
+/// the `--config` file, rather than left at its default; false if the binary did not parse
+/// with [`parse_with_config`].
+pub fn given(id: &str) -> bool {
+    GIVEN.get().is_some_and(|g| g.iter().any(|x| x == id))
+}
+
 fn config_path(args: &[OsString]) -> Result<Option<(usize, usize, PathBuf)>, String> {
     for (i, a) in args.iter().enumerate() {
         let s = a.to_string_lossy();
@@ -285,6 +296,21 @@ pub fn parse_with_config<C: clap::Parser>(program: &str) -> Result<C, std::proce
         Err(e) => return Err(super::clap_error(program, e)),
     };
     let _ = EFFECTIVE.set(text);
+    let _ = GIVEN.set(
+        matches
+            .ids()
+            .filter(|id| {
+                matches!(
+                    matches.value_source(id.as_str()),
+                    Some(
+                        clap::parser::ValueSource::CommandLine
+                            | clap::parser::ValueSource::EnvVariable
+                    )
+                )
+            })
+            .map(|id| id.to_string())
+            .collect(),
+    );
     Ok(cli)
 }
 

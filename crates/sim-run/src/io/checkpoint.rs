@@ -125,6 +125,35 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// Decodes `payload` with bincode's standard configuration and a limit on the memory its
+/// containers may claim: 1024 times the power of two at or above the payload's length
+/// ([`CLAIM_FACTOR_BITS`]; a container in memory takes more than its encoding, 8 bytes for a
+/// one-byte varint). bincode sizes a string's buffer by the length read from the payload
+/// before reading it, so without the limit a corrupted length (2^60) would be an allocation
+/// of that size and an abort; with it, an error. The limit is a type parameter of bincode's
+/// configuration, hence the table of powers.
+fn decode_limited<T: DeserializeOwned>(
+    payload: &[u8],
+) -> Result<(T, usize), bincode::error::DecodeError> {
+    use bincode::config::standard;
+    use bincode::serde::decode_from_slice;
+    let bits = payload.len().max(1).next_power_of_two().trailing_zeros() + CLAIM_FACTOR_BITS;
+    macro_rules! limited {
+        ($($b:literal)+) => {
+            match bits {
+                $($b => decode_from_slice(payload, standard().with_limit::<{ 1usize << $b }>()),)+
+                _ => decode_from_slice(payload, standard()),
+            }
+        };
+    }
+    limited!(10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32 33 34 35 36
+        37 38 39 40 41 42 43 44 45 46 47 48 49 50 51 52 53 54 55 56 57 58)
+}
+
+/// The memory a checkpoint's decoding may claim is `2^CLAIM_FACTOR_BITS` times its payload's
+/// length (rounded up to a power of two).
+const CLAIM_FACTOR_BITS: u32 = 10;
+
 /// Decode checkpoint bytes written by [`encode_checkpoint`] for `model`.
 pub fn decode_checkpoint<T: DeserializeOwned>(
     bytes: &[u8],
@@ -167,8 +196,8 @@ pub fn decode_checkpoint<T: DeserializeOwned>(
             expected: model.into(),
         });
     }
-    let (state, used) = bincode::serde::decode_from_slice(payload, bincode::config::standard())
-        .map_err(|e| CheckpointError::Decode(e.to_string()))?;
+    let (state, used) =
+        decode_limited(payload).map_err(|e| CheckpointError::Decode(e.to_string()))?;
     if used != payload.len() {
         return Err(CheckpointError::Decode(format!(
             "{} of {} payload bytes left over",

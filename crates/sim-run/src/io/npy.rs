@@ -107,17 +107,32 @@ fn read_header(file: &mut File, path: &Path) -> Result<(u64, usize), NpyError> {
         .map(str::trim)
         .filter(|s| !s.is_empty())
         .collect();
-    match dims.as_slice() {
+    let (rows, cols) = match dims.as_slice() {
         [r, c] => match (r.parse::<u64>(), c.parse::<usize>()) {
-            (Ok(r), Ok(c)) if c > 0 => Ok((r, c)),
-            _ => Err(format_error(path, format!("bad shape ({shape})"))),
+            (Ok(r), Ok(c)) if c > 0 => (r, c),
+            _ => return Err(format_error(path, format!("bad shape ({shape})"))),
         },
-        _ => Err(format_error(
+        _ => {
+            return Err(format_error(
+                path,
+                format!("shape ({shape}) is not two-dimensional"),
+            ));
+        }
+    };
+    // A row is sized by the column count, so that is bounded before anyone allocates one;
+    // the row count sizes nothing (rows are read one at a time, and a file shorter than its
+    // count is an error when the reader gets there).
+    if cols > MAX_COLS {
+        return Err(format_error(
             path,
-            format!("shape ({shape}) is not two-dimensional"),
-        )),
+            format!("shape ({shape}) has more than {MAX_COLS} columns"),
+        ));
     }
+    Ok((rows, cols))
 }
+
+/// Most columns an `.npy` file this reader opens may have (aggsim writes at most a few).
+pub const MAX_COLS: usize = 1 << 16;
 
 /// Appends rows of `cols` `f64` to an `.npy` file (see the module doc).
 #[derive(Debug)]

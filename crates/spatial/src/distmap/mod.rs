@@ -84,6 +84,12 @@ pub enum DistanceMapError {
         /// Cells per axis that were needed.
         cells_per_axis: f64,
     },
+    /// The system refused the memory of the map's cells.
+    #[error("cannot allocate {bytes} bytes for the distance map")]
+    Alloc {
+        /// Bytes asked for.
+        bytes: u64,
+    },
 }
 
 /// The coarse distance map (see the module docs).
@@ -609,8 +615,14 @@ impl<const D: usize> DistanceMap<D> {
         }
         let half = cells as i64;
         let side = side as usize;
-        let mut values: Vec<AtomicU8> =
-            (0..total as usize).map(|_| AtomicU8::new(CAPPED)).collect();
+        // Fallible, so a map that does not fit is an error rather than an abort.
+        let mut values: Vec<AtomicU8> = Vec::new();
+        values
+            .try_reserve_exact(total as usize)
+            .map_err(|_| DistanceMapError::Alloc {
+                bytes: total as u64,
+            })?;
+        values.extend((0..total as usize).map(|_| AtomicU8::new(CAPPED)));
         if self.side > 0 {
             let off = (half - self.half) as usize;
             // Copy old rows (along axis 0) into the new array.
