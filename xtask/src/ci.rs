@@ -29,7 +29,7 @@ pub enum Run {
     /// `cargo ARGS` (words separated by spaces) with extra environment variables.
     Cargo(&'static str, &'static [(&'static str, &'static str)]),
     /// `cargo package` of the library crates, after removing cargo's unpacked copies of them
-    /// from the last packaging (see [`forget_packaged_sources`]).
+    /// from the last packaging (see `forget_packaged_sources`).
     Package,
     /// `pip install` of the Python package and its test tools into the CI virtual environment.
     PythonInstall,
