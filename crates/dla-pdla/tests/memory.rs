@@ -58,3 +58,30 @@ fn a_run_larger_than_any_machine_is_refused_naming_the_memory_available() {
     let failures = refusals(Path::new(DLA), "dla", tmp.path(), cases);
     assert!(failures.is_empty(), "\n{}", failures.join("\n"));
 }
+
+/// An allocation the system refuses while the cluster grows (the check waved through with
+/// `--max-memory`, the process's address space capped at 32 MiB with `ulimit -v`) ends the run
+/// with exit code 1 and one line `dla: run failed: ... cannot allocate N bytes ...`, not an
+/// abort.
+#[cfg(unix)]
+#[test]
+fn a_refused_allocation_while_growing_is_one_line_and_exit_code_1() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 32768 && exec '{DLA}' --particles 1e8 --max-memory 1T -q --out '{}'",
+            out.display()
+        ))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    let lines: Vec<&str> = stderr.lines().collect();
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(
+        lines[0].starts_with("dla: run failed: ") && lines[0].contains("cannot allocate"),
+        "{stderr}"
+    );
+}

@@ -181,16 +181,20 @@ impl<T: Element> Arena<T> {
     }
 
     /// Resizes the buffer to exactly `cap` elements, keeping the first `len` (`len <= cap`,
-    /// exclusive access).
-    pub(super) fn set_capacity(&mut self, len: usize, cap: usize) {
+    /// exclusive access). When the allocator refuses, the arena is unchanged and the error
+    /// gives the bytes asked for.
+    pub(super) fn try_set_capacity(&mut self, len: usize, cap: usize) -> Result<(), AllocFailed> {
         assert!(len <= cap && len <= self.cap);
         if cap == self.cap {
-            return;
+            return Ok(());
         }
-        let new = Layout::array::<T>(cap).expect("orthtree arena too large");
+        let refused = AllocFailed {
+            bytes: cap.saturating_mul(size_of::<T>()),
+        };
+        let new = Layout::array::<T>(cap).map_err(|_| refused)?;
         if cap == 0 {
             self.free();
-            return;
+            return Ok(());
         }
         let ptr = if self.cap == 0 {
             // SAFETY: `new` has a non-zero size (cap > 0, elements are not zero-sized).
@@ -198,17 +202,25 @@ impl<T: Element> Arena<T> {
         } else {
             let old = Layout::array::<T>(self.cap).expect("layout was valid when allocated");
             // SAFETY: `ptr` was allocated with `old` by this allocator; `new.size()` is non-zero.
+            // On failure `realloc` returns null and leaves the old block as it was.
             unsafe { alloc::realloc(self.ptr.as_ptr().cast(), old, new.size()) }
         };
-        match NonNull::new(ptr.cast::<T>()) {
-            Some(p) => {
-                self.ptr = p;
-                self.cap = cap;
-                #[cfg(loom)]
-                self.track
-                    .resize_with(cap, || loom::cell::UnsafeCell::new(()));
-            }
-            None => alloc::handle_alloc_error(new),
+        let p = NonNull::new(ptr.cast::<T>()).ok_or(refused)?;
+        self.ptr = p;
+        self.cap = cap;
+        #[cfg(loom)]
+        self.track
+            .resize_with(cap, || loom::cell::UnsafeCell::new(()));
+        Ok(())
+    }
+
+    /// [`try_set_capacity`](Self::try_set_capacity) where a refusal cannot be reported (a
+    /// clone of the tree): the allocator's usual out-of-memory handling.
+    pub(super) fn set_capacity(&mut self, len: usize, cap: usize) {
+        if let Err(e) = self.try_set_capacity(len, cap) {
+            let layout = Layout::from_size_align(e.bytes.max(1), align_of::<T>())
+                .unwrap_or(Layout::new::<T>());
+            alloc::handle_alloc_error(layout)
         }
     }
 
@@ -247,6 +259,12 @@ impl<T: Element> Drop for Arena<T> {
     fn drop(&mut self) {
         self.free();
     }
+}
+
+/// The allocator refused to grow an arena to `bytes` bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct AllocFailed {
+    pub(super) bytes: usize,
 }
 
 /// Capacity to grow an arena of capacity `cap` to so it holds `need` elements: by at most 1/8

@@ -128,19 +128,24 @@ impl<const D: usize> Orthtree<D> {
         n as u32
     }
 
-    /// Grows the arenas (exclusive access) so that the next insert fits.
-    fn reserve_for_insert(&mut self, leaf_len: u32) {
+    /// Grows the arenas (exclusive access) so that the next insert fits; an allocation the
+    /// system refuses is an error, with the tree's points unchanged.
+    fn reserve_for_insert(&mut self, leaf_len: u32) -> Result<(), OrthtreeError> {
         let fanout = Self::FANOUT;
         let depth = self.root_level as usize + 64;
         let w = Self::writer_mut(&mut self.shared);
         let nodes = w.nodes * fanout;
-        self.children.set_capacity(
-            nodes,
-            slow_growth(self.children.capacity(), nodes + depth * fanout),
-        );
-        self.leaves
-            .set_capacity(w.leaves, slow_growth(self.leaves.capacity(), w.leaves + 1));
-        w.pool.reserve(&mut self.slots, leaf_len);
+        self.children
+            .try_set_capacity(
+                nodes,
+                slow_growth(self.children.capacity(), nodes + depth * fanout),
+            )
+            .and_then(|()| {
+                self.leaves
+                    .try_set_capacity(w.leaves, slow_growth(self.leaves.capacity(), w.leaves + 1))
+            })
+            .and_then(|()| w.pool.reserve(&mut self.slots, leaf_len))
+            .map_err(|e| OrthtreeError::OutOfMemory { bytes: e.bytes })
     }
 
     /// Doubles the root towards leaf cell `k` (the variable-precision paper builds its tree over a
@@ -178,7 +183,7 @@ impl<const D: usize> Orthtree<D> {
 
     /// Makes the root contain leaf cell `k` (exclusive access): creates it for the first point
     /// `p`, or doubles it towards `k`.
-    fn cover(&mut self, p: &[f64; D], k: &[i64; D]) {
+    fn cover(&mut self, p: &[f64; D], k: &[i64; D]) -> Result<(), OrthtreeError> {
         if self.root == EMPTY {
             // Root of 2 x 2 leaf cells centred on the leaf-cell corner nearest to p.
             for i in 0..D {
@@ -187,7 +192,10 @@ impl<const D: usize> Orthtree<D> {
                 self.anchor[i] = self.root_origin[i] + 1;
             }
             self.root_level = 1;
-            self.reserve_for_insert(0);
+            if let Err(e) = self.reserve_for_insert(0) {
+                self.root_level = 0;
+                return Err(e);
+            }
             let mut w = self.writer();
             // SAFETY: `w` is this tree's writer, and `&mut self` excludes readers.
             let n = unsafe { self.new_node(&mut w) };
@@ -195,9 +203,10 @@ impl<const D: usize> Orthtree<D> {
             self.root = n;
         }
         while !self.root_contains(k) {
-            self.reserve_for_insert(0);
+            self.reserve_for_insert(0)?;
             self.grow_root(k);
         }
+        Ok(())
     }
 
     /// Stores the record `code` in leaf cell `k` (inside the root; limits and room checked):
@@ -287,8 +296,8 @@ impl<const D: usize> Orthtree<D> {
         // Capacity checks before any change, so that an error leaves the tree as it was.
         let leaf_len = self.existing_leaf_len(&k);
         self.check_limits(&self.writer(), leaf_len)?;
-        self.cover(&p, &k);
-        self.reserve_for_insert(leaf_len);
+        self.cover(&p, &k)?;
+        self.reserve_for_insert(leaf_len)?;
         {
             let mut w = self.writer();
             // SAFETY: `w` is this tree's writer; `&mut self` excludes readers, so the old
@@ -399,7 +408,7 @@ impl<const D: usize> Orthtree<D> {
         }
         for corner in [-radius, radius] {
             let (k, _) = self.locate(&[corner; D])?;
-            self.cover(&[corner; D], &k);
+            self.cover(&[corner; D], &k)?;
         }
         let n = self.len().max(1);
         let fanout = Self::FANOUT;
@@ -416,16 +425,22 @@ impl<const D: usize> Orthtree<D> {
             used + (ratio * points as f64 * 1.25) as usize + RESERVE_FLOOR
         };
         let nodes = per(w.nodes, 1.0) + levels;
-        self.children.set_capacity(
-            w.nodes * fanout,
-            self.children.capacity().max(nodes * fanout),
-        );
         let leaves = per(w.leaves, 1.0);
-        self.leaves
-            .set_capacity(w.leaves, self.leaves.capacity().max(leaves));
         let slots = per(w.pool.len, 2.0);
-        self.slots
-            .set_capacity(w.pool.len, self.slots.capacity().max(slots));
+        self.children
+            .try_set_capacity(
+                w.nodes * fanout,
+                self.children.capacity().max(nodes * fanout),
+            )
+            .and_then(|()| {
+                self.leaves
+                    .try_set_capacity(w.leaves, self.leaves.capacity().max(leaves))
+            })
+            .and_then(|()| {
+                self.slots
+                    .try_set_capacity(w.pool.len, self.slots.capacity().max(slots))
+            })
+            .map_err(|e| OrthtreeError::OutOfMemory { bytes: e.bytes })?;
         // SAFETY: `&mut self`: no reader holds anything from the tree, so every retired block
         // can be reused; `self.slots` is the arena of `w.pool`.
         unsafe { w.pool.reclaim(&self.slots, u64::MAX) };
@@ -441,14 +456,17 @@ impl<const D: usize> Orthtree<D> {
         // can be reused; `self.slots` is the arena of `w.pool`.
         unsafe { w.pool.reclaim(&self.slots, u64::MAX) };
         let keep = |len: usize| len + (len / 8).max(64);
-        self.children.set_capacity(
+        // Shrinking: where the allocator refuses, the larger buffer simply stays.
+        let _ = self.children.try_set_capacity(
             w.nodes * fanout,
             keep(w.nodes * fanout).min(self.children.capacity()),
         );
-        self.leaves
-            .set_capacity(w.leaves, keep(w.leaves).min(self.leaves.capacity()));
-        self.slots
-            .set_capacity(w.pool.len, keep(w.pool.len).min(self.slots.capacity()));
+        let _ = self
+            .leaves
+            .try_set_capacity(w.leaves, keep(w.leaves).min(self.leaves.capacity()));
+        let _ = self
+            .slots
+            .try_set_capacity(w.pool.len, keep(w.pool.len).min(self.slots.capacity()));
     }
 
     /// The position [`insert`](Self::insert) would store for `p` (its fixed-point rounding),

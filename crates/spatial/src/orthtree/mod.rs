@@ -260,6 +260,13 @@ pub enum OrthtreeError {
     /// [`Orthtree::set_index_limit`]) cannot number another node, leaf or point slot.
     #[error("orthtree capacity exceeded: no index left for more {0}")]
     CapacityExceeded(&'static str),
+    /// The allocator refused to grow the tree's arrays; the tree holds the same points as
+    /// before the call.
+    #[error("cannot allocate {bytes} bytes for the orthtree's arrays")]
+    OutOfMemory {
+        /// The size of the allocation refused.
+        bytes: usize,
+    },
     /// A shared insert ([`Orthtree::insert_shared`]) needs the root grown or more capacity
     /// than [`Orthtree::prepare_shared`] reserved: both need exclusive access.
     #[error(

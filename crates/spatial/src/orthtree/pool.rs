@@ -11,7 +11,7 @@
 //! free lists cost no memory either.
 
 use super::Leaf;
-use super::arena::{Arena, slow_growth};
+use super::arena::{AllocFailed, Arena, slow_growth};
 use super::sync::{AtomicU64, load_mut, store_mut};
 use std::collections::VecDeque;
 
@@ -99,9 +99,13 @@ impl LeafPool {
     }
 
     /// Grows `slots` (exclusive access) so that a push into a leaf of length `leaf_len` fits.
-    pub(super) fn reserve<const D: usize>(&self, slots: &mut Arena<[u32; D]>, leaf_len: u32) {
+    pub(super) fn reserve<const D: usize>(
+        &self,
+        slots: &mut Arena<[u32; D]>,
+        leaf_len: u32,
+    ) -> Result<(), AllocFailed> {
         let need = self.len + Self::push_needs(leaf_len) as usize;
-        slots.set_capacity(self.len, slow_growth(slots.capacity(), need));
+        slots.try_set_capacity(self.len, slow_growth(slots.capacity(), need))
     }
 
     /// A block of `cap` slots of class `class`, from the free list or the end of the pool
@@ -344,10 +348,10 @@ mod tests {
         // and every record passed is the empty one or one the pool returned.
         unsafe {
             for i in 0..40u32 {
-                pool.reserve(&mut slots, a.len);
+                pool.reserve(&mut slots, a.len).unwrap();
                 a = pool.push(&slots, a, [i, 1000 + i], None);
                 if i % 3 == 0 {
-                    pool.reserve(&mut slots, b.len);
+                    pool.reserve(&mut slots, b.len).unwrap();
                     b = pool.push(&slots, b, [i, 7], None);
                 }
             }
@@ -372,7 +376,7 @@ mod tests {
             assert_eq!(LeafPool::points(&slots, a), &pa[..]);
             assert_eq!(LeafPool::points(&slots, b), &pb[..]);
             // Growing after compaction works.
-            pool.reserve(&mut slots, b.len);
+            pool.reserve(&mut slots, b.len).unwrap();
             let b = pool.push(&slots, b, [99, 99], None);
             assert_eq!(LeafPool::points(&slots, b).len(), 15);
             assert_eq!(LeafPool::points(&slots, b)[14], [99, 99]);
@@ -390,7 +394,7 @@ mod tests {
         // pool returned.
         unsafe {
             for i in 0..3u32 {
-                pool.reserve(&mut slots, a.len);
+                pool.reserve(&mut slots, a.len).unwrap();
                 a = pool.push(&slots, a, [i, i], Some(u64::from(i) + 1));
             }
             // Blocks of 1 (epoch 2) and 2 (epoch 3) slots are retired, not free.
