@@ -223,10 +223,7 @@ const CURVES: &[Curve] = &[Curve {
 }];
 
 fn main() -> ExitCode {
-    if let Some(code) = sim_run::cli::refuse_unsupported_cpu("animat") {
-        return code;
-    }
-    if let Some(code) = sim_run::ensemble::merge_main("animat", CURVES) {
+    if let Some(code) = sim_run::ensemble::before_parsing("animat", CURVES) {
         return code;
     }
     sim_run::cli::main_with(

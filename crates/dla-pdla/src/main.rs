@@ -308,10 +308,7 @@ const CURVES: &[Curve] = &[Curve {
 }];
 
 fn main() -> ExitCode {
-    if let Some(code) = sim_run::cli::refuse_unsupported_cpu("dla") {
-        return code;
-    }
-    if let Some(code) = sim_run::ensemble::merge_main("dla", CURVES) {
+    if let Some(code) = sim_run::ensemble::before_parsing("dla", CURVES) {
         return code;
     }
     sim_run::cli::main_with_config(

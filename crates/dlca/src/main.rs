@@ -290,10 +290,7 @@ const RUN_FILES: &[&str] = &[
 ];
 
 fn main() -> ExitCode {
-    if let Some(code) = sim_run::cli::refuse_unsupported_cpu("dlca") {
-        return code;
-    }
-    if let Some(code) = sim_run::ensemble::merge_main("dlca", CURVES) {
+    if let Some(code) = sim_run::ensemble::before_parsing("dlca", CURVES) {
         return code;
     }
     sim_run::cli::main_with_config(

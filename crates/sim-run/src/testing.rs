@@ -507,9 +507,8 @@ pub struct Ownership<'a> {
     pub checkpointed: &'a [&'a str],
 }
 
-/// Runs `binary` with `args` in `dir` and checks a usage refusal: exit code 2 and one stderr
-/// line `program: error: ...` containing every one of `needles`. Returns the line.
-pub fn expect_refusal(o: &Ownership<'_>, args: &[&str], needles: &[&str]) -> String {
+/// Runs `o.binary` with `args` in `o.dir`, without input: its output and its stderr as text.
+fn run_in(o: &Ownership<'_>, args: &[&str]) -> (std::process::Output, String) {
     let out = Command::new(o.binary)
         .args(args)
         .current_dir(o.dir)
@@ -517,6 +516,13 @@ pub fn expect_refusal(o: &Ownership<'_>, args: &[&str], needles: &[&str]) -> Str
         .output()
         .expect("the binary runs");
     let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    (out, stderr)
+}
+
+/// Runs `binary` with `args` in `dir` and checks a usage refusal: exit code 2 and one stderr
+/// line `program: error: ...` containing every one of `needles`. Returns the line.
+pub fn expect_refusal(o: &Ownership<'_>, args: &[&str], needles: &[&str]) -> String {
+    let (out, stderr) = run_in(o, args);
     let lines: Vec<&str> = stderr.lines().collect();
     assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
     assert_eq!(lines.len(), 1, "{args:?}: not one line: {stderr}");
@@ -532,13 +538,7 @@ pub fn expect_refusal(o: &Ownership<'_>, args: &[&str], needles: &[&str]) -> Str
 
 /// Runs `binary` with `args` in `dir`, asserting success; returns stderr.
 fn expect_success(o: &Ownership<'_>, args: &[&str]) -> String {
-    let out = Command::new(o.binary)
-        .args(args)
-        .current_dir(o.dir)
-        .stdin(Stdio::null())
-        .output()
-        .expect("the binary runs");
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let (out, stderr) = run_in(o, args);
     assert!(out.status.success(), "{args:?}: {stderr}");
     stderr
 }

@@ -558,6 +558,13 @@ fn terminate(child: &std::process::Child) {
 #[cfg(not(unix))]
 fn terminate(_child: &std::process::Child) {}
 
+/// What every binary does before it parses its flags: refuses a processor the build cannot
+/// run on ([`crate::cli::refuse_unsupported_cpu`]) and handles `PROG --merge DIR`
+/// ([`merge_main`]). `Some(exit code)` when either ended the program.
+pub fn before_parsing(program: &str, curves: &[Curve]) -> Option<ExitCode> {
+    crate::cli::refuse_unsupported_cpu(program).or_else(|| merge_main(program, curves))
+}
+
 /// Handles `PROG --merge DIR` (exactly those arguments) before the model parses its flags:
 /// rebuilds the combined result of the members in `DIR`. `None` for any other command line.
 pub fn merge_main(program: &str, curves: &[Curve]) -> Option<ExitCode> {
