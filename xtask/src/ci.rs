@@ -200,13 +200,25 @@ fn venv_python() -> PathBuf {
     workspace_root().join("target/ci-venv/bin/python")
 }
 
-/// Removes cargo's unpacked copies of the workspace's own crates from the local registries
-/// `cargo package` made before (`$CARGO_HOME/registry/src/-<hash>/<crate>-<version>`): cargo
-/// unpacks a package of the same name and version only once, so a second packaging would
-/// verify a crate against the first one's dependencies (seen here: `animat` verified against a
-/// `spatial` from before `spatial::cells` existed). Crates from crates.io are not touched:
-/// their registry directories are named after the index, never starting with `-`.
+/// The target directory of the package step, apart from the ordinary one: the verification
+/// builds compile our crates as registry crates, which cargo never rebuilds for changed
+/// sources, so each packaging starts from an empty one.
+const PACKAGE_TARGET: &str = "target/package-check";
+
+/// Removes what an earlier `cargo package` left that a new one would take for current: the
+/// unpacked copies of the workspace's own crates from its local registry
+/// (`$CARGO_HOME/registry/src/-<hash>/<crate>-<version>`), which cargo unpacks once per name
+/// and version, and the verification builds ([`PACKAGE_TARGET`]), which cargo reuses for a
+/// registry crate of the same version without looking at its sources. Otherwise a second
+/// packaging verifies a crate against the first one's dependencies (seen here: `animat`
+/// against a `spatial` from before `spatial::cells` existed). Crates from crates.io are not
+/// touched: their registry directories are named after the index, never starting with `-`.
 fn forget_packaged_sources() -> Result<()> {
+    let builds = workspace_root().join(PACKAGE_TARGET);
+    if builds.exists() {
+        std::fs::remove_dir_all(&builds)
+            .with_context(|| format!("removing {}", builds.display()))?;
+    }
     let home = std::env::var_os("CARGO_HOME")
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cargo")));
@@ -255,7 +267,9 @@ fn run_step(step: &Step) -> Result<()> {
             let args = "package --workspace --exclude xtask --allow-dirty";
             eprintln!("==> {}: cargo {args}", step.name);
             status(
-                Command::new(cargo()).args(args.split_whitespace()),
+                Command::new(cargo())
+                    .args(args.split_whitespace())
+                    .env("CARGO_TARGET_DIR", PACKAGE_TARGET),
                 &format!("cargo {args}"),
             )
         }
