@@ -325,13 +325,13 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     };
     world.set_timing(cli.timing);
     // Ours until the run ends: refused if another run holds it or it holds an earlier run.
-    let _lock = sim_run::cli::own_out_dir(&sim_run::cli::Claim {
-        out: cli.out(),
-        run_files: RUN_FILES,
-        resume: cli.resume.as_deref(),
-        overwrite: cli.overwrite.overwrite,
-        ensemble: false,
-    })?;
+    let claim = sim_run::cli::Claim::single(
+        cli.out(),
+        RUN_FILES,
+        cli.resume.as_deref(),
+        cli.overwrite.overwrite,
+    );
+    let _lock = sim_run::cli::own_out_dir(&claim)?;
     // The effective parameters, so that `--config OUT/config.toml` repeats the run.
     sim_run::io::write_atomic(
         cli.out().join("config.toml"),

@@ -127,6 +127,24 @@ pub struct Claim<'a> {
     pub ensemble: bool,
 }
 
+impl<'a> Claim<'a> {
+    /// The claim of a single run (not an ensemble) on `out`.
+    pub fn single(
+        out: &'a Path,
+        run_files: &'a [&'a str],
+        resume: Option<&'a Path>,
+        overwrite: bool,
+    ) -> Self {
+        Claim {
+            out,
+            run_files,
+            resume,
+            overwrite,
+            ensemble: false,
+        }
+    }
+}
+
 /// What an earlier run left in a directory.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct EarlierRun {
