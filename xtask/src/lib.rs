@@ -42,8 +42,12 @@ pub fn cargo() -> String {
 }
 
 /// For the integration tests: the model binaries (`dla`, `dlca`, `animat`) of the calling test's
-/// build profile, built if missing or stale (a no-op after `cargo test --workspace`, which builds
-/// them for the models' own tests). Returns their directory, `target/<profile>`.
+/// build profile, built if missing or stale. Returns their directory, `target/<profile>`.
+///
+/// The build is `cargo test --workspace --no-run`, the README's test command without running
+/// the tests: it unifies the dependencies' features exactly as that command does, so under it
+/// the build is a no-op, while a plain `cargo build --bins` would resolve other features
+/// (without the dev-dependencies') and rebuild the binaries and their dependencies once more.
 ///
 /// # Panics
 /// If the test's own path is not `target/<profile>/deps/<test>` or cargo fails.
@@ -55,14 +59,12 @@ pub fn model_binaries_for_tests() -> PathBuf {
         .expect("target/<profile>/deps/<test>")
         .to_path_buf();
     let mut cmd = std::process::Command::new(cargo());
-    cmd.args([
-        "build", "-p", "dla-pdla", "-p", "dlca", "-p", "animat", "--bins",
-    ])
-    .current_dir(workspace_root());
+    cmd.args(["test", "--workspace", "--no-run", "--quiet"])
+        .current_dir(workspace_root());
     if profile_dir.file_name().is_some_and(|n| n == "release") {
         cmd.arg("--release");
     }
-    let status = cmd.status().expect("starting cargo build");
+    let status = cmd.status().expect("starting cargo test --no-run");
     assert!(status.success(), "building the model binaries failed");
     profile_dir
 }

@@ -183,3 +183,128 @@ fn the_readme_commands_run() {
     }
     assert!(ran >= 5, "only {ran} README commands found");
 }
+
+/// The numbers in `text`, in order, as written (`4.66`, `16.8`; a `-` between two numbers is a
+/// range, not a sign).
+fn numbers(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    for c in text.chars().chain(std::iter::once(' ')) {
+        if c.is_ascii_digit() || (c == '.' && !cur.is_empty()) {
+            cur.push(c);
+        } else {
+            let n = cur.trim_end_matches('.');
+            if !n.is_empty() {
+                out.push(n.to_string());
+            }
+            cur.clear();
+        }
+    }
+    out
+}
+
+/// Whether `quoted` is `actual` rounded to the decimals `quoted` shows.
+fn quotes(quoted: &str, actual: f64) -> bool {
+    let decimals = quoted.split_once('.').map_or(0, |(_, d)| d.len());
+    format!("{actual:.decimals$}") == quoted
+}
+
+/// The benchmark table of `docs/benchmarks.md` and the README's timing table quote the committed
+/// `docs/results/bench.json` (wall seconds of each round, CPU seconds, peak memory), so a new
+/// benchmark cannot land without the figures the docs show, and a figure cannot be edited by
+/// hand away from its measurement.
+#[test]
+fn the_benchmark_tables_quote_the_committed_bench_json() {
+    let root = workspace_root();
+    let json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root.join("docs/results/bench.json")).unwrap(),
+    )
+    .unwrap();
+    let workloads = json["workloads"].as_array().unwrap();
+    let md = std::fs::read_to_string(root.join("docs/benchmarks.md")).unwrap();
+    let rows = core_lattice::spec::markdown_table(&md, "## Headline workloads");
+    assert_eq!(
+        &rows[0][..6],
+        [
+            "workload",
+            "command (`target/release/...`)",
+            "wall s (three rounds)",
+            "CPU s",
+            "peak RSS",
+            "rate"
+        ]
+    );
+    assert_eq!(
+        rows.len() - 1,
+        workloads.len(),
+        "one row per workload of bench.json"
+    );
+    for (row, w) in rows[1..].iter().zip(workloads) {
+        let name = w["name"].as_str().unwrap();
+        let f = |k: &str| w[k].as_f64().unwrap();
+        let walls = numbers(row[2].split("round trip").next().unwrap());
+        let runs: Vec<f64> = w["wall_seconds_runs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert!(
+            quotes(&walls[0], f("wall_seconds")),
+            "{name}: wall {} in the docs, {} measured",
+            walls[0],
+            f("wall_seconds")
+        );
+        assert_eq!(
+            walls.len(),
+            1 + runs.len(),
+            "{name}: the rounds in {:?}",
+            row[2]
+        );
+        for (q, r) in walls[1..].iter().zip(&runs) {
+            assert!(quotes(q, *r), "{name}: round {q} in the docs, {r} measured");
+        }
+        let cpu = &numbers(&row[3])[0];
+        assert!(
+            quotes(cpu, f("cpu_seconds")),
+            "{name}: CPU {cpu} in the docs, {} measured",
+            f("cpu_seconds")
+        );
+        let rss = &numbers(&row[4])[0];
+        assert!(row[4].contains(" MB"), "{name}: peak RSS in MB: {}", row[4]);
+        assert!(
+            quotes(rss, f("peak_rss_bytes") / 1e6),
+            "{name}: {rss} MB in the docs, {} bytes measured",
+            f("peak_rss_bytes")
+        );
+    }
+
+    // The README's one-thread 2D 1e6 row: its time range holds the measured rounds, its bytes per
+    // particle is the measured peak over N.
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let line = readme
+        .lines()
+        .find(|l| l.starts_with("| 2D DLA, 1e6 particles, one thread |"))
+        .expect("the README's 2D 1e6 row");
+    let cell = line.split('|').nth(2).unwrap();
+    let q: Vec<f64> = numbers(cell).iter().map(|n| n.parse().unwrap()).collect();
+    let w = workloads
+        .iter()
+        .find(|w| w["name"] == "dla-2d-1e6-1thread")
+        .unwrap();
+    for r in w["wall_seconds_runs"].as_array().unwrap() {
+        let r = r.as_f64().unwrap();
+        assert!(
+            q[0] <= r && r <= q[1],
+            "README: {}-{} s, a round took {r} s",
+            q[0],
+            q[1]
+        );
+    }
+    let bpp = w["peak_rss_bytes"].as_f64().unwrap() / 1e6;
+    assert!(
+        quotes(&numbers(cell)[2], bpp),
+        "README: {} bytes per particle, {bpp} measured",
+        q[2]
+    );
+}

@@ -48,15 +48,15 @@ struct Cli {
     #[arg(long)]
     dump_config: bool,
 
-    /// Foxes at the start.
+    /// Foxes at the start [default: 300].
     #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     foxes: Option<u64>,
 
-    /// Rabbits at the start.
+    /// Rabbits at the start [default: 2000].
     #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     rabbits: Option<u64>,
 
-    /// Radius of the start disc around the origin, in cells, 0..=1073741824.
+    /// Radius of the start disc around the origin, in cells, 0..=1073741824 [default: 60].
     #[arg(long, conflicts_with = "density")]
     start_radius: Option<i64>,
 
@@ -66,12 +66,12 @@ struct Cli {
     #[arg(long, allow_hyphen_values = true)]
     density: Option<f64>,
 
-    /// Vision radius in cells, 1..=1073741824.
+    /// Vision radius in cells, 1..=1073741824 [default: 60].
     #[arg(long)]
     vision: Option<i64>,
 
-    /// Grid-box side in cells: a positive integer, `vision` or `none` (exhaustive search); by default
-    /// `vision`. Changes only the speed, never the result.
+    /// Grid-box side in cells: a positive integer, `vision` or `none` (exhaustive search).
+    /// Changes only the speed, never the result [default: vision].
     #[arg(long)]
     grid_box: Option<String>,
 

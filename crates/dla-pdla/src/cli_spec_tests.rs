@@ -18,7 +18,7 @@ fn spec() -> CliSpec<'static> {
 
 #[test]
 fn every_parameter_is_a_flag_with_the_library_default_and_choices() {
-    spec().check_flags(&Cli::command(), true);
+    spec().check_flags(&Cli::command());
 }
 
 #[test]

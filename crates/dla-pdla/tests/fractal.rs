@@ -3,11 +3,11 @@
 //! Sizes are chosen so the suite stays fast (dev profile): 2D 8 x 5e4 particles, 3D 8 x 1e4,
 //! 4D 8 x 4e3, 5D 8 x 1.5e3, exact-vs-vpdist 2 x 8 x 2e4 in 2D. Off-lattice DLA has D = 1.71 (2D) and 2.50 (3D)
 //! (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for random fractal
-//! cluster simulations", Table 2); small clusters have a lower effective D (about 1.66-1.67
-//! below 1e6 particles in 2D), and the cluster-to-cluster spread falls like N^-0.33. The
-//! tolerances (+-0.05 in 2D, +-0.10 in 3D) contain the finite-size value 1.66-1.67 and the
-//! seed spread of the mean over 8 clusters (of order 0.01), and they exclude the values a
-//! broken contact or far field would give (for example lattice-like or compact growth).
+//! cluster simulations", Table 2); fits that start at small N give a lower effective D, and the
+//! cluster-to-cluster spread falls like N^-0.33. The tolerances (+-0.05 in 2D, +-0.10 in 3D)
+//! contain the finite-size shift of these small clusters and the seed spread of the mean over
+//! 8 clusters (of order 0.01), and they exclude the values a broken contact or far field would
+//! give (for example lattice-like or compact growth).
 
 use core_lattice::Welford;
 use dla_pdla::{Dim, Params, Simulation, Space};

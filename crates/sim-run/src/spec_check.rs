@@ -75,10 +75,10 @@ impl<'a> CliSpec<'a> {
     }
 
     /// Every parameter with a flag is a flag of `cmd` whose help states its unit and range and
-    /// whose possible values are its choices; its default is the library's (or, with
-    /// `defaults_in_cli` false, the flag has none: the value then comes from a config file or
-    /// the library); every other long flag of `cmd` is a run flag.
-    pub fn check_flags(&self, cmd: &Command, defaults_in_cli: bool) {
+    /// whose possible values are its choices; its default is the library's, as clap's default
+    /// or, for a flag without one (its value may come from a config file), stated in its help
+    /// as `[default: X]`; every other long flag of `cmd` is a run flag.
+    pub fn check_flags(&self, cmd: &Command) {
         let mut unitless = Vec::new();
         for s in self.params {
             let Some(flag) = s.flag else { continue };
@@ -90,12 +90,11 @@ impl<'a> CliSpec<'a> {
             let help = arg.get_long_help().or(arg.get_help()).unwrap().to_string();
             let library = &self.defaults[s.name];
             match arg.get_default_values() {
-                [] if !defaults_in_cli => {}
-                [v] if defaults_in_cli => assert!(
+                [v] => assert!(
                     same_default(&v.to_string_lossy(), &show(library)),
                     "--{flag}: default {v:?} in the CLI, {library} in the library"
                 ),
-                [] if defaults_in_cli => {
+                [] => {
                     // A switch is off unless given; a required flag or a library without a
                     // default has none; an optional flag refused where unused states the
                     // library's default in its help.
@@ -157,15 +156,24 @@ impl<'a> CliSpec<'a> {
             );
         }
         let help = cmd.clone().render_long_help().to_string();
-        assert!(!help.contains("[`"), "rustdoc markup in the help: {help}");
+        assert!(
+            !help.contains("[`") && !help.contains("crate::"),
+            "rustdoc markup in the help: {help}"
+        );
+        let foreign = foreign_flags(cmd, &help);
+        assert!(
+            foreign.is_empty(),
+            "`{} --help` names flags it does not have (another model's?): {foreign:?}",
+            self.program
+        );
     }
 
     /// A docs table (`rows`, header first, as `core_lattice::spec::markdown_table` reads it)
     /// against the table: for each parameter, the row `find_row` picks states the library's
     /// default in column `default` (unless the row names several flags or the library has no
     /// default) and the range or choices in column `range`; every flag the column `flags`
-    /// names exists in `cmd` (or is `--merge`, read before the parser). `doc` names the file
-    /// in messages.
+    /// names exists in `cmd`, and every long flag of `cmd` is in that column of some row.
+    /// `doc` names the file in messages.
     pub fn check_docs_table(
         &self,
         doc: &str,
@@ -205,17 +213,29 @@ impl<'a> CliSpec<'a> {
                 ),
             }
         }
-        for r in &rows[1..] {
-            for f in flags_of(&r[columns.flags]) {
-                if let Some(long) = f.strip_prefix("--") {
-                    assert!(
-                        long == "merge" || cmd.get_arguments().any(|a| a.get_long() == Some(long)),
-                        "{doc} lists {f}, which `{}` does not have",
-                        self.program
-                    );
-                }
+        let listed: Vec<String> = rows[1..]
+            .iter()
+            .flat_map(|r| flags_of(&r[columns.flags]))
+            .collect();
+        for f in &listed {
+            if let Some(long) = f.strip_prefix("--") {
+                assert!(
+                    cmd.get_arguments().any(|a| a.get_long() == Some(long)),
+                    "{doc} lists {f}, which `{}` does not have",
+                    self.program
+                );
             }
         }
+        let unlisted: Vec<&str> = cmd
+            .get_arguments()
+            .filter_map(|a| a.get_long())
+            .filter(|long| *long != "help" && !listed.contains(&format!("--{long}")))
+            .collect();
+        assert!(
+            unlisted.is_empty(),
+            "flags of `{}` missing from {doc}'s option list: {unlisted:?}",
+            self.program
+        );
     }
 }
 
@@ -254,4 +274,52 @@ pub fn flags_of(cell: &str) -> Vec<String> {
         })
         .filter(|f| !f.is_empty())
         .collect()
+}
+
+/// The flags `help` names that are not long flags of `cmd`, written `--flag` or as a config
+/// key in backquotes (`` `flag = 1` ``): a help text that names another model's flag (or a
+/// renamed one) misleads whoever follows it.
+pub fn foreign_flags(cmd: &Command, help: &str) -> Vec<String> {
+    // clap adds --help and --version when it builds the command.
+    let own: Vec<String> = cmd
+        .get_arguments()
+        .filter_map(|a| a.get_long())
+        .chain(["help", "version"])
+        .map(str::to_string)
+        .collect();
+    let name_at = |rest: &str| -> String {
+        let name: String = rest
+            .chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+            .collect();
+        name.trim_end_matches(['-', '_']).replace('_', "-")
+    };
+    let dashed = help.split("--").skip(1).map(name_at);
+    let keys = help.split('`').skip(1).filter_map(|rest| {
+        let name = name_at(rest);
+        rest[name.len()..].starts_with(" = ").then_some(name)
+    });
+    let mut foreign: Vec<String> = dashed
+        .chain(keys)
+        .filter(|n| n.starts_with(|c: char| c.is_ascii_lowercase()) && !own.contains(n))
+        .collect();
+    foreign.sort();
+    foreign.dedup();
+    foreign
+}
+
+#[cfg(test)]
+mod tests {
+    use super::foreign_flags;
+    use clap::{Arg, Command};
+
+    #[test]
+    fn foreign_flags_are_found_as_flags_and_as_config_keys() {
+        let cmd = Command::new("m")
+            .arg(Arg::new("size").long("size"))
+            .arg(Arg::new("fill").long("fill"));
+        let help = "Use --size and --fill, `size = 4` or `step-min = 0.1`; see --particles. \
+                    Also -q, -- and --help.";
+        assert_eq!(foreign_flags(&cmd, help), ["particles", "step-min"]);
+    }
 }

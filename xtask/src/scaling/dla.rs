@@ -240,7 +240,7 @@ fn table2(ctx: &Ctx, doc: &mut Doc) -> Result<Vec<DimRow>> {
             }
             let reference = match d {
                 2 => {
-                    "paper: 1.7106 (sigma 0.0047, N 1e9, P 1, E 10); 1.7125 (0.0129, 1e9, P 4, E 80); literature 1.71; about 1.66-1.67 below 1e6 (finite size, `docs/dla.md`)"
+                    "paper: 1.7106 (sigma 0.0047, N 1e9, P 1, E 10); 1.7125 (0.0129, 1e9, P 4, E 80); literature 1.71"
                 }
                 _ => {
                     "paper: 2.5312 (sigma 0.0082, N 1e8, P 1, E 50); 2.5032 (0.0172, 1e8, P 4, E 80); literature 2.50 +- 0.02"

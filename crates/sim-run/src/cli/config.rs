@@ -16,9 +16,9 @@ use std::sync::OnceLock;
 /// The flags `--config` and `--dump-config`, flattened into a binary's flags.
 #[derive(Debug, Clone, Default, clap::Args)]
 pub struct ConfigArgs {
-    /// TOML file of flags (`particles = 100000`, `step-min = 0.1`, `png = true`): read as if
-    /// given before the command line's flags, which win. A run saves its own as
-    /// OUT/config.toml, so `--config OUT/config.toml` repeats it.
+    /// TOML file of flags, one NAME = VALUE per line with the long flag's name (--dump-config
+    /// prints every one): read as if given before the command line's flags, which win. A run saves its own
+    /// as OUT/config.toml, so `--config OUT/config.toml` repeats it.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
 

@@ -52,6 +52,11 @@ pub struct EnsembleArgs {
     /// With --seeds: members run at once (default: the cores divided by each member's threads).
     #[arg(long, value_name = "J", requires = "seeds", value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub jobs: Option<u64>,
+
+    /// Rebuild an ensemble's combined result (ensemble.json, ensemble.md, averaged curves) from
+    /// the members in DIR, finished or not, and exit: `PROG --merge DIR`, with no other flag.
+    #[arg(long, value_name = "DIR", exclusive = true)]
+    pub merge: Option<PathBuf>,
 }
 
 impl EnsembleArgs {
