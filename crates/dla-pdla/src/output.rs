@@ -161,6 +161,7 @@ where
         .set_result("pdla_parallel_seconds", sim.parallel_seconds())
         .set_result("pdla_lock_wait_seconds", sim.lock_wait_seconds())
         .set_result("pdla_phases", sim.pdla_phases())
+        .set_result("walk_counts", json!(sim.walk_counts()))
         .set_result("state_hash", sim.state_hash())
         .set_result("tree_memory_bytes", sim.tree().memory_bytes() as u64)
         // Against the 2^32 - 2 the tree's 32-bit indices can number: the headroom left.

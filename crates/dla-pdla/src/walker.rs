@@ -70,8 +70,10 @@ where
         // Far field. The margin keeps a walker just returned to the birth sphere (whose norm
         // may round to slightly above r_b) in the near field, which is valid everywhere;
         // without it a walker at r_b (1 + 1e-16) would be "returned" to itself forever.
+        state.counts.moves += 1;
         if r > r_b * FAR_FIELD_MARGIN {
-            state.reset();
+            state.counts.far_field += 1;
+            state.forget();
             match params.far_field {
                 FarField::Return => self.p = Dim::<D>::return_to_sphere(&self.p, r_b, rng),
                 FarField::Jump => {
@@ -93,6 +95,7 @@ where
         // (region / cap)^2 moves to cross them, a cost growing with the cluster. There the
         // tree's distance, a few hundred nanoseconds, gives the long jump instead.
         let mut floor = 0.0;
+        state.counts.map_reads += 1;
         if let Some((lb, ub, capped)) = cluster.map_bounds(&self.p) {
             // The map bounds the distance from above too: a walker with no answer yet (just
             // born or returned) or a looser one starts its tree query from the few nodes
@@ -101,6 +104,7 @@ where
             if capped {
                 floor = lb;
             } else if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
+                state.counts.map_jumps += 1;
                 self.jump(lb - 1.0, rng);
                 state.upper += (lb - 1.0) * (1.0 + 1e-9);
                 return None;
@@ -110,16 +114,21 @@ where
         // Near the cluster the walker's near cache gives the same exact answer as the tree.
         let tree = cluster.tree();
         let (est, nearest) = match state.near_query(&self.p, tree) {
-            Some((distance, x)) => (
-                VpEstimate {
-                    distance,
-                    half_diagonal: None,
-                },
-                Some(x),
-            ),
-            None => tree
-                .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
-                .expect("the cluster is never empty"),
+            Some((distance, x)) => {
+                state.counts.near_answers += 1;
+                (
+                    VpEstimate {
+                        distance,
+                        half_diagonal: None,
+                    },
+                    Some(x),
+                )
+            }
+            None => {
+                state.counts.tree_queries += 1;
+                tree.vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
+                    .expect("the cluster is never empty")
+            }
         };
         state.anchor = nearest;
         // The exact distance is at most the estimate + 2 r (the gap of a far node's bound), with
@@ -138,6 +147,7 @@ where
         // `covers` is false unless the cache was built, which only `near_query` does, and only
         // when the cache is on.
         let t = if state.near.covers(&self.p, r) {
+            state.counts.contact_near += 1;
             // The same particles as the tree's range query (see `near`), so the same contact.
             let mut best = (f64::INFINITY, [0.0; D]);
             state
@@ -145,6 +155,7 @@ where
                 .for_each_within(&self.p, r, |q| contact(&self.p, &u, &q, &mut best));
             (best.0 <= params.step_min).then_some(best)
         } else {
+            state.counts.contact_tree += 1;
             first_contact_with(tree, &self.p, &u, params.step_min)
         };
         if let Some((t, touched)) = t {
@@ -243,6 +254,54 @@ pub(crate) struct WalkState<const D: usize> {
     /// wherever the cache answers (`(kappa - 1/2)` leaf diagonals cover [`NEAR_RADIUS`]).
     near_on: bool,
     near: NearCache<D>,
+    /// What the walkers of this state did, summed over them.
+    pub(crate) counts: WalkCounts,
+}
+
+/// What walkers did, summed over walkers (and over threads, for a run): the software counts
+/// behind the cost of a particle, since this machine class exposes no hardware counters.
+/// Counting is a handful of register increments per move, so it is always on. Every move
+/// ends in exactly one of: a far-field return, a map jump, a tree or near-cache jump, or a
+/// step of `step_min` (with a contact search, by the cache or the tree).
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct WalkCounts {
+    /// Walkers released (a PDLA walker discarded at the re-check counts as released).
+    pub walkers: u64,
+    /// Moves: calls of the walk's one step, whatever it did.
+    pub moves: u64,
+    /// Moves in the far field (returned to the birth sphere, or the paper's far jump).
+    pub far_field: u64,
+    /// Distance-map reads (one per near-field move; each reads a cell of every level it
+    /// needs).
+    pub map_reads: u64,
+    /// Moves that ended in a jump by the map's bound, without a tree query.
+    pub map_jumps: u64,
+    /// Nearest-distance answers from the near cache.
+    pub near_answers: u64,
+    /// Near-cache rebuilds (a range query of the tree each).
+    pub near_rebuilds: u64,
+    /// Nearest-distance queries of the tree (variable-precision search).
+    pub tree_queries: u64,
+    /// Contact searches of a `step_min` step answered by the near cache.
+    pub contact_near: u64,
+    /// Contact searches of a `step_min` step answered by the tree.
+    pub contact_tree: u64,
+}
+
+impl WalkCounts {
+    /// Adds `other`'s counts to these.
+    pub fn add(&mut self, other: &WalkCounts) {
+        self.walkers += other.walkers;
+        self.moves += other.moves;
+        self.far_field += other.far_field;
+        self.map_reads += other.map_reads;
+        self.map_jumps += other.map_jumps;
+        self.near_answers += other.near_answers;
+        self.near_rebuilds += other.near_rebuilds;
+        self.tree_queries += other.tree_queries;
+        self.contact_near += other.contact_near;
+        self.contact_tree += other.contact_tree;
+    }
 }
 
 impl<const D: usize> WalkState<D> {
@@ -259,11 +318,18 @@ impl<const D: usize> WalkState<D> {
             touched: None,
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
             near: NearCache::new(),
+            counts: WalkCounts::default(),
         }
     }
 
     /// A new walker: nothing known.
     pub(crate) fn reset(&mut self) {
+        self.counts.walkers += 1;
+        self.forget();
+    }
+
+    /// Forgets what the walker knew (it left for the far field).
+    fn forget(&mut self) {
         self.upper = f64::INFINITY;
         self.anchor = None;
         self.touched = None;
@@ -333,6 +399,7 @@ impl<const D: usize> WalkState<D> {
             return Some(hit);
         }
         if self.upper(p) <= REBUILD_UPPER {
+            self.counts.near_rebuilds += 1;
             self.near.rebuild(tree, p);
             return self.near.nearest(p);
         }

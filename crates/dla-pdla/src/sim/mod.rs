@@ -388,6 +388,14 @@ impl<const D: usize> Simulation<D> {
         self.pdla.lock_wait_seconds
     }
 
+    /// What this process's walkers did (serial and parallel phases; a resumed run counts from
+    /// its resume): the software counts behind the cost per particle.
+    pub fn walk_counts(&self) -> crate::walker::WalkCounts {
+        let mut c = self.serial.walk.counts;
+        c.add(&self.pdla.walk);
+        c
+    }
+
     /// PDLA phases run: one per growth call or checkpoint interval, plus one each time the
     /// shared tree needed more room than reserved (0 with one thread).
     pub fn pdla_phases(&self) -> u64 {

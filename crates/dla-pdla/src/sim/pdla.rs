@@ -15,7 +15,7 @@ use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use crate::walker::{WalkState, Walker};
+use crate::walker::{WalkCounts, WalkState, Walker};
 use core_lattice::rng::{Rng, stream, stream_id};
 use parking_lot::Mutex;
 use spatial::orthtree::{OrthtreeError, dist_sq};
@@ -38,6 +38,8 @@ pub(crate) struct PdlaStats {
     pub(crate) lock_wait_seconds: f64,
     /// Parallel phases run (one per call, more when the tree needed more room).
     pub(crate) phases: u64,
+    /// What the threads' walkers did.
+    pub(crate) walk: WalkCounts,
 }
 
 /// The first phase reserves the tree's root for this many times the expected radius of the
@@ -186,25 +188,34 @@ where
         final_target: params.particles,
         wait_nanos: &wait_nanos,
     };
-    std::thread::scope(|s| {
-        for t in 0..threads {
-            s.spawn(move || {
-                let mut me = Thread {
-                    r_ext: r_ext0,
-                    applied: start,
-                    pending: Vec::new(),
-                    index: t,
-                    walk: WalkState::new(params),
-                };
-                // Round 0 draws from the streams of a run without checkpoints.
-                let index = round.wrapping_mul(1024).wrapping_add(t as u32);
-                let mut rng = stream(seed, stream_id(PURPOSE_PDLA, index));
-                ctx.walk(&mut me, params, &mut rng, progress);
-                // A finished thread no longer holds anything from the tree.
-                ctx.slots[t].epoch.store(u64::MAX, Ordering::Release);
-            });
+    let walk = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                s.spawn(move || {
+                    let mut me = Thread {
+                        r_ext: r_ext0,
+                        applied: start,
+                        pending: Vec::new(),
+                        index: t,
+                        walk: WalkState::new(params),
+                    };
+                    // Round 0 draws from the streams of a run without checkpoints.
+                    let index = round.wrapping_mul(1024).wrapping_add(t as u32);
+                    let mut rng = stream(seed, stream_id(PURPOSE_PDLA, index));
+                    ctx.walk(&mut me, params, &mut rng, progress);
+                    // A finished thread no longer holds anything from the tree.
+                    ctx.slots[t].epoch.store(u64::MAX, Ordering::Release);
+                    me.walk.counts
+                })
+            })
+            .collect();
+        let mut walk = WalkCounts::default();
+        for h in handles {
+            walk.add(&h.join().expect("a PDLA thread panicked"));
         }
+        walk
     });
+    stats.walk.add(&walk);
     stats.seconds += started.elapsed().as_secs_f64();
     stats.lock_wait_seconds += wait_nanos.into_inner() as f64 * 1e-9;
     let mut log = log.into_inner();
