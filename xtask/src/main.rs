@@ -94,6 +94,18 @@ enum Cmd {
         #[arg(long, default_value_t = 1)]
         repeat: usize,
     },
+    /// Measure this machine's memory latency: a pointer chase through one random cycle of
+    /// cache lines, at working sets from 16 KiB to --max (powers of two), with 4 KiB pages and
+    /// with transparent huge pages; prints a markdown table (the floor under DLA's cost per
+    /// memory read, docs/benchmarks.md "DLA at scale"). Run it on a quiet machine.
+    Latency {
+        /// Largest working set, in bytes (suffixes K, M, G).
+        #[arg(long, default_value = "4G", value_parser = sim_run::memory::parse_bytes)]
+        max: u64,
+        /// Dependent loads timed per size.
+        #[arg(long, default_value_t = 20_000_000)]
+        loads: u64,
+    },
     /// Fuzz every reader of a file a user can hand the programs (checkpoints, positions.npy,
     /// config files, ensemble members for --merge) with many cases of arbitrary bytes and
     /// mutated valid files; prints cases and seconds per reader (xtask/src/fuzz.rs).
@@ -174,6 +186,10 @@ fn main() -> Result<()> {
             against.as_deref(),
         )
         .map(|_| ()),
+        Cmd::Latency { max, loads } => {
+            print!("{}", xtask::probe::latency_table(max as usize, loads));
+            Ok(())
+        }
         Cmd::Fuzz { cases, only } => {
             xtask::fuzz::run(&workspace_root(), &cargo(), cases, only.as_deref())
         }
