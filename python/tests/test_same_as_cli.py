@@ -14,6 +14,8 @@ MEASURED = {
     "cpu_seconds",
     "peak_rss_bytes",
     "bytes_per_particle",
+    "simulation_peak_rss_bytes",
+    "output_peak_rss_bytes",
     "pdla_parallel_seconds",
     "pdla_lock_wait_seconds",
 }
