@@ -336,3 +336,9 @@ def animat(
     progress: Progress = None,
 ) -> AnimatResult:
     """Run the animat model; see ``help(aggsim.animat)``."""
+
+def dlca_pooled_fit(
+    results: Sequence[DlcaResult], fit_min_size: Optional[Count] = None
+) -> Dict[str, Any]:
+    """The fractal dimension pooled over the clusters of every run (jackknife error over runs),
+    beside the mean of the runs' own fits: ``ensemble.json``'s ``pooled.fractal_dimension``."""

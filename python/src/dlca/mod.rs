@@ -485,3 +485,89 @@ pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
     o.insert("seed".into(), 1.into());
     crate::convert::json(py, &serde_json::Value::Object(o))
 }
+
+/// The fractal dimension of an ensemble of DLCA runs as the literature computes it: one fit of
+/// ``log s = D log R_g + c`` over the clusters of every run (pooled), with the jackknife error
+/// over runs (the runs are the independent units), beside the mean and standard error of the
+/// runs' own fits. The keys are those of ``ensemble.json``'s ``pooled.fractal_dimension`` that
+/// ``dlca --seeds ... --gyration`` writes.
+///
+/// Parameters
+/// ----------
+/// results : sequence of DlcaResult
+///     Runs made with ``gyration=True`` (one per seed, same parameters).
+/// fit_min_size : int, optional
+///     Smallest cluster in the fit; default: the runs' ``fit_min_size``.
+///
+/// Returns
+/// -------
+/// dict
+///     ``fractal_dimension``, ``fractal_dimension_stderr`` (jackknife over runs; None for one
+///     run), ``stderr_method``, ``fit_stderr`` (the pooled regression's), ``fit_clusters``,
+///     ``fit_min_size``, ``members``, ``per_member_mean``, ``per_member_stderr``,
+///     ``per_member_fits``.
+///
+/// Raises
+/// ------
+/// ValueError
+///     A run without ``gyration``, runs with different ``fit_min_size`` and none given, or
+///     fewer than 3 clusters to fit.
+#[pyfunction]
+#[pyo3(signature = (results, fit_min_size = None))]
+pub fn dlca_pooled_fit<'py>(
+    py: Python<'py>,
+    results: Vec<Bound<'py, DlcaResult>>,
+    fit_min_size: Option<Count>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut runs = Vec::with_capacity(results.len());
+    let mut sizes = Vec::new();
+    for (i, r) in results.iter().enumerate() {
+        let g = r.getattr("gyration")?;
+        if g.is_none() {
+            return Err(value_error(format!(
+                "results[{i}] was run without gyration=True: it has no clusters to pool"
+            )));
+        }
+        let ids: Vec<u32> = g
+            .get_item("cluster")?
+            .extract::<Vec<i64>>()?
+            .iter()
+            .map(|&v| v as u32)
+            .collect();
+        let size: Vec<u64> = g.get_item("size")?.extract()?;
+        let rg: Vec<f64> = g.get_item("radius_of_gyration")?.extract()?;
+        let wraps: Vec<bool> = g.get_item("wraps")?.extract()?;
+        runs.push(
+            (0..ids.len())
+                .map(|k| ::dlca::analysis::ClusterMeasure {
+                    id: ids[k],
+                    size: size[k],
+                    radius_of_gyration: rg[k],
+                    wraps: wraps[k],
+                })
+                .collect::<Vec<_>>(),
+        );
+        sizes.push(
+            r.getattr("params")?
+                .get_item("fit_min_size")?
+                .extract::<u64>()?,
+        );
+    }
+    let min_size = match fit_min_size {
+        Some(v) => count(PARAMS, "fit_min_size", v)?,
+        None => {
+            sizes.dedup();
+            match sizes.as_slice() {
+                [one] => *one,
+                [] => return Err(value_error("results is empty: nothing to pool")),
+                _ => {
+                    return Err(value_error(
+                        "the runs differ in fit_min_size; give fit_min_size",
+                    ));
+                }
+            }
+        }
+    };
+    let summary = ::dlca::output::pooled_summary(&runs, min_size).map_err(value_error)?;
+    crate::convert::json(py, &summary)
+}
