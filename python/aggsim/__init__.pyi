@@ -34,7 +34,8 @@ class DlaResult:
     positions: npt.NDArray[np.float64]
     """float64 (N, D): centres in arrival order, seed particle first."""
     growth: Dict[str, npt.NDArray[Any]]
-    """``N`` (uint64), ``R_g``, ``R_ext``, ``seconds`` (float64) per growth sample."""
+    """``growth.csv``'s columns: ``n`` (uint64), ``radius_of_gyration``, ``r_ext``,
+    ``seconds`` (float64) per growth sample."""
     state_hash: str
     particles: int
     radius_of_gyration: float

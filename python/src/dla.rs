@@ -31,9 +31,9 @@ const PARTICLES: u64 = 100_000;
 ///     first, at the origin); diameters are 1.
 /// growth : dict[str, numpy.ndarray]
 ///     The growth samples (200 log-spaced sizes per decade and the final size), as the
-///     binary's ``growth.csv``: ``N`` (uint64, particles), ``R_g`` (radius of gyration),
-///     ``R_ext`` (largest centre distance from the origin), ``seconds`` (wall time since the
-///     start of growth).
+///     binary's ``growth.csv``, same names and dtypes: ``n`` (uint64, particles),
+///     ``radius_of_gyration``, ``r_ext`` (largest centre distance from the origin; both float64,
+///     diameters), ``seconds`` (float64, wall time since the start of growth).
 /// state_hash : str
 ///     16 hex digits, a hash of the positions in arrival order: the binary's for the same
 ///     seed and parameters (with one thread).
@@ -249,13 +249,13 @@ where
     let m = dla_pdla::output::manifest(&sim, clock).map_err(run_error)?;
     let samples = sim.samples();
     let growth = Columns::default()
-        .add(py, "N", samples.iter().map(|s| s.n).collect())
+        .add(py, "n", samples.iter().map(|s| s.n).collect())
         .add(
             py,
-            "R_g",
+            "radius_of_gyration",
             samples.iter().map(|s| s.radius_of_gyration).collect(),
         )
-        .add(py, "R_ext", samples.iter().map(|s| s.r_ext).collect())
+        .add(py, "r_ext", samples.iter().map(|s| s.r_ext).collect())
         .add(py, "seconds", samples.iter().map(|s| s.seconds).collect())
         .into_dict(py)?;
     let positions = sim
