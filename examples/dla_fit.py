@@ -22,9 +22,9 @@ import aggsim
 
 def fit_fractal_dimension(growth, n_min):
     """D_f and its standard error from a least-squares line through (log N, log R_g), N >= n_min."""
-    n = growth["N"].astype(float)
+    n = growth["n"].astype(float)
     keep = n >= n_min
-    x, y = np.log(n[keep]), np.log(growth["R_g"][keep])
+    x, y = np.log(n[keep]), np.log(growth["radius_of_gyration"][keep])
     (slope, intercept), cov = np.polyfit(x, y, 1, cov=True)
     d_f = 1.0 / slope
     # d(1/s) = ds / s^2. Log-spaced samples of one growing cluster are correlated: this error
@@ -52,7 +52,7 @@ def main():
     ax1.scatter(x, y, c=np.arange(len(x)), s=0.4, cmap="viridis", linewidths=0)
     ax1.set_aspect("equal")
     ax1.set_title(f"2D DLA, {r.particles} particles (colour: arrival order)")
-    n, rg = r.growth["N"].astype(float), r.growth["R_g"]
+    n, rg = r.growth["n"].astype(float), r.growth["radius_of_gyration"]
     ax2.loglog(n, rg, ".", ms=2, color="0.6", label="growth samples")
     ax2.loglog(n[keep], np.exp(intercept) * n[keep] ** slope, "r-",
                label=f"fit N >= {a.fit_from}: D_f = {d_f:.3f}")

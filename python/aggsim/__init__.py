@@ -34,6 +34,7 @@ from ._aggsim import (
     __version__,
     _params,
     defaults,
+    dlca_pooled_fit,
 )
 
 
@@ -83,4 +84,5 @@ __all__ = [
     "defaults",
     "dla",
     "dlca",
+    "dlca_pooled_fit",
 ]

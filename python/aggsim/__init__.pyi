@@ -14,6 +14,10 @@ FOX: int
 RABBIT: int
 """Species code of rabbits in ``species`` arrays (1)."""
 
+Count = Union[int, float]
+"""A count: an int, or a float holding a whole number (``1e4``, ``2.5e5``); ``1.5``, ``nan``
+and values beyond the parameter's range raise ``ValueError`` naming the parameter."""
+
 Progress = Union[None, bool, Callable[[int, int], Any]]
 """``True``: progress on ``sys.stderr``; a callable: called as ``progress(done, total)``."""
 
@@ -30,7 +34,8 @@ class DlaResult:
     positions: npt.NDArray[np.float64]
     """float64 (N, D): centres in arrival order, seed particle first."""
     growth: Dict[str, npt.NDArray[Any]]
-    """``N`` (uint64), ``R_g``, ``R_ext``, ``seconds`` (float64) per growth sample."""
+    """``growth.csv``'s columns: ``n`` (uint64), ``radius_of_gyration``, ``r_ext``,
+    ``seconds`` (float64) per growth sample."""
     state_hash: str
     particles: int
     radius_of_gyration: float
@@ -49,6 +54,12 @@ class DlaResult:
     tree_point_slots: int
     distance_map_bytes: int
     bytes_per_particle: Optional[float]
+    """Peak resident memory of the process during the simulation, per particle."""
+    simulation_peak_rss_bytes: Optional[int]
+    """Peak resident memory of the process during the simulation."""
+    output_peak_rss_bytes: Optional[int]
+    """Peak through the output stage (the binary's files and picture); None here, where the
+    run writes no files."""
     model: str
     version: str
     seed: int
@@ -63,9 +74,9 @@ class DlaResult:
 
 def dla(
     dim: int = ...,
-    particles: int = ...,
+    particles: Count = ...,
     seed: int = 1,
-    threads: int = ...,
+    threads: Count = ...,
     *,
     birth_gap: float = ...,
     far_field: Literal["return", "jump"] = ...,
@@ -76,8 +87,8 @@ def dla(
     distance_map: bool = ...,
     near_cache: bool = ...,
     paper_settings: bool = False,
-    serial_until: int = ...,
-    fit_from: int = ...,
+    serial_until: Count = ...,
+    fit_from: Count = ...,
     progress: Progress = None,
 ) -> DlaResult:
     """Grow an off-lattice DLA cluster (PDLA with ``threads`` > 1); see ``help(aggsim.dla)``."""
@@ -125,7 +136,7 @@ class DlcaResult:
     params: Dict[str, Any]
     run_json: Dict[str, Any]
 
-Size = Union[int, str, Sequence[int]]
+Size = Union[Count, str, Sequence[Count]]
 Boundary = Union[str, Sequence[str]]
 
 class DlcaLattice:
@@ -135,7 +146,7 @@ class DlcaLattice:
         self,
         size: Size,
         fill: Optional[float] = None,
-        particles: Optional[int] = None,
+        particles: Optional[Count] = None,
         *,
         dim: Optional[int] = None,
         seed: int = 1,
@@ -143,18 +154,18 @@ class DlcaLattice:
         temperature: float = ...,
         gravity: float = ...,
         mobility_exponent: float = ...,
-        target_clusters: int = ...,
-        max_sweeps: Optional[int] = None,
+        target_clusters: Count = ...,
+        max_sweeps: Optional[Count] = None,
         search: Literal["auto", "all-pairs", "grid", "grid-doubling", "lattice"] = ...,
-        grid_box: Optional[int] = None,
-        max_memory: Union[None, int, str] = None,
+        grid_box: Optional[Count] = None,
+        max_memory: Union[None, Count, str] = None,
         timing: bool = False,
         histogram: bool = False,
-        histogram_sweeps: Optional[Sequence[int]] = None,
+        histogram_sweeps: Optional[Sequence[Count]] = None,
         gyration: bool = False,
-        fit_min_size: int = ...,
+        fit_min_size: Count = ...,
     ) -> None: ...
-    def step(self, n: int = 1, progress: Progress = None) -> int:
+    def step(self, n: Count = 1, progress: Progress = None) -> int:
         """Run up to ``n`` sweeps (fewer once done); return how many ran."""
     def run(self, progress: Progress = None) -> int:
         """Sweep until done; return how many sweeps ran."""
@@ -190,7 +201,7 @@ class DlcaLattice:
 def dlca(
     size: Size,
     fill: Optional[float] = None,
-    particles: Optional[int] = None,
+    particles: Optional[Count] = None,
     *,
     dim: Optional[int] = None,
     seed: int = 1,
@@ -198,16 +209,16 @@ def dlca(
     temperature: float = ...,
     gravity: float = ...,
     mobility_exponent: float = ...,
-    target_clusters: int = ...,
-    max_sweeps: Optional[int] = None,
+    target_clusters: Count = ...,
+    max_sweeps: Optional[Count] = None,
     search: Literal["auto", "all-pairs", "grid", "grid-doubling", "lattice"] = ...,
-    grid_box: Optional[int] = None,
-    max_memory: Union[None, int, str] = None,
+    grid_box: Optional[Count] = None,
+    max_memory: Union[None, Count, str] = None,
     timing: bool = False,
     histogram: bool = False,
-    histogram_sweeps: Optional[Sequence[int]] = None,
+    histogram_sweeps: Optional[Sequence[Count]] = None,
     gyration: bool = False,
-    fit_min_size: int = ...,
+    fit_min_size: Count = ...,
     progress: Progress = None,
 ) -> DlcaResult:
     """Run DLCA to the end; see ``help(aggsim.dlca)``."""
@@ -254,26 +265,26 @@ class AnimatWorld:
         seed: int = 1,
         *,
         config: Union[None, str, PathLike[str]] = None,
-        foxes: Optional[int] = None,
-        rabbits: Optional[int] = None,
+        foxes: Optional[Count] = None,
+        rabbits: Optional[Count] = None,
         start_radius: Optional[int] = None,
         density: Optional[float] = None,
         vision: Optional[int] = None,
         grid_box: Optional[GridBox] = None,
-        hungry_at: Optional[int] = None,
-        starve: Optional[int] = None,
-        fox_max_age: Optional[int] = None,
-        rabbit_max_age: Optional[int] = None,
+        hungry_at: Optional[Count] = None,
+        starve: Optional[Count] = None,
+        fox_max_age: Optional[Count] = None,
+        rabbit_max_age: Optional[Count] = None,
         fox_breed_p: Optional[float] = None,
         rabbit_breed_p: Optional[float] = None,
-        prey_needed: Optional[int] = None,
-        crowd_max: Optional[int] = None,
+        prey_needed: Optional[Count] = None,
+        crowd_max: Optional[Count] = None,
         crowd_radius: Optional[int] = None,
         fox_rules: Optional[Sequence[str]] = None,
         rabbit_rules: Optional[Sequence[str]] = None,
         timing: bool = False,
     ) -> None: ...
-    def step(self, n: int = 1, progress: Progress = None) -> int:
+    def step(self, n: Count = 1, progress: Progress = None) -> int:
         """Run up to ``n`` steps (fewer once every animat has died); return how many ran."""
     def result(self) -> AnimatResult:
         """The state now, as :func:`animat` returns it."""
@@ -301,24 +312,24 @@ class AnimatWorld:
     def populations(self) -> Dict[str, npt.NDArray[Any]]: ...
 
 def animat(
-    steps: int = ...,
+    steps: Count = ...,
     seed: int = 1,
     *,
     config: Union[None, str, PathLike[str]] = None,
-    foxes: Optional[int] = None,
-    rabbits: Optional[int] = None,
+    foxes: Optional[Count] = None,
+    rabbits: Optional[Count] = None,
     start_radius: Optional[int] = None,
     density: Optional[float] = None,
     vision: Optional[int] = None,
     grid_box: Optional[GridBox] = None,
-    hungry_at: Optional[int] = None,
-    starve: Optional[int] = None,
-    fox_max_age: Optional[int] = None,
-    rabbit_max_age: Optional[int] = None,
+    hungry_at: Optional[Count] = None,
+    starve: Optional[Count] = None,
+    fox_max_age: Optional[Count] = None,
+    rabbit_max_age: Optional[Count] = None,
     fox_breed_p: Optional[float] = None,
     rabbit_breed_p: Optional[float] = None,
-    prey_needed: Optional[int] = None,
-    crowd_max: Optional[int] = None,
+    prey_needed: Optional[Count] = None,
+    crowd_max: Optional[Count] = None,
     crowd_radius: Optional[int] = None,
     fox_rules: Optional[Sequence[str]] = None,
     rabbit_rules: Optional[Sequence[str]] = None,
@@ -326,3 +337,9 @@ def animat(
     progress: Progress = None,
 ) -> AnimatResult:
     """Run the animat model; see ``help(aggsim.animat)``."""
+
+def dlca_pooled_fit(
+    results: Sequence[DlcaResult], fit_min_size: Optional[Count] = None
+) -> Dict[str, Any]:
+    """The fractal dimension pooled over the clusters of every run (jackknife error over runs),
+    beside the mean of the runs' own fits: ``ensemble.json``'s ``pooled.fractal_dimension``."""

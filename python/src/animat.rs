@@ -2,10 +2,10 @@
 //! `animat` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 //! Performance Optimisation", section II.B).
 
-use crate::convert::{Columns, count, run_error, set_manifest, value_error};
+use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::run::{Progress, interruptible};
 use ::animat::output::PopulationRow;
-use ::animat::params::{DEFAULT_STEPS, FLAGS, error_message};
+use ::animat::params::{DEFAULT_STEPS, FLAGS, PARAMS, error_message};
 use ::animat::{GridBox, Params, World, WorldError};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
@@ -16,20 +16,6 @@ use sim_run::io::RunClock;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
-
-/// A `u32` parameter (set in config files, not by a flag of its own): out of range is the
-/// library's wording of a range error, with the range of the library's table.
-fn u32_arg(name: &str, v: i64) -> PyResult<u32> {
-    u32::try_from(v).map_err(|_| {
-        let range = ::animat::params::PARAMS
-            .iter()
-            .find(|s| s.name == name)
-            .map_or_else(|| format!("0..={}", u32::MAX), |s| s.range.to_string());
-        value_error(format!(
-            "{name} = {v} is outside the accepted range {range}"
-        ))
-    })
-}
 
 /// `--grid-box`: an int side, `"vision"` or `"none"`.
 fn grid_box(arg: &Bound<'_, PyAny>) -> PyResult<GridBox> {
@@ -46,20 +32,20 @@ fn grid_box(arg: &Bound<'_, PyAny>) -> PyResult<GridBox> {
 #[derive(Default)]
 struct Args<'a, 'py> {
     config: Option<PathBuf>,
-    foxes: Option<i64>,
-    rabbits: Option<i64>,
+    foxes: Option<Count>,
+    rabbits: Option<Count>,
     start_radius: Option<i64>,
     density: Option<f64>,
     vision: Option<i64>,
     grid_box: Option<&'a Bound<'py, PyAny>>,
-    hungry_at: Option<i64>,
-    starve: Option<i64>,
-    fox_max_age: Option<i64>,
-    rabbit_max_age: Option<i64>,
+    hungry_at: Option<Count>,
+    starve: Option<Count>,
+    fox_max_age: Option<Count>,
+    rabbit_max_age: Option<Count>,
     fox_breed_p: Option<f64>,
     rabbit_breed_p: Option<f64>,
-    prey_needed: Option<i64>,
-    crowd_max: Option<i64>,
+    prey_needed: Option<Count>,
+    crowd_max: Option<Count>,
     crowd_radius: Option<i64>,
     fox_rules: Option<Vec<String>>,
     rabbit_rules: Option<Vec<String>>,
@@ -73,11 +59,11 @@ impl Args<'_, '_> {
             Some(path) => ::animat::config::read_config(path).map_err(value_error)?,
             None => Params::default(),
         };
-        if let Some(v) = self.foxes {
-            p.foxes = count("--foxes", v)?;
+        if let Some(v) = self.foxes.clone() {
+            p.foxes = count(PARAMS, "foxes", v)?;
         }
-        if let Some(v) = self.rabbits {
-            p.rabbits = count("--rabbits", v)?;
+        if let Some(v) = self.rabbits.clone() {
+            p.rabbits = count(PARAMS, "rabbits", v)?;
         }
         if self.start_radius.is_some() && self.density.is_some() {
             return Err(value_error(
@@ -97,16 +83,20 @@ impl Args<'_, '_> {
             p.grid_box = grid_box(g)?;
         }
         let u32s = [
-            ("hungry_at", self.hungry_at, &mut p.hungry_at),
-            ("starve", self.starve, &mut p.starve),
-            ("fox_max_age", self.fox_max_age, &mut p.fox_max_age),
-            ("rabbit_max_age", self.rabbit_max_age, &mut p.rabbit_max_age),
-            ("prey_needed", self.prey_needed, &mut p.prey_needed),
-            ("crowd_max", self.crowd_max, &mut p.crowd_max),
+            ("hungry_at", self.hungry_at.clone(), &mut p.hungry_at),
+            ("starve", self.starve.clone(), &mut p.starve),
+            ("fox_max_age", self.fox_max_age.clone(), &mut p.fox_max_age),
+            (
+                "rabbit_max_age",
+                self.rabbit_max_age.clone(),
+                &mut p.rabbit_max_age,
+            ),
+            ("prey_needed", self.prey_needed.clone(), &mut p.prey_needed),
+            ("crowd_max", self.crowd_max.clone(), &mut p.crowd_max),
         ];
         for (name, given, field) in u32s {
             if let Some(v) = given {
-                *field = u32_arg(name, v)?;
+                *field = count(PARAMS, name, v)?;
             }
         }
         if let Some(v) = self.fox_breed_p {
@@ -353,20 +343,20 @@ impl AnimatWorld {
         py: Python<'_>,
         seed: u64,
         config: Option<PathBuf>,
-        foxes: Option<i64>,
-        rabbits: Option<i64>,
+        foxes: Option<Count>,
+        rabbits: Option<Count>,
         start_radius: Option<i64>,
         density: Option<f64>,
         vision: Option<i64>,
         grid_box: Option<&Bound<'_, PyAny>>,
-        hungry_at: Option<i64>,
-        starve: Option<i64>,
-        fox_max_age: Option<i64>,
-        rabbit_max_age: Option<i64>,
+        hungry_at: Option<Count>,
+        starve: Option<Count>,
+        fox_max_age: Option<Count>,
+        rabbit_max_age: Option<Count>,
         fox_breed_p: Option<f64>,
         rabbit_breed_p: Option<f64>,
-        prey_needed: Option<i64>,
-        crowd_max: Option<i64>,
+        prey_needed: Option<Count>,
+        crowd_max: Option<Count>,
         crowd_radius: Option<i64>,
         fox_rules: Option<Vec<String>>,
         rabbit_rules: Option<Vec<String>>,
@@ -401,9 +391,9 @@ impl AnimatWorld {
     /// step every animat alive at its start, in a fresh random order, runs the first rule of
     /// its species' list whose condition holds. ``progress`` as in :func:`aggsim.animat`.
     /// Ctrl-C stops after the current step (``KeyboardInterrupt``).
-    #[pyo3(signature = (n = 1, progress = None))]
-    fn step(&self, py: Python<'_>, n: i64, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
-        let n = count("n", n)?;
+    #[pyo3(signature = (n = Count::Int(1), progress = None))]
+    fn step(&self, py: Python<'_>, n: Count, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
+        let n = count(&[], "n", n)?;
         let progress = Progress::from_arg(progress, "animat", "steps")?;
         self.lock()?.steps(py, n, &progress)
     }
@@ -569,7 +559,7 @@ impl AnimatWorld {
 /// The run releases the GIL: other Python threads run meanwhile.
 #[pyfunction]
 #[pyo3(signature = (
-    steps = DEFAULT_STEPS as i64,
+    steps = Count::Int(i128::from(DEFAULT_STEPS)),
     seed = 1,
     *,
     config = None,
@@ -596,30 +586,30 @@ impl AnimatWorld {
 #[allow(clippy::too_many_arguments)]
 pub fn animat(
     py: Python<'_>,
-    steps: i64,
+    steps: Count,
     seed: u64,
     config: Option<PathBuf>,
-    foxes: Option<i64>,
-    rabbits: Option<i64>,
+    foxes: Option<Count>,
+    rabbits: Option<Count>,
     start_radius: Option<i64>,
     density: Option<f64>,
     vision: Option<i64>,
     grid_box: Option<&Bound<'_, PyAny>>,
-    hungry_at: Option<i64>,
-    starve: Option<i64>,
-    fox_max_age: Option<i64>,
-    rabbit_max_age: Option<i64>,
+    hungry_at: Option<Count>,
+    starve: Option<Count>,
+    fox_max_age: Option<Count>,
+    rabbit_max_age: Option<Count>,
     fox_breed_p: Option<f64>,
     rabbit_breed_p: Option<f64>,
-    prey_needed: Option<i64>,
-    crowd_max: Option<i64>,
+    prey_needed: Option<Count>,
+    crowd_max: Option<Count>,
     crowd_radius: Option<i64>,
     fox_rules: Option<Vec<String>>,
     rabbit_rules: Option<Vec<String>>,
     timing: bool,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<AnimatResult>> {
-    let steps = count("--steps", steps)?;
+    let steps = count(&[], "steps", steps)?;
     let progress = Progress::from_arg(progress, "animat", "steps")?;
     let world = AnimatWorld::new(
         py,

@@ -1,10 +1,10 @@
 //! Conversions shared by the models: `run.json` values to Python objects, a manifest onto a
-//! result object's attributes, integer arguments, and columns to dicts of NumPy arrays.
+//! result object's attributes, count arguments, and columns to dicts of NumPy arrays.
 
 use numpy::{Element, IntoPyArray};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyOverflowError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyFloat, PyList};
 use serde_json::Value;
 use sim_run::io::RunManifest;
 
@@ -61,14 +61,109 @@ pub fn set_manifest(obj: &Bound<'_, PyAny>, m: &RunManifest) -> PyResult<()> {
     Ok(())
 }
 
-/// A count argument (`flag` as the CLI spells it): negative values are refused with a
-/// `ValueError` naming the flag.
-pub fn count(flag: &str, v: i64) -> PyResult<u64> {
-    u64::try_from(v).map_err(|_| {
+/// A count argument as Python code writes it: an int (or anything with `__index__`, NumPy
+/// integers included), or a float holding a whole number (`1e4`, `2.5e5`), as the binaries
+/// take `--particles 1e4`. [`count`] checks it, naming the parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Count {
+    /// An int.
+    Int(i128),
+    /// An int beyond 128 bits (its sign: `true` for negative).
+    Huge(bool),
+    /// A float, whole or not.
+    Float(f64),
+    /// Not a number: the name of its type (refused by [`count`] with the parameter's name).
+    NotANumber(String),
+}
+
+impl From<i64> for Count {
+    fn from(v: i64) -> Self {
+        Count::Int(i128::from(v))
+    }
+}
+
+impl std::fmt::Display for Count {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Count::Int(v) => write!(f, "{v}"),
+            Count::Huge(neg) => {
+                write!(f, "{}(an int beyond 128 bits)", if *neg { "-" } else { "" })
+            }
+            Count::Float(v) => write!(f, "{}", core_lattice::spec::show_number(*v)),
+            Count::NotANumber(t) => write!(f, "a {t}"),
+        }
+    }
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Count {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(f) = obj.cast::<PyFloat>() {
+            return Ok(Count::Float(f.value()));
+        }
+        match obj.extract::<i128>() {
+            Ok(v) => Ok(Count::Int(v)),
+            Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => {
+                let negative = obj.lt(0).unwrap_or(false);
+                Ok(Count::Huge(negative))
+            }
+            Err(_) => Ok(Count::NotANumber(
+                obj.get_type()
+                    .name()
+                    .map_or_else(|_| "value of another type".into(), |n| n.to_string()),
+            )),
+        }
+    }
+}
+
+/// A count argument `name` (the keyword argument; `table` is the model's parameter table, for
+/// the accepted range): an int, or a float holding a whole number, that fits `T`. Anything else
+/// (`1.5`, `nan`, `1e30`, `-1`) is a `ValueError` naming the parameter and its range:
+/// `particles = 1.5 is not a whole number; the accepted range is 1..=3000000000`. The range
+/// itself (at least one particle, say) is the model's validation, as for the binary.
+pub fn count<T: TryFrom<i128> + Into<u64>>(
+    table: &[core_lattice::spec::ParamSpec],
+    name: &str,
+    v: Count,
+) -> PyResult<T> {
+    let range = table
+        .iter()
+        .find(|s| s.name == name)
+        .map(|s| s.range)
+        .filter(|r| !matches!(r, core_lattice::spec::Range::Any))
+        .map_or_else(|| format!("0..={}", max::<T>()), |r| r.to_string());
+    let whole = match v {
+        Count::Int(i) => Some(i),
+        // Exactly: a float beyond 2^53 is still a whole number, and is converted exactly.
+        Count::Float(f) if f.is_finite() && f.fract() == 0.0 && f.abs() < 1.7e38 => Some(f as i128),
+        Count::Float(f) if f.is_finite() && f.fract() == 0.0 => None,
+        Count::Float(_) => {
+            return Err(PyValueError::new_err(format!(
+                "{name} = {v} is not a whole number; a count is, in the accepted range {range}"
+            )));
+        }
+        Count::Huge(_) => None,
+        Count::NotANumber(_) => {
+            return Err(PyTypeError::new_err(format!(
+                "{name} = {v}: a count is an int, or a float holding a whole number (1e4)"
+            )));
+        }
+    };
+    whole.and_then(|i| T::try_from(i).ok()).ok_or_else(|| {
         PyValueError::new_err(format!(
-            "{flag} {v} is outside the accepted range: it counts something and cannot be negative"
+            "{name} = {v} is outside the accepted range {range}"
         ))
     })
+}
+
+/// The largest value of `T`, for messages.
+fn max<T: TryFrom<i128> + Into<u64>>() -> u64 {
+    let mut hi = u64::MAX;
+    while T::try_from(i128::from(hi)).is_err() {
+        hi >>= 1;
+    }
+    hi
 }
 
 /// A `ValueError` with `message`: the message the CLI prints for the same bad value.

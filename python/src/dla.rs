@@ -2,8 +2,9 @@
 //! Rodriguez-Romo, "Variable precision distance search for random fractal cluster
 //! simulations").
 
-use crate::convert::{Columns, count, run_error, set_manifest, value_error};
+use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::run::{Progress, interruptible};
+use dla_pdla::params::PARAMS;
 use dla_pdla::{Dim, FarField, Params, SimError, Simulation, Space};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
@@ -30,15 +31,16 @@ const PARTICLES: u64 = 100_000;
 ///     first, at the origin); diameters are 1.
 /// growth : dict[str, numpy.ndarray]
 ///     The growth samples (200 log-spaced sizes per decade and the final size), as the
-///     binary's ``growth.csv``: ``N`` (uint64, particles), ``R_g`` (radius of gyration),
-///     ``R_ext`` (largest centre distance from the origin), ``seconds`` (wall time since the
-///     start of growth).
+///     binary's ``growth.csv``, same names and dtypes: ``n`` (uint64, particles),
+///     ``radius_of_gyration``, ``r_ext`` (largest centre distance from the origin; both float64,
+///     diameters), ``seconds`` (float64, wall time since the start of growth).
 /// state_hash : str
 ///     16 hex digits, a hash of the positions in arrival order: the binary's for the same
 ///     seed and parameters (with one thread).
 /// particles, radius_of_gyration, r_ext, fractal_dimension, fractal_dimension_stderr,
 /// fit_points, fit_error, discarded_walkers, pdla_parallel_seconds, pdla_lock_wait_seconds,
-/// pdla_phases, tree_memory_bytes, tree_point_slots, distance_map_bytes, bytes_per_particle
+/// pdla_phases, tree_memory_bytes, tree_point_slots, distance_map_bytes, bytes_per_particle,
+/// simulation_peak_rss_bytes, output_peak_rss_bytes (None: no output stage)
 ///     The results of ``run.json`` (``fit_error`` only when no fit was possible, and then
 ///     ``fractal_dimension`` is None).
 /// model, version, seed, threads, wall_seconds, cpu_seconds, peak_rss_bytes, provenance
@@ -138,9 +140,9 @@ impl DlaResult {
 #[pyfunction]
 #[pyo3(signature = (
     dim = defaults().dim,
-    particles = PARTICLES as i64,
+    particles = Count::Int(PARTICLES as i128),
     seed = 1,
-    threads = defaults().threads as i64,
+    threads = Count::Int(defaults().threads as i128),
     *,
     birth_gap = defaults().birth_gap,
     far_field = defaults().far_field.name(),
@@ -151,17 +153,17 @@ impl DlaResult {
     distance_map = defaults().distance_map,
     near_cache = defaults().near_cache,
     paper_settings = false,
-    serial_until = defaults().serial_until as i64,
-    fit_from = defaults().fit_from as i64,
+    serial_until = Count::Int(i128::from(defaults().serial_until)),
+    fit_from = Count::Int(i128::from(defaults().fit_from)),
     progress = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn dla(
     py: Python<'_>,
     dim: usize,
-    particles: i64,
+    particles: Count,
     seed: u64,
-    threads: i64,
+    threads: Count,
     birth_gap: f64,
     far_field: &str,
     death_ratio: Option<f64>,
@@ -171,22 +173,22 @@ pub fn dla(
     distance_map: bool,
     near_cache: bool,
     paper_settings: bool,
-    serial_until: i64,
-    fit_from: i64,
+    serial_until: Count,
+    fit_from: Count,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<DlaResult>> {
     let clock = RunClock::start();
     let params = Params {
         dim,
-        particles: count("--particles", particles)?,
+        particles: count(PARAMS, "particles", particles)?,
         birth_gap,
         far_field: far_field.parse::<FarField>().map_err(value_error)?,
         death_ratio: death_ratio.unwrap_or(defaults().death_ratio),
         step_min,
         precision,
-        threads: count("--threads", threads)? as usize,
-        serial_until: count("--serial-until", serial_until)?,
-        fit_from: count("--fit-from", fit_from)?,
+        threads: count::<u64>(PARAMS, "threads", threads)? as usize,
+        serial_until: count(PARAMS, "serial_until", serial_until)?,
+        fit_from: count(PARAMS, "fit_from", fit_from)?,
         // The positions are returned.
         keep_positions: true,
         leaf_side,
@@ -247,13 +249,13 @@ where
     let m = dla_pdla::output::manifest(&sim, clock).map_err(run_error)?;
     let samples = sim.samples();
     let growth = Columns::default()
-        .add(py, "N", samples.iter().map(|s| s.n).collect())
+        .add(py, "n", samples.iter().map(|s| s.n).collect())
         .add(
             py,
-            "R_g",
+            "radius_of_gyration",
             samples.iter().map(|s| s.radius_of_gyration).collect(),
         )
-        .add(py, "R_ext", samples.iter().map(|s| s.r_ext).collect())
+        .add(py, "r_ext", samples.iter().map(|s| s.r_ext).collect())
         .add(py, "seconds", samples.iter().map(|s| s.seconds).collect())
         .into_dict(py)?;
     let positions = sim

@@ -78,6 +78,7 @@ fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     }
     m.add_function(wrap_pyfunction!(dla::dla, m)?)?;
     m.add_function(wrap_pyfunction!(dlca::dlca, m)?)?;
+    m.add_function(wrap_pyfunction!(dlca::dlca_pooled_fit, m)?)?;
     m.add_function(wrap_pyfunction!(animat::animat, m)?)?;
     m.add_function(wrap_pyfunction!(defaults, m)?)?;
     m.add_function(wrap_pyfunction!(params_table, m)?)?;

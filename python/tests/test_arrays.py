@@ -15,12 +15,12 @@ def test_dla_arrays(dim):
     np.testing.assert_array_equal(r.positions[0], np.zeros(dim))
     # The attribute is one array, not a copy made per access.
     assert r.positions is r.positions
-    assert list(r.growth) == ["N", "R_g", "R_ext", "seconds"]
-    n = len(r.growth["N"])
-    assert r.growth["N"].dtype == np.uint64 and r.growth["N"][-1] == 2000
-    for k in ("R_g", "R_ext", "seconds"):
+    assert list(r.growth) == ["n", "radius_of_gyration", "r_ext", "seconds"]
+    n = len(r.growth["n"])
+    assert r.growth["n"].dtype == np.uint64 and r.growth["n"][-1] == 2000
+    for k in ("radius_of_gyration", "r_ext", "seconds"):
         assert r.growth[k].dtype == np.float64 and r.growth[k].shape == (n,)
-    assert np.all(np.diff(r.growth["N"].astype(np.int64)) > 0)
+    assert np.all(np.diff(r.growth["n"].astype(np.int64)) > 0)
     # R_g of the positions is the reported one.
     c = r.positions - r.positions.mean(0)
     assert np.isclose(np.sqrt((c * c).sum(1).mean()), r.radius_of_gyration)

@@ -96,7 +96,7 @@ def test_animat_config_messages(cli, tmp_path):
 def test_values_the_command_line_cannot_spell():
     """Arguments clap would refuse before the library sees them: a ValueError naming the flag."""
     cases = [
-        (lambda: aggsim.dla(particles=-5), "--particles -5"),
+        (lambda: aggsim.dla(particles=-5), "particles = -5 is outside the accepted range 1.."),
         (lambda: aggsim.dla(particles=10, far_field="bounce"), "'--far-field'"),
         (lambda: aggsim.dla(particles=10, paper_settings=True, step_min=0.2), "--paper-settings"),
         (lambda: aggsim.dlca(size=64, fill=0.1, particles=10), "exactly one of --fill"),
@@ -109,7 +109,7 @@ def test_values_the_command_line_cannot_spell():
         (lambda: aggsim.animat(fox_rules=["eat", "fly"]), "unknown fox rule \"fly\""),
         (lambda: aggsim.animat(fox_breed_p=1.5), "fox_breed_p = 1.5 is outside"),
         (lambda: aggsim.animat(hungry_at=-1), "hungry_at = -1 is outside"),
-        (lambda: aggsim.DlcaLattice(64, 0.1).step(-1), "n -1"),
+        (lambda: aggsim.DlcaLattice(64, 0.1).step(-1), "n = -1 is outside"),
     ]
     for call, text in cases:
         with pytest.raises(ValueError) as e:

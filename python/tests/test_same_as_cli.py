@@ -14,6 +14,8 @@ MEASURED = {
     "cpu_seconds",
     "peak_rss_bytes",
     "bytes_per_particle",
+    "simulation_peak_rss_bytes",
+    "output_peak_rss_bytes",
     "pdla_parallel_seconds",
     "pdla_lock_wait_seconds",
 }
@@ -72,9 +74,9 @@ def test_dla_equals_the_binary(cli, flags, kwargs):
     assert r.params == params
     np.testing.assert_array_equal(r.positions, np.load(out / "positions.npy"))
     g = read_csv(out / "growth.csv")
-    np.testing.assert_array_equal(r.growth["N"], g["n"].astype(np.uint64))
-    np.testing.assert_array_equal(r.growth["R_g"], g["radius_of_gyration"].astype(float))
-    np.testing.assert_array_equal(r.growth["R_ext"], g["r_ext"].astype(float))
+    np.testing.assert_array_equal(r.growth["n"], g["n"].astype(np.uint64))
+    np.testing.assert_array_equal(r.growth["radius_of_gyration"], g["radius_of_gyration"].astype(float))
+    np.testing.assert_array_equal(r.growth["r_ext"], g["r_ext"].astype(float))
 
 
 def test_pdla_runs_and_reports_as_the_binary(cli):

@@ -10,6 +10,7 @@ pub mod codemap;
 pub mod fuzz;
 pub mod plot;
 pub mod probe;
+pub mod quoted;
 pub mod report;
 pub mod scale;
 pub mod scaling;

@@ -60,7 +60,7 @@ enum Cmd {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Base seed; the runs of an ensemble use seed, seed + 1, ...
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = sim_run::count::count::<u64>)]
         seed: u64,
         /// Run size: overrides --quick (`tiny` is the harness test's size).
         #[arg(long, value_enum, hide = true)]
@@ -91,7 +91,7 @@ enum Cmd {
         only: Option<String>,
         /// Run every workload this many times, in rounds, and keep each one's fastest run
         /// (for shared or noisy machines; every repeat's time is in the JSON).
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, value_parser = sim_run::count::count_at_least_1::<usize>)]
         repeat: usize,
     },
     /// Measure this machine's memory latency: a pointer chase through one random cycle of
@@ -111,7 +111,7 @@ enum Cmd {
     /// mutated valid files; prints cases and seconds per reader (xtask/src/fuzz.rs).
     Fuzz {
         /// Cases per reader.
-        #[arg(long, default_value_t = 100_000)]
+        #[arg(long, default_value_t = 100_000, value_parser = sim_run::count::count::<u64>)]
         cases: u64,
         /// Only readers (or tests) whose name contains this text.
         #[arg(long)]

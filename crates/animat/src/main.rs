@@ -27,7 +27,7 @@ struct Cli {
     steps: u64,
 
     /// Seed of every random stream of the run: same seed and parameters, same run.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
     seed: u64,
 
     /// Output directory (created if missing; nothing is written on bad input). It is this run's
@@ -100,7 +100,7 @@ struct Cli {
     /// Save the run to OUT/checkpoint.bin every N steps and at the end (atomically), for
     /// --resume; SIGINT or SIGTERM then save it after the current step and stop (exit code
     /// 130).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
     /// Continue the run saved in DIR/checkpoint.bin (by --checkpoint-every) to the same state

@@ -83,7 +83,20 @@ fn bad_inputs_are_refused_before_any_work() {
             "--start-radius",
         ),
         (with(&["--snapshot-every", "0"]), "--snapshot-every 0"),
-        (with(&["--checkpoint-every", "0"]), "0"),
+        (
+            with(&["--checkpoint-every", "0"]),
+            "0 is outside the accepted range 1..",
+        ),
+        (
+            with(&["--checkpoint-every", "1.5"]),
+            "1.5 is not a whole number",
+        ),
+        (with(&["--snapshot-every", "1e-1"]), "not a whole number"),
+        (
+            with(&["--step", "10"]),
+            "tip: a similar argument exists: '--steps'",
+        ),
+        (with(&["--seed", "1-10"]), "use --seeds 1..=10"),
         (with(&["--heartbeat", "-5"]), "-5"),
         (with(&["--wings", "2"]), "--wings"),
         (with(&["--config", "missing.toml"]), "missing.toml"),

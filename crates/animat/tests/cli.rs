@@ -395,3 +395,58 @@ fn config_files_repeat_runs() {
     };
     assert_eq!(hash(&a), hash(&b));
 }
+
+/// Counts as physicists write them (`1e3`, `4.0e1`, `1_000`) are the same run as plain digits,
+/// in every count flag and in a seed.
+#[test]
+fn counts_in_every_notation_are_the_same_run() {
+    let hash = |args: &[&str]| {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("run");
+        let mut all = vec!["--out", out.to_str().unwrap(), "-qq"];
+        all.extend_from_slice(args);
+        let o = animat(&all);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        run_json(&out)["results"]["state_hash"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    let plain = hash(&[
+        "--foxes",
+        "30",
+        "--rabbits",
+        "300",
+        "--start-radius",
+        "40",
+        "--steps",
+        "40",
+        "--checkpoint-every",
+        "10",
+        "--snapshot-every",
+        "20",
+        "--seed",
+        "1000",
+    ]);
+    let written = hash(&[
+        "--foxes",
+        "3e1",
+        "--rabbits",
+        "3.0e2",
+        "--start-radius",
+        "40",
+        "--steps",
+        "4E1",
+        "--checkpoint-every",
+        "1e1",
+        "--snapshot-every",
+        "2_0",
+        "--seed",
+        "1e3",
+    ]);
+    assert_eq!(written, plain);
+}

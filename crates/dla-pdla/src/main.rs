@@ -36,7 +36,7 @@ struct Cli {
     particles: u64,
 
     /// Seed of every random stream of the run: same seed and flags, same run (one thread).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
     seed: u64,
 
     /// Output directory (created if missing; nothing is written on bad input). It is this run's

@@ -19,8 +19,8 @@ use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
-    AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, RunClock, RunManifest, write_png_gray,
-    write_points,
+    AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest,
+    write_png_gray, write_points,
 };
 use std::io::Write;
 use std::path::Path;
@@ -74,6 +74,9 @@ pub fn write_outputs<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
+    // The simulation's peak, before the output stage (the PNG's pixels, a positions file
+    // converted from positions.npy) can raise the process's high-water mark.
+    let simulation_peak = ProcessUsage::now().map(|u| u.peak_rss_bytes);
     if !sim.streams_growth() {
         let mut w = CsvWriter::create(dir.join("growth.csv"), &GROWTH_COLUMNS)?;
         for s in sim.samples() {
@@ -124,7 +127,9 @@ where
         write_picture(sim, dir, &dir.join("dla.png"), side)?;
     }
 
-    let m = manifest(sim, clock)?;
+    let mut m = manifest_with_peak(sim, clock, simulation_peak)?;
+    // The high-water mark now covers the output stage too.
+    m.set_result("output_peak_rss_bytes", m.peak_rss_bytes);
     m.write(dir)?;
     Ok(m)
 }
@@ -133,9 +138,30 @@ where
 /// measurements of `clock` taken now, and every result (`particles`, `radius_of_gyration`,
 /// `r_ext`, `state_hash`, the fractal dimension or `fit_error`, the PDLA and memory figures).
 /// The one place these results are assembled, for the `dla` binary and the Python bindings.
+/// Called right after the simulation (as the Python bindings do), the process's peak memory is
+/// the simulation's: `simulation_peak_rss_bytes` and `bytes_per_particle` measure it, and
+/// `output_peak_rss_bytes` is null (no output stage ran; [`write_outputs`] sets it).
 pub fn manifest<const D: usize>(
     sim: &Simulation<D>,
     clock: &RunClock,
+) -> Result<RunManifest, OutputError>
+where
+    Dim<D>: Space<D>,
+{
+    let peak = ProcessUsage::now().map(|u| u.peak_rss_bytes);
+    let mut m = manifest_with_peak(sim, clock, peak)?;
+    // No output stage ran.
+    m.set_result("output_peak_rss_bytes", serde_json::Value::Null);
+    Ok(m)
+}
+
+/// [`manifest`] with the simulation's peak resident memory measured before the output stage
+/// (`simulation_peak`), so that `bytes_per_particle` is the simulation's cost per particle and
+/// not that of rendering `dla.png`.
+fn manifest_with_peak<const D: usize>(
+    sim: &Simulation<D>,
+    clock: &RunClock,
+    simulation_peak: Option<u64>,
 ) -> Result<RunManifest, OutputError>
 where
     Dim<D>: Space<D>,
@@ -150,8 +176,7 @@ where
         params,
     )?;
     let n = sim.particles();
-    let bpp = m
-        .peak_rss_bytes
+    let bpp = simulation_peak
         .map(|b| json!(b as f64 / n as f64))
         .unwrap_or(serde_json::Value::Null);
     m.set_result("particles", n)
@@ -170,6 +195,7 @@ where
             "distance_map_bytes",
             (sim.cluster().memory_bytes() - sim.tree().memory_bytes()) as u64,
         )
+        .set_result("simulation_peak_rss_bytes", simulation_peak)
         .set_result("bytes_per_particle", bpp);
     match fit {
         Ok(f) => {

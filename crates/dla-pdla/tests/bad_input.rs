@@ -178,6 +178,39 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--distance-map", "maybe"]), "maybe"),
         (with(&["--fit-from", "0"]), "--fit-from 0"),
         (with(&["--checkpoint-every", "0"]), "--checkpoint-every 0"),
+        (
+            with(&["--checkpoint-every", "1.5"]),
+            "1.5 is not a whole number",
+        ),
+        // clap's tip for a misspelt flag survives the one-line message.
+        (
+            vec!["--particle", "300", "--out", "out"],
+            "tip: a similar argument exists: '--particles'",
+        ),
+        // A list of seeds given to --seed points to --seeds, in its own syntax.
+        (
+            with(&["--seed", "1..=10"]),
+            "several seeds, --seed takes one; for one run per seed (an ensemble) use --seeds 1..=10",
+        ),
+        (with(&["--seed", "1-10"]), "use --seeds 1..=10"),
+        (with(&["--seed", "2.5"]), "not a whole number"),
+        (
+            with(&["--seeds", "1-10"]),
+            "`1-10` is not a seed range; write 1..=10 for seeds 1 to 10",
+        ),
+        (with(&["--seeds", "1..=1e30"]), "`1e30` is not a seed"),
+        (
+            with(&["--seeds", "1..=2", "--jobs", "0"]),
+            "0 is outside the accepted range 1..=4096",
+        ),
+        (
+            with(&["--seeds", "1..=2", "--jobs", "1e4"]),
+            "10000 is outside the accepted range 1..=4096",
+        ),
+        (
+            with(&["--seeds", "1..=2", "--jobs", "1.5"]),
+            "not a whole number",
+        ),
         (with(&["--heartbeat", "-1"]), "-1"),
         (with(&["--no-such-flag"]), "--no-such-flag"),
         (vec!["--particles", "300", "--out", "file"], "--out file"),

@@ -352,3 +352,39 @@ fn counts_in_every_notation_are_the_same_run() {
         assert_eq!(hash(notation), plain, "--particles {notation}");
     }
 }
+
+/// `bytes_per_particle` is the simulation's peak memory per particle, measured before the
+/// output stage (writing files, rendering `dla.png`); the output stage's peak is
+/// `output_peak_rss_bytes`, apart. Peak memory is a high-water mark, so the output stage's is
+/// at least the simulation's, and the process's (`peak_rss_bytes`) is the output stage's.
+#[test]
+fn bytes_per_particle_measures_the_simulation_not_the_output_stage() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let st = dla()
+        .args([
+            "--particles",
+            "500",
+            "-qq",
+            "--png",
+            "--png-size",
+            "2048",
+            "--out",
+        ])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    let r = &m["results"];
+    let sim = r["simulation_peak_rss_bytes"].as_u64().unwrap();
+    let output = r["output_peak_rss_bytes"].as_u64().unwrap();
+    assert!(sim > 0);
+    assert_eq!(
+        r["bytes_per_particle"].as_f64().unwrap(),
+        sim as f64 / 500.0
+    );
+    assert!(output >= sim, "simulation {sim}, output {output}");
+    assert_eq!(m["peak_rss_bytes"].as_u64().unwrap(), output);
+}

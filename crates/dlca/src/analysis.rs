@@ -1,7 +1,8 @@
 //! Final-state measurements: the cluster size distribution and, with `--gyration`, each
 //! cluster's radius of gyration (unwrapped across periodic boundaries) and the fractal dimension
 //! `D` from the fit `log s = D log R_g + c` over the clusters (docs/dlca.md,
-//! "Validation").
+//! "Validation"), of one run or pooled over the runs of an ensemble
+//! ([`pooled_fractal_dimension`]).
 
 use crate::params::{ParamError, Params};
 use crate::sim::Simulation;
@@ -107,6 +108,67 @@ pub fn fractal_dimension(clusters: &[ClusterMeasure], min_size: u64) -> Result<F
     Fit::log_log(&rg, &s)
 }
 
+/// The fractal dimension of the clusters of several runs pooled into one fit, as the literature
+/// measures DLCA's `D` (one run at low fill ends with tens of clusters; their fit scatters).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PooledFit {
+    /// `D`: the slope of `log s = D log R_g + c` over every fitted cluster of every run.
+    pub slope: f64,
+    /// The error of `D` with the runs as the independent units: the jackknife over runs
+    /// (`sqrt((m - 1) / m * sum (D_-i - mean D_-i)^2)`, `D_-i` the fit without run `i`); the
+    /// clusters of one run share its history, so the regression's own error, which treats
+    /// each cluster as independent, understates it. `None` with fewer than 2 runs (or when a
+    /// leave-one-out fit fails).
+    pub jackknife_stderr: Option<f64>,
+    /// The regression's standard error of the slope over the pooled clusters.
+    pub fit_stderr: f64,
+    /// Clusters in the fit (at least `min_size` particles, not wrapping).
+    pub clusters: usize,
+    /// Runs pooled.
+    pub runs: usize,
+}
+
+/// Fit `log s = D log R_g + c` over the clusters of every run in `runs` (each run's
+/// [`ClusterMeasure`]s; those of at least `min_size` particles that do not wrap, as
+/// [`fractal_dimension`]), with the jackknife error over runs.
+///
+/// # Errors
+/// The pooled fit fails (fewer than 3 clusters, or all of one radius).
+pub fn pooled_fractal_dimension(
+    runs: &[Vec<ClusterMeasure>],
+    min_size: u64,
+) -> Result<PooledFit, StatsError> {
+    let all: Vec<ClusterMeasure> = runs.iter().flatten().copied().collect();
+    let fit = fractal_dimension(&all, min_size)?;
+    let m = runs.len();
+    let jackknife_stderr = (m >= 2)
+        .then(|| {
+            let leave_one_out: Option<Vec<f64>> = (0..m)
+                .map(|i| {
+                    let rest: Vec<ClusterMeasure> = runs
+                        .iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != i)
+                        .flat_map(|(_, r)| r.iter().copied())
+                        .collect();
+                    fractal_dimension(&rest, min_size).ok().map(|f| f.slope)
+                })
+                .collect();
+            let d = leave_one_out?;
+            let mean = d.iter().sum::<f64>() / m as f64;
+            let ss: f64 = d.iter().map(|x| (x - mean) * (x - mean)).sum();
+            Some((ss * (m - 1) as f64 / m as f64).sqrt())
+        })
+        .flatten();
+    Ok(PooledFit {
+        slope: fit.slope,
+        jackknife_stderr,
+        fit_stderr: fit.slope_stderr,
+        clusters: fit.n,
+        runs: m,
+    })
+}
+
 /// When one run contributes its clusters to a pooled fractal-dimension fit
 /// ([`pooled_clusters`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -149,4 +211,62 @@ pub fn pooled_clusters(
         pooled.extend(gyration(&sim));
     }
     Ok(pooled)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cluster(size: u64, rg: f64) -> ClusterMeasure {
+        ClusterMeasure {
+            id: 0,
+            size,
+            radius_of_gyration: rg,
+            wraps: false,
+        }
+    }
+
+    /// Clusters on the exact power law s = R_g^2 give D = 2 with no error; runs that
+    /// differ in their exponent give a jackknife error that grows with the spread between runs,
+    /// which the pooled regression's error does not see.
+    #[test]
+    fn the_pooled_fit_has_the_spread_between_runs_as_its_error() {
+        // Sizes rounded to whole particles: the slope is close to `d`, not exact.
+        let run = |d: f64| -> Vec<ClusterMeasure> {
+            (1..=20)
+                .map(|i| {
+                    let rg = 2.0 + f64::from(i);
+                    cluster((rg.powf(d).round() as u64).max(2), rg)
+                })
+                .collect()
+        };
+        let exact: Vec<Vec<ClusterMeasure>> = (0..4)
+            .map(|_| {
+                (1..=20)
+                    .map(|i| {
+                        let rg = 2f64.powi(i % 10 + 1);
+                        cluster(4u64.pow((i % 10 + 1) as u32), rg)
+                    })
+                    .collect()
+            })
+            .collect();
+        let f = pooled_fractal_dimension(&exact, 2).unwrap();
+        assert!((f.slope - 2.0).abs() < 1e-12, "{f:?}");
+        assert!(f.jackknife_stderr.unwrap() < 1e-12, "{f:?}");
+        assert_eq!((f.clusters, f.runs), (80, 4));
+
+        let close = vec![run(1.40), run(1.42), run(1.44), run(1.46)];
+        let far = vec![run(1.20), run(1.35), run(1.50), run(1.65)];
+        let c = pooled_fractal_dimension(&close, 2).unwrap();
+        let w = pooled_fractal_dimension(&far, 2).unwrap();
+        assert!((c.slope - 1.43).abs() < 0.02, "{c:?}");
+        assert!(
+            w.jackknife_stderr.unwrap() > 4.0 * c.jackknife_stderr.unwrap(),
+            "{c:?} {w:?}"
+        );
+
+        let one = pooled_fractal_dimension(&close[..1], 2).unwrap();
+        assert_eq!(one.jackknife_stderr, None);
+        assert!(pooled_fractal_dimension(&[vec![cluster(5, 1.0)]], 2).is_err());
+    }
 }

@@ -8,7 +8,7 @@ use clap::{ArgGroup, Parser};
 use dlca::params::flags;
 use dlca::{Params, Search, Simulation, Snapshot};
 use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
-use sim_run::ensemble::{Curve, EnsembleArgs};
+use sim_run::ensemble::{Combine, Curve, EnsembleArgs, MemberRun, Pooled, PooledResult};
 use sim_run::io::{Positions, RunClock};
 use sim_run::io::{read_checkpoint, write_checkpoint};
 use std::sync::atomic::Ordering;
@@ -49,7 +49,7 @@ struct Cli {
     particles: Option<u64>,
 
     /// Seed of every random stream of the run: same seed and flags, same run.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
     seed: u64,
 
     /// Output directory (created if missing; nothing is written on bad input). It is this run's
@@ -61,7 +61,7 @@ struct Cli {
 
     /// Save the run's state to OUT/checkpoint.bin every N sweeps (atomically), for --resume;
     /// SIGINT or SIGTERM then save it after the current sweep and stop (exit code 130).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
     /// Continue the run saved in DIR/checkpoint.bin (by --checkpoint-every) to the same final
@@ -103,7 +103,7 @@ struct Cli {
     /// Initial grid-box side in sites for `--search grid` or `grid-doubling`, a power of two (default:
     /// `grid` takes the side of least predicted cost and re-tunes it as clusters grow;
     /// `grid-doubling` starts from the cluster spacing and doubles with the largest cluster).
-    #[arg(long)]
+    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     grid_box: Option<u64>,
 
     /// Memory in bytes; suffixes K, M, G, T (powers of 1024). The occupancy lattice
@@ -128,6 +128,7 @@ struct Cli {
         long,
         requires = "histogram",
         value_delimiter = ',',
+        value_parser = sim_run::cli::count::<u64>,
         default_value = dlca::params::DEFAULT_HISTOGRAM_SWEEPS
     )]
     histogram_sweeps: Vec<u64>,
@@ -277,6 +278,56 @@ const CURVES: &[Curve] = &[
     },
 ];
 
+/// What an ensemble (`--seeds`) pools over its members: with `--gyration`, the fractal
+/// dimension fitted over the clusters of every member, as the literature measures it.
+const POOLED: &[Pooled] = &[Pooled {
+    name: "fractal_dimension",
+    title: "Fractal dimension pooled over the members",
+    compute: pooled_fractal_dimension,
+}];
+
+/// The pooled fit over the members' `clusters.csv` (none without `--gyration`).
+fn pooled_fractal_dimension(members: &[MemberRun<'_>]) -> anyhow::Result<Option<PooledResult>> {
+    if members.iter().any(|m| !m.dir.join("clusters.csv").exists()) {
+        return Ok(None);
+    }
+    let min_size = members[0].manifest.params["fit_min_size"]
+        .as_u64()
+        .context("run.json has no fit_min_size")?;
+    let runs = members
+        .iter()
+        .map(|m| dlca::output::read_clusters(&m.dir.join("clusters.csv")))
+        .collect::<Result<Vec<_>, _>>()?;
+    let json = dlca::output::pooled_summary(&runs, min_size)?;
+    let num = |k: &str| {
+        json[k]
+            .as_f64()
+            .map_or_else(|| "n/a".to_string(), |v| format!("{v:.4}"))
+    };
+    let markdown = format!(
+        "D = {} +- {} (jackknife over the {} members) from one fit of log s = D log R_g + c \
+         over the {} clusters of at least {min_size} particles of every member; the regression's \
+         own error, which takes the clusters as independent, is {}. The mean of the members' own \
+         fits is {} +- {} (standard error over {} fits). ensemble.json: \
+         `pooled.fractal_dimension`.",
+        num("fractal_dimension"),
+        num("fractal_dimension_stderr"),
+        json["members"],
+        json["fit_clusters"],
+        num("fit_stderr"),
+        num("per_member_mean"),
+        num("per_member_stderr"),
+        json["per_member_fits"],
+    );
+    Ok(Some(PooledResult { json, markdown }))
+}
+
+/// What an ensemble combines.
+const COMBINE: Combine<'static> = Combine {
+    curves: CURVES,
+    pooled: POOLED,
+};
+
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.
 const RUN_FILES: &[&str] = &[
@@ -290,7 +341,7 @@ const RUN_FILES: &[&str] = &[
 ];
 
 fn main() -> ExitCode {
-    if let Some(code) = sim_run::ensemble::before_parsing("dlca", CURVES) {
+    if let Some(code) = sim_run::ensemble::before_parsing("dlca", COMBINE) {
         return code;
     }
     sim_run::cli::main_with_config(
@@ -306,7 +357,7 @@ fn main() -> ExitCode {
                 overwrite: cli.overwrite.overwrite,
             };
             cli.ensemble
-                .run("dlca", 1, &cli.out, CURVES, &cli.log, &owner)
+                .run("dlca", 1, &cli.out, COMBINE, &cli.log, &owner)
                 .unwrap_or_else(|| run(cli, params))
         },
     )

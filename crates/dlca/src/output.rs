@@ -11,7 +11,9 @@
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
 //! | `dlca.png` | with `--png`: the final state, one colour per cluster, a square of pixels per site on lattices under 512 sites wide |
 
-use crate::analysis::{ClusterMeasure, fractal_dimension, gyration, size_distribution};
+use crate::analysis::{
+    ClusterMeasure, fractal_dimension, gyration, pooled_fractal_dimension, size_distribution,
+};
 use crate::sim::Simulation;
 use serde_json::json;
 use sim_run::io::{
@@ -190,11 +192,84 @@ pub fn each_particle<E>(
     sim.try_for_each_particle(f)
 }
 
+/// The header of `clusters.csv`.
+pub const CLUSTER_COLUMNS: [&str; 4] = ["cluster", "size", "radius_of_gyration", "wraps"];
+
+/// Reads a `clusters.csv` written by [`write_outputs`] (with `--gyration`).
+///
+/// # Errors
+/// The file does not read, or is not a `clusters.csv` (its header, a row that does not parse).
+pub fn read_clusters(path: &Path) -> Result<Vec<ClusterMeasure>, OutputError> {
+    let bad = |why: String| {
+        OutputError::from(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("{}: {why}", path.display()),
+        ))
+    };
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text.lines();
+    let header = lines.next().unwrap_or("");
+    if header != CLUSTER_COLUMNS.join(",") {
+        return Err(bad(format!(
+            "header `{header}`, not `{}`",
+            CLUSTER_COLUMNS.join(",")
+        )));
+    }
+    lines
+        .enumerate()
+        .filter(|(_, l)| !l.is_empty())
+        .map(|(i, l)| {
+            let f: Vec<&str> = l.split(',').collect();
+            let row = || bad(format!("line {}: `{l}` is not a cluster row", i + 2));
+            if f.len() != 4 {
+                return Err(row());
+            }
+            Ok(ClusterMeasure {
+                id: f[0].parse().map_err(|_| row())?,
+                size: f[1].parse().map_err(|_| row())?,
+                radius_of_gyration: f[2].parse().map_err(|_| row())?,
+                wraps: f[3].parse().map_err(|_| row())?,
+            })
+        })
+        .collect()
+}
+
+/// An ensemble's fractal dimension both ways (docs/dlca.md, "Validation"): pooled over the
+/// clusters of every member (`runs`, each member's [`ClusterMeasure`]s), with the jackknife
+/// error over members ([`pooled_fractal_dimension`]), beside the mean and standard error of
+/// the members' own fits. Its keys are those of `ensemble.json`'s `pooled.fractal_dimension`
+/// and of `aggsim.dlca_pooled_fit`.
+///
+/// # Errors
+/// The pooled fit fails (fewer than 3 clusters of at least `min_size`).
+pub fn pooled_summary(
+    runs: &[Vec<ClusterMeasure>],
+    min_size: u64,
+) -> Result<serde_json::Value, core_lattice::stats::StatsError> {
+    let pooled = pooled_fractal_dimension(runs, min_size)?;
+    let own: Vec<f64> = runs
+        .iter()
+        .filter_map(|r| fractal_dimension(r, min_size).ok().map(|f| f.slope))
+        .collect();
+    let mut w = core_lattice::stats::Welford::new();
+    own.iter().for_each(|&d| w.push(d));
+    let m = own.len();
+    Ok(json!({
+        "fractal_dimension": pooled.slope,
+        "fractal_dimension_stderr": pooled.jackknife_stderr,
+        "stderr_method": "jackknife over members",
+        "fit_stderr": pooled.fit_stderr,
+        "fit_clusters": pooled.clusters,
+        "fit_min_size": min_size,
+        "members": pooled.runs,
+        "per_member_mean": (m > 0).then(|| w.mean()),
+        "per_member_stderr": (m > 1).then(|| w.std_error()),
+        "per_member_fits": m,
+    }))
+}
+
 fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputError> {
-    let mut w = CsvWriter::create(
-        dir.join("clusters.csv"),
-        &["cluster", "size", "radius_of_gyration", "wraps"],
-    )?;
+    let mut w = CsvWriter::create(dir.join("clusters.csv"), &CLUSTER_COLUMNS)?;
     for c in measures {
         w.row(&[&c.id, &c.size, &c.radius_of_gyration, &c.wraps])?;
     }

@@ -407,9 +407,8 @@ pub mod flags {
     pub fn parse_size(s: &str) -> Result<Vec<u64>, String> {
         s.split('x')
             .map(|p| {
-                p.trim()
-                    .parse::<u64>()
-                    .map_err(|_| format!("'{s}' is not a size like 1024 or 1024x512"))
+                sim_run::count::count::<u64>(p.trim())
+                    .map_err(|_| format!("'{s}' is not a size like 1024, 1024x512 or 1e3"))
             })
             .collect()
     }

@@ -131,7 +131,25 @@ fn bad_inputs_are_refused_before_any_work() {
         ),
         (with(&["--histogram", "--histogram-sweeps", "1,x"]), "x"),
         (with(&["--histogram-sweeps", "1,2"]), "--histogram"),
-        (with(&["--checkpoint-every", "0"]), "0"),
+        (
+            with(&["--checkpoint-every", "0"]),
+            "0 is outside the accepted range 1..",
+        ),
+        (
+            with(&["--checkpoint-every", "2.5"]),
+            "2.5 is not a whole number",
+        ),
+        (with(&["--checkpoint-every", "1e30"]), "1e30 is too large"),
+        (with(&["--grid-box", "1.5"]), "1.5 is not a whole number"),
+        (
+            with(&["--histogram", "--histogram-sweeps", "1,2.5"]),
+            "2.5 is not a whole number",
+        ),
+        (
+            with(&["--target-cluster", "3"]),
+            "tip: a similar argument exists: '--target-clusters'",
+        ),
+        (with(&["--seed", "1..=4"]), "use --seeds 1..=4"),
         (with(&["--heartbeat", "soon"]), "soon"),
         (with(&["--frobnicate"]), "--frobnicate"),
         (

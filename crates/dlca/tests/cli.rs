@@ -331,3 +331,70 @@ fn config_files_repeat_runs_and_flags_override_them() {
         &["--size", "32x16", "--fill", "0.05", "--seed", "4", "--png"],
     );
 }
+
+/// Counts as physicists write them (`1e3`, `6.4e1`, `1_000`) are the same run as plain digits,
+/// in every count flag, in lattice sides and in a seed.
+#[test]
+fn counts_in_every_notation_are_the_same_run() {
+    let hash = |args: &[&str]| {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("run");
+        let mut all = vec!["--out", out.to_str().unwrap(), "-qq", "--histogram"];
+        all.extend_from_slice(args);
+        let o = dlca(&all);
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        run_json(&out)["results"]["state_hash"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    let plain = hash(&[
+        "--size",
+        "64x32",
+        "--particles",
+        "100",
+        "--target-clusters",
+        "10",
+        "--max-sweeps",
+        "1000",
+        "--checkpoint-every",
+        "10",
+        "--seed",
+        "1000",
+        "--histogram-sweeps",
+        "1,10",
+        "--search",
+        "grid",
+        "--grid-box",
+        "8",
+        "--fit-min-size",
+        "2",
+    ]);
+    let written = hash(&[
+        "--size",
+        "6.4e1x32",
+        "--particles",
+        "1e2",
+        "--target-clusters",
+        "1_0",
+        "--max-sweeps",
+        "1e3",
+        "--checkpoint-every",
+        "1E1",
+        "--seed",
+        "1e3",
+        "--histogram-sweeps",
+        "1,1e1",
+        "--search",
+        "grid",
+        "--grid-box",
+        "8.0",
+        "--fit-min-size",
+        "2e0",
+    ]);
+    assert_eq!(written, plain);
+}

@@ -3,6 +3,7 @@
 //! Everything around a simulation run that is not the simulation: what the model binaries of
 //! the workspace share, usable by any program that runs seeded simulations.
 //!
+//! - [`count`]: counts as physicists write them (`1e6`, `2.5e5`, `1_000_000`), exactly.
 //! - [`io`]: atomic file writes, the run manifest `run.json` (parameters, seed, wall and CPU
 //!   time, peak memory, provenance), the versioned and checksummed checkpoint envelope,
 //!   NumPy `.npy` files streamed row by row, PNG and CSV writers, point files (CSV, `.npy`,
@@ -39,6 +40,7 @@
 
 #[cfg(feature = "cli")]
 pub mod cli;
+pub mod count;
 #[cfg(feature = "cli")]
 pub mod ensemble;
 #[cfg(any(test, feature = "test-support"))]

@@ -44,7 +44,7 @@ impl DlcaLattice {
         temperature = defaults().temperature,
         gravity = defaults().gravity,
         mobility_exponent = defaults().mobility_exponent,
-        target_clusters = defaults().target_clusters as i64,
+        target_clusters = Count::Int(i128::from(defaults().target_clusters)),
         max_sweeps = None,
         search = defaults().search.name(),
         grid_box = None,
@@ -53,30 +53,30 @@ impl DlcaLattice {
         histogram = false,
         histogram_sweeps = None,
         gyration = false,
-        fit_min_size = defaults().fit_min_size as i64,
+        fit_min_size = Count::Int(i128::from(defaults().fit_min_size)),
     ))]
     #[allow(clippy::too_many_arguments)]
     pub(super) fn new(
         py: Python<'_>,
         size: &Bound<'_, PyAny>,
         fill: Option<f64>,
-        particles: Option<i64>,
+        particles: Option<Count>,
         dim: Option<usize>,
         seed: u64,
         boundary: Option<&Bound<'_, PyAny>>,
         temperature: f64,
         gravity: f64,
         mobility_exponent: f64,
-        target_clusters: i64,
-        max_sweeps: Option<i64>,
+        target_clusters: Count,
+        max_sweeps: Option<Count>,
         search: &str,
-        grid_box: Option<i64>,
+        grid_box: Option<Count>,
         max_memory: Option<&Bound<'_, PyAny>>,
         timing: bool,
         histogram: bool,
-        histogram_sweeps: Option<Vec<i64>>,
+        histogram_sweeps: Option<Vec<Count>>,
         gyration: bool,
-        fit_min_size: i64,
+        fit_min_size: Count,
     ) -> PyResult<Self> {
         let periodic = PyString::new(py, &defaults().boundary[0].to_string());
         let memory = defaults().max_memory.into_pyobject(py)?.into_any();
@@ -109,9 +109,9 @@ impl DlcaLattice {
     /// clusters left, or ``max_sweeps`` reached) and return how many ran. Each sweep moves
     /// every cluster once, in a fresh random order. ``progress`` as in :func:`aggsim.dlca`,
     /// counting sweeps. Ctrl-C stops after the current sweep (``KeyboardInterrupt``).
-    #[pyo3(signature = (n = 1, progress = None))]
-    fn step(&self, py: Python<'_>, n: i64, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
-        let n = count("n", n)?;
+    #[pyo3(signature = (n = Count::Int(1), progress = None))]
+    fn step(&self, py: Python<'_>, n: Count, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
+        let n = count(&[], "n", n)?;
         let progress = Progress::from_arg(progress, "dlca", "sweeps")?;
         self.lock()?.sweeps(py, n, &progress)
     }

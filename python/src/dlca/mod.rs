@@ -2,10 +2,10 @@
 //! the `dlca` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 //! Performance Optimisation").
 
-use crate::convert::{Columns, count, run_error, set_manifest, value_error};
+use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::run::{Progress, interruptible};
 use ::dlca::analysis::{gyration, size_distribution};
-use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, flags};
+use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, PARAMS, flags};
 use ::dlca::{Params, Search, Simulation};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
@@ -30,11 +30,18 @@ fn sizes(arg: &Bound<'_, PyAny>) -> PyResult<Vec<u64>> {
     if let Ok(s) = arg.cast::<PyString>() {
         return flags::parse_size(s.to_str()?).map_err(value_error);
     }
-    let given: Vec<i64> = match arg.extract::<i64>() {
-        Ok(v) => vec![v],
-        Err(_) => arg.extract()?,
+    let given: Vec<Count> = match arg.extract::<Count>()? {
+        Count::NotANumber(t) => arg.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "size = a {t}: a size is a count, a sequence of counts or a string (\"1024x512\")"
+            ))
+        })?,
+        v => vec![v],
     };
-    given.into_iter().map(|v| count("--size", v)).collect()
+    given
+        .into_iter()
+        .map(|v| count(PARAMS, "size", v))
+        .collect()
 }
 
 /// `--boundary`: `"periodic"`, `"wall"`, one per axis separated by commas, or a sequence of
@@ -52,7 +59,7 @@ fn bytes(arg: &Bound<'_, PyAny>) -> PyResult<u64> {
     if let Ok(s) = arg.cast::<PyString>() {
         return flags::parse_bytes(s.to_str()?).map_err(value_error);
     }
-    count("--max-memory", arg.extract()?)
+    count(PARAMS, "max_memory", arg.extract()?)
 }
 
 /// The parameters of the keyword arguments, checked as the binary checks its flags.
@@ -60,29 +67,31 @@ fn bytes(arg: &Bound<'_, PyAny>) -> PyResult<u64> {
 fn params(
     size: &Bound<'_, PyAny>,
     fill: Option<f64>,
-    particles: Option<i64>,
+    particles: Option<Count>,
     dim: Option<usize>,
     boundary: &Bound<'_, PyAny>,
     temperature: f64,
     gravity: f64,
     mobility_exponent: f64,
-    target_clusters: i64,
-    max_sweeps: Option<i64>,
+    target_clusters: Count,
+    max_sweeps: Option<Count>,
     search: &str,
-    grid_box: Option<i64>,
+    grid_box: Option<Count>,
     max_memory: &Bound<'_, PyAny>,
     timing: bool,
     histogram: bool,
-    histogram_sweeps: Option<Vec<i64>>,
+    histogram_sweeps: Option<Vec<Count>>,
     gyration: bool,
-    fit_min_size: i64,
+    fit_min_size: Count,
 ) -> PyResult<Params> {
     let given = sizes(size)?;
     // A sequence of lengths gives the dimension; one length takes the binary's default, 2.
     let dim = dim.unwrap_or(if given.len() > 1 { given.len() } else { 2 });
     let (size, boundary) =
         flags::axes(dim, &given, &self::boundary(boundary)?).map_err(value_error)?;
-    let particles = particles.map(|n| count("--particles", n)).transpose()?;
+    let particles = particles
+        .map(|n| count(PARAMS, "particles", n))
+        .transpose()?;
     let histogram_sweeps = match (histogram, histogram_sweeps) {
         (false, Some(_)) => {
             return Err(value_error(
@@ -92,7 +101,7 @@ fn params(
         (false, None) => Vec::new(),
         (true, Some(v)) => v
             .into_iter()
-            .map(|s| count("--histogram-sweeps", s))
+            .map(|s| count(PARAMS, "histogram_sweeps", s))
             .collect::<PyResult<_>>()?,
         (true, None) => DEFAULT_HISTOGRAM_SWEEPS
             .split(',')
@@ -106,15 +115,17 @@ fn params(
         temperature,
         gravity,
         mobility_exponent,
-        target_clusters: count("--target-clusters", target_clusters)?,
-        max_sweeps: max_sweeps.map(|n| count("--max-sweeps", n)).transpose()?,
+        target_clusters: count(PARAMS, "target_clusters", target_clusters)?,
+        max_sweeps: max_sweeps
+            .map(|n| count(PARAMS, "max_sweeps", n))
+            .transpose()?,
         search: search.parse::<Search>().map_err(value_error)?,
-        grid_box: grid_box.map(|n| count("--grid-box", n)).transpose()?,
+        grid_box: grid_box.map(|n| count(PARAMS, "grid_box", n)).transpose()?,
         max_memory: bytes(max_memory)?,
         timing,
         histogram_sweeps,
         gyration,
-        fit_min_size: count("--fit-min-size", fit_min_size)?,
+        fit_min_size: count(PARAMS, "fit_min_size", fit_min_size)?,
     };
     p.validate().map_err(value_error)?;
     Ok(p)
@@ -400,7 +411,7 @@ impl DlcaResult {
     temperature = defaults().temperature,
     gravity = defaults().gravity,
     mobility_exponent = defaults().mobility_exponent,
-    target_clusters = defaults().target_clusters as i64,
+    target_clusters = Count::Int(i128::from(defaults().target_clusters)),
     max_sweeps = None,
     search = defaults().search.name(),
     grid_box = None,
@@ -409,7 +420,7 @@ impl DlcaResult {
     histogram = false,
     histogram_sweeps = None,
     gyration = false,
-    fit_min_size = defaults().fit_min_size as i64,
+    fit_min_size = Count::Int(i128::from(defaults().fit_min_size)),
     progress = None,
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -417,23 +428,23 @@ pub fn dlca(
     py: Python<'_>,
     size: &Bound<'_, PyAny>,
     fill: Option<f64>,
-    particles: Option<i64>,
+    particles: Option<Count>,
     dim: Option<usize>,
     seed: u64,
     boundary: Option<&Bound<'_, PyAny>>,
     temperature: f64,
     gravity: f64,
     mobility_exponent: f64,
-    target_clusters: i64,
-    max_sweeps: Option<i64>,
+    target_clusters: Count,
+    max_sweeps: Option<Count>,
     search: &str,
-    grid_box: Option<i64>,
+    grid_box: Option<Count>,
     max_memory: Option<&Bound<'_, PyAny>>,
     timing: bool,
     histogram: bool,
-    histogram_sweeps: Option<Vec<i64>>,
+    histogram_sweeps: Option<Vec<Count>>,
     gyration: bool,
-    fit_min_size: i64,
+    fit_min_size: Count,
     progress: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Py<DlcaResult>> {
     let progress = Progress::from_arg(progress, "dlca", "merges")?;
@@ -473,4 +484,90 @@ pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
     }
     o.insert("seed".into(), 1.into());
     crate::convert::json(py, &serde_json::Value::Object(o))
+}
+
+/// The fractal dimension of an ensemble of DLCA runs as the literature computes it: one fit of
+/// ``log s = D log R_g + c`` over the clusters of every run (pooled), with the jackknife error
+/// over runs (the runs are the independent units), beside the mean and standard error of the
+/// runs' own fits. The keys are those of ``ensemble.json``'s ``pooled.fractal_dimension`` that
+/// ``dlca --seeds ... --gyration`` writes.
+///
+/// Parameters
+/// ----------
+/// results : sequence of DlcaResult
+///     Runs made with ``gyration=True`` (one per seed, same parameters).
+/// fit_min_size : int, optional
+///     Smallest cluster in the fit; default: the runs' ``fit_min_size``.
+///
+/// Returns
+/// -------
+/// dict
+///     ``fractal_dimension``, ``fractal_dimension_stderr`` (jackknife over runs; None for one
+///     run), ``stderr_method``, ``fit_stderr`` (the pooled regression's), ``fit_clusters``,
+///     ``fit_min_size``, ``members``, ``per_member_mean``, ``per_member_stderr``,
+///     ``per_member_fits``.
+///
+/// Raises
+/// ------
+/// ValueError
+///     A run without ``gyration``, runs with different ``fit_min_size`` and none given, or
+///     fewer than 3 clusters to fit.
+#[pyfunction]
+#[pyo3(signature = (results, fit_min_size = None))]
+pub fn dlca_pooled_fit<'py>(
+    py: Python<'py>,
+    results: Vec<Bound<'py, DlcaResult>>,
+    fit_min_size: Option<Count>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut runs = Vec::with_capacity(results.len());
+    let mut sizes = Vec::new();
+    for (i, r) in results.iter().enumerate() {
+        let g = r.getattr("gyration")?;
+        if g.is_none() {
+            return Err(value_error(format!(
+                "results[{i}] was run without gyration=True: it has no clusters to pool"
+            )));
+        }
+        let ids: Vec<u32> = g
+            .get_item("cluster")?
+            .extract::<Vec<i64>>()?
+            .iter()
+            .map(|&v| v as u32)
+            .collect();
+        let size: Vec<u64> = g.get_item("size")?.extract()?;
+        let rg: Vec<f64> = g.get_item("radius_of_gyration")?.extract()?;
+        let wraps: Vec<bool> = g.get_item("wraps")?.extract()?;
+        runs.push(
+            (0..ids.len())
+                .map(|k| ::dlca::analysis::ClusterMeasure {
+                    id: ids[k],
+                    size: size[k],
+                    radius_of_gyration: rg[k],
+                    wraps: wraps[k],
+                })
+                .collect::<Vec<_>>(),
+        );
+        sizes.push(
+            r.getattr("params")?
+                .get_item("fit_min_size")?
+                .extract::<u64>()?,
+        );
+    }
+    let min_size = match fit_min_size {
+        Some(v) => count(PARAMS, "fit_min_size", v)?,
+        None => {
+            sizes.dedup();
+            match sizes.as_slice() {
+                [one] => *one,
+                [] => return Err(value_error("results is empty: nothing to pool")),
+                _ => {
+                    return Err(value_error(
+                        "the runs differ in fit_min_size; give fit_min_size",
+                    ));
+                }
+            }
+        }
+    };
+    let summary = ::dlca::output::pooled_summary(&runs, min_size).map_err(value_error)?;
+    crate::convert::json(py, &summary)
 }

@@ -16,13 +16,12 @@
 //!   `-qq` silences it ([`LogArgs`], [`Progress`]).
 
 pub mod config;
-mod count;
 mod out_dir;
 mod progress;
 mod resume;
 
+pub use crate::count::{count, count_at_least_1, seed};
 pub use config::ConfigArgs;
-pub use count::count;
 pub use out_dir::{
     Claim, ClaimError, ENSEMBLE_FILES, EarlierRun, LOCK_FILE, LockHolder, OutDirLock,
     check_out_dir, claim_out_dir, prepare_out_dir,
@@ -289,14 +288,17 @@ pub fn clap_error(program: &str, e: clap::Error) -> ExitCode {
         let _ = e.print();
         return ExitCode::SUCCESS;
     }
-    // clap's message up to its blank line, folded onto one line.
+    // clap's message and its tips (`tip: a similar argument exists: '--particles'`), up to
+    // the usage line, folded onto one line; the blank lines between them are dropped.
     let text = e.to_string();
-    let message: Vec<&str> = text
-        .lines()
-        .take_while(|l| !l.trim().is_empty())
-        .map(str::trim)
-        .collect();
-    usage_error(program, message.join(" ").trim_start_matches("error: "))
+    let message = text
+        .split("\n\n")
+        .take_while(|p| !p.starts_with("Usage:") && !p.starts_with("For more information"))
+        .map(|p| p.split_whitespace().collect::<Vec<_>>().join(" "))
+        .filter(|p| !p.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ");
+    usage_error(program, message.trim_start_matches("error: "))
 }
 
 /// Print `program: error: msg` on one line and return exit code 2 (bad input).

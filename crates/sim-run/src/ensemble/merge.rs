@@ -33,6 +33,61 @@ pub struct Curve {
     pub log_y: bool,
 }
 
+/// A result computed from every member's outputs together rather than averaged over the members
+/// (a fit over the clusters of all members, say), written beside the per-member statistics:
+/// `ensemble.json`'s `pooled.<name>` and a section of `ensemble.md`.
+#[derive(Debug, Clone, Copy)]
+pub struct Pooled {
+    /// Key under `pooled` in `ensemble.json`.
+    pub name: &'static str,
+    /// Heading of its section in `ensemble.md`.
+    pub title: &'static str,
+    /// Computes it from the finished members: `Ok(None)` when the members hold nothing to pool
+    /// (a flag that writes the input was not given); its `markdown` text, if any, is the
+    /// section's body. An `Err` is reported in `ensemble.json` and `ensemble.md` instead of
+    /// the result, and the rest of the merge goes on.
+    pub compute: fn(&[MemberRun<'_>]) -> anyhow::Result<Option<PooledResult>>,
+}
+
+/// A pooled result: its JSON and its text for `ensemble.md`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PooledResult {
+    /// Written as `ensemble.json`'s `pooled.<name>`.
+    pub json: Value,
+    /// The body of its section in `ensemble.md`.
+    pub markdown: String,
+}
+
+/// One finished member as a [`Pooled`] result sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct MemberRun<'a> {
+    /// Its seed.
+    pub seed: u64,
+    /// Its directory (`DIR/seed-NNNN`).
+    pub dir: &'a Path,
+    /// Its `run.json`.
+    pub manifest: &'a RunManifest,
+}
+
+/// What a model's ensemble combines: the curves averaged over the members and the results
+/// pooled over them.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Combine<'a> {
+    /// The curves averaged over the members.
+    pub curves: &'a [Curve],
+    /// The results computed from all members together.
+    pub pooled: &'a [Pooled],
+}
+
+impl<'a> From<&'a [Curve]> for Combine<'a> {
+    fn from(curves: &'a [Curve]) -> Self {
+        Combine {
+            curves,
+            pooled: &[],
+        }
+    }
+}
+
 /// Mean, standard deviation (n - 1 in the denominator), standard error and count of one scalar
 /// over the members.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -92,6 +147,12 @@ struct Member {
 /// Fails when no member has finished, when a member is another model's, or when the members
 /// were run with different parameters (an average over them would mean nothing).
 pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<MergeReport> {
+    merge_with(dir, program, Combine::from(curves))
+}
+
+/// [`merge`] with the model's pooled results too ([`Combine`]).
+pub fn merge_with(dir: &Path, program: &str, combine: Combine<'_>) -> anyhow::Result<MergeReport> {
+    let curves = combine.curves;
     let mut members = Vec::new();
     let mut unfinished = Vec::new();
     let mut invalid = Vec::new();
@@ -215,6 +276,31 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
             })
         })
         .collect();
+    let runs: Vec<MemberRun<'_>> = members
+        .iter()
+        .map(|m| MemberRun {
+            seed: m.seed,
+            dir: &m.dir,
+            manifest: &m.manifest,
+        })
+        .collect();
+    let mut pooled_json = Map::new();
+    let mut pooled_md = Vec::new();
+    for p in combine.pooled {
+        match (p.compute)(&runs) {
+            Ok(None) => {}
+            Ok(Some(r)) => {
+                pooled_json.insert(p.name.to_owned(), r.json);
+                pooled_md.push((p.title, r.markdown));
+            }
+            Err(e) => {
+                let why = format!("{e:#}");
+                tracing::warn!("{}: {why}", p.name);
+                pooled_json.insert(p.name.to_owned(), json!({ "error": why }));
+                pooled_md.push((p.title, format!("Not computed: {why}.")));
+            }
+        }
+    }
     let doc = json!({
         "model": program,
         "version": first.manifest.version,
@@ -226,6 +312,7 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
         "results": results,
         "per_member": per_member,
         "curves": curve_files,
+        "pooled": pooled_json,
     });
     let mut bytes = serde_json::to_vec_pretty(&doc)?;
     bytes.push(b'\n');
@@ -244,6 +331,7 @@ pub fn merge(dir: &Path, program: &str, curves: &[Curve]) -> anyhow::Result<Merg
             &results,
             curves,
             &doc,
+            &pooled_md,
         )
         .as_bytes(),
     )
@@ -267,6 +355,7 @@ fn markdown(
     results: &BTreeMap<&str, ScalarStats>,
     curves: &[Curve],
     doc: &Value,
+    pooled: &[(&str, String)],
 ) -> String {
     let mut s = String::new();
     let seeds: Vec<String> = members.iter().map(|m| m.seed.to_string()).collect();
@@ -302,6 +391,9 @@ fn markdown(
         "\nstd is the sample standard deviation over the members, stderr = std / sqrt(n) the \
          standard error of the mean; per-member values are in ensemble.json."
     );
+    for (title, body) in pooled {
+        let _ = writeln!(s, "\n## {title}\n\n{body}");
+    }
     for c in curves {
         if let Some(stem) = Path::new(c.file).file_stem().map(|s| s.to_string_lossy()) {
             if doc["curves"].get(stem.as_ref()).is_some() {

@@ -25,7 +25,9 @@ mod merge;
 mod ranks;
 mod seeds;
 
-pub use merge::{Curve, MergeReport, ScalarStats, merge};
+pub use merge::{
+    Combine, Curve, MemberRun, MergeReport, Pooled, PooledResult, ScalarStats, merge, merge_with,
+};
 pub use seeds::{Seeds, parse_seeds};
 
 use crate::cli::{Interrupted, LogArgs};
@@ -50,7 +52,7 @@ pub struct EnsembleArgs {
     pub seeds: Option<Seeds>,
 
     /// With --seeds: members run at once (default: the cores divided by each member's threads).
-    #[arg(long, value_name = "J", requires = "seeds", value_parser = clap::value_parser!(u64).range(1..=4096))]
+    #[arg(long, value_name = "J", requires = "seeds", value_parser = parse_jobs)]
     pub jobs: Option<u64>,
 
     /// Rebuild an ensemble's combined result (ensemble.json, ensemble.md, averaged curves) from
@@ -59,15 +61,28 @@ pub struct EnsembleArgs {
     pub merge: Option<PathBuf>,
 }
 
+/// Most members `--jobs` runs at once.
+pub const MAX_JOBS: u64 = 4096;
+
+/// `--jobs`: a count (any notation of [`crate::count::count`]) in `1..=MAX_JOBS`.
+fn parse_jobs(s: &str) -> Result<u64, String> {
+    let j = crate::count::count::<u64>(s)?;
+    if (1..=MAX_JOBS).contains(&j) {
+        Ok(j)
+    } else {
+        Err(format!("{j} is outside the accepted range 1..={MAX_JOBS}"))
+    }
+}
+
 impl EnsembleArgs {
     /// Runs the ensemble these flags ask for, if they ask for one (`--seeds`): the branch every
     /// model binary takes before its own run. `member_threads` is each member's `--threads`.
-    pub fn run(
+    pub fn run<'c>(
         &self,
         program: &str,
         member_threads: usize,
         out: &Path,
-        curves: &[Curve],
+        combine: impl Into<Combine<'c>>,
         log: &LogArgs,
         owner: &Owner<'_>,
     ) -> Option<anyhow::Result<()>> {
@@ -78,7 +93,7 @@ impl EnsembleArgs {
             jobs: self.jobs,
             member_threads,
             out,
-            curves,
+            combine: combine.into(),
             log,
             owner,
         }))
@@ -98,8 +113,8 @@ pub struct Ensemble<'a> {
     pub member_threads: usize,
     /// The ensemble's directory (`--out`).
     pub out: &'a Path,
-    /// The curves to average.
-    pub curves: &'a [Curve],
+    /// The curves to average and the results to pool.
+    pub combine: Combine<'a>,
     /// The logging flags.
     pub log: &'a LogArgs,
     /// What the members must agree on, and `--overwrite`.
@@ -278,7 +293,7 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     progress.finish();
     let mut ended = ended.into_inner().unwrap_or_else(|p| p.into_inner());
     ended.sort_by_key(|(s, _)| *s);
-    let report = merge(e.out, e.program, e.curves);
+    let report = merge_with(e.out, e.program, e.combine);
     let failed: Vec<String> = ended
         .iter()
         .filter_map(|(s, end)| match end {
@@ -566,20 +581,20 @@ fn terminate(_child: &std::process::Child) {}
 /// What every binary does before it parses its flags: refuses a processor the build cannot
 /// run on ([`crate::cli::refuse_unsupported_cpu`]) and handles `PROG --merge DIR`
 /// ([`merge_main`]). `Some(exit code)` when either ended the program.
-pub fn before_parsing(program: &str, curves: &[Curve]) -> Option<ExitCode> {
-    crate::cli::refuse_unsupported_cpu(program).or_else(|| merge_main(program, curves))
+pub fn before_parsing<'a>(program: &str, combine: impl Into<Combine<'a>>) -> Option<ExitCode> {
+    crate::cli::refuse_unsupported_cpu(program).or_else(|| merge_main(program, combine))
 }
 
 /// Handles `PROG --merge DIR` (exactly those arguments) before the model parses its flags:
 /// rebuilds the combined result of the members in `DIR`. `None` for any other command line.
-pub fn merge_main(program: &str, curves: &[Curve]) -> Option<ExitCode> {
+pub fn merge_main<'a>(program: &str, combine: impl Into<Combine<'a>>) -> Option<ExitCode> {
     let args: Vec<OsString> = std::env::args_os().skip(1).collect();
     let dir = match args.as_slice() {
         [flag, dir] if flag == "--merge" => PathBuf::from(dir),
         [flag] => PathBuf::from(flag.to_str()?.strip_prefix("--merge=")?),
         _ => return None,
     };
-    Some(match merge(&dir, program, curves) {
+    Some(match merge_with(&dir, program, combine.into()) {
         Ok(r) => {
             for why in &r.invalid {
                 eprintln!("{program}: warning: left out {why}");

@@ -1,4 +1,7 @@
-//! The `--seeds` list: `1..=80`, `1..81`, `3,5,9`, or a mix such as `1..=4,10,20..=22`.
+//! The `--seeds` list: `1..=80`, `1..81`, `3,5,9`, or a mix such as `1..=4,10,20..=22`. Each
+//! number may be written as any count (`1..=1e3`, `1_000`). A range written as in prose,
+//! `1-10`, is refused with its `1..=10` form rather than guessed at: whether `1-10` includes 10
+//! is a convention, and the run's recorded command line should not depend on one.
 
 /// Most members one ensemble accepts.
 pub const MAX_MEMBERS: usize = 1_000_000;
@@ -11,8 +14,7 @@ pub struct Seeds(pub Vec<u64>);
 pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
     let mut out = Vec::new();
     let num = |t: &str| {
-        t.trim()
-            .parse::<u64>()
+        crate::count::count::<u64>(t.trim())
             .map_err(|_| format!("`{}` is not a seed (a whole number >= 0)", t.trim()))
     };
     for item in s.split(',') {
@@ -20,6 +22,12 @@ pub fn parse_seeds(s: &str) -> Result<Vec<u64>, String> {
         if item.is_empty() {
             return Err(format!(
                 "`{s}` has an empty item; expected e.g. 1..=80 or 3,5,9"
+            ));
+        }
+        if let Some((a, b)) = crate::count::dash_range(item) {
+            return Err(format!(
+                "`{item}` is not a seed range; write {a}..={b} for seeds {a} to {b} \
+                 ({a}..{b} leaves out {b})"
             ));
         }
         let (lo, hi) = if let Some((a, b)) = item.split_once("..=") {
@@ -68,6 +76,8 @@ mod tests {
             vec![1, 2, 10, 20, 21]
         );
         assert_eq!(parse_seeds("7").unwrap(), vec![7]);
+        assert_eq!(parse_seeds("1..=1e3").unwrap().len(), 1000);
+        assert_eq!(parse_seeds("1_000,2e3").unwrap(), vec![1000, 2000]);
     }
 
     #[test]
@@ -82,6 +92,9 @@ mod tests {
             ("1,2,1", "seed 1 appears twice"),
             ("1..=2000000", "more than"),
             ("-1", "`-1`"),
+            ("1-10", "write 1..=10 for seeds 1 to 10"),
+            ("3,1-10", "write 1..=10"),
+            ("1.5", "`1.5`"),
         ] {
             let e = parse_seeds(bad).unwrap_err();
             assert!(e.contains(says), "{bad}: {e}");

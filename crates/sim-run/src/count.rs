@@ -80,6 +80,48 @@ pub fn count<T: TryFrom<u128>>(s: &str) -> Result<T, String> {
     T::try_from(value).map_err(|_| too_large())
 }
 
+/// [`count`] for a count of at least one (`--checkpoint-every N`, `--jobs J`): 0 is refused
+/// with the range.
+///
+/// # Errors
+/// As [`count`], and `0 is outside the accepted range 1..` for zero.
+pub fn count_at_least_1<T: TryFrom<u128> + PartialEq + Default>(s: &str) -> Result<T, String> {
+    let v = count::<T>(s)?;
+    if v == T::default() {
+        return Err(format!("{} is outside the accepted range 1..", s.trim()));
+    }
+    Ok(v)
+}
+
+/// A seed (`--seed`): a whole number in any notation [`count`] accepts. A list or range of
+/// seeds (`1..=10`, `1-10`, `3,5`) is refused with the `--seeds` flag that runs one member per
+/// seed, in its own syntax.
+///
+/// # Errors
+/// Why `s` is not one seed, with the `--seeds` form of a list or range.
+pub fn seed(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let hint = |list: &str| {
+        format!(
+            "`{t}` is several seeds, --seed takes one; for one run per seed (an ensemble) use              --seeds {list}"
+        )
+    };
+    if t.contains("..") || t.contains(',') {
+        return Err(hint(t));
+    }
+    if let Some((a, b)) = dash_range(t) {
+        return Err(hint(&format!("{a}..={b}")));
+    }
+    count::<u64>(t).map_err(|e| format!("{e} (a seed is a whole number >= 0)"))
+}
+
+/// `a-b` with both ends whole numbers (`1-10`): the ends, as a user writes a range in prose.
+pub(crate) fn dash_range(t: &str) -> Option<(&str, &str)> {
+    let (a, b) = t.split_once('-')?;
+    let (a, b) = (a.trim(), b.trim());
+    (count::<u64>(a).is_ok() && count::<u64>(b).is_ok() && !a.is_empty()).then_some((a, b))
+}
+
 /// The largest value of `T` (found by bisection over what `T::try_from` accepts), for messages.
 fn max<T: TryFrom<u128>>() -> u128 {
     let (mut lo, mut hi) = (0u128, u128::MAX);
@@ -96,7 +138,43 @@ fn max<T: TryFrom<u128>>() -> u128 {
 
 #[cfg(test)]
 mod tests {
-    use super::count;
+    use super::{count, count_at_least_1, seed};
+
+    #[test]
+    fn counts_of_at_least_one_refuse_zero_with_the_range() {
+        assert_eq!(count_at_least_1::<u64>("1e3"), Ok(1000));
+        assert_eq!(count_at_least_1::<u64>("1"), Ok(1));
+        for z in ["0", "0e5", "0.0"] {
+            let e = count_at_least_1::<u64>(z).unwrap_err();
+            assert!(e.contains("outside the accepted range 1.."), "{z}: {e}");
+        }
+        assert!(
+            count_at_least_1::<u64>("1.5")
+                .unwrap_err()
+                .contains("not a whole number")
+        );
+    }
+
+    #[test]
+    fn a_seed_is_one_whole_number_and_a_list_points_to_seeds() {
+        assert_eq!(seed("7"), Ok(7));
+        assert_eq!(seed("1e3"), Ok(1000));
+        assert_eq!(seed("1_000"), Ok(1000));
+        for (s, hint) in [
+            ("1..=10", "--seeds 1..=10"),
+            ("1..11", "--seeds 1..11"),
+            ("3,5,9", "--seeds 3,5,9"),
+            ("1-10", "--seeds 1..=10"),
+            ("1 - 10", "--seeds 1..=10"),
+        ] {
+            let e = seed(s).unwrap_err();
+            assert!(e.contains(hint) && e.contains("several seeds"), "{s}: {e}");
+        }
+        for s in ["1.5", "-3", "x", "1e30"] {
+            let e = seed(s).unwrap_err();
+            assert!(!e.contains("--seeds"), "{s}: {e}");
+        }
+    }
 
     #[test]
     fn accepts_counts_in_every_notation() {
