@@ -89,7 +89,10 @@ mod under_mpirun {
         .arg(DLA)
         .args(args)
         .arg("--out")
-        .arg(ens);
+        .arg(ens)
+        // Read at the end only (`mpirun` says little), or by `output()`.
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped());
         cmd
     }
 
@@ -260,12 +263,7 @@ mod under_mpirun {
         }
         check_stopped(&job.wait_with_output().unwrap(), "SIGTERM to the ranks");
         // The same command continues; SIGUSR1 to mpirun once a member runs again.
-        let mut cmd = mpirun(3, &[], &args, &ens);
-        let job = cmd
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
+        let job = mpirun(3, &[], &args, &ens).spawn().unwrap();
         let logs: Vec<_> = (1..=4)
             .map(|s| {
                 std::fs::metadata(member(&ens, s).join("member.log"))
