@@ -161,6 +161,15 @@ pub struct UsageError(pub String);
 #[error("{0}")]
 pub struct Interrupted(pub String);
 
+/// Environment variable an ensemble sets for each member: the ensemble's process id. The
+/// member ties its life to that process (`sim_run::ensemble::tie_member_to_ensemble`).
+pub const MEMBER_OF: &str = "AGGSIM_MEMBER_OF";
+
+/// Whether this process runs as a member of an ensemble ([`MEMBER_OF`] set).
+pub fn is_member() -> bool {
+    std::env::var_os(MEMBER_OF).is_some()
+}
+
 /// A flag that SIGINT and SIGTERM set instead of killing the process, for a run that polls it
 /// to checkpoint and stop cleanly. A second signal of the same kind ends the process at once,
 /// as usual, so a run that does not stop can still be interrupted; except in an ensemble's
@@ -173,7 +182,7 @@ pub struct Interrupted(pub String);
 pub fn stop_on_signals() -> std::io::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let member = crate::ensemble::is_member();
+    let member = is_member();
     for sig in [SIGINT, SIGTERM] {
         // Registered first, so it runs when the flag is already set: the second signal.
         if !member {

@@ -4,6 +4,7 @@
 //! `mpi` refuses to run as one of several ranks ([`refuse_without_mpi`]), where every rank
 //! would otherwise run the whole command in the same directory.
 
+use crate::cli::MEMBER_OF;
 use std::ffi::OsString;
 use std::process::ExitCode;
 
@@ -72,15 +73,6 @@ pub fn refuse_without_mpi(program: &str) -> Option<ExitCode> {
         mpi_build_command(program)
     ));
     Some(ExitCode::from(crate::cli::EXIT_USAGE))
-}
-
-/// Environment variable an ensemble sets for each member: the ensemble's process id. The
-/// member ties its life to that process ([`tie_member_to_ensemble`]).
-pub const MEMBER_OF: &str = "AGGSIM_MEMBER_OF";
-
-/// Whether this process runs as a member of an ensemble ([`MEMBER_OF`] set).
-pub fn is_member() -> bool {
-    std::env::var_os(MEMBER_OF).is_some()
 }
 
 /// In a member: asks the kernel to kill this process when the process that started it ends

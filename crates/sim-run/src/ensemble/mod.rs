@@ -27,13 +27,12 @@ mod ranks;
 mod seeds;
 
 pub use launcher::{
-    MEMBER_OF, is_member, launcher_ranks, mpi_build_command, node_share, refuse_without_mpi,
-    tie_member_to_ensemble,
+    launcher_ranks, mpi_build_command, node_share, refuse_without_mpi, tie_member_to_ensemble,
 };
 pub use merge::{Curve, MergeReport, ScalarStats, merge};
 pub use seeds::{Seeds, parse_seeds};
 
-use crate::cli::{Interrupted, LogArgs};
+use crate::cli::{Interrupted, LogArgs, MEMBER_OF};
 use anyhow::{Context, anyhow};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
