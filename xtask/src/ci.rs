@@ -137,19 +137,25 @@ pub const STEPS: &[Step] = &[
         run: Run::PythonTests,
     },
     // Feature `mpi` (ensembles over the ranks of an MPI job): built, linted and tested where
-    // Open MPI and libclang are installed.
+    // Open MPI and libclang are installed, in a target directory of its own (as
+    // docs/ensembles.md builds it), so that the MPI binaries and the plain ones do not replace
+    // each other in target/debug. The plain build's refusal under `mpirun` is tested by the
+    // test step (tests/mpi.rs without the feature).
     Step {
         name: "mpi-clippy",
         needs: Needs::Mpi,
         run: Run::Cargo(
             "clippy -p dla-pdla -p dlca -p animat --features mpi --all-targets -- -D warnings",
-            &[],
+            &[("CARGO_TARGET_DIR", "target/mpi")],
         ),
     },
     Step {
         name: "mpi-tests",
         needs: Needs::Mpi,
-        run: Run::Cargo("test -p dla-pdla --features mpi --test ensemble", &[]),
+        run: Run::Cargo(
+            "test -p dla-pdla --features mpi --test ensemble --test mpi",
+            &[("CARGO_TARGET_DIR", "target/mpi")],
+        ),
     },
 ];
 

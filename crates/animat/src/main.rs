@@ -20,7 +20,7 @@ use std::sync::atomic::Ordering;
 /// win). Outputs go into --out DIR: run.json, populations.csv, and on request PNG snapshots
 /// and positions.csv (see docs/animat.md).
 #[derive(Parser, Debug)]
-#[command(name = "animat", version, allow_negative_numbers = true)]
+#[command(name = "animat", version = sim_run::cli::version(), allow_negative_numbers = true)]
 struct Cli {
     /// Steps to run.
     #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = animat::params::DEFAULT_STEPS)]

@@ -22,7 +22,7 @@ use std::process::ExitCode;
 // Defaults come from the library (`Params::default()`); `cli_spec_tests` checks the rest
 // (flags, choices, ranges in the help) against `dla_pdla::params::PARAMS`.
 #[derive(Parser, Debug)]
-#[command(name = "dla", version, allow_negative_numbers = true)]
+#[command(name = "dla", version = sim_run::cli::version(), allow_negative_numbers = true)]
 struct Cli {
     /// Space dimension, one of {2, 3, 4, 5}.
     #[arg(long, default_value_t = Params::default().dim)]

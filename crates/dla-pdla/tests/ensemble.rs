@@ -66,6 +66,48 @@ fn checkpointed_members_are_resumed() {
     );
 }
 
+/// A member directory that a live process holds (its `run.lock`: a member of an earlier job
+/// still stopping, a run started by hand) is never shared: the ensemble waits for it, then
+/// reports that member failed naming the holder, without touching its files; the others
+/// finish. Once the holder has gone, the same command finishes the ensemble.
+#[test]
+fn a_member_directory_held_by_a_live_process_is_not_shared() {
+    use std::process::Command;
+    let dir = tempfile::tempdir().unwrap();
+    let ens = dir.path().join("ens");
+    let held = ens.join("seed-0002");
+    let lock = sim_run::cli::claim_out_dir(&sim_run::cli::Claim::single(&held, &[], None, false))
+        .expect("the test holds member 2's directory");
+    std::fs::write(held.join("member.log"), "the holder's log\n").unwrap();
+    let run = || {
+        Command::new(env!("CARGO_BIN_EXE_dla"))
+            .args(["--seeds", "1..=2", "--particles", "300", "--out"])
+            .arg(&ens)
+            .output()
+            .unwrap()
+    };
+    let o = run();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("seed 2:")
+            && err.contains(&format!(
+                "in use by another run (pid {}",
+                std::process::id()
+            )),
+        "{err}"
+    );
+    assert!(ens.join("seed-0001/run.json").exists(), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(held.join("member.log")).unwrap(),
+        "the holder's log\n"
+    );
+    drop(lock);
+    let o = run();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(held.join("run.json").exists());
+}
+
 /// `mpirun -np 3 dla --seeds ...` (feature `mpi`, Open MPI installed): rank 0 hands the members
 /// out, ranks 1 and 2 run them; the combined result and every member are those of a local
 /// ensemble, and a member that cannot run is reported by seed.

@@ -28,7 +28,7 @@ use std::process::ExitCode;
 // (`--boundary`, `--max-memory`) and the flags, choices and ranges in the help are checked
 // against `dlca::params::PARAMS` by `cli_spec_tests`.
 #[derive(Parser, Debug)]
-#[command(name = "dlca", version, allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
+#[command(name = "dlca", version = sim_run::cli::version(), allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
 struct Cli {
     /// Lattice dimension, 1..=5. With a single --size value, every axis gets that length.
     #[arg(long, default_value_t = Params::default().dim())]

@@ -22,6 +22,7 @@ mod resume;
 
 pub use crate::count::{count, count_at_least_1, seed};
 pub use config::ConfigArgs;
+pub(crate) use out_dir::held;
 pub use out_dir::{
     Claim, ClaimError, ENSEMBLE_FILES, EarlierRun, LOCK_FILE, LockHolder, OutDirLock,
     check_out_dir, claim_out_dir, prepare_out_dir,
@@ -159,21 +160,66 @@ pub struct UsageError(pub String);
 #[error("{0}")]
 pub struct Interrupted(pub String);
 
+/// Environment variable an ensemble sets for each member: the ensemble's process id. The
+/// member ties its life to that process (`sim_run::ensemble::tie_member_to_ensemble`).
+pub const MEMBER_OF: &str = "AGGSIM_MEMBER_OF";
+
+/// Whether this process runs as a member of an ensemble ([`MEMBER_OF`] set).
+pub fn is_member() -> bool {
+    std::env::var_os(MEMBER_OF).is_some()
+}
+
 /// A flag that SIGINT and SIGTERM set instead of killing the process, for a run that polls it
 /// to checkpoint and stop cleanly. A second signal of the same kind ends the process at once,
-/// as usual, so a run that does not stop can still be interrupted.
+/// as usual, so a run that does not stop can still be interrupted; except in an ensemble's
+/// member, which may get the same signal twice (from a batch system that signals every process
+/// of a job, and from its ensemble passing it on) and is killed with its ensemble anyway
+/// ([`tie_member_to_ensemble`](crate::ensemble::tie_member_to_ensemble)).
 ///
 /// # Errors
 /// The handlers could not be installed.
 pub fn stop_on_signals() -> std::io::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
     use signal_hook::consts::{SIGINT, SIGTERM};
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let member = is_member();
     for sig in [SIGINT, SIGTERM] {
         // Registered first, so it runs when the flag is already set: the second signal.
-        signal_hook::flag::register_conditional_default(sig, std::sync::Arc::clone(&stop))?;
+        if !member {
+            signal_hook::flag::register_conditional_default(sig, std::sync::Arc::clone(&stop))?;
+        }
         signal_hook::flag::register(sig, std::sync::Arc::clone(&stop))?;
     }
     Ok(stop)
+}
+
+/// Prints `line` and a line break on standard error in one `write`, so that a process stopped
+/// while it prints (a member killed with its MPI rank) never leaves half a line in its log:
+/// `eprintln!` writes each piece of its format separately.
+pub fn say(line: &str) {
+    use std::io::Write;
+    let mut text = String::with_capacity(line.len() + 1);
+    text.push_str(line);
+    text.push('\n');
+    let _ = std::io::stderr().lock().write_all(text.as_bytes());
+}
+
+/// The text of `PROG --version` (after the program's name): the version, the optional
+/// features built in (`mpi`, or `none`, with how to get it) and the git commit, so that two
+/// binaries of the same name (an MPI build and a plain one) are told apart.
+pub fn version() -> &'static str {
+    static TEXT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    TEXT.get_or_init(|| {
+        let features = if cfg!(feature = "mpi") {
+            "mpi"
+        } else {
+            "none, so no ensembles over MPI ranks"
+        };
+        let commit = crate::io::provenance::GIT_COMMIT.map_or("unknown", |c| &c[..c.len().min(12)]);
+        format!(
+            "{} (features: {features}; commit {commit})",
+            env!("CARGO_PKG_VERSION")
+        )
+    })
 }
 
 /// A [`UsageError`] as an `anyhow::Error`, for `run` steps that return `anyhow::Result`.
@@ -186,7 +232,7 @@ pub fn usage(message: impl Into<String>) -> anyhow::Error {
 /// ([`cpu`](core_lattice::cpu)), rather than an illegal instruction later in the run.
 pub fn refuse_unsupported_cpu(program: &str) -> Option<ExitCode> {
     let why = core_lattice::cpu::unsupported()?;
-    eprintln!("{program}: {why}");
+    say(&format!("{program}: {why}"));
     Some(ExitCode::from(EXIT_RUN_FAILED))
 }
 
@@ -243,11 +289,11 @@ fn main_parsed<C, P>(
         Err(e) => match e.downcast_ref::<UsageError>() {
             Some(u) => usage_error(program, &u.0),
             None if e.downcast_ref::<Interrupted>().is_some() => {
-                eprintln!("{program}: {e}");
+                say(&format!("{program}: {e}"));
                 ExitCode::from(EXIT_INTERRUPTED)
             }
             None => {
-                eprintln!("{program}: run failed: {}", error_line(&e));
+                say(&format!("{program}: run failed: {}", error_line(&e)));
                 ExitCode::from(EXIT_RUN_FAILED)
             }
         },
@@ -304,7 +350,7 @@ pub fn clap_error(program: &str, e: clap::Error) -> ExitCode {
 /// Print `program: error: msg` on one line and return exit code 2 (bad input).
 pub fn usage_error(program: &str, msg: &str) -> ExitCode {
     let msg = msg.split_whitespace().collect::<Vec<_>>().join(" ");
-    eprintln!("{program}: error: {msg}");
+    say(&format!("{program}: error: {msg}"));
     ExitCode::from(EXIT_USAGE)
 }
 

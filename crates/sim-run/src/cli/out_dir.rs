@@ -53,7 +53,7 @@ pub fn check_out_dir(out: &Path) -> Result<(), String> {
 /// Whether a live run holds `dir/run.lock` (`Some(its details, if written)`), found without
 /// creating or changing anything.
 #[cfg(unix)]
-fn held(dir: &Path) -> Option<Option<LockHolder>> {
+pub(crate) fn held(dir: &Path) -> Option<Option<LockHolder>> {
     use nix::fcntl::{Flock, FlockArg};
     let path = dir.join(LOCK_FILE);
     let file = std::fs::File::open(&path).ok()?;
@@ -65,7 +65,7 @@ fn held(dir: &Path) -> Option<Option<LockHolder>> {
 }
 
 #[cfg(not(unix))]
-fn held(_dir: &Path) -> Option<Option<LockHolder>> {
+pub(crate) fn held(_dir: &Path) -> Option<Option<LockHolder>> {
     None
 }
 

@@ -91,7 +91,7 @@ impl Progress {
                         )
                         .is_ok()
                 {
-                    eprintln!("{}", self.line(h, pos, now));
+                    super::say(&self.line(h, pos, now));
                 }
             }
         }

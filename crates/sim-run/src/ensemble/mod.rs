@@ -20,17 +20,21 @@
 //! - **Combined result** ([`merge`]): `DIR/ensemble.json`, `DIR/ensemble.md` and averaged
 //!   curves with error bands, rebuilt from whatever members exist by `PROG --merge DIR`.
 
+mod launcher;
 mod merge;
 #[cfg(feature = "mpi")]
 mod ranks;
 mod seeds;
 
+pub use launcher::{
+    launcher_ranks, mpi_build_command, node_share, refuse_without_mpi, tie_member_to_ensemble,
+};
 pub use merge::{
     Combine, Curve, MemberRun, MergeReport, Pooled, PooledResult, ScalarStats, merge, merge_with,
 };
 pub use seeds::{Seeds, parse_seeds};
 
-use crate::cli::{Interrupted, LogArgs};
+use crate::cli::{Interrupted, LogArgs, MEMBER_OF};
 use anyhow::{Context, anyhow};
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -221,13 +225,37 @@ enum Ended {
     Failed(String),
 }
 
+/// How to start a member: the binary, the flags every member gets, the ensemble's directory
+/// and the environment a member is started with ([`MEMBER_OF`], and its MPI placement).
+#[derive(Debug, Clone)]
+struct Member<'a> {
+    exe: &'a Path,
+    args: &'a [OsString],
+    out: &'a Path,
+    env: Vec<(&'static str, String)>,
+}
+
 /// Runs the ensemble and writes its combined result; see the module documentation.
 pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     let exe = std::env::current_exe().context("locating the model's binary for the members")?;
     let args = member_args(std::env::args_os().skip(1));
     let stop = crate::cli::stop_on_signals().context("installing signal handlers")?;
+    // SIGUSR1 asks for the same stop: Open MPI's mpirun passes it on to every rank, while it
+    // turns SIGTERM and SIGINT into an abort of its own (exit code 1, SIGKILL after a second).
+    signal_hook::flag::register(signal_hook::consts::SIGUSR1, std::sync::Arc::clone(&stop))
+        .context("installing signal handlers")?;
+    #[cfg_attr(not(feature = "mpi"), allow(unused_mut))]
+    let mut member = Member {
+        exe: &exe,
+        args: &args,
+        out: e.out,
+        env: vec![(MEMBER_OF, std::process::id().to_string())],
+    };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let default_jobs = (cores / e.member_threads.max(1)).max(1);
+    let jobs_for = |cpus: usize| {
+        e.jobs
+            .map_or((cpus / e.member_threads.max(1)).max(1), |j| j as usize)
+    };
     // Under mpirun (feature `mpi`), rank 0 hands out the members and every other rank only
     // runs them.
     #[cfg(feature = "mpi")]
@@ -238,11 +266,40 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
         w.size() > 1
     });
     #[cfg(feature = "mpi")]
-    if let Some(w) = &world {
+    if let (None, Some((var, n))) = (&world, launcher_ranks()) {
+        return Err(crate::cli::usage(format!(
+            "started as one of {n} MPI ranks ({var}), but this build's MPI library sees a job of one rank: it was built against another MPI than the launcher's (use the mpirun of the MPI it was built with)"
+        )));
+    }
+    #[cfg(feature = "mpi")]
+    let placed = world.as_ref().map(ranks::place);
+    #[cfg(feature = "mpi")]
+    if let Some(place) = &placed {
+        tracing::info!(
+            "MPI rank {} on {}: bound by the launcher to {} CPUs; its members may use the node's {} CPUs, {} of them its share ({} ranks there): {} members at a time",
+            place.mpi.rank,
+            crate::io::provenance::host_name(),
+            place.bound,
+            place.node_cpus,
+            place.mpi.cpus,
+            place.node_workers,
+            jobs_for(place.mpi.cpus as usize)
+        );
+        member
+            .env
+            .push((crate::io::provenance::MPI_PLACE_VAR, place.mpi.env_value()));
+    }
+    #[cfg(feature = "mpi")]
+    if let (Some(w), Some(place)) = (&world, &placed) {
         use mpi::traits::Communicator;
         if w.rank() != 0 {
-            let jobs = e.jobs.map_or(default_jobs, |j| j as usize);
-            ranks::work(w, &exe, &args, e.out, jobs, &stop);
+            if ranks::work(w, &member, jobs_for(place.mpi.cpus as usize), &stop) {
+                return Err(Interrupted(format!(
+                    "MPI rank {} stopped its members (each at a safe point); run the same command again to continue",
+                    place.mpi.rank
+                ))
+                .into());
+            }
             return Ok(());
         }
     }
@@ -251,7 +308,7 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     // Refused under mpirun: the other ranks are told there is nothing to run, so they end.
     #[cfg(feature = "mpi")]
     if let (Err(_), Some(w)) = (&owned, &world) {
-        ranks::dispatch(w, e.out, &[], &stop, &crate::cli::Progress::silent());
+        ranks::dispatch(w, e.out, &[], None, &stop, &crate::cli::Progress::silent());
     }
     let _lock = owned?;
     let work: Vec<(u64, Todo)> = e
@@ -265,10 +322,7 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     if skipped > 0 {
         tracing::info!("{skipped} members finished already");
     }
-    let jobs = e
-        .jobs
-        .map_or(default_jobs, |j| j as usize)
-        .min(work.len().max(1));
+    let jobs = jobs_for(cores).min(work.len().max(1));
     let progress = e.log.progress(
         e.program,
         work.len() as u64,
@@ -280,15 +334,34 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     let distributed = world;
     #[cfg(not(feature = "mpi"))]
     let distributed: Option<()> = None;
+    #[cfg_attr(not(feature = "mpi"), allow(unused_mut))]
+    let mut dispatched: Option<String> = None;
     match distributed {
         #[cfg(feature = "mpi")]
         Some(world) => {
-            let done = ranks::dispatch(&world, e.out, &work, &stop, &progress);
+            use mpi::traits::Communicator;
+            let local = placed.as_ref().map(|p| jobs_for(p.mpi.cpus as usize));
+            let (wall, cpu) = (std::time::Instant::now(), ranks::cpu_seconds());
+            let done = ranks::dispatch(
+                &world,
+                e.out,
+                &work,
+                local.map(|jobs| (&member, jobs)),
+                &stop,
+                &progress,
+            );
+            dispatched = Some(ranks::dispatch_line(
+                e.program,
+                work.len(),
+                world.size(),
+                wall,
+                cpu,
+            ));
             *ended.lock().unwrap_or_else(|p| p.into_inner()) = done;
         }
         #[cfg(not(feature = "mpi"))]
         Some(()) => {}
-        None => run_local(&exe, &args, e.out, &work, jobs, &stop, &progress, &ended),
+        None => run_local(&member, &work, jobs, &stop, &progress, &ended),
     }
     progress.finish();
     let mut ended = ended.into_inner().unwrap_or_else(|p| p.into_inner());
@@ -304,8 +377,11 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
     let unfinished =
         e.seeds.len() - skipped - ended.iter().filter(|(_, x)| *x == Ended::Ok).count();
     if !e.log.is_quiet() {
+        if let Some(line) = &dispatched {
+            crate::cli::say(line);
+        }
         if let Ok(r) = &report {
-            eprintln!(
+            crate::cli::say(&format!(
                 "{}: ensemble of {} members in {}: {} finished ({} already, {} resumed from a checkpoint), {} failed; {}",
                 e.program,
                 e.seeds.len(),
@@ -315,10 +391,12 @@ pub fn run(e: &Ensemble<'_>) -> anyhow::Result<()> {
                 resumed,
                 failed.len(),
                 e.out.join("ensemble.json").display()
-            );
+            ));
         }
     }
-    if stop.load(Ordering::Relaxed) {
+    // Stopped by a signal here, or (under MPI) on a rank that ran members.
+    let interrupted = ended.iter().any(|(_, x)| *x == Ended::Interrupted);
+    if stop.load(Ordering::Relaxed) || interrupted {
         return Err(Interrupted(format!(
             "interrupted with {} of {} members unfinished; run the same command again to continue",
             unfinished.saturating_sub(failed.len()),
@@ -360,34 +438,59 @@ fn own(e: &Ensemble<'_>) -> anyhow::Result<crate::cli::OutDirLock> {
     Ok(lock)
 }
 
-/// Runs one member to its end, passing SIGTERM on once `stop` is set.
-fn run_member(
-    exe: &Path,
-    args: &[OsString],
-    out: &Path,
-    seed: u64,
-    todo: Todo,
-    stop: &AtomicBool,
-) -> Ended {
-    let dir = member_dir(out, seed);
+/// How long a member waits for its directory to be let go by a run that still holds it (a
+/// member of an earlier job that is writing its last checkpoint) before it is reported failed.
+const HELD_MEMBER_WAIT: Duration = Duration::from_secs(10);
+
+/// Runs one member to its end, passing SIGTERM on once `stop` is set. A member directory that
+/// a live process holds (its `run.lock`) is never shared: the member waits for it up to
+/// [`HELD_MEMBER_WAIT`], then fails naming the holder. What the member needs (`todo`, as the
+/// ensemble saw it when it started) is looked at again once the directory is free.
+fn run_member(m: &Member<'_>, seed: u64, todo: Todo, stop: &AtomicBool) -> Ended {
+    let dir = member_dir(m.out, seed);
     if let Err(e) = std::fs::create_dir_all(&dir) {
         return Ended::Failed(format!("creating {}: {e}", dir.display()));
     }
+    let waited_since = std::time::Instant::now();
+    while let Some(holder) = crate::cli::held(&dir) {
+        if stop.load(Ordering::Relaxed) {
+            return Ended::Interrupted;
+        }
+        if waited_since.elapsed() > HELD_MEMBER_WAIT {
+            let who = holder.map_or_else(|| "a run".to_string(), |h| h.to_string());
+            return Ended::Failed(format!(
+                "{} is in use by another run ({who}) after {} s; not started",
+                dir.display(),
+                HELD_MEMBER_WAIT.as_secs()
+            ));
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let todo = match (todo, self::todo(&dir)) {
+        (_, Todo::Finished) => return Ended::Ok,
+        (_, now) => now,
+    };
     let log_path = dir.join(MEMBER_LOG);
     let log = match std::fs::File::create(&log_path) {
         Ok(f) => f,
         Err(e) => return Ended::Failed(format!("creating {}: {e}", log_path.display())),
     };
-    let mut cmd = Command::new(exe);
-    cmd.args(args)
+    let mut cmd = Command::new(m.exe);
+    cmd.args(m.args)
         .arg("--seed")
         .arg(seed.to_string())
         .arg("--out")
         .arg(&dir)
         .arg("-qq")
+        .envs(m.env.iter().map(|(k, v)| (k, v)))
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(log);
+    // A process group of its own: signals for the ensemble's group (Ctrl-C in a terminal, a
+    // launcher killing a rank's group) reach the member only as the ensemble passes them on,
+    // once, so it stops at a safe point.
+    #[cfg(unix)]
+    std::os::unix::process::CommandExt::process_group(&mut cmd, 0);
     match todo {
         Todo::Resume => cmd.arg("--resume").arg(&dir),
         // Partial outputs of a member killed before its first checkpoint (checked to be this
@@ -396,7 +499,7 @@ fn run_member(
     };
     let mut child = match cmd.spawn() {
         Ok(c) => c,
-        Err(e) => return Ended::Failed(format!("starting {}: {e}", exe.display())),
+        Err(e) => return Ended::Failed(format!("starting {}: {e}", m.exe.display())),
     };
     let mut signalled = false;
     let status = loop {
@@ -528,11 +631,8 @@ fn last_line(log: &Path) -> String {
 }
 
 /// Runs `work` on this machine, `jobs` members at a time, recording how each ended.
-#[allow(clippy::too_many_arguments)]
 fn run_local(
-    exe: &Path,
-    args: &[OsString],
-    out: &Path,
+    member: &Member<'_>,
     work: &[(u64, Todo)],
     jobs: usize,
     stop: &AtomicBool,
@@ -543,6 +643,8 @@ fn run_local(
     let done = AtomicUsize::new(0);
     std::thread::scope(|s| {
         for _ in 0..jobs {
+            // Each thread starts its members and waits for them: a member dies when the thread
+            // that started it ends (`tie_member_to_ensemble`).
             s.spawn(|| {
                 loop {
                     if stop.load(Ordering::Relaxed) {
@@ -552,7 +654,7 @@ fn run_local(
                     let Some(&(seed, todo)) = work.get(i) else {
                         return;
                     };
-                    let end = run_member(exe, args, out, seed, todo, stop);
+                    let end = run_member(member, seed, todo, stop);
                     ended
                         .lock()
                         .unwrap_or_else(|p| p.into_inner())
@@ -579,10 +681,15 @@ fn terminate(child: &std::process::Child) {
 fn terminate(_child: &std::process::Child) {}
 
 /// What every binary does before it parses its flags: refuses a processor the build cannot
-/// run on ([`crate::cli::refuse_unsupported_cpu`]) and handles `PROG --merge DIR`
-/// ([`merge_main`]). `Some(exit code)` when either ended the program.
+/// run on ([`crate::cli::refuse_unsupported_cpu`]), refuses to run as one of several MPI ranks
+/// without MPI support ([`refuse_without_mpi`]), ties an ensemble's member to its ensemble
+/// ([`tie_member_to_ensemble`]) and handles `PROG --merge DIR` ([`merge_main`]).
+/// `Some(exit code)` when one of them ended the program.
 pub fn before_parsing<'a>(program: &str, combine: impl Into<Combine<'a>>) -> Option<ExitCode> {
-    crate::cli::refuse_unsupported_cpu(program).or_else(|| merge_main(program, combine))
+    crate::cli::refuse_unsupported_cpu(program)
+        .or_else(|| refuse_without_mpi(program))
+        .or_else(tie_member_to_ensemble)
+        .or_else(|| merge_main(program, combine))
 }
 
 /// Handles `PROG --merge DIR` (exactly those arguments) before the model parses its flags:
@@ -597,9 +704,9 @@ pub fn merge_main<'a>(program: &str, combine: impl Into<Combine<'a>>) -> Option<
     Some(match merge_with(&dir, program, combine.into()) {
         Ok(r) => {
             for why in &r.invalid {
-                eprintln!("{program}: warning: left out {why}");
+                crate::cli::say(&format!("{program}: warning: left out {why}"));
             }
-            eprintln!(
+            crate::cli::say(&format!(
                 "{program}: combined {} members of {} into {}{}",
                 r.members,
                 dir.display(),
@@ -609,11 +716,14 @@ pub fn merge_main<'a>(program: &str, combine: impl Into<Combine<'a>>) -> Option<
                 } else {
                     format!("; not finished: {}", r.unfinished.join(", "))
                 }
-            );
+            ));
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{program}: error: --merge {}: {e:#}", dir.display());
+            crate::cli::say(&format!(
+                "{program}: error: --merge {}: {e:#}",
+                dir.display()
+            ));
             ExitCode::from(crate::cli::EXIT_USAGE)
         }
     })

@@ -34,7 +34,7 @@ pub use image::{write_png_gray, write_png_rgb};
 pub use manifest::{ProcessUsage, RunClock, RunManifest};
 pub use npy::{NpyError, NpyReader, NpyWriter};
 pub use points::{Attribute, PointFormat, PointSet, Positions, write_points};
-pub use provenance::Provenance;
+pub use provenance::{MpiPlace, Provenance};
 pub use table::{CsvField, CsvWriter};
 
 /// Why a model's output could not be written (every model's `output::write_outputs`); each

@@ -28,8 +28,54 @@ pub struct Provenance {
     pub cpu: String,
     /// Worker threads the run used.
     pub threads: usize,
-    /// Logical CPUs available to the process.
+    /// Logical CPUs available to the process (its CPU affinity: under an MPI launcher, the
+    /// CPUs its rank gave it).
     pub cpus: usize,
+    /// For a member of an ensemble over MPI ranks: the rank that ran it (the host is
+    /// [`host`](Self::host)); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mpi: Option<MpiPlace>,
+}
+
+/// Where an ensemble member ran in an MPI job (`provenance.mpi` of its `run.json`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpiPlace {
+    /// The MPI rank (in `MPI_COMM_WORLD`) that ran the member.
+    pub rank: u64,
+    /// The ranks of the job.
+    pub ranks: u64,
+    /// The CPUs of the rank's share of its node, which its members were sized by (`--jobs`
+    /// defaults to this divided by `--threads`).
+    pub cpus: u64,
+}
+
+/// Environment variable a rank sets for each member it runs, `RANK,RANKS,CPUS`
+/// ([`MpiPlace`]), read by the member's [`Provenance::now`].
+pub const MPI_PLACE_VAR: &str = "AGGSIM_MPI_PLACE";
+
+impl MpiPlace {
+    /// The placement a rank gave this process ([`MPI_PLACE_VAR`]), if any.
+    pub fn from_env() -> Option<Self> {
+        Self::parse(&std::env::var(MPI_PLACE_VAR).ok()?)
+    }
+
+    /// `RANK,RANKS,CPUS`, as [`MpiPlace::env_value`] writes it.
+    pub fn parse(text: &str) -> Option<Self> {
+        let v: Vec<u64> = text
+            .split(',')
+            .map(|s| s.trim().parse().ok())
+            .collect::<Option<_>>()?;
+        match v[..] {
+            [rank, ranks, cpus] => Some(MpiPlace { rank, ranks, cpus }),
+            _ => None,
+        }
+    }
+
+    /// The value of [`MPI_PLACE_VAR`] for this placement.
+    pub fn env_value(&self) -> String {
+        format!("{},{},{}", self.rank, self.ranks, self.cpus)
+    }
 }
 
 impl Provenance {
@@ -46,6 +92,7 @@ impl Provenance {
             cpu: cpu_model(),
             threads,
             cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            mpi: MpiPlace::from_env(),
         }
     }
 }
@@ -123,11 +170,36 @@ mod tests {
     }
 
     #[test]
+    fn an_mpi_placement_round_trips_through_its_variable_and_run_json() {
+        let place = MpiPlace {
+            rank: 3,
+            ranks: 5,
+            cpus: 16,
+        };
+        assert_eq!(MpiPlace::parse(&place.env_value()), Some(place));
+        assert_eq!(MpiPlace::parse("3,5"), None);
+        assert_eq!(MpiPlace::parse("3,x,1"), None);
+        let mut p = Provenance::now("9.9.9", 1);
+        let plain = serde_json::to_value(&p).unwrap();
+        assert!(plain.get("mpi").is_none(), "{plain}");
+        p.mpi = Some(place);
+        let json = serde_json::to_value(&p).unwrap();
+        assert_eq!(json["mpi"]["rank"], 3);
+        assert_eq!(serde_json::from_value::<Provenance>(json).unwrap(), p);
+        // A run.json written before the field existed still reads.
+        assert_eq!(
+            serde_json::from_value::<Provenance>(plain).unwrap().mpi,
+            None
+        );
+    }
+
+    #[test]
     fn provenance_describes_this_process() {
         let p = Provenance::now("9.9.9", 3);
         assert_eq!((p.version.as_str(), p.threads), ("9.9.9", 3));
         assert!(p.cpus >= 1 && !p.host.is_empty() && !p.cpu.is_empty());
         assert!(!p.command_line.is_empty());
+        assert_eq!(p.mpi, None);
         assert_eq!(p.date_utc.len(), "2026-01-01T00:00:00Z".len());
         // Built from this checkout, the commit is a full hash.
         if let Some(c) = &p.git_commit {
