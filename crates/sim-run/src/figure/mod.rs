@@ -19,6 +19,12 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
+impl From<anyhow::Error> for crate::io::OutputError {
+    fn from(e: anyhow::Error) -> Self {
+        crate::io::OutputError::Figure(format!("{e:#}"))
+    }
+}
+
 /// An RGB image, row-major, top row first, three bytes a pixel.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Raster {
@@ -131,6 +137,49 @@ pub fn scale_bar_length(span: f64) -> f64 {
         .unwrap_or(p)
 }
 
+/// The labelled ticks of a colour bar from `lo` to `hi`: `(fraction of the bar, value)` at
+/// round values (1, 2 or 5 times a power of ten apart; powers of ten on a log bar), with both
+/// ends labelled when no round value is near them.
+pub fn colour_bar_ticks(lo: f64, hi: f64, log: bool) -> Vec<(f64, f64)> {
+    if !(lo.is_finite() && hi.is_finite() && hi > lo) || (log && lo <= 0.0) {
+        return vec![(0.0, lo), (1.0, hi)];
+    }
+    let frac = |v: f64| {
+        if log {
+            (v / lo).ln() / (hi / lo).ln()
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    let mut ticks: Vec<(f64, f64)> = if log {
+        let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
+        (a..=b).map(|k| 10f64.powi(k)).map(|v| (frac(v), v)).collect()
+    } else {
+        // The round step nearest a quarter of the range (on a log scale).
+        let target = (hi - lo) / 4.0;
+        let p = 10f64.powf(target.log10().floor());
+        let step = [1.0, 2.0, 5.0, 10.0]
+            .into_iter()
+            .map(|m| m * p)
+            .min_by(|a, b| (a / target).ln().abs().total_cmp(&(b / target).ln().abs()))
+            .unwrap_or(p);
+        let first = (lo / step).ceil() as i64;
+        let last = (hi / step).floor() as i64;
+        (first..=last)
+            .map(|k| k as f64 * step)
+            .map(|v| (frac(v), v))
+            .collect()
+    };
+    // The ends, unless a round value is within an eighth of the bar of them.
+    if ticks.first().is_none_or(|t| t.0 > 0.125) {
+        ticks.insert(0, (0.0, lo));
+    }
+    if ticks.last().is_none_or(|t| t.0 < 0.875) {
+        ticks.push((1.0, hi));
+    }
+    ticks
+}
+
 /// `1234567` as `1,234,567`.
 pub fn group_digits(n: u64) -> String {
     let s = n.to_string();
@@ -149,27 +198,49 @@ fn rgb(c: Rgb) -> RGBColor {
 }
 
 impl Figure<'_> {
-    /// The figure's size in pixels for its picture and legend: the picture plus the margins.
+    /// The figure's margins for its picture, header and legend, from the widths of the text
+    /// as the font lays it out.
     fn layout(&self) -> Layout {
+        register_font();
         let u = text_scale(self.raster.width.max(self.raster.height));
         let px = |v: f64| (v * u).round() as u32;
-        let legend_w = match &self.legend {
-            Legend::ColourBar { .. } => px(120.0),
-            Legend::Key(entries) => {
-                let longest = entries.iter().map(|e| e.0.chars().count()).max();
-                px(44.0 + 8.5 * longest.unwrap_or(0) as f64)
-            }
-            Legend::Note(lines) => {
-                let longest = lines.iter().map(|l| l.chars().count()).max();
-                px(24.0 + 7.5 * longest.unwrap_or(0) as f64)
-            }
+        // Width in units of `u` (a tenth more than laid out, for the rasteriser's rounding).
+        let text_w = |s: &str, size: f64| {
+            let w = ("sans-serif", size * u)
+                .into_font()
+                .box_size(s)
+                .map_or(s.chars().count() as f64 * 0.62 * size * u, |b| f64::from(b.0));
+            1.1 * w / u
         };
+        let legend_w = match &self.legend {
+            Legend::ColourBar { .. } => 120.0,
+            Legend::Key(entries) => {
+                24.0 + entries
+                    .iter()
+                    .map(|e| text_w(&e.0, 15.0))
+                    .fold(0.0, f64::max)
+            }
+            Legend::Note(lines) => lines.iter().map(|l| text_w(l, 13.0)).fold(0.0, f64::max),
+        };
+        // The header's run description and scale bar share one line when they fit side by side
+        // above the picture; otherwise the scale bar gets a line of its own.
+        let span = self.extent.x.1 - self.extent.x.0;
+        let bar = scale_bar_length(span);
+        let picture_w = f64::from(self.raster.width) / u;
+        let bar_w = bar / span * picture_w
+            + text_w(&format!("{} {}", crate::plot::tick(bar), self.unit), 15.0)
+            + 8.0;
+        let header_w = text_w(&self.header, 16.0);
+        let one_line = header_w + 24.0 + bar_w <= picture_w;
+        // The right margin holds the legend, and the header where the picture is narrower.
+        let right = (legend_w + 32.0).max(header_w + 8.0 - picture_w);
         Layout {
             u,
-            top: px(40.0),
-            left: px(78.0),
+            top: px(if one_line { 40.0 } else { 66.0 }),
+            two_line_header: !one_line,
+            left: px(90.0),
             bottom: px(58.0),
-            right: legend_w + px(16.0),
+            right: px(right),
         }
     }
 
@@ -211,10 +282,10 @@ impl Figure<'_> {
         let mut chart = ChartBuilder::on(root)
             .margin_top(l.top)
             .margin_right(l.right)
-            .margin_left(0)
+            .margin_left(l.left / 6)
             .margin_bottom(0)
             .x_label_area_size(l.bottom)
-            .y_label_area_size(l.left)
+            .y_label_area_size(l.left - l.left / 6)
             .build_cartesian_2d(e.x.0..e.x.1, e.y.0..e.y.1)?;
         let (xs, ys) = chart.plotting_area().get_pixel_range();
         debug_assert_eq!(
@@ -224,8 +295,9 @@ impl Figure<'_> {
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_labels(6)
-            .y_labels(6)
+            // About one label per 100 pixels (in text units) across, per 60 up.
+            .x_labels((f64::from(r.width) / (100.0 * u)).clamp(2.0, 8.0) as usize)
+            .y_labels((f64::from(r.height) / (60.0 * u)).clamp(2.0, 8.0) as usize)
             .x_desc(format!("{} ({})", self.axes.0, self.unit))
             .y_desc(format!("{} ({})", self.axes.1, self.unit))
             .x_label_formatter(&|v| crate::plot::tick(*v))
@@ -244,29 +316,28 @@ impl Figure<'_> {
             BLACK.stroke_width(1),
         ))?;
 
-        // Header: the run on the left, the scale bar on the right.
-        let mid = (l.top as f64 * 0.5) as i32;
+        // Header: the run on the left, the scale bar on the right (on a second line below the
+        // run when both do not fit on one).
+        let (first, mid) = if l.two_line_header {
+            ((20.0 * u) as i32, (46.0 * u) as i32)
+        } else {
+            let m = (20.0 * u) as i32;
+            (m, m)
+        };
         root.draw(&Text::new(
             self.header.clone(),
-            (xs.start, mid),
+            (xs.start, first),
             font(16.0).pos(Pos::new(HPos::Left, VPos::Center)),
         ))?;
         let span = e.x.1 - e.x.0;
         let length = scale_bar_length(span);
         let bar_px = ((length / span) * f64::from(r.width)).round().max(1.0) as i32;
-        let stroke = ((2.5 * u).round() as u32).max(2);
-        let tick = (5.0 * u) as i32;
-        root.draw(&PathElement::new(
-            vec![
-                (xs.end - bar_px, mid - tick),
-                (xs.end - bar_px, mid + tick),
-                (xs.end - bar_px, mid),
-                (xs.end, mid),
-                (xs.end, mid - tick),
-                (xs.end, mid + tick),
-            ],
-            BLACK.stroke_width(stroke),
+        let half = ((3.0 * u).round() as i32).max(2);
+        root.draw(&Rectangle::new(
+            [(xs.end - bar_px, mid - half), (xs.end, mid + half)],
+            BLACK.filled(),
         ))?;
+        let tick = (5.0 * u) as i32;
         root.draw(&Text::new(
             format!("{} {}", crate::plot::tick(length), self.unit),
             (xs.end - bar_px - (8.0 * u) as i32, mid),
@@ -297,18 +368,10 @@ impl Figure<'_> {
                     [(x0, top), (x0 + bar_w, bottom)],
                     BLACK.stroke_width(1),
                 ))?;
-                let value_at = |f: f64| {
-                    if *log && *lo > 0.0 && *hi > *lo {
-                        lo * (hi / lo).powf(f)
-                    } else {
-                        lo + f * (hi - lo)
-                    }
-                };
-                for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-                    let y = bottom - (f * f64::from(n)) as i32;
-                    let v = value_at(f);
-                    let text = if (v - v.round()).abs() < 1e-9 && v.abs() < 1e15 {
-                        group_digits(v.round().max(0.0) as u64)
+                for (f, v) in colour_bar_ticks(*lo, *hi, *log) {
+                    let y = bottom - (f * f64::from(n)).round() as i32;
+                    let text = if v.fract() == 0.0 && v.abs() < 1e15 {
+                        group_digits(v.abs() as u64)
                     } else {
                         crate::plot::tick(v)
                     };
@@ -364,6 +427,7 @@ impl Figure<'_> {
 struct Layout {
     u: f64,
     top: u32,
+    two_line_header: bool,
     left: u32,
     bottom: u32,
     right: u32,
@@ -446,6 +510,16 @@ mod tests {
         assert_eq!(scale_bar_length(7.0), 1.0);
         assert_eq!(group_digits(1234567), "1,234,567");
         assert_eq!(group_digits(999), "999");
+        let values = |t: Vec<(f64, f64)>| t.into_iter().map(|t| t.1).collect::<Vec<_>>();
+        assert_eq!(
+            values(colour_bar_ticks(1.0, 20000.0, false)),
+            [1.0, 5000.0, 10000.0, 15000.0, 20000.0]
+        );
+        assert_eq!(
+            values(colour_bar_ticks(1.0, 5000.0, true)),
+            [1.0, 10.0, 100.0, 1000.0, 5000.0]
+        );
+        assert_eq!(values(colour_bar_ticks(1.0, 3.0, true)), [1.0, 3.0]);
     }
 
     #[test]
