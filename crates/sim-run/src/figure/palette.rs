@@ -148,20 +148,25 @@ impl Sequential {
 }
 
 /// Colours of the regions of a label image (row-major, `width` pixels a row, `empty` where
-/// there is none) such that regions touching in the picture (horizontally, vertically or
-/// diagonally adjacent pixels) get different colours from a palette of `colours` entries.
+/// there is none) such that neighbouring regions get different colours from a palette of
+/// `colours` entries. Regions are neighbours when, each grown by up to `reach` pixels into the
+/// empty pixels around it (breadth first, so an empty pixel goes to the nearest region), they
+/// meet: regions that touch, and regions less than about `2 reach` pixels apart with no other
+/// region between them. (Regions that never touch, such as DLCA clusters, which merge on
+/// contact, need a `reach` of several pixels to be told apart.)
 ///
 /// Greedy colouring in smallest-last order (Matula & Beck, "Smallest-last ordering and
 /// clustering and graph coloring algorithms", 1983): it needs at most one colour more than the
-/// graph's degeneracy, which is at most 5 for a planar map, so 7 colours suffice for regions on
-/// a plane and in practice for a torus. `prefer` names a colour a region should keep if no
-/// neighbour has it (the colour it had in the previous frame of an animation). Should every
-/// colour be taken by a neighbour, the region gets the one its neighbours use least; the
-/// second value counts such regions.
+/// graph's degeneracy, which is at most 5 for a planar map (and the grown regions form one but
+/// for pixel corners), so 7 colours suffice in practice. `prefer` names a colour a region
+/// should keep if no neighbour has it (the colour it had in the previous frame of an
+/// animation). Should every colour be taken by a neighbour, the region gets the one its
+/// neighbours use least; the second value counts such regions.
 pub fn colour_regions(
     labels: &[u32],
     width: usize,
     empty: u32,
+    reach: usize,
     colours: usize,
     prefer: impl Fn(u32) -> Option<usize>,
 ) -> (HashMap<u32, usize>, usize) {
@@ -170,8 +175,34 @@ pub fn colour_regions(
     ids.sort_unstable();
     ids.dedup();
     let index: HashMap<u32, usize> = ids.iter().enumerate().map(|(i, &id)| (id, i)).collect();
-    let mut edges: Vec<(usize, usize)> = Vec::new();
     let height = labels.len() / width;
+    // Grow every region into the empty pixels, breadth first, `reach` steps at most.
+    let mut owner = labels.to_vec();
+    let mut queue: std::collections::VecDeque<(usize, usize)> = owner
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| **l != empty)
+        .map(|(at, _)| (at, 0))
+        .collect();
+    while let Some((at, d)) = queue.pop_front() {
+        if d >= reach {
+            continue;
+        }
+        let (x, y) = (at % width, at / width);
+        for (dx, dy) in [(-1i64, -1i64), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+            let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+            if nx < 0 || ny < 0 || nx >= width as i64 || ny >= height as i64 {
+                continue;
+            }
+            let n = ny as usize * width + nx as usize;
+            if owner[n] == empty {
+                owner[n] = owner[at];
+                queue.push_back((n, d + 1));
+            }
+        }
+    }
+    let labels = &owner;
+    let mut edges: Vec<(usize, usize)> = Vec::new();
     let mut link = |a: u32, b: u32| {
         if a != b && a != empty && b != empty {
             let (i, j) = (index[&a], index[&b]);
@@ -309,7 +340,7 @@ mod tests {
         let labels: Vec<u32> = (0..w * w)
             .map(|i| ((i / w) / 3 * 3 + (i % w) / 3) as u32)
             .collect();
-        let (c, clashes) = colour_regions(&labels, w, u32::MAX, 8, |_| None);
+        let (c, clashes) = colour_regions(&labels, w, u32::MAX, 0, 8, |_| None);
         assert_eq!(clashes, 0);
         for y in 0..w {
             for x in 0..w {
@@ -325,10 +356,19 @@ mod tests {
             }
         }
         // A preferred colour is kept when free.
-        let (c2, _) = colour_regions(&labels, w, u32::MAX, 8, |id| (id == 4).then_some(7));
+        let (c2, _) = colour_regions(&labels, w, u32::MAX, 0, 8, |id| (id == 4).then_some(7));
         assert_eq!(c2[&4], 7);
         // Too few colours: the clash is counted, never hidden.
-        let (_, clashes) = colour_regions(&labels, w, u32::MAX, 2, |_| None);
+        let (_, clashes) = colour_regions(&labels, w, u32::MAX, 0, 2, |_| None);
         assert!(clashes > 0);
+        // Two dots 5 pixels apart are neighbours when grown by 2 pixels (they meet in the
+        // middle of the 4 empty pixels), not by 1.
+        let mut dots = vec![u32::MAX; 20];
+        dots[2] = 1;
+        dots[7] = 2;
+        for (reach, apart) in [(1, false), (2, true)] {
+            let (c, _) = colour_regions(&dots, 20, u32::MAX, reach, 8, |_| Some(0));
+            assert_eq!(c[&1] != c[&2], apart, "reach {reach}");
+        }
     }
 }
