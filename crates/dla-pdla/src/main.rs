@@ -337,6 +337,7 @@ const CURVES: &[Curve] = &[Curve {
     axes: ("particles N", "R_g and R_ext (particle diameters)"),
     log_x: true,
     log_y: true,
+    colours: &[],
 }];
 
 fn main() -> ExitCode {

@@ -298,6 +298,7 @@ const CURVES: &[Curve] = &[
         axes: ("sweep", "clusters; particles in the largest"),
         log_x: true,
         log_y: true,
+        colours: &[],
     },
     Curve {
         file: "sizes.csv",
@@ -308,6 +309,7 @@ const CURVES: &[Curve] = &[
         axes: ("cluster size (particles)", "clusters of that size"),
         log_x: true,
         log_y: true,
+        colours: &[],
     },
 ];
 
