@@ -222,22 +222,18 @@ impl Figure<'_> {
             }
             Legend::Note(lines) => lines.iter().map(|l| text_w(l, 13.0)).fold(0.0, f64::max),
         };
-        // The header's run description and scale bar share one line when they fit side by side
-        // above the picture; otherwise the scale bar gets a line of its own.
-        let span = self.extent.x.1 - self.extent.x.0;
-        let bar = scale_bar_length(span);
+        // The layout depends on the picture's size and the legend only, never on the
+        // header's text, so that every frame of an animation has the same size: the header
+        // has a line of its own above the scale bar's, and may run over the legend's column.
         let picture_w = f64::from(self.raster.width) / u;
-        let bar_w = bar / span * picture_w
-            + text_w(&format!("{} {}", crate::plot::tick(bar), self.unit), 15.0)
-            + 8.0;
+        let right = legend_w + 32.0;
         let header_w = text_w(&self.header, 16.0);
-        let one_line = header_w + 24.0 + bar_w <= picture_w;
-        // The right margin holds the legend, and the header where the picture is narrower.
-        let right = (legend_w + 32.0).max(header_w + 8.0 - picture_w);
+        // A header wider than the figure is set smaller (small pictures only).
+        let header_size = 16.0 * ((picture_w + right - 8.0) / header_w).min(1.0);
         Layout {
             u,
-            top: px(if one_line { 40.0 } else { 66.0 }),
-            two_line_header: !one_line,
+            top: px(66.0),
+            header_size,
             left: px(90.0),
             bottom: px(58.0),
             right: px(right),
@@ -316,18 +312,12 @@ impl Figure<'_> {
             BLACK.stroke_width(1),
         ))?;
 
-        // Header: the run on the left, the scale bar on the right (on a second line below the
-        // run when both do not fit on one).
-        let (first, mid) = if l.two_line_header {
-            ((20.0 * u) as i32, (46.0 * u) as i32)
-        } else {
-            let m = (20.0 * u) as i32;
-            (m, m)
-        };
+        // Header: the run on the first line, the scale bar right-aligned on the second.
+        let (first, mid) = ((20.0 * u) as i32, (46.0 * u) as i32);
         root.draw(&Text::new(
             self.header.clone(),
             (xs.start, first),
-            font(16.0).pos(Pos::new(HPos::Left, VPos::Center)),
+            font(l.header_size).pos(Pos::new(HPos::Left, VPos::Center)),
         ))?;
         let span = e.x.1 - e.x.0;
         let length = scale_bar_length(span);
@@ -427,7 +417,7 @@ impl Figure<'_> {
 struct Layout {
     u: f64,
     top: u32,
-    two_line_header: bool,
+    header_size: f64,
     left: u32,
     bottom: u32,
     right: u32,
@@ -520,6 +510,16 @@ mod tests {
             [1.0, 10.0, 100.0, 1000.0, 5000.0]
         );
         assert_eq!(values(colour_bar_ticks(1.0, 3.0, true)), [1.0, 3.0]);
+    }
+
+    #[test]
+    fn the_size_never_depends_on_the_header() {
+        let r = Raster::new(40, 40, palette::WHITE);
+        let mut f = figure(&r, Legend::Note(vec!["a note".into()]));
+        let a = f.render().unwrap();
+        f.header = "a much longer header, N = 1,000,000 of 10,000,000, seed 12345678".into();
+        let b = f.render().unwrap();
+        assert_eq!((a.width, a.height), (b.width, b.height));
     }
 
     #[test]
