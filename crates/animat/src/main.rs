@@ -185,14 +185,19 @@ fn params(cli: &Cli) -> Result<Params, String> {
     }
     let pictures = cli.snapshot_every.is_some() || cli.animate;
     if cli.png_size.is_some() && !pictures {
-        return Err("--png-size sizes the pictures of --snapshot-every and --animate; give one".into());
+        return Err(
+            "--png-size sizes the pictures of --snapshot-every and --animate; give one".into(),
+        );
     }
     if cli.frame_radius.is_some() && !pictures {
         return Err(
             "--frame-radius frames the pictures of --snapshot-every and --animate; give one".into(),
         );
     }
-    if let Some(side) = cli.png_size.filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE) {
+    if let Some(side) = cli
+        .png_size
+        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
+    {
         return Err(format!(
             "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
              pixels a side"

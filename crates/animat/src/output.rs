@@ -13,7 +13,9 @@ use crate::params::Species;
 use crate::world::{StepStats, World};
 use sim_run::figure::palette;
 use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
-use sim_run::io::{Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points};
+use sim_run::io::{
+    Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points,
+};
 use std::path::Path;
 
 pub use sim_run::io::OutputError;
@@ -158,7 +160,9 @@ impl SnapshotFrame {
     /// spreads) and `side` pixels (default: a whole number of pixels per cell and at least
     /// [`SNAPSHOT_MIN_SIDE`], or one pixel per cell up to [`SNAPSHOT_MAX_SIDE`]).
     pub fn new(params: &crate::Params, radius: Option<i64>, side: Option<u32>) -> Self {
-        let radius = radius.unwrap_or(params.start_radius.saturating_mul(3)).max(1);
+        let radius = radius
+            .unwrap_or(params.start_radius.saturating_mul(3))
+            .max(1);
         let cells = i128::from(radius) * 2 + 1;
         let side = side.unwrap_or_else(|| {
             let min = i128::from(SNAPSHOT_MIN_SIDE);
@@ -251,7 +255,11 @@ impl SnapshotFrame {
 ///
 /// # Errors
 /// [`OutputError`] if the PNG cannot be encoded or written.
-pub fn write_snapshot(path: &Path, world: &World, frame: &SnapshotFrame) -> Result<(), OutputError> {
+pub fn write_snapshot(
+    path: &Path,
+    world: &World,
+    frame: &SnapshotFrame,
+) -> Result<(), OutputError> {
     let (r, outside) = frame.raster(world);
     frame.figure(world, &r, outside).write_png(path)?;
     Ok(())

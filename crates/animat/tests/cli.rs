@@ -431,8 +431,7 @@ fn snapshots_share_one_frame_and_the_animation_has_its_frames() {
     let steps = run_json(&out)["results"]["steps"].as_u64().unwrap();
     assert_eq!(steps, 40);
     // Steps 0, 15, 30 and 40.
-    let (gif_size, frames) =
-        sim_run::figure::animation::read_gif(&out.join("animat.gif")).unwrap();
+    let (gif_size, frames) = sim_run::figure::animation::read_gif(&out.join("animat.gif")).unwrap();
     assert_eq!(frames, 4);
     assert_eq!(gif_size, first);
 }

@@ -262,7 +262,10 @@ fn animats_at_the_edges_of_the_plane_stay_on_it() {
         let frame = animat::output::SnapshotFrame::new(w.params(), None, None);
         animat::output::write_snapshot(&dir.path().join("edges.png"), &w, &frame).unwrap();
         // The animats at the plane's edges are outside the frame, and counted.
-        assert_eq!(frame.raster(&w).1, w.foxes() + w.rabbits() - frame_count(&w, &frame));
+        assert_eq!(
+            frame.raster(&w).1,
+            w.foxes() + w.rabbits() - frame_count(&w, &frame)
+        );
     }
 }
 

@@ -238,7 +238,10 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.png_size.is_some() && !cli.png && !cli.animate {
         return Err("--png-size sizes the pictures of --png and --animate; give one".into());
     }
-    if let Some(side) = cli.png_size.filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE) {
+    if let Some(side) = cli
+        .png_size
+        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
+    {
         return Err(format!(
             "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
              pixels a side"

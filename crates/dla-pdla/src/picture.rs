@@ -83,7 +83,10 @@ impl Canvas {
     /// Adds particle `i` (arrival order, from 0) at `p`.
     fn add(&mut self, i: u64, p: &[f64]) {
         let s = self.side as usize;
-        let (cx, cy) = ((p[0] + self.extent) * self.scale, (self.extent - p[1]) * self.scale);
+        let (cx, cy) = (
+            (p[0] + self.extent) * self.scale,
+            (self.extent - p[1]) * self.scale,
+        );
         let frac = (i as f64 / (self.total.max(2) - 1) as f64) as f32;
         match self.mode {
             Mode::Density => {
@@ -161,7 +164,14 @@ impl Canvas {
     }
 
     /// The figure of the picture: `shown` particles of `total`.
-    fn figure<'a>(&self, raster: &'a Raster, dim: usize, seed: u64, shown: u64, top: u32) -> Figure<'a> {
+    fn figure<'a>(
+        &self,
+        raster: &'a Raster,
+        dim: usize,
+        seed: u64,
+        shown: u64,
+        top: u32,
+    ) -> Figure<'a> {
         let view = match (self.mode, dim) {
             (Mode::Density, 2) => ", particles per pixel",
             (Mode::Density, _) => ", projected on x, y",

@@ -180,7 +180,10 @@ fn bad_inputs_are_refused_before_any_work() {
             with(&["--animate", "--png-size", "20000"]),
             "--png-size 20000 with --animate",
         ),
-        (with(&["--animate", "--animate-every", "0"]), "--animate-every 0"),
+        (
+            with(&["--animate", "--animate-every", "0"]),
+            "--animate-every 0",
+        ),
         (with(&["--animate-every", "10"]), "--animate"),
         (with(&["--distance-map", "maybe"]), "maybe"),
         (with(&["--fit-from", "0"]), "--fit-from 0"),

@@ -360,7 +360,15 @@ fn png_size_and_animation() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("run");
     let o = dla()
-        .args(["--particles", "300", "--seed", "2", "--png", "--png-size", "64"])
+        .args([
+            "--particles",
+            "300",
+            "--seed",
+            "2",
+            "--png",
+            "--png-size",
+            "64",
+        ])
         .args(["--animate", "--animate-every", "100", "--quiet", "--out"])
         .arg(&out)
         .output()

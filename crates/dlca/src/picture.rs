@@ -173,12 +173,7 @@ impl Animation {
     ///
     /// # Errors
     /// The file cannot be created or the frame not drawn.
-    pub fn start(
-        sim: &Simulation,
-        seed: u64,
-        path: &Path,
-        side: u32,
-    ) -> Result<Self, OutputError> {
+    pub fn start(sim: &Simulation, seed: u64, path: &Path, side: u32) -> Result<Self, OutputError> {
         let size = picture_size(sim, Some(side));
         let (raster, colours, _) = draw(sim, size, &HashMap::new());
         let image = figure(sim, seed, &raster).render()?;
@@ -238,7 +233,13 @@ mod tests {
         let ids = labels(&sim, size);
         let (r, colours, clashes) = draw(&sim, size, &HashMap::new());
         assert_eq!(clashes, 0);
-        assert!(colours.values().collect::<std::collections::HashSet<_>>().len() >= 3);
+        assert!(
+            colours
+                .values()
+                .collect::<std::collections::HashSet<_>>()
+                .len()
+                >= 3
+        );
         // Clusters whose pixels are 4 pixels (2 sites) apart or closer: DLCA clusters never
         // touch (they merge on contact), so these are the nearest neighbours there are.
         let (w, h) = (size.0 as i64, size.1 as i64);

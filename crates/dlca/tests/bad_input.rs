@@ -134,8 +134,14 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--png", "--png-size", "8"]), "8"),
         (with(&["--png", "--png-size", "65537"]), "65537"),
         (with(&["--png-size", "512"]), "--png and --animate"),
-        (with(&["--animate", "--png-size", "20000"]), "--png-size 20000 with --animate"),
-        (with(&["--animate", "--animate-every", "0"]), "--animate-every 0"),
+        (
+            with(&["--animate", "--png-size", "20000"]),
+            "--png-size 20000 with --animate",
+        ),
+        (
+            with(&["--animate", "--animate-every", "0"]),
+            "--animate-every 0",
+        ),
         (with(&["--animate-every", "3"]), "--animate"),
         (with(&["--checkpoint-every", "0"]), "0"),
         (with(&["--heartbeat", "soon"]), "soon"),

@@ -194,7 +194,9 @@ pub fn place_labels(
                 (ax - 6 - w, ay + 2),
             ];
             let step = h + 6;
-            let rings = (1..).map(|k| k * step).take_while(|&r| r <= reach.max(step));
+            let rings = (1..)
+                .map(|k| k * step)
+                .take_while(|&r| r <= reach.max(step));
             let around = rings.flat_map(|r| {
                 (0..16).map(move |j| {
                     let t = f64::from(j) * std::f64::consts::PI / 8.0;
@@ -413,7 +415,11 @@ macro_rules! draw_chart {
                     .map_err(|e| anyhow!("{e}"))?;
             }
             $root
-                .draw(&Text::new(text.clone(), (x0 + 1, y0 + 1), label_font.clone()))
+                .draw(&Text::new(
+                    text.clone(),
+                    (x0 + 1, y0 + 1),
+                    label_font.clone(),
+                ))
                 .map_err(|e| anyhow!("{e}"))?;
         }
         $placed.extend(placed);
@@ -595,10 +601,26 @@ fn render(
         match (chart.log_x, chart.log_y) {
             (false, false) => draw_chart!(&root, chart, x0..x1, y0..y1, corner, lb, placed),
             (true, false) => {
-                draw_chart!(&root, chart, (x0..x1).log_scale(), y0..y1, corner, lb, placed)
+                draw_chart!(
+                    &root,
+                    chart,
+                    (x0..x1).log_scale(),
+                    y0..y1,
+                    corner,
+                    lb,
+                    placed
+                )
             }
             (false, true) => {
-                draw_chart!(&root, chart, x0..x1, (y0..y1).log_scale(), corner, lb, placed)
+                draw_chart!(
+                    &root,
+                    chart,
+                    x0..x1,
+                    (y0..y1).log_scale(),
+                    corner,
+                    lb,
+                    placed
+                )
             }
             (true, true) => {
                 draw_chart!(
@@ -706,7 +728,9 @@ mod tests {
             .map(|i| (4.6 + 0.01 * f64::from(i % 5), 0.04 + 0.001 * f64::from(i)))
             .chain([(7.9, 0.04), (8.6, 0.03)])
             .collect();
-        let labels: Vec<String> = (0..pts.len()).map(|i| format!("k{i} s0.5 jump100")).collect();
+        let labels: Vec<String> = (0..pts.len())
+            .map(|i| format!("k{i} s0.5 jump100"))
+            .collect();
         let chart = Chart {
             title: "t".into(),
             x_label: "x".into(),

@@ -43,8 +43,8 @@ impl Gif {
             (1..=MAX_SIDE).contains(&width) && (1..=MAX_SIDE).contains(&height),
             "an animation frame of {width}x{height} pixels: GIF sides are 1 to {MAX_SIDE}"
         );
-        let file = AtomicFile::create(path)
-            .with_context(|| format!("creating {}", path.display()))?;
+        let file =
+            AtomicFile::create(path).with_context(|| format!("creating {}", path.display()))?;
         let mut encoder = gif::Encoder::new(
             std::io::BufWriter::new(file),
             width as u16,
@@ -85,12 +85,8 @@ impl Gif {
             self.size.1
         );
         // Speed 10 of 1 (best) to 30 (fastest): NeuQuant's default trade-off.
-        let mut f = gif::Frame::from_rgb_speed(
-            frame.width as u16,
-            frame.height as u16,
-            &frame.rgb,
-            10,
-        );
+        let mut f =
+            gif::Frame::from_rgb_speed(frame.width as u16, frame.height as u16, &frame.rgb, 10);
         f.delay = FRAME_DELAY_CS;
         if let Some(previous) = self.pending.replace(f) {
             self.write(&previous)?;
@@ -100,7 +96,10 @@ impl Gif {
     }
 
     fn write(&mut self, frame: &gif::Frame<'_>) -> Result<()> {
-        let encoder = self.encoder.as_mut().context("animation already finished")?;
+        let encoder = self
+            .encoder
+            .as_mut()
+            .context("animation already finished")?;
         encoder
             .write_frame(frame)
             .with_context(|| format!("writing {}", self.path.display()))

@@ -153,7 +153,10 @@ pub fn colour_bar_ticks(lo: f64, hi: f64, log: bool) -> Vec<(f64, f64)> {
     };
     let mut ticks: Vec<(f64, f64)> = if log {
         let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
-        (a..=b).map(|k| 10f64.powi(k)).map(|v| (frac(v), v)).collect()
+        (a..=b)
+            .map(|k| 10f64.powi(k))
+            .map(|v| (frac(v), v))
+            .collect()
     } else {
         // The round step nearest a quarter of the range (on a log scale).
         let target = (hi - lo) / 4.0;
@@ -209,7 +212,9 @@ impl Figure<'_> {
             let w = ("sans-serif", size * u)
                 .into_font()
                 .box_size(s)
-                .map_or(s.chars().count() as f64 * 0.62 * size * u, |b| f64::from(b.0));
+                .map_or(s.chars().count() as f64 * 0.62 * size * u, |b| {
+                    f64::from(b.0)
+                });
             1.1 * w / u
         };
         let legend_w = match &self.legend {
@@ -255,7 +260,8 @@ impl Figure<'_> {
         let mut out = Raster::new(w, h, palette::WHITE);
         {
             let root = BitMapBackend::with_buffer(&mut out.rgb, (w, h)).into_drawing_area();
-            self.draw(&root, &l).map_err(|e| anyhow!("drawing a figure: {e}"))?;
+            self.draw(&root, &l)
+                .map_err(|e| anyhow!("drawing a figure: {e}"))?;
             root.present().map_err(|e| anyhow!("{e}"))?;
         }
         Ok(out)
@@ -391,7 +397,10 @@ impl Figure<'_> {
                 let side = (16.0 * u) as i32;
                 for (i, (name, c)) in entries.iter().enumerate() {
                     let y = ys.start + (i as f64 * 26.0 * u) as i32;
-                    root.draw(&Rectangle::new([(x0, y), (x0 + side, y + side)], rgb(*c).filled()))?;
+                    root.draw(&Rectangle::new(
+                        [(x0, y), (x0 + side, y + side)],
+                        rgb(*c).filled(),
+                    ))?;
                     root.draw(&Text::new(
                         name.clone(),
                         (x0 + side + (8.0 * u) as i32, y + side / 2),
@@ -479,7 +488,10 @@ mod tests {
                 hi: 1000.0,
                 log: true,
             },
-            Legend::Key(vec![("a".into(), palette::FOX), ("b".into(), palette::RABBIT)]),
+            Legend::Key(vec![
+                ("a".into(), palette::FOX),
+                ("b".into(), palette::RABBIT),
+            ]),
             Legend::Note(vec!["one colour".into(), "per cluster".into()]),
         ];
         for legend in legends {

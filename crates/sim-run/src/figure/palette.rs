@@ -94,11 +94,7 @@ impl Sequential {
 
     /// The longest run of `gradient`'s colours (sampled at 1/1024 steps) whose contrast with
     /// `background` is at least [`MIN_CONTRAST`].
-    pub fn legible_on(
-        gradient: colorous::Gradient,
-        name: &'static str,
-        background: Rgb,
-    ) -> Self {
+    pub fn legible_on(gradient: colorous::Gradient, name: &'static str, background: Rgb) -> Self {
         const STEPS: usize = 1024;
         let ok = |i: usize| {
             let c = gradient.eval_continuous(i as f64 / STEPS as f64);
@@ -117,7 +113,10 @@ impl Sequential {
                 _ => {}
             }
         }
-        assert!(best.1 > best.0, "{name} has no colour legible on {background:?}");
+        assert!(
+            best.1 > best.0,
+            "{name} has no colour legible on {background:?}"
+        );
         Sequential {
             gradient,
             name,
@@ -129,7 +128,9 @@ impl Sequential {
     /// The colour of `t` in `[0, 1]` (clamped): the map's `lo` at 0, its `hi` at 1.
     pub fn at(&self, t: f64) -> Rgb {
         let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
-        let c = self.gradient.eval_continuous(self.lo + t * (self.hi - self.lo));
+        let c = self
+            .gradient
+            .eval_continuous(self.lo + t * (self.hi - self.lo));
         [c.r, c.g, c.b]
     }
 
@@ -141,9 +142,7 @@ impl Sequential {
     /// A table of `n` colours (at least 2) from 0 to 1, for drawing many pixels quickly.
     pub fn table(&self, n: usize) -> Vec<Rgb> {
         let n = n.max(2);
-        (0..n)
-            .map(|i| self.at(i as f64 / (n - 1) as f64))
-            .collect()
+        (0..n).map(|i| self.at(i as f64 / (n - 1) as f64)).collect()
     }
 }
 
@@ -189,7 +188,16 @@ pub fn colour_regions(
             continue;
         }
         let (x, y) = (at % width, at / width);
-        for (dx, dy) in [(-1i64, -1i64), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+        for (dx, dy) in [
+            (-1i64, -1i64),
+            (0, -1),
+            (1, -1),
+            (-1, 0),
+            (1, 0),
+            (-1, 1),
+            (0, 1),
+            (1, 1),
+        ] {
             let (nx, ny) = (x as i64 + dx, y as i64 + dy);
             if nx < 0 || ny < 0 || nx >= width as i64 || ny >= height as i64 {
                 continue;
@@ -329,7 +337,11 @@ mod tests {
             }
             // Most of the map is kept, and its two ends differ clearly.
             assert!(map.hi - map.lo > 0.5, "{}", map.describe());
-            assert!(contrast(map.at(0.0), map.at(1.0)) > 2.0, "{}", map.describe());
+            assert!(
+                contrast(map.at(0.0), map.at(1.0)) > 2.0,
+                "{}",
+                map.describe()
+            );
         }
     }
 

@@ -9,8 +9,8 @@ use crate::scaling::Ctx;
 use crate::scaling::dla::fit_from;
 use crate::scaling::ensemble::columns;
 use anyhow::{Context, Result};
-use std::path::{Path, PathBuf};
 use dla_pdla::{FarField, Params};
+use std::path::{Path, PathBuf};
 
 /// One point of a sweep: the flags of `dla` that change the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]
