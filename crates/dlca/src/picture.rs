@@ -131,7 +131,7 @@ fn figure<'a>(sim: &Simulation, seed: u64, raster: &'a Raster) -> Figure<'a> {
             "DLCA {}, sweep {}: {} clusters, {} particles, seed {seed}",
             sizes.join("x"),
             group_digits(sim.sweeps()),
-            group_digits(sim.clusters() as u64),
+            group_digits(sim.clusters()),
             group_digits(sim.particles()),
         ),
         legend: Legend::Note(note),
