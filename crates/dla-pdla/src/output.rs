@@ -16,15 +16,16 @@
 //! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (see [`crate::picture`]) |
 //! | `dla.gif` | `--animate`: the growth of the cluster, one frame every `--animate-every` particles |
 
-use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
+use crate::sim::{GROWTH_COLUMNS, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
-    AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, RunClock, RunManifest, write_points,
+    AtomicFile, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points,
 };
 use std::io::Write;
 use std::path::Path;
 
+pub use crate::sim::each_position;
 pub use sim_run::io::OutputError;
 
 /// Format of the optional positions file.
@@ -183,44 +184,6 @@ where
         }
     }
     Ok(m)
-}
-
-/// Calls `f(i, p)` with every stored position `p` in arrival order (`i` from 0): from memory
-/// (`keep_positions`) or from `positions.npy` in `dir`, read row by row.
-///
-/// # Errors
-/// Neither source holds the positions, the file does not read, or `f` fails.
-pub fn each_position<const D: usize>(
-    sim: &Simulation<D>,
-    dir: &Path,
-    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), OutputError>,
-) -> Result<(), OutputError> {
-    if let Some(pos) = sim.positions() {
-        for (i, p) in pos.iter().enumerate() {
-            f(i as u64, p)?;
-        }
-        return Ok(());
-    }
-    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
-    let path = dir.join(POSITIONS_FILE);
-    let mut r = NpyReader::open(&path).map_err(npy)?;
-    if r.cols() != D || r.rows() != sim.particles() {
-        return Err(std::io::Error::other(format!(
-            "{}: shape ({}, {}), not ({}, {D})",
-            path.display(),
-            r.rows(),
-            r.cols(),
-            sim.particles()
-        ))
-        .into());
-    }
-    let mut p = [0.0; D];
-    let mut i = 0;
-    while r.next_row(&mut p).map_err(npy)? {
-        f(i, &p)?;
-        i += 1;
-    }
-    Ok(())
 }
 
 /// `positions.bin`: little-endian; the 8 bytes `DLAPOS01`, `u32` dimension `D`, `u64` count

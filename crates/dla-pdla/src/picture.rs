@@ -10,8 +10,7 @@
 //! viewer and where its surface turns away. When a pixel spans more than a diameter (a large
 //! cluster), each pixel shows how many particles it holds on a log scale, projected on x, y.
 
-use crate::output::each_position;
-use crate::sim::Simulation;
+use crate::sim::{Simulation, each_position};
 use crate::space::{Dim, Space};
 use sim_run::figure::animation::Gif;
 use sim_run::figure::palette::{self, Sequential};
@@ -337,6 +336,7 @@ mod tests {
         let r = c.raster(&map, c.max_count());
         assert_eq!(c.max_count(), 100);
         assert_eq!(r.get(8, 8), map.table(1024)[1023]);
-        assert_eq!(r.get(12, 4), map.table(1024)[0]);
+        // (50, 50) is at pixel (151 * 16 / 202, 51 * 16 / 202) = (11, 4).
+        assert_eq!(r.get(11, 4), map.table(1024)[0]);
     }
 }
