@@ -65,6 +65,10 @@ enum Cmd {
         /// Run size: overrides --quick (`tiny` is the harness test's size).
         #[arg(long, value_enum, hide = true)]
         scale: Option<Scale>,
+        /// Run nothing: draw the charts again from the CSVs in the output directory (the
+        /// accuracy sweeps' Pareto charts), for a change of the charts' style.
+        #[arg(long)]
+        replot: bool,
     },
     /// DLA at the papers' scale: 2D 1e7 and 1e8, 3D 1e6 and 1e7, one and two threads (about
     /// an hour and a half on 2 cores); time, memory, D_f, and projections to 2D 1e9 and 3D
@@ -133,6 +137,7 @@ fn main() -> Result<()> {
             out,
             seed,
             scale,
+            replot,
         } => {
             let scale = scale.unwrap_or(if quick { Scale::Quick } else { Scale::Full });
             let out = out.unwrap_or_else(|| {
@@ -143,6 +148,18 @@ fn main() -> Result<()> {
                     base.join("quick")
                 }
             });
+            if replot {
+                let written = xtask::scaling::accuracy::replot(&out)?;
+                for p in &written {
+                    eprintln!("==> {}", p.display());
+                }
+                anyhow::ensure!(
+                    !written.is_empty(),
+                    "no accuracy CSV to replot in {}",
+                    out.display()
+                );
+                return Ok(());
+            }
             let command = std::iter::once("cargo xtask".to_string())
                 .chain(std::env::args().skip(1))
                 .collect::<Vec<_>>()

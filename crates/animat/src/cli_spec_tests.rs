@@ -10,7 +10,16 @@ use sim_run::spec_check::{CliSpec, DocColumns};
 
 /// Flags of `animat` that are not model parameters, beyond the run flags every binary has
 /// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
-const NOT_PARAMS: &[&str] = &["steps", "timing", "max-memory", "snapshot-every"];
+const NOT_PARAMS: &[&str] = &[
+    "steps",
+    "timing",
+    "max-memory",
+    "snapshot-every",
+    "frame-radius",
+    "png-size",
+    "animate",
+    "animate-every",
+];
 
 fn spec() -> CliSpec<'static> {
     CliSpec::new("animat", PARAMS, defaults(), NOT_PARAMS)

@@ -87,9 +87,29 @@ struct Cli {
     #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
     max_memory: Option<u64>,
 
-    /// Write a PNG snapshot every K steps (and of the start and the end).
+    /// Write a PNG snapshot every K steps (and of the start and the end): a figure of the world
+    /// on the run's fixed frame (axes in cells, scale bar, step, populations, seed, key).
     #[arg(long, value_parser = sim_run::cli::count::<u64>)]
     snapshot_every: Option<u64>,
+
+    /// Half the side of the one frame of every snapshot and animation frame, in cells around
+    /// the origin, 1.. (default: 3 start radii); animats outside it are counted in the header.
+    #[arg(long, value_name = "CELLS", value_parser = sim_run::cli::count::<i64>)]
+    frame_radius: Option<i64>,
+
+    /// Side of the picture in the snapshots and animat.gif in pixels (the axes and legend come
+    /// on top), 16 to 65536, at most 16384 with --animate (default: a whole number of pixels
+    /// per cell and at least 512, or one per cell up to 1024).
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    png_size: Option<u32>,
+
+    /// Write animat.gif: the world at the start, every --animate-every steps and at the end.
+    #[arg(long)]
+    animate: bool,
+
+    /// Steps between frames of animat.gif, 1.. (default: a hundredth of --steps).
+    #[arg(long, value_name = "N", requires = "animate", value_parser = sim_run::cli::count::<u64>)]
+    animate_every: Option<u64>,
 
     /// Write every live animat at the end (id, species, x, y, age, hunger): positions.csv
     /// (`--positions` alone), positions.npy with one positions_<attribute>.npy per attribute
@@ -157,6 +177,32 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.snapshot_every == Some(0) {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
+    if cli.animate_every == Some(0) {
+        return Err("--animate-every 0 is outside the accepted range 1..".into());
+    }
+    if cli.frame_radius == Some(0) {
+        return Err("--frame-radius 0 is outside the accepted range 1..".into());
+    }
+    let pictures = cli.snapshot_every.is_some() || cli.animate;
+    if cli.png_size.is_some() && !pictures {
+        return Err(
+            "--png-size sizes the pictures of --snapshot-every and --animate; give one".into(),
+        );
+    }
+    if cli.frame_radius.is_some() && !pictures {
+        return Err(
+            "--frame-radius frames the pictures of --snapshot-every and --animate; give one".into(),
+        );
+    }
+    if let Some(side) = cli
+        .png_size
+        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
+    {
+        return Err(format!(
+            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
+             pixels a side"
+        ));
+    }
     p.validate().map_err(|e| culprit(cli, &e))?;
     if cli.resume.is_none() {
         let what = format!(
@@ -201,11 +247,15 @@ fn culprit(cli: &Cli, e: &ParamsError) -> String {
     animat::params::error_message(e, by_flag, cli.config.as_deref())
 }
 
+/// Largest side of the picture in animat.gif (the figure stays within GIF's 65535 pixels).
+const ANIMATION_MAX_SIDE: u32 = 16384;
+
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.
 const RUN_FILES: &[&str] = &[
     "populations.csv",
     "snapshot_*.png",
+    "animat.gif",
     "positions.*",
     "positions_*",
 ];
@@ -220,6 +270,11 @@ const CURVES: &[Curve] = &[Curve {
     axes: ("step", "animats"),
     log_x: false,
     log_y: false,
+    // The species' colours of the snapshots.
+    colours: &[
+        sim_run::figure::palette::FOX,
+        sim_run::figure::palette::RABBIT,
+    ],
 }];
 
 fn main() -> ExitCode {
@@ -353,11 +408,27 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             .context("writing a checkpoint")?;
         Ok(())
     };
+    let frame = output::SnapshotFrame::new(world.params(), cli.frame_radius, cli.png_size);
     let snapshot = |w: &World| -> anyhow::Result<()> {
         let path = cli.out().join(format!("snapshot_{:06}.png", w.steps()));
-        output::write_snapshot(&path, w)?;
+        output::write_snapshot(&path, w, &frame)?;
         Ok(())
     };
+    let mut animation = if cli.animate {
+        let image = frame.render(&world)?;
+        let mut gif = sim_run::figure::animation::Gif::create(
+            &cli.out().join("animat.gif"),
+            image.width,
+            image.height,
+        )?;
+        gif.push(&image)?;
+        Some(gif)
+    } else {
+        None
+    };
+    let animate_every = cli
+        .animate_every
+        .unwrap_or_else(|| cli.steps.div_ceil(100).max(1));
     let progress = cli.log.progress(
         "animat",
         cli.steps,
@@ -402,6 +473,11 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             );
         }
         rows.push(PopulationRow::of(&world, s));
+        if let Some(gif) = animation.as_mut()
+            && world.steps() % animate_every == 0
+        {
+            gif.push(&frame.render(&world)?)?;
+        }
         if let Some(k) = cli.snapshot_every {
             if world.steps() % k == 0 {
                 snapshot(&world)?;
@@ -430,6 +506,13 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         if world.steps() % k != 0 {
             snapshot(&world)?;
         }
+    }
+    if let Some(mut gif) = animation {
+        if world.steps() % animate_every != 0 {
+            gif.push(&frame.render(&world)?)?;
+        }
+        let frames = gif.finish()?;
+        tracing::info!(frames, "animat.gif");
     }
     output::write_populations(cli.out(), &rows, cli.timing)?;
     if let Some(format) = cli.positions.format() {

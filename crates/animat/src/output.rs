@@ -5,13 +5,16 @@
 //! |---|---|
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results (`steps`, `foxes`, `rabbits`, `state_hash`, `distance_evaluations`, `queries`) |
 //! | `populations.csv` | `step,foxes,rabbits` from step 0 (with `--timing` also `search_seconds,distance_evaluations`) |
-//! | `snapshot_NNNNNN.png` | with `--snapshot-every K`: foxes red, rabbits green, on black, framing the population |
+//! | `snapshot_NNNNNN.png` | with `--snapshot-every K`: a figure of the world on the run's fixed frame ([`SnapshotFrame`]), foxes vermillion, rabbits blue (Okabe-Ito), on white |
+//! | `animat.gif` | with `--animate`: the world every `--animate-every` steps, on the same frame |
 //! | `positions.csv` | with `--positions`: `id,species,x,y,age,hunger` of every live animat at the end |
 
 use crate::params::Species;
 use crate::world::{StepStats, World};
+use sim_run::figure::palette;
+use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
 use sim_run::io::{
-    Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_png_rgb, write_points,
+    Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points,
 };
 use std::path::Path;
 
@@ -133,60 +136,132 @@ pub fn write_positions(dir: &Path, world: &World, format: PointFormat) -> Result
     Ok(())
 }
 
-/// Largest side of a snapshot in cells (one pixel each, or a block of pixels when zoomed).
+/// Largest default side of a snapshot's picture in pixels: a larger frame is scaled down.
 pub const SNAPSHOT_MAX_SIDE: i64 = 1024;
-/// Smallest side of a snapshot in pixels: a smaller world is zoomed by an integer factor.
+/// Smallest default side of a snapshot's picture in pixels: a smaller frame is zoomed by a
+/// whole number of pixels per cell.
 pub const SNAPSHOT_MIN_SIDE: i64 = 512;
 
-/// Writes a PNG of the world: foxes red, rabbits green, on black. The frame is the bounding
-/// box of the live animats plus a margin, one pixel per cell, scaled down by an integer factor
-/// when it would exceed [`SNAPSHOT_MAX_SIDE`], or zoomed (a square of pixels per cell) to at
-/// least [`SNAPSHOT_MIN_SIDE`]; y points up.
-///
-/// # Errors
-/// [`OutputError`] if the PNG cannot be encoded or written.
-pub fn write_snapshot(path: &Path, world: &World) -> Result<(), OutputError> {
-    let (mut x0, mut y0, mut x1, mut y1) = (i64::MAX, i64::MAX, i64::MIN, i64::MIN);
-    for a in world.animats() {
-        x0 = x0.min(a.pos[0]);
-        y0 = y0.min(a.pos[1]);
-        x1 = x1.max(a.pos[0]);
-        y1 = y1.max(a.pos[1]);
+/// The one frame of every snapshot and animation frame of a run: the square of cells from
+/// `-radius` to `radius` on both axes around the origin (where the animats start), drawn
+/// `side` pixels wide. It depends on the parameters and flags only, so every picture of a run
+/// (and of its resumed continuation) has the same scale; animats outside it are counted in the
+/// header.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SnapshotFrame {
+    /// Half the frame's side in cells.
+    pub radius: i64,
+    /// The picture's side in pixels.
+    pub side: u32,
+}
+
+impl SnapshotFrame {
+    /// The frame for `params`: `radius` cells (default: three start radii, as a population
+    /// spreads) and `side` pixels (default: a whole number of pixels per cell and at least
+    /// [`SNAPSHOT_MIN_SIDE`], or one pixel per cell up to [`SNAPSHOT_MAX_SIDE`]).
+    pub fn new(params: &crate::Params, radius: Option<i64>, side: Option<u32>) -> Self {
+        let radius = radius
+            .unwrap_or(params.start_radius.saturating_mul(3))
+            .max(1);
+        let cells = i128::from(radius) * 2 + 1;
+        let side = side.unwrap_or_else(|| {
+            let min = i128::from(SNAPSHOT_MIN_SIDE);
+            if cells < min {
+                (cells * ((min + cells - 1) / cells)) as u32
+            } else {
+                cells.min(i128::from(SNAPSHOT_MAX_SIDE)) as u32
+            }
+        });
+        SnapshotFrame { radius, side }
     }
-    if x0 > x1 {
-        (x0, y0, x1, y1) = (0, 0, 0, 0);
-    }
-    let margin = 5;
-    let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
-    // In i128: animats at both ends of the plane span more than an i64 holds.
-    let wide = |lo: i64, hi: i64| i128::from(hi.saturating_add(margin)) - i128::from(lo) + 1;
-    let span = wide(x0, x1).max(wide(y0, y1));
-    let factor = (span + i128::from(SNAPSHOT_MAX_SIDE) - 1) / i128::from(SNAPSHOT_MAX_SIDE);
-    // At most SNAPSHOT_MAX_SIDE.
-    let cells = ((span + factor - 1) / factor) as i64;
-    // A small world is drawn with `zoom` x `zoom` pixels per cell, so the picture is readable.
-    let zoom = ((SNAPSHOT_MIN_SIDE + cells - 1) / cells).max(1);
-    let side = cells * zoom;
-    let mut pixels = vec![0u8; (side * side * 3) as usize];
-    let cell = |p: i64, lo: i64| ((i128::from(p) - i128::from(lo)) / factor) as i64;
-    for a in world.animats() {
-        let cx = cell(a.pos[0], x0);
-        let cy = cells - 1 - cell(a.pos[1], y0);
-        let c: [u8; 3] = match a.species {
-            Species::Fox => [255, 60, 40],
-            Species::Rabbit => [80, 220, 80],
+
+    /// The picture of `world`: foxes (drawn over rabbits where both share a pixel) and rabbits
+    /// on white, and the number of animats outside the frame.
+    pub fn raster(&self, world: &World) -> (Raster, u64) {
+        let mut r = Raster::new(self.side, self.side, palette::WHITE);
+        let cells = i128::from(self.radius) * 2 + 1;
+        let side = i128::from(self.side);
+        // The pixels of cell `c` (from 0 at the frame's low edge): at least one each.
+        let span = |c: i128| {
+            let a = c * side / cells;
+            let b = ((c + 1) * side / cells).max(a + 1).min(side);
+            a as u32..b as u32
         };
-        for py in cy * zoom..(cy + 1) * zoom {
-            for px in cx * zoom..(cx + 1) * zoom {
-                let at = ((py * side + px) * 3) as usize;
-                // A fox drawn over a rabbit in a shared scaled pixel stays visible.
-                if a.species == Species::Fox || pixels[at] != 255 {
-                    pixels[at..at + 3].copy_from_slice(&c);
+        let mut outside = 0;
+        for species in [Species::Rabbit, Species::Fox] {
+            let colour = match species {
+                Species::Fox => palette::FOX,
+                Species::Rabbit => palette::RABBIT,
+            };
+            for a in world.animats().filter(|a| a.species == species) {
+                let x = i128::from(a.pos[0]) + i128::from(self.radius);
+                let y = i128::from(self.radius) - i128::from(a.pos[1]);
+                if !(0..cells).contains(&x) || !(0..cells).contains(&y) {
+                    outside += 1;
+                    continue;
+                }
+                for py in span(y) {
+                    for px in span(x) {
+                        r.put(px, py, colour);
+                    }
                 }
             }
         }
+        (r, outside)
     }
-    write_png_rgb(path, side as u32, side as u32, &pixels)?;
+
+    /// The figure of `world` on this frame (`raster` from [`SnapshotFrame::raster`]).
+    pub fn figure<'a>(&self, world: &World, raster: &'a Raster, outside: u64) -> Figure<'a> {
+        let edge = self.radius as f64 + 0.5;
+        let mut header = format!(
+            "Animats, step {}: {} foxes, {} rabbits, seed {}",
+            group_digits(world.steps()),
+            group_digits(world.foxes()),
+            group_digits(world.rabbits()),
+            world.seed()
+        );
+        if outside > 0 {
+            header.push_str(&format!("; {} outside", group_digits(outside)));
+        }
+        Figure {
+            raster,
+            extent: Extent {
+                x: (-edge, edge),
+                y: (-edge, edge),
+            },
+            unit: "cells".into(),
+            axes: ("x".into(), "y".into()),
+            header,
+            legend: Legend::Key(vec![
+                ("foxes".into(), palette::FOX),
+                ("rabbits".into(), palette::RABBIT),
+            ]),
+        }
+    }
+
+    /// The figure of `world` as an image (a frame of an animation).
+    ///
+    /// # Errors
+    /// The figure cannot be drawn.
+    pub fn render(&self, world: &World) -> Result<Raster, OutputError> {
+        let (r, outside) = self.raster(world);
+        Ok(self.figure(world, &r, outside).render()?)
+    }
+}
+
+/// Writes a snapshot of the world: a figure of the animats in `frame` (axes in cells, scale
+/// bar, step, populations and seed, species key), foxes Okabe-Ito vermillion, rabbits
+/// Okabe-Ito blue, on white; y points up.
+///
+/// # Errors
+/// [`OutputError`] if the PNG cannot be encoded or written.
+pub fn write_snapshot(
+    path: &Path,
+    world: &World,
+    frame: &SnapshotFrame,
+) -> Result<(), OutputError> {
+    let (r, outside) = frame.raster(world);
+    frame.figure(world, &r, outside).write_png(path)?;
     Ok(())
 }
 

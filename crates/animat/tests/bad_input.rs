@@ -97,6 +97,32 @@ fn bad_inputs_are_refused_before_any_work() {
             "tip: a similar argument exists: '--steps'",
         ),
         (with(&["--seed", "1-10"]), "use --seeds 1..=10"),
+        (with(&["--snapshot-every", "5", "--png-size", "8"]), "8"),
+        (
+            with(&["--snapshot-every", "5", "--png-size", "65537"]),
+            "65537",
+        ),
+        (
+            with(&["--png-size", "512"]),
+            "--snapshot-every and --animate",
+        ),
+        (
+            with(&["--frame-radius", "50"]),
+            "--snapshot-every and --animate",
+        ),
+        (
+            with(&["--snapshot-every", "5", "--frame-radius", "0"]),
+            "--frame-radius 0",
+        ),
+        (
+            with(&["--animate", "--png-size", "20000"]),
+            "--png-size 20000 with --animate",
+        ),
+        (
+            with(&["--animate", "--animate-every", "0"]),
+            "--animate-every 0",
+        ),
+        (with(&["--animate-every", "3"]), "--animate"),
         (with(&["--heartbeat", "-5"]), "-5"),
         (with(&["--wings", "2"]), "--wings"),
         (with(&["--config", "missing.toml"]), "missing.toml"),

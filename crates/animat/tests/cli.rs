@@ -450,3 +450,43 @@ fn counts_in_every_notation_are_the_same_run() {
     ]);
     assert_eq!(written, plain);
 }
+
+/// `--png-size` sizes the snapshots, every snapshot of a run has the same frame (the same
+/// figure size, whatever the population's spread), and `--animate` writes a GIF with a frame
+/// at the start, every `--animate-every` steps and at the end.
+#[test]
+fn snapshots_share_one_frame_and_the_animation_has_its_frames() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let mut args = SMALL.to_vec();
+    args.extend([
+        "--seed",
+        "3",
+        "--snapshot-every",
+        "20",
+        "--png-size",
+        "96",
+        "--animate",
+        "--animate-every",
+        "15",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let o = animat(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let size = |name: &str| {
+        let png = std::fs::read(out.join(name)).unwrap();
+        let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
+        (side(16), side(20))
+    };
+    let first = size("snapshot_000000.png");
+    assert!(first.0 > 96 && first.1 > 96, "{first:?}");
+    assert_eq!(size("snapshot_000040.png"), first);
+    let steps = run_json(&out)["results"]["steps"].as_u64().unwrap();
+    assert_eq!(steps, 40);
+    // Steps 0, 15, 30 and 40.
+    let (gif_size, frames) = sim_run::figure::animation::read_gif(&out.join("animat.gif")).unwrap();
+    assert_eq!(frames, 4);
+    assert_eq!(gif_size, first);
+}

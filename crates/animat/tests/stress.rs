@@ -82,7 +82,8 @@ fn populations_that_die_out_stop_the_run_cleanly() {
     w.run(50);
     assert_eq!(w.steps(), died_at, "an empty world does not step");
     let dir = tempfile::tempdir().unwrap();
-    animat::output::write_snapshot(&dir.path().join("empty.png"), &w).unwrap();
+    let frame = animat::output::SnapshotFrame::new(w.params(), None, None);
+    animat::output::write_snapshot(&dir.path().join("empty.png"), &w, &frame).unwrap();
     // Both species absent from the start.
     let empty = run_everywhere(
         &Params {
@@ -258,8 +259,22 @@ fn animats_at_the_edges_of_the_plane_stay_on_it() {
         }
         assert!(w.rabbits() >= corners.len() as u64 * 2);
         let dir = tempfile::tempdir().unwrap();
-        animat::output::write_snapshot(&dir.path().join("edges.png"), &w).unwrap();
+        let frame = animat::output::SnapshotFrame::new(w.params(), None, None);
+        animat::output::write_snapshot(&dir.path().join("edges.png"), &w, &frame).unwrap();
+        // The animats at the plane's edges are outside the frame, and counted.
+        assert_eq!(
+            frame.raster(&w).1,
+            w.foxes() + w.rabbits() - frame_count(&w, &frame)
+        );
     }
+}
+
+/// Animats inside `frame`.
+fn frame_count(w: &World, frame: &animat::output::SnapshotFrame) -> u64 {
+    let r = i128::from(frame.radius);
+    w.animats()
+        .filter(|a| a.pos.iter().all(|&c| (-r..=r).contains(&i128::from(c))))
+        .count() as u64
 }
 
 const ANIMAT: &str = env!("CARGO_BIN_EXE_animat");

@@ -10,7 +10,14 @@ use sim_run::spec_check::{CliSpec, DocColumns};
 
 /// Flags of `dla` that are not model parameters, beyond the run flags every binary has
 /// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
-const NOT_PARAMS: &[&str] = &["paper-settings", "png", "png-size", "max-memory"];
+const NOT_PARAMS: &[&str] = &[
+    "paper-settings",
+    "png",
+    "png-size",
+    "animate",
+    "animate-every",
+    "max-memory",
+];
 
 fn spec() -> CliSpec<'static> {
     CliSpec::new("dla", PARAMS, defaults(), NOT_PARAMS)

@@ -139,16 +139,27 @@ struct Cli {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
 
-    /// Write dla.png: the cluster shaded by arrival order (3D: shaded spheres seen from +z,
-    /// nearer brighter; 4D and 5D: the same picture of the projection on x, y, z), or, when a
-    /// pixel spans more than a diameter, the number of particles per pixel on a log scale
-    /// (projected on x, y).
+    /// Write dla.png: a figure of the cluster (axes in diameters, scale bar, N and seed, colour
+    /// bar), coloured by arrival order (3D: shaded spheres seen from +z; 4D and 5D: the same
+    /// picture of the projection on x, y, z), or, when a pixel spans more than a diameter, by
+    /// the number of particles per pixel on a log scale (projected on x, y).
     #[arg(long)]
     png: bool,
 
-    /// Side of dla.png in pixels, 16 to 65536 (default: one pixel per diameter, 512 to 4096).
-    #[arg(long, value_name = "PX", requires = "png", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    /// Side of the picture in dla.png and dla.gif in pixels (the axes and legend come on top),
+    /// 16 to 65536, at most 16384 with --animate (default: dla.png one pixel per diameter, 512
+    /// to 4096; dla.gif 512).
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
     png_size: Option<u32>,
+
+    /// Write dla.gif: the growth of the cluster, one frame every --animate-every particles and
+    /// one of the whole cluster, all on the finished cluster's frame and colours.
+    #[arg(long)]
+    animate: bool,
+
+    /// Particles between frames of dla.gif, 1.. (default: a hundredth of --particles).
+    #[arg(long, value_name = "N", requires = "animate", value_parser = sim_run::cli::count::<u64>)]
+    animate_every: Option<u64>,
 
     /// Memory the run may take, in bytes; suffixes K, M, G, T (powers of 1024). A run whose
     /// estimated peak (docs/dla.md, "Memory") is larger is refused before it starts. Default:
@@ -221,6 +232,21 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }
+    if cli.animate_every == Some(0) {
+        return Err("--animate-every 0 is outside the accepted range 1..".into());
+    }
+    if cli.png_size.is_some() && !cli.png && !cli.animate {
+        return Err("--png-size sizes the pictures of --png and --animate; give one".into());
+    }
+    if let Some(side) = cli
+        .png_size
+        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
+    {
+        return Err(format!(
+            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
+             pixels a side"
+        ));
+    }
     if cli.positions == PositionsFormat::Vtk && p.particles > sim_run::io::points::VTK_MAX_POINTS {
         return Err(format!(
             "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
@@ -240,7 +266,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
 /// one per job, so each member must fit.
 fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
     let side = u64::from(cli.png_size.unwrap_or(dla_pdla::output::PNG_MAX_SIDE));
-    let png = if cli.png {
+    let png = if cli.png || cli.animate {
         dla_pdla::output::png_memory_bytes(side)
     } else {
         0
@@ -250,7 +276,11 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
         p.particles,
         p.dim,
         dla_pdla::params::PEAK_BYTES_PER_PARTICLE[p.dim.clamp(2, 5) - 2],
-        if cli.png { " and the picture" } else { "" }
+        if cli.png || cli.animate {
+            " and the picture"
+        } else {
+            ""
+        }
     );
     sim_run::memory::Limit::from_flag(cli.max_memory).check(
         p.peak_memory_bytes().saturating_add(png),
@@ -291,9 +321,14 @@ where
     Ok(sim)
 }
 
+/// Side of the picture in dla.gif without --png-size.
+const ANIMATION_DEFAULT_SIDE: u32 = 512;
+/// Largest side of the picture in dla.gif (the figure around it stays within GIF's 65535).
+const ANIMATION_MAX_SIDE: u32 = 16384;
+
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.
-const RUN_FILES: &[&str] = &["growth.csv", "positions.*", "dla.png"];
+const RUN_FILES: &[&str] = &["growth.csv", "positions.*", "dla.png", "dla.gif"];
 
 /// What an ensemble (`--seeds`) averages over its members.
 const CURVES: &[Curve] = &[Curve {
@@ -305,6 +340,7 @@ const CURVES: &[Curve] = &[Curve {
     axes: ("particles N", "R_g and R_ext (particle diameters)"),
     log_x: true,
     log_y: true,
+    colours: &[],
 }];
 
 fn main() -> ExitCode {
@@ -360,8 +396,10 @@ where
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
     sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
-    let positions =
-        cli.png || cli.positions != PositionsFormat::None || cli.checkpoint_every.is_some();
+    let positions = cli.png
+        || cli.animate
+        || cli.positions != PositionsFormat::None
+        || cli.checkpoint_every.is_some();
     if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {
         tracing::warn!(
             "--positions {} for {total} particles writes about {} GB of text; positions.npy holds them in {} GB",
@@ -397,6 +435,20 @@ where
         cli.png_size
             .unwrap_or_else(|| default_png_side(sim.r_ext()))
     });
+    if cli.animate {
+        let side = cli.png_size.unwrap_or(ANIMATION_DEFAULT_SIDE);
+        let every = cli
+            .animate_every
+            .unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));
+        let frames = dla_pdla::picture::write_animation(
+            &sim,
+            &cli.out,
+            &cli.out.join("dla.gif"),
+            side,
+            every,
+        )?;
+        tracing::info!(frames, "dla.gif");
+    }
     let m = write_outputs(&sim, &clock, &cli.out, cli.positions, png)?;
     if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
         tracing::warn!("no fractal dimension: {e}");

@@ -13,18 +13,19 @@
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
 //! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C`; 2D and 3D only |
 //! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView); 2D and 3D only |
-//! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: shaded spheres seen from +z with a depth buffer; 4D and 5D: the same for the projection on x, y, z; the density image projects on x, y) |
+//! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (see [`crate::picture`]) |
+//! | `dla.gif` | `--animate`: the growth of the cluster, one frame every `--animate-every` particles |
 
-use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
+use crate::sim::{GROWTH_COLUMNS, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
-    AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest,
-    write_png_gray, write_points,
+    AtomicFile, CsvWriter, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest, write_points,
 };
 use std::io::Write;
 use std::path::Path;
 
+pub use crate::sim::each_position;
 pub use sim_run::io::OutputError;
 
 /// Format of the optional positions file.
@@ -124,7 +125,7 @@ where
         }
     }
     if let Some(side) = png {
-        write_picture(sim, dir, &dir.join("dla.png"), side)?;
+        crate::picture::write_png(sim, dir, &dir.join("dla.png"), side)?;
     }
 
     let mut m = manifest_with_peak(sim, clock, simulation_peak)?;
@@ -212,44 +213,6 @@ where
     Ok(m)
 }
 
-/// Calls `f(i, p)` with every stored position `p` in arrival order (`i` from 0): from memory
-/// (`keep_positions`) or from `positions.npy` in `dir`, read row by row.
-///
-/// # Errors
-/// Neither source holds the positions, the file does not read, or `f` fails.
-pub fn each_position<const D: usize>(
-    sim: &Simulation<D>,
-    dir: &Path,
-    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), OutputError>,
-) -> Result<(), OutputError> {
-    if let Some(pos) = sim.positions() {
-        for (i, p) in pos.iter().enumerate() {
-            f(i as u64, p)?;
-        }
-        return Ok(());
-    }
-    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
-    let path = dir.join(POSITIONS_FILE);
-    let mut r = NpyReader::open(&path).map_err(npy)?;
-    if r.cols() != D || r.rows() != sim.particles() {
-        return Err(std::io::Error::other(format!(
-            "{}: shape ({}, {}), not ({}, {D})",
-            path.display(),
-            r.rows(),
-            r.cols(),
-            sim.particles()
-        ))
-        .into());
-    }
-    let mut p = [0.0; D];
-    let mut i = 0;
-    while r.next_row(&mut p).map_err(npy)? {
-        f(i, &p)?;
-        i += 1;
-    }
-    Ok(())
-}
-
 /// `positions.bin`: little-endian; the 8 bytes `DLAPOS01`, `u32` dimension `D`, `u64` count
 /// `N`, then `N * D` `f64` coordinates, particle by particle in arrival order.
 pub fn write_positions_bin<const D: usize>(
@@ -280,10 +243,11 @@ pub fn default_png_side(r_ext: f64) -> u32 {
     ((2.0 * (r_ext + 1.0)).ceil() as u32).clamp(PNG_MIN_SIDE, PNG_MAX_SIDE)
 }
 
-/// Memory the buffers of a `side` x `side` `dla.png` take while it is drawn (a depth, a count
-/// and a grey value per pixel, at most).
+/// Memory the buffers of a `side` x `side` `dla.png` take while it is drawn: per pixel of the
+/// picture at most an arrival, a depth and a lighting value (16 bytes), its colour (3) and the
+/// figure around it (axes and legend at most double the area: 6).
 pub fn png_memory_bytes(side: u64) -> u64 {
-    side.saturating_mul(side).saturating_mul(13)
+    side.saturating_mul(side).saturating_mul(25)
 }
 
 /// Smallest default side of `dla.png`.
@@ -291,135 +255,14 @@ pub const PNG_MIN_SIDE: u32 = 512;
 /// Largest default side of `dla.png` (any side up to 65536 may be asked for).
 pub const PNG_MAX_SIDE: u32 = 4096;
 
-/// The cluster as a grayscale picture of `side` x `side` pixels on black, projected on (x, y).
-/// While a pixel is at most a diameter wide, each particle is a disc of diameter 1 shaded from
-/// dark (first) to white (last) by arrival order; when a pixel spans more than a diameter (a
-/// large cluster), each pixel shows how many particles it holds, log-scaled from dark (one) to
-/// white (the most), which shows the structure where dots would merge into a blot.
-/// The pixel ranges `(x0, x1, y0, y1)`, inclusive, that a disc of radius `rad` pixels centred
-/// at `(cx, cy)` can touch in a `side` x `side` picture.
-fn disc_bounds(cx: f64, cy: f64, rad: f64, side: u32) -> (u32, u32, u32, u32) {
-    (
-        (cx - rad).floor().max(0.0) as u32,
-        ((cx + rad).ceil() as u32).min(side - 1),
-        (cy - rad).floor().max(0.0) as u32,
-        ((cy + rad).ceil() as u32).min(side - 1),
-    )
-}
-
-/// A 3D cluster (4D and 5D: its projection on x, y, z) seen from +z: each particle a shaded
-/// sphere at its true size, the nearest surface at each pixel kept (a depth buffer), brighter
-/// where nearer the viewer and where the sphere faces the viewer, so the branches in front
-/// stand out from those behind.
-fn depth_shaded<const D: usize>(
-    sim: &Simulation<D>,
-    dir: &Path,
-    extent: f64,
-    scale: f64,
-    side: u32,
-) -> Result<Vec<u8>, OutputError> {
-    let s = side as usize;
-    let mut depth = vec![f64::NEG_INFINITY; s * s];
-    let mut px = vec![0u8; s * s];
-    let rad = 0.5 * scale;
-    each_position(sim, dir, |_, p: &[f64; D]| {
-        let (cx, cy) = ((p[0] + extent) * scale, (extent - p[1]) * scale);
-        let (x0, x1, y0, y1) = disc_bounds(cx, cy, rad, side);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
-                let r2 = (dx * dx + dy * dy) / (rad * rad);
-                if r2 > 1.0 && !(x1 == x0 && y1 == y0) {
-                    continue;
-                }
-                // The sphere's surface height above its centre, in diameters, and its normal's
-                // component towards the viewer.
-                let facing = (1.0 - r2.min(1.0)).sqrt();
-                let z = p[2] + 0.5 * facing;
-                let at = y as usize * s + x as usize;
-                if z > depth[at] {
-                    depth[at] = z;
-                    let near = ((z + extent) / (2.0 * extent)).clamp(0.0, 1.0);
-                    px[at] = (40.0 + 215.0 * (0.3 + 0.7 * near) * (0.35 + 0.65 * facing)) as u8;
-                }
-            }
-        }
-        Ok(())
-    })?;
-    Ok(px)
-}
-
-fn write_picture<const D: usize>(
-    sim: &Simulation<D>,
-    dir: &Path,
-    path: &Path,
-    side: u32,
-) -> Result<(), OutputError> {
-    // Every centre lies within R_ext of the origin.
-    let extent = sim.r_ext() + 1.0;
-    let scale = f64::from(side) / (2.0 * extent);
-    let s = side as usize;
-    // 4D and 5D: the picture of the projection on (x, y, z), as in 3D.
-    let px = if scale >= 1.0 && D >= 3 {
-        depth_shaded(sim, dir, extent, scale, side)?
-    } else if scale >= 1.0 {
-        let mut px = vec![0u8; s * s];
-        let n = sim.particles().max(2) as f64;
-        let rad = 0.5 * scale;
-        each_position(sim, dir, |i, p: &[f64; D]| {
-            let shade = (55.0 + 200.0 * i as f64 / (n - 1.0)) as u8;
-            let cx = (p[0] + extent) * scale;
-            let cy = (extent - p[1]) * scale;
-            let (x0, x1, y0, y1) = disc_bounds(cx, cy, rad, side);
-            for y in y0..=y1 {
-                for x in x0..=x1 {
-                    let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
-                    if dx * dx + dy * dy <= rad * rad || (x1 == x0 && y1 == y0) {
-                        let at = y as usize * s + x as usize;
-                        px[at] = px[at].max(shade);
-                    }
-                }
-            }
-            Ok(())
-        })?;
-        px
-    } else {
-        let mut counts = vec![0u32; s * s];
-        each_position(sim, dir, |_, p: &[f64; D]| {
-            let x = (((p[0] + extent) * scale) as usize).min(s - 1);
-            let y = (((extent - p[1]) * scale) as usize).min(s - 1);
-            let c = &mut counts[y * s + x];
-            *c = c.saturating_add(1);
-            Ok(())
-        })?;
-        density_shades(&counts)
-    };
-    write_png_gray(path, side, side, &px)?;
-    Ok(())
-}
-
-/// Gray levels of per-pixel counts: 0 black, 1 to the largest count mapped to 60-255 by
-/// `ln(count)`.
-fn density_shades(counts: &[u32]) -> Vec<u8> {
-    let top = f64::from(counts.iter().copied().max().unwrap_or(0).max(2)).ln();
-    counts
-        .iter()
-        .map(|&c| match c {
-            0 => 0,
-            c => (60.0 + 195.0 * f64::from(c).ln() / top).round() as u8,
-        })
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn density_shades_are_log_scaled_and_keep_empty_pixels_black() {
-        assert_eq!(density_shades(&[0, 1, 10, 100]), vec![0, 60, 158, 255]);
-        assert_eq!(density_shades(&[0, 1]), vec![0, 60]);
+    fn the_default_side_is_one_pixel_per_diameter_within_bounds() {
         assert_eq!(default_png_side(10.0), PNG_MIN_SIDE);
+        assert_eq!(default_png_side(1000.0), 2002);
         assert_eq!(default_png_side(1e6), PNG_MAX_SIDE);
     }
 }

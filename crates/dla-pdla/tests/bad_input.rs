@@ -175,6 +175,16 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--positions", "pdf"]), "pdf"),
         (with(&["--png", "--png-size", "8"]), "8"),
         (with(&["--png-size", "1024"]), "--png"),
+        (with(&["--png", "--png-size", "65537"]), "65537"),
+        (
+            with(&["--animate", "--png-size", "20000"]),
+            "--png-size 20000 with --animate",
+        ),
+        (
+            with(&["--animate", "--animate-every", "0"]),
+            "--animate-every 0",
+        ),
+        (with(&["--animate-every", "10"]), "--animate"),
         (with(&["--distance-map", "maybe"]), "maybe"),
         (with(&["--fit-from", "0"]), "--fit-from 0"),
         (with(&["--checkpoint-every", "0"]), "--checkpoint-every 0"),

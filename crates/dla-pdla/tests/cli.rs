@@ -388,3 +388,33 @@ fn bytes_per_particle_measures_the_simulation_not_the_output_stage() {
     assert!(output >= sim, "simulation {sim}, output {output}");
     assert_eq!(m["peak_rss_bytes"].as_u64().unwrap(), output);
 }
+
+/// `--png-size` sizes dla.png, and `--animate` writes dla.gif with a frame every
+/// `--animate-every` particles and one of the whole cluster, all of one size.
+#[test]
+fn png_size_and_animation() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let o = dla()
+        .args([
+            "--particles",
+            "300",
+            "--seed",
+            "2",
+            "--png",
+            "--png-size",
+            "64",
+        ])
+        .args(["--animate", "--animate-every", "100", "--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let png = std::fs::read(out.join("dla.png")).unwrap();
+    let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
+    assert!(side(16) > 64 && side(20) > 64);
+    // 100, 200 and the whole cluster of 300.
+    let ((w, h), frames) = sim_run::figure::animation::read_gif(&out.join("dla.gif")).unwrap();
+    assert_eq!(frames, 3);
+    assert_eq!((w, h), (side(16), side(20)));
+}

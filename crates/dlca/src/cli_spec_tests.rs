@@ -10,7 +10,7 @@ use sim_run::spec_check::{CliSpec, DocColumns, flags_of};
 
 /// Flags of `dlca` that are not model parameters, beyond the run flags every binary has
 /// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
-const NOT_PARAMS: &[&str] = &["png"];
+const NOT_PARAMS: &[&str] = &["png", "png-size", "animate", "animate-every"];
 
 fn spec() -> CliSpec<'static> {
     CliSpec::new("dlca", PARAMS, defaults(), NOT_PARAMS)

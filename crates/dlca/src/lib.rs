@@ -30,6 +30,7 @@
 pub mod analysis;
 pub mod output;
 pub mod params;
+pub mod picture;
 pub mod record;
 mod rigid;
 pub mod sim;

@@ -142,9 +142,25 @@ struct Cli {
     #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().fit_min_size)]
     fit_min_size: u64,
 
-    /// Write dlca.png: the final state, one colour per cluster (first two axes).
+    /// Write dlca.png: a figure of the final state on the first two axes (axes in lattice
+    /// cells, scale bar, sweep, clusters and seed), touching clusters in different colours.
     #[arg(long)]
     png: bool,
+
+    /// Longer side of the picture in dlca.png and dlca.gif in pixels (the axes and legend come
+    /// on top), 16 to 65536, at most 16384 with --animate (default: dlca.png a whole number of
+    /// pixels per site and at least 512, or one per site up to 8192; dlca.gif 512).
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    png_size: Option<u32>,
+
+    /// Write dlca.gif: the aggregation, a frame of the start, one every --animate-every sweeps
+    /// and one of the end.
+    #[arg(long)]
+    animate: bool,
+
+    /// Sweeps between frames of dlca.gif, 1.. (default 10).
+    #[arg(long, value_name = "N", requires = "animate", value_parser = sim_run::cli::count::<u64>)]
+    animate_every: Option<u64>,
 
     /// Every particle's final site and cluster id: particles.csv (x1..xd,cluster), particles.npy
     /// with particles_cluster.npy (NumPy), particles.vtk (ParaView, cluster as a point scalar),
@@ -203,12 +219,33 @@ fn params(cli: &Cli) -> Result<Params, String> {
         fit_min_size: cli.fit_min_size,
     };
     p.validate().map_err(|e| e.to_string())?;
+    if cli.animate_every == Some(0) {
+        return Err("--animate-every 0 is outside the accepted range 1..".into());
+    }
+    if cli.png_size.is_some() && !cli.png && !cli.animate {
+        return Err("--png-size sizes the pictures of --png and --animate; give one".into());
+    }
+    if let Some(side) = cli
+        .png_size
+        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
+    {
+        return Err(format!(
+            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
+             pixels a side"
+        ));
+    }
     // The default 4G is the occupancy lattice's budget only; the run's limit is then the memory
     // available.
     let given = sim_run::cli::config::given("max_memory").then_some(cli.max_memory);
     let n = p.particles().unwrap_or(0);
+    let picture = if cli.png || cli.animate {
+        let side = u64::from(cli.png_size.unwrap_or(PICTURE_MAX_DEFAULT_SIDE));
+        dlca::picture::png_memory_bytes(side, side)
+    } else {
+        0
+    };
     sim_run::memory::Limit::from_flag(given).check(
-        dlca::sim::peak_memory_bytes(&p),
+        dlca::sim::peak_memory_bytes(&p).saturating_add(picture),
         &format!(
             "{n} particles on {} sites with the {} search",
             p.size.iter().product::<u64>(),
@@ -265,6 +302,7 @@ const CURVES: &[Curve] = &[
         axes: ("sweep", "clusters; particles in the largest"),
         log_x: true,
         log_y: true,
+        colours: &[],
     },
     Curve {
         file: "sizes.csv",
@@ -275,6 +313,7 @@ const CURVES: &[Curve] = &[
         axes: ("cluster size (particles)", "clusters of that size"),
         log_x: true,
         log_y: true,
+        colours: &[],
     },
 ];
 
@@ -338,7 +377,17 @@ const RUN_FILES: &[&str] = &[
     "positions.*",
     "positions_*",
     "dlca.png",
+    "dlca.gif",
 ];
+
+/// Longer side of the picture in dlca.gif without --png-size.
+const ANIMATION_DEFAULT_SIDE: u32 = 512;
+/// Largest longer side of the picture in dlca.gif (the figure stays within GIF's 65535).
+const ANIMATION_MAX_SIDE: u32 = 16384;
+/// Sweeps between frames of dlca.gif without --animate-every.
+const ANIMATION_DEFAULT_EVERY: u64 = 10;
+/// The largest default side of a picture, for the memory estimate before the run.
+const PICTURE_MAX_DEFAULT_SIDE: u32 = dlca::picture::PNG_MAX_SIDE as u32;
 
 fn main() -> ExitCode {
     if let Some(code) = sim_run::ensemble::before_parsing("dlca", COMBINE) {
@@ -405,9 +454,26 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot())
             .context("writing a checkpoint")
     };
+    let mut animation = if cli.animate {
+        let side = cli.png_size.unwrap_or(ANIMATION_DEFAULT_SIDE);
+        Some(dlca::picture::Animation::start(
+            &sim,
+            cli.seed,
+            &cli.out.join("dlca.gif"),
+            side,
+        )?)
+    } else {
+        None
+    };
+    let every = cli.animate_every.unwrap_or(ANIMATION_DEFAULT_EVERY);
     while !sim.is_done() {
         sim.sweep();
         let s = &sim;
+        if let Some(a) = animation.as_mut()
+            && (s.sweeps() % every == 0 || s.is_done())
+        {
+            a.frame(s)?;
+        }
         if let Some(n) = cli.checkpoint_every
             && s.sweeps() % n == 0
             && !s.is_done()
@@ -446,12 +512,16 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             sim.clusters()
         );
     }
+    if let Some(a) = animation {
+        let frames = a.finish()?;
+        tracing::info!(frames, "dlca.gif");
+    }
     let m = dlca::output::write_outputs(
         &sim,
         cli.seed,
         &clock,
         &cli.out,
-        cli.png,
+        cli.png.then_some(cli.png_size),
         cli.positions.format(),
     )?;
     if !cli.log.is_quiet() {

@@ -9,7 +9,8 @@
 //! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`sim_run::io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
-//! | `dlca.png` | with `--png`: the final state, one colour per cluster, a square of pixels per site on lattices under 512 sites wide |
+//! | `dlca.png` | with `--png`: the figure of the final state, touching clusters in different colours (see [`crate::picture`]) |
+//! | `dlca.gif` | with `--animate`: the aggregation, a frame every `--animate-every` sweeps |
 
 use crate::analysis::{
     ClusterMeasure, fractal_dimension, gyration, pooled_fractal_dimension, size_distribution,
@@ -17,19 +18,21 @@ use crate::analysis::{
 use crate::sim::Simulation;
 use serde_json::json;
 use sim_run::io::{
-    Attribute, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_png_rgb, write_points,
+    Attribute, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_points,
 };
 use spatial::lattice::ItemId;
 use std::path::Path;
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest written;
-/// the particles' sites and cluster ids go into `particles.<format>` if `positions` names one.
+/// the particles' sites and cluster ids go into `particles.<format>` if `positions` names one,
+/// and `dlca.png` is drawn if `png` is `Some` (the longer side of its picture, or `None` inside
+/// for the default, see [`crate::picture::picture_size`]).
 pub fn write_outputs(
     sim: &Simulation,
     seed: u64,
     clock: &RunClock,
     dir: &Path,
-    png: bool,
+    png: Option<Option<u32>>,
     positions: Option<PointFormat>,
 ) -> Result<sim_run::io::RunManifest, OutputError> {
     let params = sim.params();
@@ -115,8 +118,8 @@ pub fn write_outputs(
         write_clusters(dir, measures)?;
     }
 
-    if png {
-        write_picture(sim, &dir.join("dlca.png"))?;
+    if let Some(side) = png {
+        crate::picture::write_png(sim, seed, &dir.join("dlca.png"), side)?;
     }
 
     let m = manifest(sim, seed, clock, measures.as_deref())?;
@@ -274,47 +277,5 @@ fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputE
         w.row(&[&c.id, &c.size, &c.radius_of_gyration, &c.wraps])?;
     }
     w.finish()?;
-    Ok(())
-}
-
-/// A colour for cluster `id`: a hash spread over bright hues, never black.
-fn colour(id: u32) -> [u8; 3] {
-    let h = sim_run::io::hash::xxh3_64(&id.to_le_bytes());
-    let c = |shift: u32| 64 + ((h >> shift) & 0xBF) as u8;
-    [c(0), c(16), c(32)]
-}
-
-/// The final state as a picture: the lattice's first two axes (a projection for d >= 3; a strip
-/// for d = 1), one colour per cluster, scaled down by an integer factor so neither side exceeds
-/// 8192 pixels.
-fn write_picture(sim: &Simulation, path: &Path) -> Result<(), OutputError> {
-    let l = sim.lattice();
-    let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
-    let factor = w0.max(h0).div_ceil(8192).max(1);
-    let (cw, ch) = (w0.div_ceil(factor), h0.div_ceil(factor));
-    // A small lattice is drawn with `zoom` x `zoom` pixels per site, at least 512 pixels wide.
-    let zoom = 512u64.div_ceil(cw.max(ch)).max(1);
-    let (w, h) = (cw * zoom, ch * zoom);
-    let mut pixels = vec![0u8; (w * h * 3) as usize];
-    for &id in sim.sets().live() {
-        let c = colour(id);
-        for &k in sim.sets().sites(id) {
-            let x = l.coord(k, 0) / factor;
-            let y = if l.dim() >= 2 {
-                l.coord(k, 1) / factor
-            } else {
-                0
-            };
-            // Row 0 at the top: flip y so the last axis points up, as gravity pulls down.
-            let top = (ch - 1 - y) * zoom;
-            for py in top..top + zoom {
-                for px in x * zoom..(x + 1) * zoom {
-                    let at = ((py * w + px) * 3) as usize;
-                    pixels[at..at + 3].copy_from_slice(&c);
-                }
-            }
-        }
-    }
-    write_png_rgb(path, w as u32, h as u32, &pixels)?;
     Ok(())
 }

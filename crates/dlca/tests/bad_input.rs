@@ -150,6 +150,18 @@ fn bad_inputs_are_refused_before_any_work() {
             "tip: a similar argument exists: '--target-clusters'",
         ),
         (with(&["--seed", "1..=4"]), "use --seeds 1..=4"),
+        (with(&["--png", "--png-size", "8"]), "8"),
+        (with(&["--png", "--png-size", "65537"]), "65537"),
+        (with(&["--png-size", "512"]), "--png and --animate"),
+        (
+            with(&["--animate", "--png-size", "20000"]),
+            "--png-size 20000 with --animate",
+        ),
+        (
+            with(&["--animate", "--animate-every", "0"]),
+            "--animate-every 0",
+        ),
+        (with(&["--animate-every", "3"]), "--animate"),
         (with(&["--heartbeat", "soon"]), "soon"),
         (with(&["--frobnicate"]), "--frobnicate"),
         (

@@ -292,6 +292,7 @@ mod tests {
         axes: ("n", "r"),
         log_x: true,
         log_y: true,
+        colours: &[],
     }];
 
     #[cfg(feature = "cli")]

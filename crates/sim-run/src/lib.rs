@@ -14,6 +14,8 @@
 //! - `ensemble` (feature `cli`): `--seeds` for every binary, members as child processes or over
 //!   the ranks of an MPI job (feature `mpi`), restart, and the merged statistics.
 //! - `plot` (feature `plot`): PNG charts with error bands.
+//! - `figure` (feature `plot`): figures of model states (axes, scale bar, header, legend,
+//!   colour-blind-safe palettes) as PNGs or GIF animations.
 //! - `testing` (feature `test-support`): the bad-input harness of the binaries' tests;
 //!   `spec_check` (with `cli` too): a binary's flags and its docs table against the model's
 //!   parameter table.
@@ -43,6 +45,8 @@ pub mod cli;
 pub mod count;
 #[cfg(feature = "cli")]
 pub mod ensemble;
+#[cfg(feature = "plot")]
+pub mod figure;
 #[cfg(any(test, feature = "test-support"))]
 pub mod fuzz;
 pub mod io;

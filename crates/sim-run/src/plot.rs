@@ -12,7 +12,8 @@ use std::sync::Once;
 /// `crates/sim-run/assets/fonts/DejaVu-LICENSE.txt`).
 static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
 
-fn register_font() {
+/// Registers the committed font as `sans-serif` with plotters (once).
+pub(crate) fn register_font() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
@@ -51,6 +52,8 @@ pub struct Series {
     pub band: Option<Vec<(f64, f64, f64)>>,
     /// Optional symmetric error bars on y, one per point (a standard error, say).
     pub y_errors: Option<Vec<f64>>,
+    /// The series' colour (default: the chart's palette, in the order of the series).
+    pub colour: Option<[u8; 3]>,
 }
 
 impl Series {
@@ -63,7 +66,14 @@ impl Series {
             labels: None,
             band: None,
             y_errors: None,
+            colour: None,
         }
+    }
+
+    /// The same series in colour `c` (a species' colour, say) instead of the palette's.
+    pub fn with_colour(mut self, c: [u8; 3]) -> Self {
+        self.colour = Some(c);
+        self
     }
 
     /// The same series with an error bar of half-length `errors[i]` on point `i`.
@@ -139,7 +149,7 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
 }
 
 /// A short tick label: `0.05`, `10`, `2.5e-6`.
-fn tick(v: f64) -> String {
+pub(crate) fn tick(v: f64) -> String {
     let a = v.abs();
     if a == 0.0 {
         "0".into()
@@ -151,8 +161,72 @@ fn tick(v: f64) -> String {
     }
 }
 
+/// A rectangle of pixels: left, top, right, bottom (right and bottom exclusive).
+pub type Rect = (i32, i32, i32, i32);
+
+fn overlaps(a: Rect, b: Rect) -> bool {
+    a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+}
+
+/// Places labels of `sizes` (width, height in pixels) near their `anchors` (the points they
+/// name) inside `area`, so that no two labels overlap and no label overlaps an `obstacle` (the
+/// markers, the legend). Each label takes the first free spot: beside its point (upper right,
+/// lower right, upper left, lower left), then on rings of growing radius around it (16 spots a
+/// ring, the last ring a quarter of the area's larger side away). A label with no free spot is
+/// left out (`None`) rather than drawn over another.
+pub fn place_labels(
+    anchors: &[(i32, i32)],
+    sizes: &[(i32, i32)],
+    obstacles: &[Rect],
+    area: Rect,
+) -> Vec<Option<Rect>> {
+    let mut placed: Vec<Rect> = Vec::new();
+    let inside = |r: Rect| r.0 >= area.0 && r.1 >= area.1 && r.2 <= area.2 && r.3 <= area.3;
+    let reach = (area.2 - area.0).max(area.3 - area.1) / 4;
+    anchors
+        .iter()
+        .zip(sizes)
+        .map(|(&(ax, ay), &(w, h))| {
+            let beside = [
+                (ax + 6, ay - h - 2),
+                (ax + 6, ay + 2),
+                (ax - 6 - w, ay - h - 2),
+                (ax - 6 - w, ay + 2),
+            ];
+            let step = h + 6;
+            let rings = (1..)
+                .map(|k| k * step)
+                .take_while(|&r| r <= reach.max(step));
+            let around = rings.flat_map(|r| {
+                (0..16).map(move |j| {
+                    let t = f64::from(j) * std::f64::consts::PI / 8.0;
+                    let (cx, cy) = (
+                        ax + (1.6 * f64::from(r) * t.cos()) as i32,
+                        ay - (f64::from(r) * t.sin()) as i32,
+                    );
+                    (cx - w / 2, cy - h / 2)
+                })
+            });
+            let spot = beside
+                .into_iter()
+                .chain(around)
+                .map(|(x, y)| (x, y, x + w, y + h))
+                .find(|&r| {
+                    let padded = (r.0 - 2, r.1 - 2, r.2 + 2, r.3 + 2);
+                    inside(r)
+                        && !obstacles.iter().any(|&o| overlaps(padded, o))
+                        && !placed.iter().any(|&p| overlaps(padded, p))
+                });
+            if let Some(r) = spot {
+                placed.push(r);
+            }
+            spot
+        })
+        .collect()
+}
+
 macro_rules! draw_chart {
-    ($root:expr, $chart:expr, $xr:expr, $yr:expr, $corner:expr) => {{
+    ($root:expr, $chart:expr, $xr:expr, $yr:expr, $corner:expr, $legend_box:expr, $placed:expr) => {{
         let spec: &Chart = $chart;
         let mut ctx = ChartBuilder::on($root)
             .caption(&spec.title, ("sans-serif", 24))
@@ -176,7 +250,9 @@ macro_rules! draw_chart {
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
         for (i, s) in spec.series.iter().enumerate() {
-            let color = PALETTE[i % PALETTE.len()];
+            let color = s
+                .colour
+                .map_or(PALETTE[i % PALETTE.len()], |c| RGBColor(c[0], c[1], c[2]));
             let pts: Vec<(f64, f64)> = s
                 .points
                 .iter()
@@ -286,26 +362,67 @@ macro_rules! draw_chart {
                 }
             }
         }
+        // Point labels, placed where they overlap no other label, no marker and no legend
+        // (see `place_labels`), with a leader line when away from their point.
+        let (px, py) = ctx.plotting_area().get_pixel_range();
+        let area: Rect = (px.start, py.start, px.end, py.end);
+        let label_font = ("sans-serif", 12).into_font();
+        let ok = |x: f64, y: f64| {
+            x.is_finite() && y.is_finite() && (!spec.log_x || x > 0.0) && (!spec.log_y || y > 0.0)
+        };
+        let mut markers: Vec<Rect> = Vec::new();
         for s in spec.series.iter() {
-            if let Some(labels) = &s.labels {
-                ctx.draw_series(
-                    s.points
-                        .iter()
-                        .zip(labels)
-                        .filter(|((x, y), _)| {
-                            x.is_finite()
-                                && y.is_finite()
-                                && (!spec.log_x || *x > 0.0)
-                                && (!spec.log_y || *y > 0.0)
-                        })
-                        .map(|(&p, l)| {
-                            EmptyElement::at(p)
-                                + Text::new(l.clone(), (6, -14), ("sans-serif", 12).into_font())
-                        }),
-                )
-                .map_err(|e| anyhow!("{e}"))?;
+            // A highlight's hollow circle has radius 9 and a 3-pixel stroke.
+            let m = if s.style == Style::Highlight { 11 } else { 5 };
+            for &(x, y) in s.points.iter().filter(|(x, y)| ok(*x, *y)) {
+                let (cx, cy) = ctx.backend_coord(&(x, y));
+                markers.push((cx - m, cy - m, cx + m + 1, cy + m + 1));
             }
         }
+        markers.push($legend_box(area));
+        let mut anchors = Vec::new();
+        let mut texts = Vec::new();
+        for s in spec.series.iter() {
+            if let Some(labels) = &s.labels {
+                for (&(x, y), l) in s.points.iter().zip(labels) {
+                    if ok(x, y) && !l.is_empty() {
+                        anchors.push(ctx.backend_coord(&(x, y)));
+                        texts.push(l.clone());
+                    }
+                }
+            }
+        }
+        let sizes: Vec<(i32, i32)> = texts
+            .iter()
+            .map(|t| {
+                let (w, h) = label_font.box_size(t).unwrap_or((7 * t.len() as u32, 12));
+                (w as i32 + 2, h as i32 + 2)
+            })
+            .collect();
+        let placed = place_labels(&anchors, &sizes, &markers, area);
+        for ((&(ax, ay), text), spot) in anchors.iter().zip(&texts).zip(&placed) {
+            let Some((x0, y0, x1, y1)) = *spot else {
+                continue;
+            };
+            // A leader line from the point to the nearest point of a label set apart.
+            let (nx, ny) = (ax.clamp(x0, x1), ay.clamp(y0, y1));
+            if (nx - ax).abs().max((ny - ay).abs()) > 8 {
+                $root
+                    .draw(&PathElement::new(
+                        vec![(ax, ay), (nx, ny)],
+                        RGBColor(120, 120, 120).stroke_width(1),
+                    ))
+                    .map_err(|e| anyhow!("{e}"))?;
+            }
+            $root
+                .draw(&Text::new(
+                    text.clone(),
+                    (x0 + 1, y0 + 1),
+                    label_font.clone(),
+                ))
+                .map_err(|e| anyhow!("{e}"))?;
+        }
+        $placed.extend(placed);
         ctx.configure_series_labels()
             .label_font(("sans-serif", 15))
             .background_style(WHITE.mix(0.85))
@@ -400,9 +517,10 @@ fn headroom((y0, y1): (f64, f64), h: f64, log: bool) -> (f64, f64) {
     }
 }
 
-/// Draw `chart` to a PNG at `path` (written atomically).
-pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
-    register_font();
+/// The legend's corner and the axes' ranges of `chart` (named `path` in errors).
+type Ranges = (SeriesLabelPosition, (f64, f64), (f64, f64));
+
+fn ranges(chart: &Chart, path: &Path) -> Result<Ranges> {
     let all = || chart.series.iter().flat_map(|s| s.points.iter());
     let bands = || chart.series.iter().flat_map(|s| s.band.iter().flatten());
     let (x0, x1) = range(all().map(|p| p.0), chart.log_x)
@@ -429,28 +547,96 @@ pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
     } else {
         (corner, (y0, y1))
     };
+    Ok((corner, (x0, x1), (y0, y1)))
+}
+
+/// Draw `chart` to a PNG at `path` (written atomically).
+pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
+    let (corner, (x0, x1), (y0, y1)) = ranges(chart, path)?;
+    let (buf, _) = render(chart, corner, (x0, x1), (y0, y1))?;
+    crate::io::write_png_rgb(path, WIDTH, HEIGHT, &buf)
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Where [`write_png`] puts the point labels of `chart`, in pixels (`None`: left out for want
+/// of room); for checking that they never overlap.
+pub fn label_boxes(chart: &Chart) -> Result<Vec<Option<Rect>>> {
+    let ranges = ranges(chart, Path::new("chart"))?;
+    let (corner, (x0, x1), (y0, y1)) = ranges;
+    Ok(render(chart, corner, (x0, x1), (y0, y1))?.1)
+}
+
+/// The legend's box for a legend in `corner` of the plotting `area`: the size plotters gives a
+/// legend of these entries, with room to spare.
+fn legend_box(chart: &Chart, corner: &SeriesLabelPosition, area: Rect) -> Rect {
+    let longest = chart
+        .series
+        .iter()
+        .map(|s| s.name.chars().count())
+        .max()
+        .unwrap_or(0) as i32;
+    let (w, h) = (longest * 9 + 60, chart.series.len() as i32 * 22 + 20);
+    match corner {
+        SeriesLabelPosition::UpperLeft => (area.0, area.1, area.0 + w, area.1 + h),
+        SeriesLabelPosition::UpperRight => (area.2 - w, area.1, area.2, area.1 + h),
+        SeriesLabelPosition::LowerLeft => (area.0, area.3 - h, area.0 + w, area.3),
+        _ => (area.2 - w, area.3 - h, area.2, area.3),
+    }
+}
+
+/// Draws `chart` into an RGB buffer; returns it and where the point labels went.
+fn render(
+    chart: &Chart,
+    corner: SeriesLabelPosition,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<(Vec<u8>, Vec<Option<Rect>>)> {
+    register_font();
     let mut buf = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    let mut placed: Vec<Option<Rect>> = Vec::new();
     {
         let root = BitMapBackend::with_buffer(&mut buf, (WIDTH, HEIGHT)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let lb = |area: Rect| legend_box(chart, &corner, area);
         match (chart.log_x, chart.log_y) {
-            (false, false) => draw_chart!(&root, chart, x0..x1, y0..y1, corner),
-            (true, false) => draw_chart!(&root, chart, (x0..x1).log_scale(), y0..y1, corner),
-            (false, true) => draw_chart!(&root, chart, x0..x1, (y0..y1).log_scale(), corner),
+            (false, false) => draw_chart!(&root, chart, x0..x1, y0..y1, corner, lb, placed),
+            (true, false) => {
+                draw_chart!(
+                    &root,
+                    chart,
+                    (x0..x1).log_scale(),
+                    y0..y1,
+                    corner,
+                    lb,
+                    placed
+                )
+            }
+            (false, true) => {
+                draw_chart!(
+                    &root,
+                    chart,
+                    x0..x1,
+                    (y0..y1).log_scale(),
+                    corner,
+                    lb,
+                    placed
+                )
+            }
             (true, true) => {
                 draw_chart!(
                     &root,
                     chart,
                     (x0..x1).log_scale(),
                     (y0..y1).log_scale(),
-                    corner
+                    corner,
+                    lb,
+                    placed
                 )
             }
         }
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
-    crate::io::write_png_rgb(path, WIDTH, HEIGHT, &buf)
-        .with_context(|| format!("writing {}", path.display()))
+    Ok((buf, placed))
 }
 
 #[cfg(test)]
@@ -496,6 +682,69 @@ mod tests {
         let roomy = headroom((0.0, 1.0), h, false);
         let (_, covered, _) = legend_corner(&zigzag, (0.0, 1.0), roomy);
         assert_eq!(covered, 0, "{roomy:?}");
+    }
+
+    fn assert_disjoint(boxes: &[Option<Rect>], obstacles: &[Rect], area: Rect) {
+        let placed: Vec<Rect> = boxes.iter().flatten().copied().collect();
+        for (i, &a) in placed.iter().enumerate() {
+            assert!(a.0 >= area.0 && a.1 >= area.1 && a.2 <= area.2 && a.3 <= area.3);
+            for &b in &placed[i + 1..] {
+                assert!(!overlaps(a, b), "{a:?} {b:?}");
+            }
+            for &o in obstacles {
+                assert!(!overlaps(a, o), "{a:?} over {o:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn labels_never_overlap_each_other_markers_or_the_legend() {
+        let area = (100, 50, 900, 550);
+        // Adversarial: 40 labels on one point, 30 on a tight row, a legend in the corner.
+        let mut anchors = vec![(500, 300); 40];
+        anchors.extend((0..30).map(|i| (200 + i * 3, 500)));
+        let sizes: Vec<(i32, i32)> = (0..anchors.len())
+            .map(|i| (40 + (i as i32 % 7) * 9, 14))
+            .collect();
+        let mut obstacles: Vec<Rect> = anchors
+            .iter()
+            .map(|&(x, y)| (x - 5, y - 5, x + 6, y + 6))
+            .collect();
+        obstacles.push((700, 50, 900, 150));
+        let boxes = place_labels(&anchors, &sizes, &obstacles, area);
+        assert_disjoint(&boxes, &obstacles, area);
+        // There is room for all of them here.
+        assert!(boxes.iter().all(Option::is_some));
+        // No room at all: every label is left out, none drawn over another.
+        let tiny = (0, 0, 30, 30);
+        let boxes = place_labels(&[(15, 15); 3], &[(40, 14); 3], &[], tiny);
+        assert!(boxes.iter().all(Option::is_none));
+    }
+
+    #[test]
+    fn chart_labels_are_placed_apart() {
+        // Points bunched together as in the accuracy charts, labels of similar length.
+        let pts: Vec<(f64, f64)> = (0..14)
+            .map(|i| (4.6 + 0.01 * f64::from(i % 5), 0.04 + 0.001 * f64::from(i)))
+            .chain([(7.9, 0.04), (8.6, 0.03)])
+            .collect();
+        let labels: Vec<String> = (0..pts.len())
+            .map(|i| format!("k{i} s0.5 jump100"))
+            .collect();
+        let chart = Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: false,
+            log_y: true,
+            series: vec![
+                Series::new("settings", pts, Style::Points).with_labels(labels),
+                Series::new("front", vec![(4.4, 0.04), (4.7, 1e-4)], Style::Line),
+            ],
+        };
+        let boxes = label_boxes(&chart).unwrap();
+        assert!(boxes.iter().all(Option::is_some), "{boxes:?}");
+        assert_disjoint(&boxes, &[], (0, 0, WIDTH as i32, HEIGHT as i32));
     }
 
     #[test]

@@ -458,3 +458,41 @@ impl<const D: usize> Simulation<D> {
         Fit::log_log(&rg, &n)
     }
 }
+
+/// Calls `f(i, p)` with every stored position `p` in arrival order (`i` from 0): from memory
+/// (`keep_positions`) or from `positions.npy` in `dir`, read row by row.
+///
+/// # Errors
+/// Neither source holds the positions, the file does not read, or `f` fails.
+pub fn each_position<const D: usize>(
+    sim: &Simulation<D>,
+    dir: &Path,
+    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), sim_run::io::OutputError>,
+) -> Result<(), sim_run::io::OutputError> {
+    if let Some(pos) = sim.positions() {
+        for (i, p) in pos.iter().enumerate() {
+            f(i as u64, p)?;
+        }
+        return Ok(());
+    }
+    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
+    let path = dir.join(POSITIONS_FILE);
+    let mut r = sim_run::io::NpyReader::open(&path).map_err(npy)?;
+    if r.cols() != D || r.rows() != sim.particles() {
+        return Err(std::io::Error::other(format!(
+            "{}: shape ({}, {}), not ({}, {D})",
+            path.display(),
+            r.rows(),
+            r.cols(),
+            sim.particles()
+        ))
+        .into());
+    }
+    let mut p = [0.0; D];
+    let mut i = 0;
+    while r.next_row(&mut p).map_err(npy)? {
+        f(i, &p)?;
+        i += 1;
+    }
+    Ok(())
+}

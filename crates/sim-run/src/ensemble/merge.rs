@@ -31,6 +31,9 @@ pub struct Curve {
     pub log_x: bool,
     /// Logarithmic y axis.
     pub log_y: bool,
+    /// The colour of each of `ys` in the chart, where a model fixes one (the animats'
+    /// species); empty: the charts' palette in order.
+    pub colours: &'static [[u8; 3]],
 }
 
 /// A result computed from every member's outputs together rather than averaged over the members
@@ -537,7 +540,14 @@ fn average_curve(dir: &Path, members: &[Member], c: &Curve) -> anyhow::Result<Op
                 .ys
                 .iter()
                 .zip(series)
-                .map(|(y, (pts, band))| Series::new(*y, pts, Style::Line).with_band(band))
+                .enumerate()
+                .map(|(i, (y, (pts, band)))| {
+                    let s = Series::new(*y, pts, Style::Line).with_band(band);
+                    match c.colours.get(i) {
+                        Some(&c) => s.with_colour(c),
+                        None => s,
+                    }
+                })
                 .collect(),
         };
         write_png(&chart, &csv_path.with_extension("png"))?;
@@ -614,6 +624,7 @@ mod tests {
         axes: ("size", "clusters"),
         log_x: false,
         log_y: false,
+        colours: &[],
     };
 
     #[test]

@@ -53,4 +53,7 @@ pub enum OutputError {
     /// A stored lattice site that does not decode: the model's state is inconsistent.
     #[error(transparent)]
     Lattice(#[from] core_lattice::LatticeError),
+    /// Drawing a figure or writing an animation (`sim_run::figure`, feature `plot`).
+    #[error("{0}")]
+    Figure(String),
 }

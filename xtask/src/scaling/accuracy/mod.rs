@@ -7,7 +7,7 @@
 mod sweep;
 mod vpdist;
 
-pub use sweep::{Setting, Sweep, pareto};
+pub use sweep::{Setting, Sweep, pareto, replot};
 
 use super::Ctx;
 use anyhow::Result;

@@ -8,8 +8,9 @@ use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use crate::scaling::Ctx;
 use crate::scaling::dla::fit_from;
 use crate::scaling::ensemble::columns;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use dla_pdla::{FarField, Params};
+use std::path::{Path, PathBuf};
 
 /// One point of a sweep: the flags of `dla` that change the walk.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -304,14 +305,13 @@ impl Sweep {
             ),
         ] {
             pareto_chart(
-                ctx,
+                &ctx.path(&file),
                 &format!("{}: cost against error of {what}", self.title),
                 y_label,
                 pts,
                 &errors,
                 &short,
                 default,
-                &file,
             )?;
             doc.image(&format!("Pareto front for {what}"), &file);
         }
@@ -493,14 +493,13 @@ fn converged(p: &Point) -> &'static str {
 /// reference marked (a zero error is drawn at 1e-4 on the log axis).
 #[allow(clippy::too_many_arguments)]
 fn pareto_chart(
-    ctx: &Ctx,
+    path: &Path,
     title: &str,
     y_label: &str,
     pts: &[(f64, f64)],
     errors: &[f64],
     labels: &[String],
     default: Option<usize>,
-    file: &str,
 ) -> Result<()> {
     const FLOOR: f64 = 1e-4;
     let at = |i: usize| (pts[i].0, pts[i].1.max(FLOOR));
@@ -545,8 +544,122 @@ fn pareto_chart(
             log_y: true,
             series,
         },
-        &ctx.path(file),
+        path,
     )
+}
+
+/// The accuracy sweeps' stems and the titles of their charts (`{dim}` and `{n}` filled in from
+/// the CSV), as [`super::run`] names them.
+const REPLOTTED: [(&str, &str); 3] = [
+    ("accuracy", "{dim}D DLA, N = {n}"),
+    ("accuracy_farfield", "{dim}D DLA far field, N = {n}"),
+    ("accuracy_3d", "{dim}D DLA, N = {n}"),
+];
+
+/// Draws the Pareto charts of every accuracy sweep again from its CSV in `dir` (as written by
+/// [`Sweep::run`]), without running anything: for a change of the charts' style. Returns the
+/// charts written.
+pub fn replot(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut written = Vec::new();
+    for (stem, title) in REPLOTTED {
+        let csv_path = dir.join(format!("{stem}.csv"));
+        if !csv_path.exists() {
+            continue;
+        }
+        let mut r = csv::Reader::from_path(&csv_path)
+            .with_context(|| format!("reading {}", csv_path.display()))?;
+        let head = r.headers()?.clone();
+        let col = |name: &str| {
+            head.iter()
+                .position(|h| h == name)
+                .with_context(|| format!("{}: no column {name}", csv_path.display()))
+        };
+        let cols = [
+            "dim",
+            "particles",
+            "precision",
+            "step_min",
+            "far_field",
+            "death_ratio",
+            "distance_map",
+            "us_per_particle",
+            "d_minus_ref",
+            "d_minus_ref_se",
+            "prefactor_rel_err",
+            "prefactor_rel_err_se",
+            "default",
+        ]
+        .into_iter()
+        .map(col)
+        .collect::<Result<Vec<usize>>>()?;
+        let mut rows = Vec::new();
+        for rec in r.records() {
+            let rec = rec?;
+            let mut f = [""; 13];
+            for (k, &c) in cols.iter().enumerate() {
+                f[k] = rec.get(c).unwrap_or("");
+            }
+            let num = |s: &str| -> Result<f64> {
+                s.parse::<f64>()
+                    .with_context(|| format!("{}: {s:?} is not a number", csv_path.display()))
+            };
+            let setting = Setting {
+                precision: num(f[2])?,
+                step_min: num(f[3])?,
+                far_field: if f[4] == "jump" {
+                    FarField::Jump
+                } else {
+                    FarField::Return
+                },
+                death_ratio: num(f[5])?,
+                distance_map: f[6] == "true",
+            };
+            rows.push((
+                f[0].to_string(),
+                f[1].to_string(),
+                setting.short(),
+                num(f[7])?,
+                [num(f[8])?, num(f[9])?, num(f[10])?, num(f[11])?],
+                f[12] == "true",
+            ));
+        }
+        let Some(first) = rows.first() else {
+            continue;
+        };
+        let title = title.replace("{dim}", &first.0).replace("{n}", &first.1);
+        let short: Vec<String> = rows.iter().map(|r| r.2.clone()).collect();
+        let default = rows.iter().position(|r| r.5);
+        for (what, y_label, value, se, file) in [
+            ("D", "|D - D_ref|", 0, 1, format!("{stem}_pareto.png")),
+            (
+                "the R_g prefactor",
+                "|relative error of the R_g prefactor|",
+                2,
+                3,
+                format!("{stem}_pareto_prefactor.png"),
+            ),
+        ] {
+            let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.3, r.4[value].abs())).collect();
+            // The reference's own error is zero by definition.
+            let errors: Vec<f64> = rows
+                .iter()
+                .enumerate()
+                .map(|(i, r)| if i == 0 { 0.0 } else { r.4[se] })
+                .collect();
+            let path = dir.join(&file);
+            pareto_chart(
+                &path,
+                &format!("{title}: cost against error of {what}"),
+                y_label,
+                &pts,
+                &errors,
+                &short,
+                default,
+            )?;
+            written.push(path);
+        }
+    }
+    Ok(written)
 }
 
 /// Indices of the points not dominated in (cost, error): sorted by cost, keep each point whose
