@@ -301,8 +301,15 @@ impl<const D: usize> Orthtree<D> {
         for x in p {
             pmax = pmax.max(x.abs());
         }
-        // Rounding of p +- r and of the divisions below is far below this margin.
-        let r = r + (1.0 + r + pmax) * 1e-9;
+        let mut omax: f64 = 0.0;
+        for o in &self.root_origin {
+            omax = omax.max((*o as f64).abs());
+        }
+        // Rounding of p +- r and of the divisions below is far below this margin. `u` below is
+        // rounded at the magnitude of the root's corner, which may be far larger than p's (a
+        // point a few ulps below a cell boundary near the origin of a wide tree rounds onto the
+        // boundary): the margin covers that too.
+        let r = r + (1.0 + r + pmax) * 1e-9 + (omax * self.leaf_side + pmax) * 1e-12;
         let side_leaves = (r + r) / self.leaf_side;
         // Smallest level whose side (2^level leaf sides) is >= 2 r.
         let level = if side_leaves <= 1.0 {
