@@ -20,12 +20,48 @@ use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
     AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest,
-    write_png_gray, write_points,
+    Coords, write_png_gray, write_points,
 };
 use std::io::Write;
 use std::path::Path;
 
 pub use sim_run::io::OutputError;
+use sim_run::schema::{Axes, Column, Dtype, Form, Output};
+
+/// `growth.csv` in the schema: one row per growth sample.
+pub const GROWTH: Output = Output {
+    file: "growth.csv",
+    form: Form::Csv,
+    python: "growth",
+    when: None,
+    columns: &[
+        Column::new("n", Dtype::Uint64, "particles"),
+        Column::new("radius_of_gyration", Dtype::Float64, "diameters"),
+        Column::new(
+            "r_ext",
+            Dtype::Float64,
+            "diameters (largest centre distance from the seed)",
+        ),
+        Column::new("seconds", Dtype::Float64, "s since growth started").measured(),
+    ],
+};
+
+/// Every output of `dla` with its columns, names, dtypes and units (`docs/outputs.md`; see
+/// [`sim_run::schema`]).
+pub const SCHEMA: &[Output] = &[
+    GROWTH,
+    Output {
+        file: "positions",
+        form: Form::Points {
+            axes: Axes::Letters,
+            dtype: Dtype::Float64,
+            unit: "diameters",
+        },
+        python: "positions",
+        when: Some("--positions"),
+        columns: &[],
+    },
+];
 
 /// Format of the optional positions file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -119,7 +155,7 @@ where
                 title: &title,
             };
             write_points(dir, "positions", format, &set, &mut |f| {
-                each_position(sim, dir, |_, p: &[f64; D]| Ok(f(p, &[])?))
+                each_position(sim, dir, |_, p: &[f64; D]| Ok(f(Coords::Float(p), &[])?))
             })?;
         }
     }
@@ -421,5 +457,16 @@ mod tests {
         assert_eq!(density_shades(&[0, 1]), vec![0, 60]);
         assert_eq!(default_png_side(10.0), PNG_MIN_SIDE);
         assert_eq!(default_png_side(1e6), PNG_MAX_SIDE);
+    }
+}
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+
+    #[test]
+    fn the_outputs_document_lists_the_schema() {
+        let doc = include_str!("../../../docs/outputs.md");
+        sim_run::schema::check_doc(doc, "## `dla`", SCHEMA);
     }
 }

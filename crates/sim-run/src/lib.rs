@@ -47,6 +47,7 @@ pub mod ensemble;
 pub mod fuzz;
 pub mod io;
 pub mod memory;
+pub mod schema;
 #[cfg(feature = "plot")]
 pub mod plot;
 #[cfg(all(feature = "test-support", feature = "cli"))]

@@ -25,8 +25,12 @@ use std::time::Instant;
 /// particle; 1,200 samples to 1e6 and 1,800 to 1e9).
 pub const SAMPLES_PER_DECADE: f64 = 200.0;
 
-/// The column names of `growth.csv`.
-pub const GROWTH_COLUMNS: [&str; 4] = ["n", "radius_of_gyration", "r_ext", "seconds"];
+/// The column names of `growth.csv`, from the schema ([`crate::output::GROWTH`]).
+pub const GROWTH_COLUMNS: [&str; 4] = {
+    let c = crate::output::GROWTH.columns;
+    assert!(c.len() == 4, "growth.csv's columns are these four");
+    [c[0].name, c[1].name, c[2].name, c[3].name]
+};
 
 /// One row of `growth.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
