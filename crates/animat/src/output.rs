@@ -6,7 +6,7 @@
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results (`steps`, `foxes`, `rabbits`, `state_hash`, `distance_evaluations`, `queries`) |
 //! | `populations.csv` | `step,foxes,rabbits` from step 0 (with `--timing` also `search_seconds,distance_evaluations`) |
 //! | `snapshot_NNNNNN.png` | with `--snapshot-every K`: foxes red, rabbits green, on black, framing the population |
-//! | `positions.csv` | with `--positions`: `id,species,x,y,age,hunger` of every live animat at the end |
+//! | `positions.csv` | with `--positions`: `x,y,id,species,age,hunger` of every live animat at the end (the columns of [`SCHEMA`]) |
 
 use crate::params::Species;
 use crate::world::{StepStats, World};
@@ -54,7 +54,11 @@ pub const SCHEMA: &[Output] = &[
             Column::new("id", Dtype::Int64, "animat id"),
             Column::new("species", Dtype::Int64, "species").labels(&SPECIES_NAMES),
             Column::new("age", Dtype::Int64, "steps"),
-            Column::new("hunger", Dtype::Int64, "steps since the last meal (0 for rabbits)"),
+            Column::new(
+                "hunger",
+                Dtype::Int64,
+                "steps since the last meal (0 for rabbits)",
+            ),
         ],
     },
 ];

@@ -338,10 +338,14 @@ fn positions_in_every_format_hold_the_same_animats() {
         "{header}"
     );
     let species = std::fs::read(npy.join("positions_species.npy")).unwrap();
-    let int = |b: &[u8], i: usize| i64::from_le_bytes(b[128 + 8 * i..136 + 8 * i].try_into().unwrap());
+    let int =
+        |b: &[u8], i: usize| i64::from_le_bytes(b[128 + 8 * i..136 + 8 * i].try_into().unwrap());
     for (i, row) in rows.iter().enumerate() {
         assert_eq!(
-            [int(&cells, 2 * i).to_string(), int(&cells, 2 * i + 1).to_string()],
+            [
+                int(&cells, 2 * i).to_string(),
+                int(&cells, 2 * i + 1).to_string()
+            ],
             [row[0], row[1]]
         );
         assert_eq!(["fox", "rabbit"][int(&species, i) as usize], row[3]);

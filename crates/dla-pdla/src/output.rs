@@ -19,8 +19,8 @@ use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
-    AtomicFile, CsvWriter, NpyReader, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest,
-    Coords, write_png_gray, write_points,
+    AtomicFile, Coords, CsvWriter, NpyReader, PointFormat, PointSet, ProcessUsage, RunClock,
+    RunManifest, write_png_gray, write_points,
 };
 use std::io::Write;
 use std::path::Path;

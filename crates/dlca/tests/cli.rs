@@ -291,9 +291,13 @@ fn positions_in_every_format_hold_the_same_particles() {
         "{header}"
     );
     let ids = std::fs::read(npy.join("particles_cluster.npy")).unwrap();
-    let int = |b: &[u8], i: usize| i64::from_le_bytes(b[128 + 8 * i..136 + 8 * i].try_into().unwrap());
+    let int =
+        |b: &[u8], i: usize| i64::from_le_bytes(b[128 + 8 * i..136 + 8 * i].try_into().unwrap());
     for (i, row) in rows.iter().enumerate() {
-        assert_eq!([int(&sites, 2 * i), int(&sites, 2 * i + 1)], [row[0], row[1]]);
+        assert_eq!(
+            [int(&sites, 2 * i), int(&sites, 2 * i + 1)],
+            [row[0], row[1]]
+        );
         assert_eq!(int(&ids, i), row[2]);
     }
     assert!(!npy.join("particles.csv").exists());

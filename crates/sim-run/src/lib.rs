@@ -47,9 +47,9 @@ pub mod ensemble;
 pub mod fuzz;
 pub mod io;
 pub mod memory;
-pub mod schema;
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod schema;
 #[cfg(all(feature = "test-support", feature = "cli"))]
 pub mod spec_check;
 #[cfg(feature = "test-support")]

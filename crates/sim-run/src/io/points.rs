@@ -139,8 +139,8 @@ impl Coords<'_> {
 }
 
 /// A function that calls its argument with each point in order: coordinates, then attributes.
-pub type Visitor<'v> = dyn FnMut(&mut dyn FnMut(Coords<'_>, &[i64]) -> io::Result<()>) -> Result<(), OutputError>
-    + 'v;
+pub type Visitor<'v> =
+    dyn FnMut(&mut dyn FnMut(Coords<'_>, &[i64]) -> io::Result<()>) -> Result<(), OutputError> + 'v;
 
 /// The error of a point whose coordinates are not of the kind `set` declares.
 fn kind_error(set: &PointSet<'_>) -> io::Error {
@@ -223,7 +223,11 @@ pub fn write_points(
         }
         PointFormat::Npy => {
             let dim = set.axes.len();
-            let descr = if set.integer_coordinates { "<i8" } else { "<f8" };
+            let descr = if set.integer_coordinates {
+                "<i8"
+            } else {
+                "<f8"
+            };
             let mut coords = NpyFile::create(&path, descr, set.n, Some(dim))?;
             let mut attrs: Vec<NpyFile> = Vec::new();
             for a in set.attributes {
