@@ -15,7 +15,7 @@
 //! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView); 2D and 3D only |
 //! | `dla.png` | `--png`: the cluster shaded by arrival order, or a log-scaled density image when a pixel spans more than a diameter (3D: shaded spheres seen from +z with a depth buffer; 4D and 5D: the same for the projection on x, y, z; the density image projects on x, y) |
 
-use crate::sim::{GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
+use crate::sim::{GROWTH, GROWTH_COLUMNS, POSITIONS_FILE, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
@@ -26,25 +26,7 @@ use std::io::Write;
 use std::path::Path;
 
 pub use sim_run::io::OutputError;
-use sim_run::schema::{Axes, Column, Dtype, Form, Output};
-
-/// `growth.csv` in the schema: one row per growth sample.
-pub const GROWTH: Output = Output {
-    file: "growth.csv",
-    form: Form::Csv,
-    python: "growth",
-    when: None,
-    columns: &[
-        Column::new("n", Dtype::Uint64, "particles"),
-        Column::new("radius_of_gyration", Dtype::Float64, "diameters"),
-        Column::new(
-            "r_ext",
-            Dtype::Float64,
-            "diameters (largest centre distance from the seed)",
-        ),
-        Column::new("seconds", Dtype::Float64, "s since growth started").measured(),
-    ],
-};
+use sim_run::schema::{Axes, Dtype, Form, Output};
 
 /// Every output of `dla` with its columns, names, dtypes and units (`docs/outputs.md`; see
 /// [`sim_run::schema`]).
