@@ -59,6 +59,9 @@ class DlaResult:
     tree_memory_bytes: int
     tree_point_slots: int
     distance_map_bytes: int
+    walk_counts: Dict[str, int]
+    """Software counts of the walk (walkers, moves, map reads, tree queries, ...), summed over
+    PDLA threads."""
     bytes_per_particle: Optional[float]
     """Peak resident memory of the process during the simulation, per particle."""
     simulation_peak_rss_bytes: Optional[int]
