@@ -26,6 +26,7 @@ from . import _aggsim
 from ._aggsim import (
     FOX,
     RABBIT,
+    SPECIES,
     AnimatResult,
     AnimatWorld,
     DlaResult,
@@ -33,6 +34,7 @@ from ._aggsim import (
     DlcaResult,
     __version__,
     _params,
+    _schema,
     defaults,
     dlca_pooled_fit,
 )
@@ -74,6 +76,7 @@ del _cls, _model
 __all__ = [
     "FOX",
     "RABBIT",
+    "SPECIES",
     "AnimatResult",
     "AnimatWorld",
     "DlaResult",

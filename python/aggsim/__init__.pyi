@@ -13,6 +13,8 @@ FOX: int
 """Species code of foxes in ``species`` arrays (0)."""
 RABBIT: int
 """Species code of rabbits in ``species`` arrays (1)."""
+SPECIES: List[str]
+"""Species names by code (``["fox", "rabbit"]``): the names ``positions.csv`` writes."""
 
 Count = Union[int, float]
 """A count: an int, or a float holding a whole number (``1e4``, ``2.5e5``); ``1.5``, ``nan``
@@ -23,6 +25,10 @@ Progress = Union[None, bool, Callable[[int, int], Any]]
 
 def defaults(model: Literal["dla", "dlca", "animat"]) -> Dict[str, Any]:
     """The defaults of ``model``'s keyword arguments: the binary's, from the library."""
+
+def _schema(model: Literal["dla", "dlca", "animat"]) -> List[Dict[str, Any]]:
+    """The library's output schema of ``model``: each file with its columns' names, dtypes
+    and units, and the result attribute holding them (docs/outputs.md)."""
 
 def _params(model: Literal["dla", "dlca", "animat"]) -> List[Dict[str, Any]]:
     """The library's parameter table of ``model``: name, flag, unit, doc, range, choices and
@@ -53,6 +59,9 @@ class DlaResult:
     tree_memory_bytes: int
     tree_point_slots: int
     distance_map_bytes: int
+    walk_counts: Dict[str, int]
+    """Software counts of the walk (walkers, moves, map reads, tree queries, ...), summed over
+    PDLA threads."""
     bytes_per_particle: Optional[float]
     """Peak resident memory of the process during the simulation, per particle."""
     simulation_peak_rss_bytes: Optional[int]
@@ -98,8 +107,8 @@ class DlcaResult:
 
     positions: npt.NDArray[np.int64]
     """int64 (N, D): lattice sites, clusters by increasing id."""
-    labels: npt.NDArray[np.int64]
-    """int64 (N,): cluster id of each particle."""
+    cluster: npt.NDArray[np.int64]
+    """int64 (N,): cluster id of each particle (``particles.csv``'s ``cluster``)."""
     per_sweep: Dict[str, npt.NDArray[Any]]
     """``sweep``, ``clusters``, ``largest`` (uint64), ``seconds`` with ``timing``."""
     sizes: Dict[str, npt.NDArray[np.uint64]]
@@ -192,7 +201,7 @@ class DlcaLattice:
     @property
     def positions(self) -> npt.NDArray[np.int64]: ...
     @property
-    def labels(self) -> npt.NDArray[np.int64]: ...
+    def cluster(self) -> npt.NDArray[np.int64]: ...
     @property
     def per_sweep(self) -> Dict[str, npt.NDArray[Any]]: ...
     @property
@@ -231,11 +240,14 @@ class AnimatResult:
     ``distance_evaluations``."""
     positions: npt.NDArray[np.int64]
     """int64 (M, 2): cells of the live animats, by increasing id."""
-    species: npt.NDArray[np.uint8]
-    """uint8 (M,): :data:`FOX` or :data:`RABBIT`."""
-    ids: npt.NDArray[np.uint64]
-    ages: npt.NDArray[np.uint32]
-    hunger: npt.NDArray[np.uint32]
+    id: npt.NDArray[np.int64]
+    """int64 (M,): each live animat's id."""
+    species: npt.NDArray[np.int64]
+    """int64 (M,): :data:`FOX` or :data:`RABBIT` (names by code: :data:`SPECIES`)."""
+    age: npt.NDArray[np.int64]
+    """int64 (M,): steps lived."""
+    hunger: npt.NDArray[np.int64]
+    """int64 (M,): steps since the last meal (0 for rabbits)."""
     state_hash: str
     steps: int
     foxes: int
@@ -301,13 +313,13 @@ class AnimatWorld:
     @property
     def positions(self) -> npt.NDArray[np.int64]: ...
     @property
-    def species(self) -> npt.NDArray[np.uint8]: ...
+    def id(self) -> npt.NDArray[np.int64]: ...
     @property
-    def ids(self) -> npt.NDArray[np.uint64]: ...
+    def species(self) -> npt.NDArray[np.int64]: ...
     @property
-    def ages(self) -> npt.NDArray[np.uint32]: ...
+    def age(self) -> npt.NDArray[np.int64]: ...
     @property
-    def hunger(self) -> npt.NDArray[np.uint32]: ...
+    def hunger(self) -> npt.NDArray[np.int64]: ...
     @property
     def populations(self) -> Dict[str, npt.NDArray[Any]]: ...
 

@@ -184,13 +184,14 @@ impl Run {
         })
     }
 
-    /// The live animats' columns: positions (int64, (M, 2)), species codes, ids, ages,
-    /// hunger.
+    /// The live animats' columns, named and typed as the binary's positions files
+    /// (`animat::output::SCHEMA`): positions (int64, (M, 2)), species codes, id, age, hunger
+    /// (int64 each).
     fn animats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let w = &self.world;
         let n = (w.foxes() + w.rabbits()) as usize;
         let mut pos = Vec::with_capacity(2 * n);
-        let (mut species, mut ids, mut ages, mut hunger) = (
+        let (mut species, mut id, mut age, mut hunger) = (
             Vec::with_capacity(n),
             Vec::with_capacity(n),
             Vec::with_capacity(n),
@@ -198,16 +199,16 @@ impl Run {
         );
         for a in w.animats() {
             pos.extend_from_slice(&a.pos);
-            species.push(a.species.code() as u8);
-            ids.push(a.id);
-            ages.push(a.age);
-            hunger.push(a.hunger);
+            species.push(a.species.code() as i64);
+            id.push(a.id as i64);
+            age.push(i64::from(a.age));
+            hunger.push(i64::from(a.hunger));
         }
-        let pos = Array2::from_shape_vec((ids.len(), 2), pos).map_err(run_error)?;
+        let pos = Array2::from_shape_vec((id.len(), 2), pos).map_err(run_error)?;
         let d = Columns::default()
+            .add(py, "id", id)
             .add(py, "species", species)
-            .add(py, "ids", ids)
-            .add(py, "ages", ages)
+            .add(py, "age", age)
             .add(py, "hunger", hunger)
             .into_dict(py)?;
         d.set_item("positions", pos.into_pyarray(py))?;
@@ -259,11 +260,14 @@ impl Run {
 ///     (uint64), and with ``timing=True`` ``search_seconds`` and ``distance_evaluations``.
 /// positions : numpy.ndarray
 ///     int64, shape (M, 2): the cell of every live animat at the end, by increasing id.
+/// id : numpy.ndarray
+///     int64, shape (M,): every live animat's id.
 /// species : numpy.ndarray
-///     uint8, shape (M,): :data:`aggsim.FOX` (0) or :data:`aggsim.RABBIT` (1).
-/// ids, ages, hunger : numpy.ndarray
-///     uint64, uint32, uint32, shape (M,): id, steps lived, and (foxes) steps since the last
-///     meal, as the binary's ``positions.csv``.
+///     int64, shape (M,): :data:`aggsim.FOX` (0) or :data:`aggsim.RABBIT` (1); the names by
+///     code are :data:`aggsim.SPECIES`.
+/// age, hunger : numpy.ndarray
+///     int64, shape (M,): steps lived, and (foxes) steps since the last meal; names and dtypes
+///     as the binary's ``positions.csv`` and ``positions_<name>.npy``.
 /// state_hash : str
 ///     16 hex digits over every live animat: the binary's for the same seed and parameters.
 /// steps, foxes, rabbits, distance_evaluations, grid_box, queries
@@ -441,25 +445,25 @@ impl AnimatWorld {
         self.column(py, "positions")
     }
 
-    /// uint8 array (M,): ``FOX`` (0) or ``RABBIT`` (1) for every live animat.
+    /// int64 array (M,): ``FOX`` (0) or ``RABBIT`` (1) for every live animat.
     #[getter]
     fn species<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.column(py, "species")
     }
 
-    /// uint64 array (M,): every live animat's id.
+    /// int64 array (M,): every live animat's id.
     #[getter]
-    fn ids<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "ids")
+    fn id<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "id")
     }
 
-    /// uint32 array (M,): steps lived.
+    /// int64 array (M,): steps lived.
     #[getter]
-    fn ages<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "ages")
+    fn age<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.column(py, "age")
     }
 
-    /// uint32 array (M,): steps since the last meal (0 for rabbits).
+    /// int64 array (M,): steps since the last meal (0 for rabbits).
     #[getter]
     fn hunger<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.column(py, "hunger")

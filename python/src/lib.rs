@@ -66,6 +66,29 @@ fn params_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>
     convert::json(py, &serde_json::Value::Array(rows))
 }
 
+/// The output schema of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``), from the library
+/// (``sim_run::schema``): a list of dicts, one per file, with ``file`` (a positions set: its
+/// stem), ``form`` (``kind`` ``"csv"`` or ``"points"``, with the coordinates' ``axes``, ``dtype``
+/// and ``unit``), ``python`` (the result's attribute), ``when`` and ``columns`` (``name``,
+/// ``dtype`` as NumPy names it, ``unit``, ``when``, ``labels``, ``measured``). The tests check
+/// the binaries' files and the results against it.
+#[pyfunction]
+#[pyo3(name = "_schema")]
+fn schema_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
+    let schema = match model {
+        "dla" => dla_pdla::output::SCHEMA,
+        "dlca" => ::dlca::output::SCHEMA,
+        "animat" => ::animat::output::SCHEMA,
+        other => {
+            return Err(convert::value_error(format!(
+                "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
+            )));
+        }
+    };
+    let v = serde_json::to_value(schema).map_err(convert::value_error)?;
+    convert::json(py, &v)
+}
+
 /// The aggsim models (DLA/PDLA, DLCA, animats) at native speed, results as NumPy arrays.
 #[pymodule]
 fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -82,13 +105,15 @@ fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(animat::animat, m)?)?;
     m.add_function(wrap_pyfunction!(defaults, m)?)?;
     m.add_function(wrap_pyfunction!(params_table, m)?)?;
+    m.add_function(wrap_pyfunction!(schema_table, m)?)?;
     m.add_class::<dla::DlaResult>()?;
     m.add_class::<dlca::DlcaResult>()?;
     m.add_class::<dlca::DlcaLattice>()?;
     m.add_class::<animat::AnimatResult>()?;
     m.add_class::<animat::AnimatWorld>()?;
-    m.add("FOX", ::animat::Species::Fox.code() as u8)?;
-    m.add("RABBIT", ::animat::Species::Rabbit.code() as u8)?;
+    m.add("FOX", ::animat::Species::Fox.code())?;
+    m.add("RABBIT", ::animat::Species::Rabbit.code())?;
+    m.add("SPECIES", ::animat::output::SPECIES_NAMES.to_vec())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -32,9 +32,9 @@ def test_dla_arrays(dim):
 def test_dlca_arrays():
     r = aggsim.dlca(size=[40, 30], particles=100, seed=2, target_clusters=10, gyration=True)
     assert r.positions.shape == (100, 2) and r.positions.dtype == np.int64
-    assert r.labels.shape == (100,) and r.labels.dtype == np.int64
+    assert r.cluster.shape == (100,) and r.cluster.dtype == np.int64
     assert (r.positions >= 0).all() and (r.positions < [40, 30]).all()
-    assert len(np.unique(r.labels)) == r.clusters
+    assert len(np.unique(r.cluster)) == r.clusters
     assert len({tuple(p) for p in r.positions}) == 100
     s = r.per_sweep
     assert set(s) == {"sweep", "clusters", "largest"}
@@ -51,8 +51,8 @@ def test_dlca_lattice_accessors():
     lat = aggsim.DlcaLattice("32x32", fill=0.1, seed=1, target_clusters=20)
     assert lat.size == (32, 32) and lat.sweeps == 0 and not lat.done
     assert lat.step(2) == 2 and lat.sweeps == 2
-    assert lat.positions.shape == (lat.particles, 2) and lat.labels.shape == (lat.particles,)
-    assert len(np.unique(lat.labels)) == lat.clusters
+    assert lat.positions.shape == (lat.particles, 2) and lat.cluster.shape == (lat.particles,)
+    assert len(np.unique(lat.cluster)) == lat.clusters
     assert lat.per_sweep["clusters"].shape == (3,)
     lat.run()
     assert lat.done and lat.clusters <= 20
@@ -63,11 +63,11 @@ def test_animat_arrays():
     r = aggsim.animat(steps=15, seed=3, foxes=30, rabbits=200, start_radius=30, timing=True)
     m = r.foxes + r.rabbits
     assert r.positions.shape == (m, 2) and r.positions.dtype == np.int64
-    assert r.species.dtype == np.uint8 and r.species.shape == (m,)
+    assert r.species.dtype == np.int64 and r.species.shape == (m,)
     assert (r.species == aggsim.FOX).sum() == r.foxes
     assert (r.species == aggsim.RABBIT).sum() == r.rabbits
-    assert r.ids.dtype == np.uint64 and np.all(np.diff(r.ids.astype(np.int64)) > 0)
-    assert r.ages.dtype == np.uint32 and r.hunger.dtype == np.uint32
+    assert r.id.dtype == np.int64 and np.all(np.diff(r.id) > 0)
+    assert r.age.dtype == np.int64 and r.hunger.dtype == np.int64
     assert (r.hunger[r.species == aggsim.RABBIT] == 0).all()
     p = r.populations
     assert list(p) == ["step", "foxes", "rabbits", "search_seconds", "distance_evaluations"]

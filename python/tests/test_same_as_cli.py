@@ -119,7 +119,7 @@ def test_dlca_equals_the_binary(cli, flags, kwargs):
     p = read_csv(out / "particles.csv")
     axes = [f"x{a + 1}" for a in range(r.positions.shape[1])]
     np.testing.assert_array_equal(r.positions, np.stack([p[a].astype(np.int64) for a in axes], 1))
-    np.testing.assert_array_equal(r.labels, p["cluster"].astype(np.int64))
+    np.testing.assert_array_equal(r.cluster, p["cluster"].astype(np.int64))
     if r.gyration is not None:
         c = read_csv(out / "clusters.csv")
         np.testing.assert_array_equal(r.gyration["cluster"], c["cluster"].astype(np.int64))
@@ -154,13 +154,13 @@ def test_animat_equals_the_binary(cli, flags, kwargs):
     for k in ("step", "foxes", "rabbits"):
         np.testing.assert_array_equal(r.populations[k], pops[k].astype(np.uint64))
     p = read_csv(out / "positions.csv")
-    np.testing.assert_array_equal(r.ids, p["id"].astype(np.uint64))
+    np.testing.assert_array_equal(r.id, p["id"].astype(np.int64))
     np.testing.assert_array_equal(r.positions[:, 0], p["x"].astype(np.int64))
     np.testing.assert_array_equal(r.positions[:, 1], p["y"].astype(np.int64))
     codes = np.where(p["species"] == "fox", aggsim.FOX, aggsim.RABBIT)
     np.testing.assert_array_equal(r.species, codes)
-    np.testing.assert_array_equal(r.ages, p["age"].astype(np.uint32))
-    np.testing.assert_array_equal(r.hunger, p["hunger"].astype(np.uint32))
+    np.testing.assert_array_equal(r.age, p["age"].astype(np.int64))
+    np.testing.assert_array_equal(r.hunger, p["hunger"].astype(np.int64))
 
 
 def test_animat_config_file_as_the_binary(cli, tmp_path):

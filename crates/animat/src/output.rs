@@ -7,18 +7,63 @@
 //! | `populations.csv` | `step,foxes,rabbits` from step 0 (with `--timing` also `search_seconds,distance_evaluations`) |
 //! | `snapshot_NNNNNN.png` | with `--snapshot-every K`: a figure of the world on the run's fixed frame ([`SnapshotFrame`]), foxes vermillion, rabbits blue (Okabe-Ito), on white |
 //! | `animat.gif` | with `--animate`: the world every `--animate-every` steps, on the same frame |
-//! | `positions.csv` | with `--positions`: `id,species,x,y,age,hunger` of every live animat at the end |
+//! | `positions.csv` | with `--positions`: `x,y,id,species,age,hunger` of every live animat at the end (the columns of [`SCHEMA`]) |
 
 use crate::params::Species;
 use crate::world::{StepStats, World};
 use sim_run::figure::palette;
 use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
 use sim_run::io::{
-    Attribute, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points,
+    Attribute, Coords, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points,
 };
 use std::path::Path;
 
 pub use sim_run::io::OutputError;
+use sim_run::schema::{Axes, Column, Dtype, Form, Output, output};
+
+/// Species names by code: `species` is 0 for foxes, 1 for rabbits in `.npy`, VTK and Python,
+/// and these names in CSV and XYZ.
+pub const SPECIES_NAMES: [&str; 2] = [Species::Fox.name(), Species::Rabbit.name()];
+
+/// Every output of `animat` with its columns, names, dtypes and units (`docs/outputs.md`; see
+/// [`sim_run::schema`]). The writers below take their headers and attribute names from it.
+pub const SCHEMA: &[Output] = &[
+    Output {
+        file: "populations.csv",
+        form: Form::Csv,
+        python: "populations",
+        when: None,
+        columns: &[
+            Column::new("step", Dtype::Uint64, "steps"),
+            Column::new("foxes", Dtype::Uint64, "animats"),
+            Column::new("rabbits", Dtype::Uint64, "animats"),
+            Column::new("search_seconds", Dtype::Float64, "s in perception queries")
+                .when("--timing")
+                .measured(),
+            Column::new("distance_evaluations", Dtype::Uint64, "evaluations").when("--timing"),
+        ],
+    },
+    Output {
+        file: "positions",
+        form: Form::Points {
+            axes: Axes::Plane,
+            dtype: Dtype::Int64,
+            unit: "cells",
+        },
+        python: "positions",
+        when: Some("--positions"),
+        columns: &[
+            Column::new("id", Dtype::Int64, "animat id"),
+            Column::new("species", Dtype::Int64, "species").labels(&SPECIES_NAMES),
+            Column::new("age", Dtype::Int64, "steps"),
+            Column::new(
+                "hunger",
+                Dtype::Int64,
+                "steps since the last meal (0 for rabbits)",
+            ),
+        ],
+    },
+];
 
 /// One row of `populations.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -58,10 +103,7 @@ pub fn write_populations(
     rows: &[PopulationRow],
     timing: bool,
 ) -> Result<(), OutputError> {
-    let mut header = vec!["step", "foxes", "rabbits"];
-    if timing {
-        header.extend(["search_seconds", "distance_evaluations"]);
-    }
+    let header = output(SCHEMA, "populations.csv").header(timing);
     let mut w = CsvWriter::create(dir.join("populations.csv"), &header)?;
     for r in rows {
         if timing {
@@ -87,25 +129,15 @@ pub fn write_populations(
 /// # Errors
 /// [`OutputError`] if a file cannot be written.
 pub fn write_positions(dir: &Path, world: &World, format: PointFormat) -> Result<(), OutputError> {
-    const SPECIES: [&str; 2] = [Species::Fox.name(), Species::Rabbit.name()];
-    let attributes = [
-        Attribute {
-            name: "id",
-            labels: None,
-        },
-        Attribute {
-            name: "species",
-            labels: Some(&SPECIES),
-        },
-        Attribute {
-            name: "age",
-            labels: None,
-        },
-        Attribute {
-            name: "hunger",
-            labels: None,
-        },
-    ];
+    let schema = output(SCHEMA, "positions");
+    let attributes: Vec<Attribute<'_>> = schema
+        .columns
+        .iter()
+        .map(|c| Attribute {
+            name: c.name,
+            labels: c.labels,
+        })
+        .collect();
     let title = format!(
         "animats after {} steps: {} foxes, {} rabbits",
         world.steps(),
@@ -122,12 +154,9 @@ pub fn write_positions(dir: &Path, world: &World, format: PointFormat) -> Result
     };
     write_points(dir, "positions", format, &set, &mut |f| {
         for a in world.animats() {
-            let species = match a.species {
-                Species::Fox => 0,
-                Species::Rabbit => 1,
-            };
+            let species = a.species.code() as i64;
             f(
-                &[a.pos[0] as f64, a.pos[1] as f64],
+                Coords::Int(&a.pos),
                 &[a.id as i64, species, i64::from(a.age), i64::from(a.hunger)],
             )?;
         }
@@ -301,4 +330,22 @@ pub fn manifest(world: &World, seed: u64, clock: &RunClock) -> Result<RunManifes
             serde_json::json!({"adjacent": q.adjacent, "nearest": q.nearest, "count": q.count}),
         );
     Ok(m)
+}
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+
+    #[test]
+    fn the_outputs_document_lists_the_schema() {
+        let doc = include_str!("../../../docs/outputs.md");
+        sim_run::schema::check_doc(doc, "## `animat`", SCHEMA);
+    }
+
+    #[test]
+    fn species_names_are_indexed_by_code() {
+        for s in [Species::Fox, Species::Rabbit] {
+            assert_eq!(SPECIES_NAMES[s.code() as usize], s.name());
+        }
+    }
 }

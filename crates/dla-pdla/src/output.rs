@@ -16,17 +16,36 @@
 //! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (see [`crate::picture`]) |
 //! | `dla.gif` | `--animate`: the growth of the cluster, one frame every `--animate-every` particles |
 
-use crate::sim::{GROWTH_COLUMNS, Simulation};
+use crate::sim::{GROWTH, GROWTH_COLUMNS, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
-    AtomicFile, CsvWriter, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest, write_points,
+    AtomicFile, Coords, CsvWriter, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest,
+    write_points,
 };
 use std::io::Write;
 use std::path::Path;
 
 pub use crate::sim::each_position;
 pub use sim_run::io::OutputError;
+use sim_run::schema::{Axes, Dtype, Form, Output};
+
+/// Every output of `dla` with its columns, names, dtypes and units (`docs/outputs.md`; see
+/// [`sim_run::schema`]).
+pub const SCHEMA: &[Output] = &[
+    GROWTH,
+    Output {
+        file: "positions",
+        form: Form::Points {
+            axes: Axes::Letters,
+            dtype: Dtype::Float64,
+            unit: "diameters",
+        },
+        python: "positions",
+        when: Some("--positions"),
+        columns: &[],
+    },
+];
 
 /// Format of the optional positions file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -120,7 +139,7 @@ where
                 title: &title,
             };
             write_points(dir, "positions", format, &set, &mut |f| {
-                each_position(sim, dir, |_, p: &[f64; D]| Ok(f(p, &[])?))
+                each_position(sim, dir, |_, p: &[f64; D]| Ok(f(Coords::Float(p), &[])?))
             })?;
         }
     }
@@ -264,5 +283,16 @@ mod tests {
         assert_eq!(default_png_side(10.0), PNG_MIN_SIDE);
         assert_eq!(default_png_side(1000.0), 2002);
         assert_eq!(default_png_side(1e6), PNG_MAX_SIDE);
+    }
+}
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+
+    #[test]
+    fn the_outputs_document_lists_the_schema() {
+        let doc = include_str!("../../../docs/outputs.md");
+        sim_run::schema::check_doc(doc, "## `dla`", SCHEMA);
     }
 }

@@ -18,10 +18,74 @@ use crate::analysis::{
 use crate::sim::Simulation;
 use serde_json::json;
 use sim_run::io::{
-    Attribute, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_points,
+    Attribute, Coords, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_points,
 };
+use sim_run::schema::{Axes, Column, Dtype, Form, Output, output};
 use spatial::lattice::ItemId;
 use std::path::Path;
+
+/// Every output of `dlca` with its columns, names, dtypes and units (`docs/outputs.md`; see
+/// [`sim_run::schema`]). The writers below take their headers and attribute names from it.
+pub const SCHEMA: &[Output] = &[
+    Output {
+        file: "sweeps.csv",
+        form: Form::Csv,
+        python: "per_sweep",
+        when: None,
+        columns: &[
+            Column::new("sweep", Dtype::Uint64, "sweeps"),
+            Column::new("clusters", Dtype::Uint64, "clusters"),
+            Column::new("largest", Dtype::Uint64, "particles"),
+            Column::new("seconds", Dtype::Float64, "s (wall clock of the sweep)")
+                .when("--timing")
+                .measured(),
+        ],
+    },
+    Output {
+        file: "sizes.csv",
+        form: Form::Csv,
+        python: "sizes",
+        when: None,
+        columns: &[
+            Column::new("size", Dtype::Uint64, "particles"),
+            Column::new("count", Dtype::Uint64, "clusters"),
+        ],
+    },
+    Output {
+        file: "particles",
+        form: Form::Points {
+            axes: Axes::Numbered,
+            dtype: Dtype::Int64,
+            unit: "sites",
+        },
+        python: "positions",
+        when: None,
+        columns: &[Column::new("cluster", Dtype::Int64, "cluster id")],
+    },
+    Output {
+        file: "histogram.csv",
+        form: Form::Csv,
+        python: "histogram",
+        when: Some("--histogram"),
+        columns: &[
+            Column::new("sweep", Dtype::Uint64, "sweeps"),
+            Column::new("candidates", Dtype::Uint64, "clusters examined by one move"),
+            Column::new("moves", Dtype::Uint64, "moves"),
+        ],
+    },
+    Output {
+        file: "clusters.csv",
+        form: Form::Csv,
+        python: "gyration",
+        when: Some("--gyration"),
+        columns: &[
+            Column::new("cluster", Dtype::Int64, "cluster id"),
+            Column::new("size", Dtype::Uint64, "particles"),
+            Column::new("radius_of_gyration", Dtype::Float64, "sites"),
+            Column::new("wraps", Dtype::Bool, "spans a periodic axis"),
+        ],
+    },
+];
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest written;
 /// the particles' sites and cluster ids go into `particles.<format>` if `positions` names one,
@@ -39,10 +103,7 @@ pub fn write_outputs(
     let dim = sim.lattice().dim();
 
     // sweeps.csv
-    let mut header = vec!["sweep", "clusters", "largest"];
-    if params.timing {
-        header.push("seconds");
-    }
+    let header = output(SCHEMA, "sweeps.csv").header(params.timing);
     let mut w = CsvWriter::create(dir.join("sweeps.csv"), &header)?;
     for r in sim.records().sweeps() {
         if params.timing {
@@ -55,7 +116,10 @@ pub fn write_outputs(
 
     // sizes.csv
     let sizes = size_distribution(sim);
-    let mut w = CsvWriter::create(dir.join("sizes.csv"), &["size", "count"])?;
+    let mut w = CsvWriter::create(
+        dir.join("sizes.csv"),
+        &output(SCHEMA, "sizes.csv").header(false),
+    )?;
     for (size, count) in sizes.iter() {
         w.row(&[&size, &count])?;
     }
@@ -63,7 +127,7 @@ pub fn write_outputs(
 
     // particles: every site of every cluster, clusters in id order, sites in index order.
     if let Some(format) = positions {
-        let axes: Vec<String> = (1..=dim).map(|a| format!("x{a}")).collect();
+        let axes = Axes::Numbered.names(dim);
         let axes: Vec<&str> = axes.iter().map(String::as_str).collect();
         let title = format!(
             "DLCA lattice {}, seed {seed}, {} particles in {} clusters",
@@ -81,20 +145,22 @@ pub fn write_outputs(
             axes: &axes,
             integer_coordinates: true,
             attributes: &[Attribute {
-                name: "cluster",
+                name: output(SCHEMA, "particles").column("cluster").name,
                 labels: None,
             }],
             index: None,
             title: &title,
         };
         write_points(dir, "particles", format, &set, &mut |f| {
-            let mut p = vec![0.0; dim];
+            let mut p = vec![0i64; dim];
             each_particle(sim, |id, k| -> Result<(), OutputError> {
                 let x = sim.lattice().decode(k)?;
                 for (c, v) in p.iter_mut().zip(x.iter()) {
-                    *c = *v as f64;
+                    // A coordinate is below its axis' length, which a lattice in memory
+                    // keeps far below i64::MAX.
+                    *c = i64::try_from(*v).map_err(std::io::Error::other)?;
                 }
-                f(&p, &[i64::from(id)])?;
+                f(Coords::Int(&p), &[i64::from(id)])?;
                 Ok(())
             })
         })?;
@@ -102,8 +168,10 @@ pub fn write_outputs(
 
     // histogram.csv
     if !params.histogram_sweeps.is_empty() {
-        let mut w =
-            CsvWriter::create(dir.join("histogram.csv"), &["sweep", "candidates", "moves"])?;
+        let mut w = CsvWriter::create(
+            dir.join("histogram.csv"),
+            &output(SCHEMA, "histogram.csv").header(false),
+        )?;
         for (sweep, h) in sim.records().histograms() {
             for (candidates, moves) in h.iter() {
                 w.row(&[sweep, &candidates, &moves])?;
@@ -195,8 +263,12 @@ pub fn each_particle<E>(
     sim.try_for_each_particle(f)
 }
 
-/// The header of `clusters.csv`.
-pub const CLUSTER_COLUMNS: [&str; 4] = ["cluster", "size", "radius_of_gyration", "wraps"];
+/// The header of `clusters.csv`, from [`SCHEMA`].
+pub const CLUSTER_COLUMNS: [&str; 4] = {
+    let c = SCHEMA[4].columns;
+    assert!(c.len() == 4, "clusters.csv's columns are these four");
+    [c[0].name, c[1].name, c[2].name, c[3].name]
+};
 
 /// Reads a `clusters.csv` written by [`write_outputs`] (with `--gyration`).
 ///
@@ -278,4 +350,15 @@ fn write_clusters(dir: &Path, measures: &[ClusterMeasure]) -> Result<(), OutputE
     }
     w.finish()?;
     Ok(())
+}
+
+#[cfg(test)]
+mod schema_tests {
+    use super::*;
+
+    #[test]
+    fn the_outputs_document_lists_the_schema() {
+        let doc = include_str!("../../../docs/outputs.md");
+        sim_run::schema::check_doc(doc, "## `dlca`", SCHEMA);
+    }
 }

@@ -53,6 +53,7 @@ pub mod io;
 pub mod memory;
 #[cfg(feature = "plot")]
 pub mod plot;
+pub mod schema;
 #[cfg(all(feature = "test-support", feature = "cli"))]
 pub mod spec_check;
 #[cfg(feature = "test-support")]

@@ -195,7 +195,7 @@ impl DlcaLattice {
 
     /// int64 array (N,): each particle's cluster id, in the order of :attr:`positions`.
     #[getter]
-    fn labels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+    fn cluster<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         Ok(self.lock()?.particles(py)?.1)
     }
 

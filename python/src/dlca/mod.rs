@@ -188,17 +188,17 @@ impl Run {
         let d = l.dim();
         let n = sim.particles() as usize;
         let mut x = Vec::with_capacity(n * d);
-        let mut labels = Vec::with_capacity(n);
+        let mut cluster = Vec::with_capacity(n);
         ::dlca::output::each_particle(sim, |id, k| -> Result<(), ()> {
             x.extend((0..d).map(|a| l.coord(k, a) as i64));
-            labels.push(i64::from(id));
+            cluster.push(i64::from(id));
             Ok(())
         })
         .map_err(|()| run_error("reading the particles"))?;
-        let x = Array2::from_shape_vec((labels.len(), d), x).map_err(run_error)?;
+        let x = Array2::from_shape_vec((cluster.len(), d), x).map_err(run_error)?;
         Ok((
             x.into_pyarray(py).into_any(),
-            Array1::from(labels).into_pyarray(py).into_any(),
+            Array1::from(cluster).into_pyarray(py).into_any(),
         ))
     }
 
@@ -233,9 +233,9 @@ impl Run {
             .map_err(run_error)?;
         let out = Bound::new(py, DlcaResult {})?;
         set_manifest(out.as_any(), &m)?;
-        let (x, labels) = self.particles(py)?;
+        let (x, cluster) = self.particles(py)?;
         out.setattr("positions", x)?;
-        out.setattr("labels", labels)?;
+        out.setattr("cluster", cluster)?;
         out.setattr("per_sweep", self.per_sweep(py)?)?;
         out.setattr("sizes", self.sizes(py)?)?;
         let g = match &measures {
@@ -285,8 +285,8 @@ impl Run {
 ///     int64, shape (N, D): every particle's lattice site, in the order of the binary's
 ///     ``particles.csv`` (clusters by increasing id, each cluster's sites by increasing
 ///     k-index).
-/// labels : numpy.ndarray
-///     int64, shape (N,): each particle's cluster id.
+/// cluster : numpy.ndarray
+///     int64, shape (N,): each particle's cluster id (``particles.csv``'s ``cluster``).
 /// per_sweep : dict[str, numpy.ndarray]
 ///     The binary's ``sweeps.csv`` from sweep 0: ``sweep``, ``clusters``, ``largest``
 ///     (uint64), and ``seconds`` (float64) with ``timing=True``.

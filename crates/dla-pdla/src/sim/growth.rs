@@ -16,6 +16,7 @@ use crate::params::Params;
 use core_lattice::Gyration;
 use serde::{Deserialize, Serialize};
 use sim_run::io::{NpyWriter, StateHasher};
+use sim_run::schema::{Column, Dtype, Form, Output};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -25,8 +26,30 @@ use std::time::Instant;
 /// particle; 1,200 samples to 1e6 and 1,800 to 1e9).
 pub const SAMPLES_PER_DECADE: f64 = 200.0;
 
-/// The column names of `growth.csv`.
-pub const GROWTH_COLUMNS: [&str; 4] = ["n", "radius_of_gyration", "r_ext", "seconds"];
+/// `growth.csv` in the schema (`crate::output::SCHEMA`): one row per growth sample.
+pub const GROWTH: Output = Output {
+    file: "growth.csv",
+    form: Form::Csv,
+    python: "growth",
+    when: None,
+    columns: &[
+        Column::new("n", Dtype::Uint64, "particles"),
+        Column::new("radius_of_gyration", Dtype::Float64, "diameters"),
+        Column::new(
+            "r_ext",
+            Dtype::Float64,
+            "diameters (largest centre distance from the seed)",
+        ),
+        Column::new("seconds", Dtype::Float64, "s since growth started").measured(),
+    ],
+};
+
+/// The column names of `growth.csv`, from the schema ([`GROWTH`]).
+pub const GROWTH_COLUMNS: [&str; 4] = {
+    let c = GROWTH.columns;
+    assert!(c.len() == 4, "growth.csv's columns are these four");
+    [c[0].name, c[1].name, c[2].name, c[3].name]
+};
 
 /// One row of `growth.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

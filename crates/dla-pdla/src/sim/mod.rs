@@ -22,7 +22,7 @@ mod serial;
 mod tests;
 
 pub use self::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_MODEL, POSITIONS_FILE};
-pub use self::growth::{GROWTH_COLUMNS, SAMPLES_PER_DECADE, Sample};
+pub use self::growth::{GROWTH, GROWTH_COLUMNS, SAMPLES_PER_DECADE, Sample};
 pub use self::pdla::{DiscardGuard, MAX_CONSECUTIVE_DISCARDS, OVERLAP_DISTANCE, PURPOSE_PDLA};
 pub use self::serial::PURPOSE_WALK;
 pub use crate::error::SimError;

@@ -33,7 +33,7 @@ pub use hash::StateHasher;
 pub use image::{write_png_gray, write_png_rgb};
 pub use manifest::{ProcessUsage, RunClock, RunManifest};
 pub use npy::{NpyError, NpyReader, NpyWriter};
-pub use points::{Attribute, PointFormat, PointSet, Positions, write_points};
+pub use points::{Attribute, Coords, PointFormat, PointSet, Positions, write_points};
 pub use provenance::{MpiPlace, Provenance};
 pub use table::{CsvField, CsvWriter};
 

@@ -4,9 +4,13 @@
 //! | format | files | read by |
 //! |---|---|---|
 //! | `csv` | `STEM.csv`: the coordinates, then one column per attribute | pandas, R, spreadsheets |
-//! | `npy` | `STEM.npy`: float64 `(N, D)`; `STEM_<attribute>.npy`: int64 `(N,)` each | `numpy.load` (memory-mapped) |
+//! | `npy` | `STEM.npy`: `(N, D)`, float64 off lattice, int64 for lattice sites; `STEM_<attribute>.npy`: int64 `(N,)` each | `numpy.load` (memory-mapped) |
 //! | `vtk` | `STEM.vtk`: legacy VTK, binary `UNSTRUCTURED_GRID`, one vertex cell per point, the attributes as point scalars | ParaView, VisIt, pyvista, meshio |
 //! | `xyz` | `STEM.xyz`: extended XYZ (count, a `Properties=` comment line, one line per point) | OVITO, VMD, ASE |
+//!
+//! Lattice sites are integers in every format but VTK (whose points are float64 for every
+//! viewer): they reach the writer as `i64` ([`Coords::Int`]), so a site beyond 2^53 keeps
+//! its value.
 //!
 //! Points come from a visitor the writer may call more than once (VTK stores each attribute in
 //! its own section after all coordinates), so a caller that streams its points from disk never
@@ -24,7 +28,8 @@ use std::path::Path;
 pub enum PointFormat {
     /// CSV with a header line.
     Csv,
-    /// NumPy `.npy`: coordinates float64 `(N, D)`, each attribute int64 `(N,)` in its own file.
+    /// NumPy `.npy`: coordinates `(N, D)` (float64, int64 for lattice sites), each attribute
+    /// int64 `(N,)` in its own file.
     Npy,
     /// Legacy VTK (binary `UNSTRUCTURED_GRID` with vertex cells and point scalars) for
     /// ParaView, VisIt, pyvista and meshio.
@@ -54,7 +59,8 @@ pub enum Positions {
     None,
     /// CSV with a header line.
     Csv,
-    /// NumPy `.npy`: coordinates float64 `(N, D)`, each attribute int64 `(N,)` in its own file.
+    /// NumPy `.npy`: coordinates `(N, D)` (float64, int64 for lattice sites), each attribute
+    /// int64 `(N,)` in its own file.
     Npy,
     /// Legacy VTK (binary `UNSTRUCTURED_GRID` with vertex cells and point scalars) for
     /// ParaView, VisIt, pyvista and meshio.
@@ -96,8 +102,9 @@ pub struct PointSet<'a> {
     pub n: u64,
     /// Names of the coordinates (`x`, `y`, `z` or `x1`, ... `xd`); their number is the dimension.
     pub axes: &'a [&'a str],
-    /// Whether the coordinates are integers (lattice sites): CSV and XYZ write them without a
-    /// fractional part.
+    /// Whether the coordinates are integers (lattice sites): the visitor then yields
+    /// [`Coords::Int`], `.npy` holds int64 and CSV and XYZ write them without a fractional
+    /// part; otherwise it yields [`Coords::Float`] and `.npy` holds float64.
     pub integer_coordinates: bool,
     /// The explicit attributes, in the order the visitor yields them.
     pub attributes: &'a [Attribute<'a>],
@@ -108,9 +115,48 @@ pub struct PointSet<'a> {
     pub title: &'a str,
 }
 
+/// One point's coordinates: off-lattice centres or lattice sites.
+#[derive(Debug, Clone, Copy)]
+pub enum Coords<'a> {
+    /// Real coordinates (a set without [`PointSet::integer_coordinates`]).
+    Float(&'a [f64]),
+    /// Integer coordinates (a set with [`PointSet::integer_coordinates`]).
+    Int(&'a [i64]),
+}
+
+impl Coords<'_> {
+    /// Coordinate `i` as a float (0 past the last axis): VTK's points.
+    fn float(&self, i: usize) -> f64 {
+        match self {
+            Coords::Float(p) => p.get(i).copied().unwrap_or(0.0),
+            Coords::Int(p) => p.get(i).map_or(0.0, |&x| x as f64),
+        }
+    }
+
+    fn is_int(&self) -> bool {
+        matches!(self, Coords::Int(_))
+    }
+}
+
 /// A function that calls its argument with each point in order: coordinates, then attributes.
 pub type Visitor<'v> =
-    dyn FnMut(&mut dyn FnMut(&[f64], &[i64]) -> io::Result<()>) -> Result<(), OutputError> + 'v;
+    dyn FnMut(&mut dyn FnMut(Coords<'_>, &[i64]) -> io::Result<()>) -> Result<(), OutputError> + 'v;
+
+/// The error of a point whose coordinates are not of the kind `set` declares.
+fn kind_error(set: &PointSet<'_>) -> io::Error {
+    io::Error::new(
+        io::ErrorKind::InvalidData,
+        format!(
+            "{}: a point's coordinates are not {}",
+            set.title,
+            if set.integer_coordinates {
+                "integers"
+            } else {
+                "floats"
+            }
+        ),
+    )
+}
 
 /// Writes `set` as `dir/STEM.<extension>` (and, for `npy`, one file per attribute); returns the
 /// paths written. `visit` yields the points and may be called several times.
@@ -148,16 +194,15 @@ pub fn write_points(
                 .collect();
             let mut w = CsvWriter::create(&path, &header)?;
             let mut count = 0u64;
-            let mut ints = Vec::new();
             visit(&mut |p, attrs| {
                 count += 1;
+                if p.is_int() != set.integer_coordinates {
+                    return Err(kind_error(set));
+                }
                 let mut fields: Vec<&dyn CsvField> = Vec::with_capacity(header.len());
-                if set.integer_coordinates {
-                    ints.clear();
-                    ints.extend(p.iter().map(|&x| x as i64));
-                    fields.extend(ints.iter().map(|x| x as &dyn CsvField));
-                } else {
-                    fields.extend(p.iter().map(|x| x as &dyn CsvField));
+                match p {
+                    Coords::Int(p) => fields.extend(p.iter().map(|x| x as &dyn CsvField)),
+                    Coords::Float(p) => fields.extend(p.iter().map(|x| x as &dyn CsvField)),
                 }
                 let labels: Vec<Option<&str>> = set
                     .attributes
@@ -178,7 +223,12 @@ pub fn write_points(
         }
         PointFormat::Npy => {
             let dim = set.axes.len();
-            let mut coords = NpyFile::create(&path, "<f8", set.n, Some(dim))?;
+            let descr = if set.integer_coordinates {
+                "<i8"
+            } else {
+                "<f8"
+            };
+            let mut coords = NpyFile::create(&path, descr, set.n, Some(dim))?;
             let mut attrs: Vec<NpyFile> = Vec::new();
             for a in set.attributes {
                 let p = dir.join(format!("{stem}_{}.npy", a.name));
@@ -188,8 +238,18 @@ pub fn write_points(
             let mut count = 0u64;
             visit(&mut |p, values| {
                 count += 1;
-                for x in p {
-                    coords.out.write_all(&x.to_le_bytes())?;
+                match p {
+                    Coords::Int(p) if set.integer_coordinates => {
+                        for x in p {
+                            coords.out.write_all(&x.to_le_bytes())?;
+                        }
+                    }
+                    Coords::Float(p) if !set.integer_coordinates => {
+                        for x in p {
+                            coords.out.write_all(&x.to_le_bytes())?;
+                        }
+                    }
+                    _ => return Err(kind_error(set)),
                 }
                 for (f, v) in attrs.iter_mut().zip(values) {
                     f.out.write_all(&v.to_le_bytes())?;
@@ -229,21 +289,22 @@ pub fn write_points(
                 )?;
                 visit(&mut |p, values| {
                     count += 1;
-                    // XYZ holds three coordinates: 0 for the axes a plane lacks.
-                    let c = |i: usize| p.get(i).copied().unwrap_or(0.0);
+                    if p.is_int() != set.integer_coordinates {
+                        return Err(kind_error(set));
+                    }
                     let element = species
                         .and_then(|k| label(&set.attributes[k], values[k]))
                         .unwrap_or("C");
-                    if set.integer_coordinates {
-                        write!(
-                            b,
-                            "{element} {} {} {}",
-                            c(0) as i64,
-                            c(1) as i64,
-                            c(2) as i64
-                        )?;
-                    } else {
-                        write!(b, "{element} {} {} {}", c(0), c(1), c(2))?;
+                    // XYZ holds three coordinates: 0 for the axes a plane lacks.
+                    match p {
+                        Coords::Int(p) => {
+                            let c = |i: usize| p.get(i).copied().unwrap_or(0);
+                            write!(b, "{element} {} {} {}", c(0), c(1), c(2))?;
+                        }
+                        Coords::Float(p) => {
+                            let c = |i: usize| p.get(i).copied().unwrap_or(0.0);
+                            write!(b, "{element} {} {} {}", c(0), c(1), c(2))?;
+                        }
                     }
                     for (k, (a, v)) in set.attributes.iter().zip(values).enumerate() {
                         if Some(k) == species {
@@ -319,8 +380,11 @@ fn write_vtk(path: &Path, set: &PointSet<'_>, visit: &mut Visitor<'_>) -> Result
         let mut count = 0u64;
         visit(&mut |p, _| {
             count += 1;
+            if p.is_int() != set.integer_coordinates {
+                return Err(kind_error(set));
+            }
             for i in 0..3 {
-                b.write_all(&p.get(i).copied().unwrap_or(0.0).to_be_bytes())?;
+                b.write_all(&p.float(i).to_be_bytes())?;
             }
             Ok(())
         })?;
@@ -404,7 +468,7 @@ mod tests {
     fn write(format: PointFormat, dir: &Path) -> Vec<std::path::PathBuf> {
         write_points(dir, "positions", format, &set(), &mut |f| {
             for (p, a) in &POINTS {
-                f(p, a)?;
+                f(Coords::Float(p), a)?;
             }
             Ok(())
         })
@@ -455,6 +519,56 @@ mod tests {
     }
 
     #[test]
+    fn lattice_sites_are_int64_in_npy_and_exact_in_text() {
+        let dir = tempfile::tempdir().unwrap();
+        // Beyond 2^53, where a float64 would round the site.
+        let far = (1i64 << 60) + 1;
+        let attributes = [Attribute {
+            name: "cluster",
+            labels: None,
+        }];
+        let set = PointSet {
+            n: 2,
+            axes: &["x1", "x2"],
+            integer_coordinates: true,
+            attributes: &attributes,
+            index: None,
+            title: "two sites",
+        };
+        for format in [PointFormat::Npy, PointFormat::Csv, PointFormat::Xyz] {
+            write_points(dir.path(), "sites", format, &set, &mut |f| {
+                f(Coords::Int(&[3, -4]), &[0])?;
+                f(Coords::Int(&[far, 0]), &[1])?;
+                Ok(())
+            })
+            .unwrap();
+        }
+        let bytes = std::fs::read(dir.path().join("sites.npy")).unwrap();
+        let header = String::from_utf8_lossy(&bytes[..128]);
+        assert!(
+            header.contains("'descr': '<i8'") && header.contains("'shape': (2, 2)"),
+            "{header}"
+        );
+        let values: Vec<i64> = bytes[128..]
+            .chunks(8)
+            .map(|c| i64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        assert_eq!(values, [3, -4, far, 0]);
+        let csv = std::fs::read_to_string(dir.path().join("sites.csv")).unwrap();
+        assert_eq!(csv, format!("x1,x2,cluster\n3,-4,0\n{far},0,1\n"));
+        let xyz = std::fs::read_to_string(dir.path().join("sites.xyz")).unwrap();
+        assert_eq!(xyz.lines().nth(3), Some(format!("C {far} 0 0 1").as_str()));
+        // A float point in an integer set is refused, and leaves no file.
+        let r = write_points(dir.path(), "mixed", PointFormat::Npy, &set, &mut |f| {
+            f(Coords::Float(&[0.5, 0.0]), &[0])?;
+            f(Coords::Int(&[0, 0]), &[0])?;
+            Ok(())
+        });
+        assert!(r.is_err());
+        assert!(!dir.path().join("mixed.npy").exists());
+    }
+
+    #[test]
     fn vtk_has_points_vertex_cells_and_scalars() {
         let dir = tempfile::tempdir().unwrap();
         write(PointFormat::Vtk, dir.path());
@@ -500,7 +614,7 @@ mod tests {
             PointFormat::Xyz,
         ] {
             let r = write_points(dir.path(), "short", format, &set(), &mut |f| {
-                f(&[0.0, 0.0], &[0, 0])?;
+                f(Coords::Float(&[0.0, 0.0]), &[0, 0])?;
                 Ok(())
             });
             assert!(r.is_err(), "{format:?}");
