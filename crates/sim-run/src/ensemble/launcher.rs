@@ -12,7 +12,7 @@ use std::process::ExitCode;
 /// has: Open MPI (`mpirun`, also under Slurm), MPICH's and Intel MPI's Hydra (`PMI_SIZE`, also
 /// `srun --mpi=pmi2`), MVAPICH2. A plain Slurm job or a single-task `srun` sets none of them,
 /// so they never refuse an ordinary batch job.
-const SIZE_VARS: [&str; 3] = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MV2_COMM_WORLD_SIZE"];
+pub const SIZE_VARS: [&str; 3] = ["OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "MV2_COMM_WORLD_SIZE"];
 
 /// The launcher's claim that this process is one of several ranks: `(variable, ranks)`, from
 /// [`SIZE_VARS`], or under `srun --mpi=pmix` (which sets `PMIX_RANK` but no size) from

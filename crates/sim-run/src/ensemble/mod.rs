@@ -27,7 +27,8 @@ mod ranks;
 mod seeds;
 
 pub use launcher::{
-    launcher_ranks, mpi_build_command, node_share, refuse_without_mpi, tie_member_to_ensemble,
+    SIZE_VARS, launcher_ranks, mpi_build_command, node_share, refuse_without_mpi,
+    tie_member_to_ensemble,
 };
 pub use merge::{
     Combine, Curve, MemberRun, MergeReport, Pooled, PooledResult, ScalarStats, merge, merge_with,
