@@ -210,7 +210,9 @@ mod under_mpirun {
     fn signals_stop_the_job_with_130_and_members_at_a_safe_point() {
         let dir = tempfile::tempdir().unwrap();
         let ens = dir.path().join("ens");
-        let flags = ["--particles", "20000", "--checkpoint-every", "500"];
+        // Members long enough (about a second each) that the signals always find some running,
+        // however fast the machine.
+        let flags = ["--particles", "200000", "--checkpoint-every", "5000"];
         let args = [&["--seeds", "1..=4", "--jobs", "1", "-qq"][..], &flags].concat();
         let check_stopped = |o: &Output, how: &str| {
             let err = String::from_utf8_lossy(&o.stderr);
