@@ -177,31 +177,21 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.snapshot_every == Some(0) {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
     }
-    if cli.animate_every == Some(0) {
-        return Err("--animate-every 0 is outside the accepted range 1..".into());
-    }
     if cli.frame_radius == Some(0) {
         return Err("--frame-radius 0 is outside the accepted range 1..".into());
     }
+    sim_run::figure::animation::check_picture_flags(
+        cli.png_size,
+        cli.animate,
+        cli.animate_every,
+        cli.snapshot_every.is_some(),
+        "--snapshot-every",
+    )?;
     let pictures = cli.snapshot_every.is_some() || cli.animate;
-    if cli.png_size.is_some() && !pictures {
-        return Err(
-            "--png-size sizes the pictures of --snapshot-every and --animate; give one".into(),
-        );
-    }
     if cli.frame_radius.is_some() && !pictures {
         return Err(
             "--frame-radius frames the pictures of --snapshot-every and --animate; give one".into(),
         );
-    }
-    if let Some(side) = cli
-        .png_size
-        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
-    {
-        return Err(format!(
-            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
-             pixels a side"
-        ));
     }
     p.validate().map_err(|e| culprit(cli, &e))?;
     if cli.resume.is_none() {
@@ -246,9 +236,6 @@ fn culprit(cli: &Cli, e: &ParamsError) -> String {
     };
     animat::params::error_message(e, by_flag, cli.config.as_deref())
 }
-
-/// Largest side of the picture in animat.gif (the figure stays within GIF's 65535 pixels).
-const ANIMATION_MAX_SIDE: u32 = 16384;
 
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.

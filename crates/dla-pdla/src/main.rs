@@ -232,21 +232,13 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.checkpoint_every == Some(0) {
         return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
     }
-    if cli.animate_every == Some(0) {
-        return Err("--animate-every 0 is outside the accepted range 1..".into());
-    }
-    if cli.png_size.is_some() && !cli.png && !cli.animate {
-        return Err("--png-size sizes the pictures of --png and --animate; give one".into());
-    }
-    if let Some(side) = cli
-        .png_size
-        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
-    {
-        return Err(format!(
-            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
-             pixels a side"
-        ));
-    }
+    sim_run::figure::animation::check_picture_flags(
+        cli.png_size,
+        cli.animate,
+        cli.animate_every,
+        cli.png,
+        "--png",
+    )?;
     if cli.positions == PositionsFormat::Vtk && p.particles > sim_run::io::points::VTK_MAX_POINTS {
         return Err(format!(
             "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
@@ -323,8 +315,6 @@ where
 
 /// Side of the picture in dla.gif without --png-size.
 const ANIMATION_DEFAULT_SIDE: u32 = 512;
-/// Largest side of the picture in dla.gif (the figure around it stays within GIF's 65535).
-const ANIMATION_MAX_SIDE: u32 = 16384;
 
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.

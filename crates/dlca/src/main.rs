@@ -219,21 +219,13 @@ fn params(cli: &Cli) -> Result<Params, String> {
         fit_min_size: cli.fit_min_size,
     };
     p.validate().map_err(|e| e.to_string())?;
-    if cli.animate_every == Some(0) {
-        return Err("--animate-every 0 is outside the accepted range 1..".into());
-    }
-    if cli.png_size.is_some() && !cli.png && !cli.animate {
-        return Err("--png-size sizes the pictures of --png and --animate; give one".into());
-    }
-    if let Some(side) = cli
-        .png_size
-        .filter(|&s| cli.animate && s > ANIMATION_MAX_SIDE)
-    {
-        return Err(format!(
-            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
-             pixels a side"
-        ));
-    }
+    sim_run::figure::animation::check_picture_flags(
+        cli.png_size,
+        cli.animate,
+        cli.animate_every,
+        cli.png,
+        "--png",
+    )?;
     // The default 4G is the occupancy lattice's budget only; the run's limit is then the memory
     // available.
     let given = sim_run::cli::config::given("max_memory").then_some(cli.max_memory);
@@ -382,8 +374,6 @@ const RUN_FILES: &[&str] = &[
 
 /// Longer side of the picture in dlca.gif without --png-size.
 const ANIMATION_DEFAULT_SIDE: u32 = 512;
-/// Largest longer side of the picture in dlca.gif (the figure stays within GIF's 65535).
-const ANIMATION_MAX_SIDE: u32 = 16384;
 /// Sweeps between frames of dlca.gif without --animate-every.
 const ANIMATION_DEFAULT_EVERY: u64 = 10;
 /// The largest default side of a picture, for the memory estimate before the run.

@@ -180,3 +180,34 @@ mod tests {
         assert!(Gif::create(&path, 0, 4).is_err());
     }
 }
+
+/// Largest side in pixels of an animation frame (`--png-size` with `--animate`).
+pub const ANIMATION_MAX_SIDE: u32 = 16384;
+
+/// The checks every binary makes of its picture flags: `--animate-every` at least 1,
+/// `--png-size` only with a picture to size (`stills` names the flag of the still pictures:
+/// `--png` or `--snapshot-every`, given or not as `still`), and at most
+/// [`ANIMATION_MAX_SIDE`] with `--animate`.
+pub fn check_picture_flags(
+    png_size: Option<u32>,
+    animate: bool,
+    animate_every: Option<u64>,
+    still: bool,
+    stills: &str,
+) -> Result<(), String> {
+    if animate_every == Some(0) {
+        return Err("--animate-every 0 is outside the accepted range 1..".into());
+    }
+    if png_size.is_some() && !still && !animate {
+        return Err(format!(
+            "--png-size sizes the pictures of {stills} and --animate; give one"
+        ));
+    }
+    if let Some(side) = png_size.filter(|&s| animate && s > ANIMATION_MAX_SIDE) {
+        return Err(format!(
+            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
+             pixels a side"
+        ));
+    }
+    Ok(())
+}
