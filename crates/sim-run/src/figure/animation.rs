@@ -149,6 +149,37 @@ pub fn read_gif(path: &Path) -> Result<((u32, u32), u64)> {
     Ok((size, frames))
 }
 
+/// Largest side in pixels of an animation frame (`--png-size` with `--animate`).
+pub const ANIMATION_MAX_SIDE: u32 = 16384;
+
+/// The checks every binary makes of its picture flags: `--animate-every` at least 1,
+/// `--png-size` only with a picture to size (`stills` names the flag of the still pictures:
+/// `--png` or `--snapshot-every`, given or not as `still`), and at most
+/// [`ANIMATION_MAX_SIDE`] with `--animate`.
+pub fn check_picture_flags(
+    png_size: Option<u32>,
+    animate: bool,
+    animate_every: Option<u64>,
+    still: bool,
+    stills: &str,
+) -> Result<(), String> {
+    if animate_every == Some(0) {
+        return Err("--animate-every 0 is outside the accepted range 1..".into());
+    }
+    if png_size.is_some() && !still && !animate {
+        return Err(format!(
+            "--png-size sizes the pictures of {stills} and --animate; give one"
+        ));
+    }
+    if let Some(side) = png_size.filter(|&s| animate && s > ANIMATION_MAX_SIDE) {
+        return Err(format!(
+            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
+             pixels a side"
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -179,35 +210,4 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
         assert!(Gif::create(&path, 0, 4).is_err());
     }
-}
-
-/// Largest side in pixels of an animation frame (`--png-size` with `--animate`).
-pub const ANIMATION_MAX_SIDE: u32 = 16384;
-
-/// The checks every binary makes of its picture flags: `--animate-every` at least 1,
-/// `--png-size` only with a picture to size (`stills` names the flag of the still pictures:
-/// `--png` or `--snapshot-every`, given or not as `still`), and at most
-/// [`ANIMATION_MAX_SIDE`] with `--animate`.
-pub fn check_picture_flags(
-    png_size: Option<u32>,
-    animate: bool,
-    animate_every: Option<u64>,
-    still: bool,
-    stills: &str,
-) -> Result<(), String> {
-    if animate_every == Some(0) {
-        return Err("--animate-every 0 is outside the accepted range 1..".into());
-    }
-    if png_size.is_some() && !still && !animate {
-        return Err(format!(
-            "--png-size sizes the pictures of {stills} and --animate; give one"
-        ));
-    }
-    if let Some(side) = png_size.filter(|&s| animate && s > ANIMATION_MAX_SIDE) {
-        return Err(format!(
-            "--png-size {side} with --animate: animation frames are at most {ANIMATION_MAX_SIDE} \
-             pixels a side"
-        ));
-    }
-    Ok(())
 }
