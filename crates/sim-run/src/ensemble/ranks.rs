@@ -91,7 +91,7 @@ pub(super) fn dispatch(
                     INTERRUPTED => Ended::Interrupted,
                     _ => {
                         let log = member_dir(out, seed).join(super::MEMBER_LOG);
-                        let last = super::last_line(&log);
+                        let last = super::member::last_line(&log);
                         Ended::Failed(if last.is_empty() {
                             format!(
                                 "failed on MPI rank {} (nothing in {})",
