@@ -34,17 +34,56 @@ pub struct Cluster<const D: usize> {
 }
 
 /// The distance maps: the optional sparse fine level, then the dense levels, finest first.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 struct Maps<const D: usize> {
     sparse: Option<SparseDistanceMap<D>>,
     levels: Box<[DistanceMap<D>]>,
+    /// `enough[k]`: a lower bound from dense level `k` at least this says that the next finer
+    /// map (level `k - 1`, or the sparse map below level 0) is capped where it was read, so
+    /// reading that map could not sharpen it: the finer map's cap plus its cell's half
+    /// diagonal (the point read is that close to its cell's centre), widened for rounding.
+    /// `0` where there is no finer map.
+    enough: Box<[f64]>,
+    /// `sure[k]`: a distance below which dense level `k` is surely not capped (its cap less
+    /// its cell's half diagonal, narrowed for rounding); `sure_sparse` the same for the
+    /// sparse map (`-inf` without one). A walker known to be nearer the cluster than that
+    /// starts reading at that level.
+    sure: Box<[f64]>,
+    sure_sparse: f64,
+    /// What a coarse level's upper bound gains: those levels hold the boxes of the tree's
+    /// leaves, so the nearest particle may lie a leaf diagonal beyond the nearest box.
+    leaf_diagonal: f64,
 }
 
-impl<const D: usize> Default for Maps<D> {
-    fn default() -> Self {
+impl<const D: usize> Maps<D> {
+    fn new(
+        sparse: Option<SparseDistanceMap<D>>,
+        levels: Box<[DistanceMap<D>]>,
+        leaf_side: f64,
+    ) -> Self {
+        let half_diagonal = |cell: f64| 0.5 * cell * (D as f64).sqrt();
+        let reach = |cap: f64, cell: f64| (cap + half_diagonal(cell)) * (1.0 + 1e-9) + 1e-9;
+        let sure = |cap: f64, cell: f64| (cap - half_diagonal(cell)) * (1.0 - 1e-9) - 1e-9;
+        let enough = (0..levels.len())
+            .map(|k| match k {
+                0 => sparse
+                    .as_ref()
+                    .map_or(0.0, |s| reach(s.cap(), s.cell_side())),
+                _ => reach(levels[k - 1].cap(), levels[k - 1].cell_side()),
+            })
+            .collect();
         Maps {
-            sparse: None,
-            levels: Box::default(),
+            sure: levels
+                .iter()
+                .map(|m| sure(m.cap(), m.cell_side()))
+                .collect(),
+            sure_sparse: sparse
+                .as_ref()
+                .map_or(f64::NEG_INFINITY, |s| sure(s.cap(), s.cell_side())),
+            sparse,
+            levels,
+            enough,
+            leaf_diagonal: leaf_side * (D as f64).sqrt() * (1.0 + 1e-12),
         }
     }
 }
@@ -58,15 +97,16 @@ impl<const D: usize> Cluster<D> {
         Ok(Cluster {
             tree: Orthtree::with_leaf_side(params.leaf_side)?,
             maps: Arc::new(if params.distance_map {
-                Maps {
-                    sparse: Dim::<D>::SPARSE_LEVEL
+                Maps::new(
+                    Dim::<D>::SPARSE_LEVEL
                         .map(|(cell, cap, block)| SparseDistanceMap::new(cell, cap, block))
                         .transpose()?,
-                    levels: Dim::<D>::MAP_LEVELS
+                    Dim::<D>::MAP_LEVELS
                         .iter()
                         .map(|&(cell, cap)| DistanceMap::new(cell, cap))
                         .collect::<Result<_, _>>()?,
-                }
+                    params.leaf_side,
+                )
             } else {
                 Maps::default()
             }),
@@ -214,58 +254,89 @@ impl<const D: usize> Cluster<D> {
     }
 
     /// A lower bound of the distance from `p` to the nearest particle from the distance maps,
-    /// and whether it is capped: the finest map that covers `p` with a cell that is not capped
-    /// (`false`), or else the last capped bound found (`true`: the distance may be far larger).
-    /// A capped sparse cell's bound (`cap - |p - z|`) is a floor under the dense maps' bound.
-    /// `None` when the maps are off or none covers `p`.
+    /// and whether it is capped (`true`: every map holding `p` is capped there, and the
+    /// distance may be far larger than the bound). `None` when the maps are off or none
+    /// covers `p`. See [`map_bounds`](Self::map_bounds).
     #[inline]
     pub fn map_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
         self.map_bounds(p).map(|(lb, _, capped)| (lb, capped))
     }
 
     /// [`map_bound`](Self::map_bound) with an upper bound of the same distance from the map
-    /// that gave the lower one (`+inf` when that map's cell is capped; see
-    /// [`DistanceMap::bounds`]; a coarser map holds leaf boxes, so its bound gains a leaf
-    /// diagonal), as `(lower, upper, capped)`.
+    /// that gave the lower one (`+inf` when capped; see [`DistanceMap::bounds`]; a coarse map
+    /// holds leaf boxes, so its bound gains a leaf diagonal), as `(lower, upper, capped)`.
     ///
-    /// The sparse fine map is asked first: a cell that is not capped answers alone (its bound
-    /// is within a small cell's diagonal of the distance). A capped one (or an absent block)
-    /// says the distance is at least its cap less `|p - z|`; that floor is combined with the
-    /// dense maps' answer (the larger lower bound; the dense map's upper bound and capped
-    /// flag), or returned as capped when no dense map covers `p`.
-    #[inline(always)]
+    /// The maps are read coarsest first, so that a walker far from the cluster reads only
+    /// the small coarse maps, which stay in cache while the fine ones (one byte per few
+    /// square diameters of the whole cluster's disk or ball) do not. A finer map is read only
+    /// where the coarser bound is below that map's cap plus its cell's half diagonal: at or
+    /// above that the finer cell is capped and could not sharpen the bound. Reading stops at
+    /// the first capped map:
+    /// - if no coarser map answered, every finer one is capped too (each level's cap,
+    ///   less its half diagonal, exceeds the finer level's cap plus its own): the bound is
+    ///   capped;
+    /// - otherwise the coarser answer stands, raised to the capped map's floor (`cap - |p -
+    ///   z|`) when that is larger.
+    ///
+    /// The answer is that of the finest map that is not capped where `p` lies, or the
+    /// coarsest capped one, whichever order the maps are read in; reading coarsest first only
+    /// skips the reads that cannot change it (and adds the capped floor above).
+    #[inline]
     pub fn map_bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
-        let mut floor = None;
-        if let Some(sparse) = &self.maps.sparse {
-            match sparse.bounds(p) {
-                Some((lb, ub, false)) => return Some((lb, ub, false)),
-                Some((lb, _, true)) => floor = Some(lb),
-                None => {}
-            }
-        }
-        match (self.dense_bounds(p), floor) {
-            (Some((lb, ub, capped)), Some(f)) => Some((lb.max(f), ub, capped)),
-            (None, Some(f)) => Some((f, f64::INFINITY, true)),
-            (best, None) => best,
-        }
+        self.map_bounds_within(p, f64::INFINITY)
     }
 
-    /// [`map_bounds`](Self::map_bounds) of the dense levels alone.
+    /// [`map_bounds`](Self::map_bounds) for a point known to lie within `upper` of a stored
+    /// particle: the read starts at the finest map that is surely not capped within that
+    /// distance, since every coarser one would only send it down there (same answer, fewer
+    /// reads for a walker near the cluster).
     #[inline(always)]
-    fn dense_bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
-        let mut best = None;
-        for (level, map) in self.maps.levels.iter().enumerate() {
-            if let Some((lb, mut ub, capped)) = map.bounds(p) {
-                if level > 0 {
-                    ub += self.tree.leaf_side() * (D as f64).sqrt() * (1.0 + 1e-12);
-                }
-                best = Some((lb, ub, capped));
-                if !capped {
-                    break;
-                }
+    pub fn map_bounds_within(&self, p: &[f64; D], upper: f64) -> Option<(f64, f64, bool)> {
+        let maps = &*self.maps;
+        if upper < maps.sure_sparse {
+            if let Some(bounds) = maps.sparse.as_ref().and_then(|s| s.bounds(p)) {
+                return Some(bounds);
             }
         }
-        best
+        let top = maps
+            .sure
+            .iter()
+            .position(|&sure| upper < sure)
+            .unwrap_or(maps.levels.len().saturating_sub(1));
+        let mut best: Option<(f64, f64, bool)> = None;
+        let mut finer = true;
+        for (k, map) in maps.levels.iter().enumerate().take(top + 1).rev() {
+            let Some((lb, mut ub, capped)) = map.bounds(p) else {
+                continue;
+            };
+            if k > 0 {
+                ub += maps.leaf_diagonal;
+            }
+            if capped {
+                best = Some(match best {
+                    Some((b_lb, b_ub, _)) => (b_lb.max(lb), b_ub, false),
+                    None => (lb, ub, true),
+                });
+                finer = false;
+                break;
+            }
+            best = Some((lb, ub, false));
+            if lb >= maps.enough[k] {
+                finer = false;
+                break;
+            }
+        }
+        if !finer {
+            return best;
+        }
+        match (maps.sparse.as_ref().and_then(|s| s.bounds(p)), best) {
+            (Some((lb, ub, false)), _) => Some((lb, ub, false)),
+            (Some((lb, _, true)), Some((b_lb, b_ub, b_capped))) => {
+                Some((b_lb.max(lb), b_ub, b_capped))
+            }
+            (Some((lb, ub, true)), None) => Some((lb, ub, true)),
+            (None, best) => best,
+        }
     }
 
     /// Particles stored.
@@ -352,15 +423,29 @@ mod tests {
             };
             pts.push(c.insert(p).unwrap());
             if n % 50 == 49 {
-                for _ in 0..200 {
-                    let probe: [f64; D] = std::array::from_fn(|_| next() * 70.0);
+                for i in 0..300 {
+                    let reach = if i % 3 == 0 { 600.0 } else { 70.0 };
+                    let probe: [f64; D] = std::array::from_fn(|_| next() * reach);
                     let d = pts
                         .iter()
                         .map(|q| spatial::orthtree::dist_sq(q, &probe).sqrt())
                         .fold(f64::INFINITY, f64::min);
-                    if let Some((lb, ub, _)) = c.map_bounds(&probe) {
+                    if let Some((lb, ub, capped)) = c.map_bounds(&probe) {
                         assert!(lb <= d, "{D}D: bound {lb} above the distance {d}");
                         assert!(ub >= d, "{D}D: upper bound {ub} below the distance {d}");
+                        // Coarsest first gives the finest-first answer, or a higher floor.
+                        let (f_lb, f_ub, f_capped) = finest_first(&c, &probe).unwrap();
+                        assert!(lb >= f_lb, "{D}D: {lb} below the finest-first {f_lb}");
+                        assert_eq!((ub, capped), (f_ub, f_capped), "{D}D at {probe:?}");
+                        // Starting lower for a walker known to be near gives the same.
+                        for slack in [1.0 + 1e-9, 1.5, 4.0] {
+                            assert_eq!(
+                                c.map_bounds_within(&probe, d * slack),
+                                Some((lb, ub, capped)),
+                                "{D}D: read from within {}",
+                                d * slack
+                            );
+                        }
                     }
                     if let Some((lb, _)) = c.map_bound(&probe) {
                         assert!(lb <= d, "{D}D: bound {lb} above the distance {d}");
@@ -369,6 +454,37 @@ mod tests {
             }
         }
         drop(keep);
+    }
+
+    /// The maps read finest first, the finest that is not capped answering (a capped sparse
+    /// map's floor under the dense answer): what [`Cluster::map_bounds`] must equal, up to
+    /// the capped floors it adds.
+    fn finest_first<const D: usize>(c: &Cluster<D>, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+        let mut floor = None;
+        if let Some(sparse) = &c.maps.sparse {
+            match sparse.bounds(p) {
+                Some((lb, ub, false)) => return Some((lb, ub, false)),
+                Some((lb, _, true)) => floor = Some(lb),
+                None => {}
+            }
+        }
+        let mut best = None;
+        for (level, map) in c.maps.levels.iter().enumerate() {
+            if let Some((lb, mut ub, capped)) = map.bounds(p) {
+                if level > 0 {
+                    ub += c.maps.leaf_diagonal;
+                }
+                best = Some((lb, ub, capped));
+                if !capped {
+                    break;
+                }
+            }
+        }
+        match (best, floor) {
+            (Some((lb, ub, capped)), Some(f)) => Some((lb.max(f), ub, capped)),
+            (None, Some(f)) => Some((f, f64::INFINITY, true)),
+            (best, None) => best,
+        }
     }
 
     #[test]

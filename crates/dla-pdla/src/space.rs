@@ -120,11 +120,16 @@ fn marsaglia_4d<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
 }
 
 impl Space<2> for Dim<2> {
-    /// A fine map of 8-diameter cells capped at 64 and a coarse one of 64-diameter cells
-    /// capped at 512 (about 200 cells lowered per insert and map). Finer cells cost more
-    /// memory than they save time; a larger coarse cap costs more per insert
-    /// (`docs/benchmarks.md`).
-    const MAP_LEVELS: &'static [(f64, f64)] = &[(8.0, 64.0), (64.0, 512.0)];
+    /// A fine map of 8-diameter cells capped at 64, then coarse ones of 64, 128 and 512
+    /// capped at 512, 1024 and 4096 (about 200 cells lowered per insert and map; the coarse
+    /// maps by the box of each new tree leaf). Finer cells cost more memory than they save
+    /// time. The two coarsest levels answer the walkers in the wide empty regions of a large
+    /// cluster (beyond 512 of it), which would otherwise ask the tree at every move: at 1e7
+    /// particles 3.9 tree queries per particle instead of 10.8 (`docs/benchmarks.md`, "DLA at
+    /// scale"). They are read first and are small (half a megabyte at 1e8 particles), so
+    /// such a walker's move reads no uncached memory.
+    const MAP_LEVELS: &'static [(f64, f64)] =
+        &[(8.0, 64.0), (64.0, 512.0), (128.0, 1024.0), (512.0, 4096.0)];
 
     const AXES: [&'static str; 2] = ["x", "y"];
 
@@ -327,6 +332,32 @@ mod tests {
                     .all(|w| w[0].0 < w[1].0 && w[0].1 < w[1].1)
             );
         }
+        // The caps nest: where a level is capped every finer one is too, so the maps can be
+        // read coarsest first and stop at the first capped one (`Cluster::map_bounds`).
+        fn nest<const D: usize>()
+        where
+            Dim<D>: Space<D>,
+        {
+            let half = |cell: f64| 0.5 * cell * (D as f64).sqrt();
+            let sparse = Dim::<D>::SPARSE_LEVEL.map(|(cell, cap, _)| (cell, cap));
+            let levels: Vec<_> = sparse
+                .into_iter()
+                .chain(Dim::<D>::MAP_LEVELS.iter().copied())
+                .collect();
+            for w in levels.windows(2) {
+                let ((fine, fine_cap), (coarse, coarse_cap)) = (w[0], w[1]);
+                assert!(
+                    coarse_cap - half(coarse) > fine_cap + half(fine),
+                    "{D}D: {:?} does not nest in {:?}",
+                    w[0],
+                    w[1]
+                );
+            }
+        }
+        nest::<2>();
+        nest::<3>();
+        nest::<4>();
+        nest::<5>();
         assert_eq!(DIMENSIONS, &[2, 3, 4, 5]);
     }
 }

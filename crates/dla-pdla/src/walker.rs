@@ -96,7 +96,7 @@ where
         // tree's distance, a few hundred nanoseconds, gives the long jump instead.
         let mut floor = 0.0;
         state.counts.map_reads += 1;
-        if let Some((lb, ub, capped)) = cluster.map_bounds(&self.p) {
+        if let Some((lb, ub, capped)) = cluster.map_bounds_within(&self.p, state.upper) {
             // The map bounds the distance from above too: a walker with no answer yet (just
             // born or returned) or a looser one starts its tree query from the few nodes
             // around that ball rather than from the root.
