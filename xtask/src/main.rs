@@ -70,9 +70,10 @@ enum Cmd {
         #[arg(long)]
         replot: bool,
     },
-    /// DLA at the papers' scale: 2D 1e7 and 1e8, 3D 1e6 and 1e7, one and two threads (about
-    /// an hour and a half on 2 cores); time, memory, D_f, and projections to 2D 1e9 and 3D
-    /// 1e8. Writes scale.md and scale.csv under --out.
+    /// DLA at the papers' scale: 2D 1e6 to 1e8 and 3D 1e5 to 1e7 with one thread, the two
+    /// largest sizes of each also with two (about an hour on 2 cores); time, memory, D_f, what
+    /// the walkers did per particle, and projections to 2D 1e9 and 3D 1e8. Writes scale.md,
+    /// scale.csv and scale_counts.csv under --out.
     Scale {
         /// 2D 1e5 and 1e6, 3D 1e5 and 1e6 (about a minute); default output docs/results/quick/.
         #[arg(long)]

@@ -69,24 +69,34 @@ struct Node(usize);
 #[allow(unsafe_code)] // madvise, on the vector's own allocation
 pub fn memory_latency_ns(bytes: usize, loads: u64, huge_pages: bool, seed: u64) -> f64 {
     let n = (bytes / size_of::<Node>()).max(2);
-    let mut nodes = vec![Node(0); n];
+    let cycle = single_cycle(n, seed);
+    // Allocated and advised before any page is touched: a page faulted in before the advice
+    // stays a 4 KiB page until the kernel's background collapse, if ever.
+    let mut nodes: Vec<Node> = Vec::with_capacity(n);
     #[cfg(target_os = "linux")]
     if huge_pages {
-        // SAFETY: the range is the vector's own allocation; MADV_HUGEPAGE only changes how the
-        // kernel backs it.
-        unsafe {
-            libc::madvise(
-                nodes.as_mut_ptr().cast(),
-                n * size_of::<Node>(),
-                libc::MADV_HUGEPAGE,
-            );
+        // madvise takes a page-aligned start (the allocator's header puts a large vector 16
+        // bytes past a page boundary, and an unaligned call fails with EINVAL): advise the
+        // whole pages inside the vector.
+        let start = nodes.as_mut_ptr() as usize;
+        let aligned = start.next_multiple_of(4096);
+        let end = start + nodes.capacity() * size_of::<Node>();
+        if end > aligned {
+            // SAFETY: the range lies inside the vector's own allocation; MADV_HUGEPAGE only
+            // changes how the kernel backs it.
+            let rc = unsafe {
+                libc::madvise(
+                    aligned as *mut libc::c_void,
+                    end - aligned,
+                    libc::MADV_HUGEPAGE,
+                )
+            };
+            assert_eq!(rc, 0, "madvise(MADV_HUGEPAGE) failed");
         }
     }
     #[cfg(not(target_os = "linux"))]
     let _ = huge_pages;
-    for (node, next) in nodes.iter_mut().zip(single_cycle(n, seed)) {
-        node.0 = next;
-    }
+    nodes.extend(cycle.into_iter().map(Node));
     let mut at = 0usize;
     for _ in 0..n {
         at = nodes[at].0;

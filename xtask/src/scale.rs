@@ -1,8 +1,10 @@
 //! `cargo xtask scale`: DLA at the sizes of the variable-precision paper's largest runs, on this
-//! machine. Runs the `dla` release binary at 2D 1e7 and 1e8 and 3D 1e6 and 1e7 (with
-//! `--quick`: 2D 1e5 and 1e6, 3D 1e5 and 1e6), each with one and two threads, and reports wall
-//! and CPU time, peak memory, microseconds and bytes per particle, the fractal dimension and
-//! the prefactor; then projects the time and memory of 2D 1e9 and 3D 1e8.
+//! machine. Runs the `dla` release binary at 2D 1e6, 1e7, 3e7 and 1e8 and 3D 1e5, 1e6 and 1e7
+//! with one thread and at the two largest sizes of each also with two (with `--quick`: 2D 1e5
+//! and 1e6, 3D 1e5 and 1e6), and reports wall and CPU time, peak memory, microseconds and bytes
+//! per particle, the fractal dimension and the prefactor, and what the walkers did per particle
+//! (moves, map reads and jumps, tree queries, near-cache answers and rebuilds); then projects
+//! the time and memory of 2D 1e9 and 3D 1e8.
 //!
 //! The projection uses only measured data: the growth samples of the largest one-thread run
 //! give the time at every size, hence the marginal cost of a particle `m(N) = dT/dN`; over the
@@ -43,7 +45,23 @@ pub struct ScaleRun {
     pub times: Vec<(f64, f64)>,
     /// The command that made it.
     pub command: String,
+    /// What the walkers did (`results.walk_counts` of `run.json`), per particle, in the
+    /// order of [`WALK_COUNTS`].
+    pub walk: Vec<f64>,
 }
+
+/// The walk counts reported per particle (keys of `results.walk_counts`) and their column
+/// names.
+pub const WALK_COUNTS: [(&str, &str); 8] = [
+    ("moves", "moves"),
+    ("far_field", "far field"),
+    ("map_reads", "map reads"),
+    ("map_jumps", "map jumps"),
+    ("tree_queries", "tree queries"),
+    ("near_answers", "near-cache answers"),
+    ("near_rebuilds", "near-cache rebuilds"),
+    ("contact_tree", "contact searches in the tree"),
+];
 
 /// A projection to a size not run.
 #[derive(Debug, Clone, Copy)]
@@ -118,7 +136,22 @@ fn measure(
         }
     }
     let fit = Fit::log_log(&rg, &n).context("fitting N against R_g")?;
+    let counts = m
+        .results
+        .get("walk_counts")
+        .context("run.json has no results.walk_counts")?;
+    let walk = WALK_COUNTS
+        .iter()
+        .map(|(key, _)| {
+            counts
+                .get(key)
+                .and_then(|v| v.as_f64())
+                .map(|v| v / particles as f64)
+                .with_context(|| format!("run.json has no walk_counts.{key}"))
+        })
+        .collect::<Result<_>>()?;
     let run = ScaleRun {
+        walk,
         dim,
         particles,
         threads,
@@ -211,8 +244,12 @@ pub fn run(root: &Path, cargo: &str, quick: bool, out: Option<PathBuf>) -> Resul
         ]
     } else {
         &[
-            (2, &[10_000_000, 100_000_000], 1_000_000_000),
-            (3, &[1_000_000, 10_000_000], 100_000_000),
+            (
+                2,
+                &[1_000_000, 10_000_000, 30_000_000, 100_000_000],
+                1_000_000_000,
+            ),
+            (3, &[100_000, 1_000_000, 10_000_000], 100_000_000),
         ]
     };
     let out = out.unwrap_or_else(|| {
@@ -226,8 +263,13 @@ pub fn run(root: &Path, cargo: &str, quick: bool, out: Option<PathBuf>) -> Resul
     let mut runs = Vec::new();
     for &(dim, ns, _) in sizes {
         for &n in ns {
+            // Two threads at the two largest sizes of each dimension (the speed-up there
+            // goes into the projection); one thread everywhere.
+            let largest = ns.iter().rev().take(2).any(|&m| m == n);
             for threads in [1, 2] {
-                runs.push(measure(&bin, &work, dim, n, threads)?);
+                if threads == 1 || largest {
+                    runs.push(measure(&bin, &work, dim, n, threads)?);
+                }
             }
         }
     }
@@ -257,6 +299,18 @@ pub fn run(root: &Path, cargo: &str, quick: bool, out: Option<PathBuf>) -> Resul
             pm(r.fractal_dimension.0, r.fractal_dimension.1),
             format!("{:.3}", r.ln_prefactor),
         ]);
+    }
+    let mut names = vec!["D", "N", "threads"];
+    names.extend(WALK_COUNTS.iter().map(|(_, name)| *name));
+    let mut counts = Table::new(&names);
+    for r in &runs {
+        let mut row = vec![
+            r.dim.to_string(),
+            sig(r.particles as f64, 3),
+            r.threads.to_string(),
+        ];
+        row.extend(r.walk.iter().map(|v| format!("{v:.2}")));
+        counts.row(row);
     }
     let mut proj = Table::new(&[
         "D",
@@ -299,6 +353,17 @@ pub fn run(root: &Path, cargo: &str, quick: bool, out: Option<PathBuf>) -> Resul
     doc.h2("Measured");
     doc.table(&table);
     table.write_csv(&out.join("scale.csv"))?;
+    doc.h2("What the walkers did, per particle");
+    doc.p(
+        "From `results.walk_counts` of each run's `run.json`, divided by N. Every move is one \
+         of: a far-field return, a jump by a distance map's bound, a jump by the tree's or the \
+         near cache's distance, or a short step with a contact search. A map read is one per \
+         near-field move (it reads one cell of each map level it needs); tree queries are the \
+         variable-precision nearest-distance searches; near-cache rebuilds are range queries \
+         of the tree around a walker close to the cluster.",
+    );
+    doc.table(&counts);
+    counts.write_csv(&out.join("scale_counts.csv"))?;
     doc.h2("Projected");
     doc.p(
         "From the largest one-thread run of each dimension: the marginal cost of a particle \
