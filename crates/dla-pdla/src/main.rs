@@ -149,7 +149,8 @@ struct Cli {
     /// Side of the picture in dla.png and dla.gif in pixels (the axes and legend come on top),
     /// 16 to 65536, at most 16384 with --animate (default: dla.png one pixel per diameter, 512
     /// to 4096; dla.gif 512).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
+        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write dla.gif: the growth of the cluster, one frame every --animate-every particles and
