@@ -314,9 +314,6 @@ where
     Ok(sim)
 }
 
-/// Side of the picture in dla.gif without --png-size.
-const ANIMATION_DEFAULT_SIDE: u32 = 512;
-
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.
 const RUN_FILES: &[&str] = &["growth.csv", "positions.*", "dla.png", "dla.gif"];
@@ -427,7 +424,7 @@ where
             .unwrap_or_else(|| default_png_side(sim.r_ext()))
     });
     if cli.animate {
-        let side = cli.png_size.unwrap_or(ANIMATION_DEFAULT_SIDE);
+        let side = cli.png_size.unwrap_or(dla_pdla::picture::ANIMATION_DEFAULT_SIDE);
         let every = cli
             .animate_every
             .unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));

@@ -369,6 +369,9 @@ pub fn write_png_of_positions(
     of_positions(positions, dim, r_ext, seed)?.write_png(path, side)
 }
 
+/// Side of the picture in `dla.gif` when none is asked for (`--png-size`).
+pub const ANIMATION_DEFAULT_SIDE: u32 = 512;
+
 /// Particles between frames of the animation when none is asked for: about 100 frames.
 pub fn default_animation_every(particles: u64) -> u64 {
     particles.div_ceil(100).max(1)
