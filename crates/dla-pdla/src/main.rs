@@ -424,7 +424,9 @@ where
             .unwrap_or_else(|| default_png_side(sim.r_ext()))
     });
     if cli.animate {
-        let side = cli.png_size.unwrap_or(dla_pdla::picture::ANIMATION_DEFAULT_SIDE);
+        let side = cli
+            .png_size
+            .unwrap_or(dla_pdla::picture::ANIMATION_DEFAULT_SIDE);
         let every = cli
             .animate_every
             .unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));
