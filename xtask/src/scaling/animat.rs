@@ -3,7 +3,7 @@
 //! log-log gradients (Table I).
 
 use super::Ctx;
-use super::replot::Csv;
+use super::csvfile::Csv;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, pm, sig};
 use animat::bench::{SCALING_DENSITY, scaling_params, step_throughput};

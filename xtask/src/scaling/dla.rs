@@ -4,8 +4,8 @@
 //! fraction from Amdahl's law.
 
 use super::Ctx;
+use super::csvfile::Csv;
 use super::ensemble::Stats;
-use super::replot::Csv;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;

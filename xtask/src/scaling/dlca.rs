@@ -4,8 +4,8 @@
 //! cost against N for each strategy, and the fractal dimension in 2D to 5D beside the
 //! literature's (`dlca_dimension`).
 
+use super::csvfile::Csv;
 use super::ensemble::columns;
-use super::replot::Csv;
 use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, mean_stderr, pm, sig};

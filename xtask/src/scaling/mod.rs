@@ -8,6 +8,7 @@
 
 pub mod accuracy;
 pub mod animat;
+pub mod csvfile;
 pub mod dla;
 pub mod dlca;
 pub mod dlca_dimension;

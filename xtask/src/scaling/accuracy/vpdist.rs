@@ -4,7 +4,7 @@
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, sig};
 use crate::scaling::Ctx;
-use crate::scaling::replot::Csv;
+use crate::scaling::csvfile::Csv;
 use anyhow::Result;
 use core_lattice::rng::{stream, uniform01};
 use dla_pdla::{Params, Simulation};
