@@ -81,6 +81,22 @@ class DlaResult:
     params: Dict[str, Any]
     run_json: Dict[str, Any]
 
+    def save_png(self, path: Union[str, PathLike[str]], size: Optional[Count] = None) -> None:
+        """Write the ``dla`` binary's ``dla.png`` of this cluster, byte for byte the binary's
+        (the same Rust renderer); ``size`` is ``--png-size`` (16..=65536, default one pixel per
+        diameter, 512 to 4096)."""
+
+    def save_gif(
+        self,
+        path: Union[str, PathLike[str]],
+        size: Optional[Count] = None,
+        every: Optional[Count] = None,
+    ) -> int:
+        """Write the ``dla`` binary's ``dla.gif`` (the growth, a frame every ``every``
+        particles), byte for byte the binary's; ``size`` is ``--png-size`` (16..=16384,
+        default 512), ``every`` ``--animate-every`` (default a hundredth of N). Returns the
+        number of frames."""
+
 def dla(
     dim: int = ...,
     particles: Count = ...,
@@ -144,6 +160,11 @@ class DlcaResult:
     provenance: Dict[str, Any]
     params: Dict[str, Any]
     run_json: Dict[str, Any]
+
+    def save_png(self, path: Union[str, PathLike[str]], size: Optional[Count] = None) -> None:
+        """Write the ``dlca`` binary's ``dlca.png`` of this state, byte for byte the binary's
+        (the same Rust renderer); ``size`` is ``--png-size``, the picture's longer side
+        (16..=65536, default a whole number of pixels per site, at least 512)."""
 
 Size = Union[Count, str, Sequence[Count]]
 Boundary = Union[str, Sequence[str]]
@@ -266,6 +287,17 @@ class AnimatResult:
     provenance: Dict[str, Any]
     params: Dict[str, Any]
     run_json: Dict[str, Any]
+
+    def save_png(
+        self,
+        path: Union[str, PathLike[str]],
+        size: Optional[Count] = None,
+        frame_radius: Optional[Count] = None,
+    ) -> None:
+        """Write the ``animat`` binary's snapshot of this world (its last
+        ``snapshot_NNNNNN.png``), byte for byte the binary's (the same Rust renderer), on the
+        run's fixed frame; ``size`` is ``--png-size`` (16..=65536), ``frame_radius``
+        ``--frame-radius`` (default three start radii)."""
 
 GridBox = Union[int, Literal["vision", "none"]]
 

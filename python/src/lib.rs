@@ -9,11 +9,13 @@
 //! | `run` | running on a worker thread without the GIL: Ctrl-C, progress |
 //! | `convert` | `run.json` onto result attributes, count arguments, columns as arrays |
 //! | `dla`, `dlca`, `animat` | one model each: its function, result class and step-wise class |
+//! | `figure` | the binaries' figures from a result's arrays, by the libraries' picture code |
 
 mod animat;
 mod convert;
 mod dla;
 mod dlca;
+mod figure;
 mod run;
 
 use pyo3::prelude::*;

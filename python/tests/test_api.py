@@ -43,6 +43,10 @@ CALLABLES = [
     (aggsim.AnimatWorld, stub("__init__", "AnimatWorld")),
     (aggsim.AnimatWorld.step, stub("step", "AnimatWorld")),
     (aggsim.defaults, stub("defaults")),
+    (aggsim.DlaResult.save_png, stub("save_png", "DlaResult")),
+    (aggsim.DlaResult.save_gif, stub("save_gif", "DlaResult")),
+    (aggsim.DlcaResult.save_png, stub("save_png", "DlcaResult")),
+    (aggsim.AnimatResult.save_png, stub("save_png", "AnimatResult")),
 ]
 
 

@@ -65,8 +65,10 @@ enum Cmd {
         /// Run size: overrides --quick (`tiny` is the harness test's size).
         #[arg(long, value_enum, hide = true)]
         scale: Option<Scale>,
-        /// Run nothing: draw the charts again from the CSVs in the output directory (the
-        /// accuracy sweeps' Pareto charts), for a change of the charts' style.
+        /// Run nothing: draw every chart again whose CSV is in the output directory (the
+        /// accuracy sweeps' Pareto charts, Fig. 3, 5, 6, 9, the DLCA histograms and cost, the
+        /// vpdist errors), with the functions the experiments draw them with, for a change of
+        /// the charts' style.
         #[arg(long)]
         replot: bool,
     },
@@ -150,13 +152,19 @@ fn main() -> Result<()> {
                 }
             });
             if replot {
-                let written = xtask::scaling::accuracy::replot(&out)?;
-                for p in &written {
+                let done = xtask::scaling::replot::replot(&out)?;
+                for p in &done.written {
                     eprintln!("==> {}", p.display());
                 }
+                for csv in &done.missing {
+                    eprintln!(
+                        "    no {csv} in {}: its chart is left as it is",
+                        out.display()
+                    );
+                }
                 anyhow::ensure!(
-                    !written.is_empty(),
-                    "no accuracy CSV to replot in {}",
+                    !done.written.is_empty(),
+                    "no chart CSV to replot in {}",
                     out.display()
                 );
                 return Ok(());

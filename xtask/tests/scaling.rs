@@ -4,6 +4,7 @@
 use core_lattice::Fit;
 use core_lattice::rng::{stream, uniform01};
 use std::path::{Path, PathBuf};
+use xtask::scaling::replot::{CHARTS, replot};
 use xtask::scaling::{Experiment, Options, Scale, run};
 
 fn read(dir: &Path, file: &str) -> String {
@@ -77,6 +78,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
     }
     for csv in [
         "dlca_fig5.csv",
+        "dlca_fig5_mean.csv",
         "dlca_fig5_summary.csv",
         "dlca_fig6.csv",
         "dlca_fig6_summary.csv",
@@ -97,6 +99,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "accuracy.csv",
         "accuracy_vpdist.csv",
         "accuracy_vpdist_hist.csv",
+        "accuracy_vpdist_ccdf.csv",
     ] {
         check_csv(d, csv);
     }
@@ -168,6 +171,77 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         .collect();
     assert_eq!(dims, ["2", "3", "4", "5"], "{dlca_dims}");
     assert!(dlca_dims.contains("2.25-2.30 ± 0.2"), "{dlca_dims}");
+
+    // --replot draws every chart from the CSVs with the run's own functions: each PNG again,
+    // byte for byte, and none left out.
+    let before: Vec<(String, Vec<u8>)> = pngs(d)
+        .into_iter()
+        .map(|p| (p.clone(), std::fs::read(d.join(&p)).unwrap()))
+        .collect();
+    for (p, _) in &before {
+        std::fs::remove_file(d.join(p)).unwrap();
+    }
+    let done = replot(d).unwrap();
+    assert!(done.missing.is_empty(), "{:?}", done.missing);
+    assert_eq!(done.written.len(), before.len());
+    for (p, bytes) in &before {
+        let again = std::fs::read(d.join(p)).unwrap_or_else(|e| panic!("{p} not replotted: {e}"));
+        assert!(again == *bytes, "{p} replotted differently");
+    }
+}
+
+/// The PNG files in `dir`, sorted.
+fn pngs(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// `cargo xtask scaling --replot` on the committed results (their CSVs copied into a temporary
+/// directory): every chart whose CSV is committed is drawn, a well-formed PNG, and every chart
+/// committed in docs/results is one of them unless its CSV is missing there.
+#[test]
+fn the_committed_results_replot() {
+    let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/results");
+    let dir = tempfile::tempdir().unwrap();
+    for e in std::fs::read_dir(&results).unwrap() {
+        let e = e.unwrap();
+        if e.file_name().to_string_lossy().ends_with(".csv") {
+            std::fs::copy(e.path(), dir.path().join(e.file_name())).unwrap();
+        }
+    }
+    let done = replot(dir.path()).unwrap();
+    for chart in CHARTS {
+        assert_eq!(
+            results.join(chart.csv).exists(),
+            !done.missing.contains(&chart.csv),
+            "{}",
+            chart.csv
+        );
+    }
+    let drawn = pngs(dir.path());
+    assert_eq!(drawn.len(), done.written.len());
+    for png in &drawn {
+        check_png(dir.path(), png);
+    }
+    // Committed charts not drawn are those whose CSV is not committed (drawn before their
+    // CSV existed).
+    let not_drawn: Vec<String> = pngs(&results)
+        .into_iter()
+        .filter(|p| !drawn.contains(p))
+        .collect();
+    assert!(
+        not_drawn
+            .iter()
+            .all(|p| ["dlca_fig5.png", "accuracy_vpdist.png"].contains(&p.as_str())),
+        "{not_drawn:?}"
+    );
+    assert!(drawn.contains(&"dla_fig3.png".to_string()));
+    assert!(drawn.contains(&"dlca_histogram_5pct.png".to_string()));
 }
 
 #[test]

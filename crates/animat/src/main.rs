@@ -100,7 +100,8 @@ struct Cli {
     /// Side of the picture in the snapshots and animat.gif in pixels (the axes and legend come
     /// on top), 16 to 65536, at most 16384 with --animate (default: a whole number of pixels
     /// per cell and at least 512, or one per cell up to 1024).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
+        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write animat.gif: the world at the start, every --animate-every steps and at the end.

@@ -184,14 +184,42 @@ pub struct SnapshotFrame {
     pub side: u32,
 }
 
+/// What a snapshot's header names: the step, the populations and the seed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Census {
+    /// Steps made.
+    pub steps: u64,
+    /// Live foxes.
+    pub foxes: u64,
+    /// Live rabbits.
+    pub rabbits: u64,
+    /// The run's seed.
+    pub seed: u64,
+}
+
+impl Census {
+    /// The census of `world` now.
+    pub fn of(world: &World) -> Self {
+        Census {
+            steps: world.steps(),
+            foxes: world.foxes(),
+            rabbits: world.rabbits(),
+            seed: world.seed(),
+        }
+    }
+}
+
 impl SnapshotFrame {
     /// The frame for `params`: `radius` cells (default: three start radii, as a population
     /// spreads) and `side` pixels (default: a whole number of pixels per cell and at least
     /// [`SNAPSHOT_MIN_SIDE`], or one pixel per cell up to [`SNAPSHOT_MAX_SIDE`]).
     pub fn new(params: &crate::Params, radius: Option<i64>, side: Option<u32>) -> Self {
-        let radius = radius
-            .unwrap_or(params.start_radius.saturating_mul(3))
-            .max(1);
+        Self::for_start_radius(params.start_radius, radius, side)
+    }
+
+    /// [`SnapshotFrame::new`] for a run whose start radius is `start_radius` cells.
+    pub fn for_start_radius(start_radius: i64, radius: Option<i64>, side: Option<u32>) -> Self {
+        let radius = radius.unwrap_or(start_radius.saturating_mul(3)).max(1);
         let cells = i128::from(radius) * 2 + 1;
         let side = side.unwrap_or_else(|| {
             let min = i128::from(SNAPSHOT_MIN_SIDE);
@@ -207,6 +235,15 @@ impl SnapshotFrame {
     /// The picture of `world`: foxes (drawn over rabbits where both share a pixel) and rabbits
     /// on white, and the number of animats outside the frame.
     pub fn raster(&self, world: &World) -> (Raster, u64) {
+        self.raster_of(|| world.animats().map(|a| (a.pos, a.species)))
+    }
+
+    /// The picture of the animats `animats()` yields (cell and species; called twice, for
+    /// the rabbits and then the foxes over them), as [`SnapshotFrame::raster`].
+    pub fn raster_of<I: Iterator<Item = ([i64; 2], Species)>>(
+        &self,
+        animats: impl Fn() -> I,
+    ) -> (Raster, u64) {
         let mut r = Raster::new(self.side, self.side, palette::WHITE);
         let cells = i128::from(self.radius) * 2 + 1;
         let side = i128::from(self.side);
@@ -222,9 +259,9 @@ impl SnapshotFrame {
                 Species::Fox => palette::FOX,
                 Species::Rabbit => palette::RABBIT,
             };
-            for a in world.animats().filter(|a| a.species == species) {
-                let x = i128::from(a.pos[0]) + i128::from(self.radius);
-                let y = i128::from(self.radius) - i128::from(a.pos[1]);
+            for (pos, _) in animats().filter(|a| a.1 == species) {
+                let x = i128::from(pos[0]) + i128::from(self.radius);
+                let y = i128::from(self.radius) - i128::from(pos[1]);
                 if !(0..cells).contains(&x) || !(0..cells).contains(&y) {
                     outside += 1;
                     continue;
@@ -241,13 +278,18 @@ impl SnapshotFrame {
 
     /// The figure of `world` on this frame (`raster` from [`SnapshotFrame::raster`]).
     pub fn figure<'a>(&self, world: &World, raster: &'a Raster, outside: u64) -> Figure<'a> {
+        self.figure_of(Census::of(world), raster, outside)
+    }
+
+    /// The figure of a picture from [`SnapshotFrame::raster_of`], its header from `census`.
+    pub fn figure_of<'a>(&self, census: Census, raster: &'a Raster, outside: u64) -> Figure<'a> {
         let edge = self.radius as f64 + 0.5;
         let mut header = format!(
             "Animats, step {}: {} foxes, {} rabbits, seed {}",
-            group_digits(world.steps()),
-            group_digits(world.foxes()),
-            group_digits(world.rabbits()),
-            world.seed()
+            group_digits(census.steps),
+            group_digits(census.foxes),
+            group_digits(census.rabbits),
+            census.seed
         );
         if outside > 0 {
             header.push_str(&format!("; {} outside", group_digits(outside)));
@@ -347,5 +389,34 @@ mod schema_tests {
         for s in [Species::Fox, Species::Rabbit] {
             assert_eq!(SPECIES_NAMES[s.code() as usize], s.name());
         }
+    }
+}
+
+#[cfg(test)]
+mod snapshot_tests {
+    use super::*;
+
+    #[test]
+    fn a_snapshot_of_columns_is_the_worlds() {
+        let mut w = World::new(crate::Params::default(), 3).unwrap();
+        w.run(20);
+        // The animats as the Python bindings hold them: cells and species codes.
+        let rows: Vec<([i64; 2], u64)> = w.animats().map(|a| (a.pos, a.species.code())).collect();
+        // The default frame, and one with several cells a pixel and animats outside.
+        for frame in [
+            SnapshotFrame::new(w.params(), None, None),
+            SnapshotFrame::for_start_radius(w.params().start_radius, Some(40), Some(30)),
+        ] {
+            let (a, out_a) = frame.raster(&w);
+            let (b, out_b) = frame.raster_of(|| {
+                rows.iter()
+                    .map(|&(p, c)| (p, Species::from_code(c).unwrap()))
+            });
+            assert_eq!((a.clone(), out_a), (b.clone(), out_b));
+            let fa = frame.figure(&w, &a, out_a).render().unwrap();
+            let fb = frame.figure_of(Census::of(&w), &b, out_b).render().unwrap();
+            assert_eq!(fa, fb);
+        }
+        assert_eq!(Species::from_code(2), None);
     }
 }

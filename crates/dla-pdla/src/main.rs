@@ -149,7 +149,8 @@ struct Cli {
     /// Side of the picture in dla.png and dla.gif in pixels (the axes and legend come on top),
     /// 16 to 65536, at most 16384 with --animate (default: dla.png one pixel per diameter, 512
     /// to 4096; dla.gif 512).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
+        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write dla.gif: the growth of the cluster, one frame every --animate-every particles and
@@ -313,9 +314,6 @@ where
     Ok(sim)
 }
 
-/// Side of the picture in dla.gif without --png-size.
-const ANIMATION_DEFAULT_SIDE: u32 = 512;
-
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.
 const RUN_FILES: &[&str] = &["growth.csv", "positions.*", "dla.png", "dla.gif"];
@@ -426,7 +424,9 @@ where
             .unwrap_or_else(|| default_png_side(sim.r_ext()))
     });
     if cli.animate {
-        let side = cli.png_size.unwrap_or(ANIMATION_DEFAULT_SIDE);
+        let side = cli
+            .png_size
+            .unwrap_or(dla_pdla::picture::ANIMATION_DEFAULT_SIDE);
         let every = cli
             .animate_every
             .unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));

@@ -213,6 +213,129 @@ impl Canvas {
     }
 }
 
+/// A finished cluster as its figures read it: dimension, R_ext (the frame), size, seed, and a
+/// pass over its positions in arrival order, `each(f)` calling `f(i, position)` for every
+/// particle (called twice for a density animation).
+struct Cluster<F> {
+    dim: usize,
+    r_ext: f64,
+    total: u64,
+    seed: u64,
+    each: F,
+}
+
+/// A callback over the positions of a cluster: arrival index and coordinates.
+type Visit<'v> = dyn FnMut(u64, &[f64]) -> Result<(), OutputError> + 'v;
+
+impl<F> Cluster<F>
+where
+    F: Fn(&mut Visit<'_>) -> Result<(), OutputError>,
+{
+    fn write_png(&self, path: &Path, side: u32) -> Result<(), OutputError> {
+        let mut canvas = Canvas::new(side, self.r_ext, self.total, self.dim);
+        (self.each)(&mut |i, p| {
+            canvas.add(i, p);
+            Ok(())
+        })?;
+        let map = Sequential::magma_on_white();
+        let top = canvas.max_count();
+        let raster = canvas.raster(&map, top);
+        canvas
+            .figure(&raster, self.dim, self.seed, self.total, top)
+            .write_png(path)?;
+        Ok(())
+    }
+
+    fn write_animation(&self, path: &Path, side: u32, every: u64) -> Result<u64, OutputError> {
+        let total = self.total;
+        let mut canvas = Canvas::new(side, self.r_ext, total, self.dim);
+        // A density picture's colours run to the finished cluster's densest pixel, so that a
+        // colour means the same count in every frame: one pass first to find it.
+        let top = if canvas.mode == Mode::Density {
+            let mut full = Canvas::new(side, self.r_ext, total, self.dim);
+            (self.each)(&mut |i, p| {
+                full.add(i, p);
+                Ok(())
+            })?;
+            full.max_count()
+        } else {
+            0
+        };
+        let map = Sequential::magma_on_white();
+        let every = every.max(1);
+        let mut gif: Option<Gif> = None;
+        let mut frame = |canvas: &Canvas, shown: u64| -> Result<(), OutputError> {
+            let raster = canvas.raster(&map, top);
+            let image = canvas
+                .figure(&raster, self.dim, self.seed, shown, top)
+                .render()?;
+            let g = match &mut gif {
+                Some(g) => g,
+                None => gif.insert(Gif::create(path, image.width, image.height)?),
+            };
+            g.push(&image)?;
+            Ok(())
+        };
+        (self.each)(&mut |i, p| {
+            canvas.add(i, p);
+            let shown = i + 1;
+            if shown % every == 0 && shown < total {
+                frame(&canvas, shown)?;
+            }
+            Ok(())
+        })?;
+        frame(&canvas, total)?;
+        Ok(gif.map(Gif::finish).transpose()?.unwrap_or(0))
+    }
+}
+
+/// The cluster of a simulation: its positions from memory, or read back from
+/// `dir/positions.npy`.
+fn of_sim<'s, const D: usize>(
+    sim: &'s Simulation<D>,
+    dir: &'s Path,
+) -> Cluster<impl Fn(&mut Visit<'_>) -> Result<(), OutputError> + 's>
+where
+    Dim<D>: Space<D>,
+{
+    Cluster {
+        dim: D,
+        r_ext: sim.r_ext(),
+        total: sim.particles(),
+        seed: sim.seed(),
+        each: move |f: &mut Visit<'_>| each_position(sim, dir, |i, p: &[f64; D]| f(i, p)),
+    }
+}
+
+/// The cluster of `positions`, `dim` coordinates a particle in arrival order (row-major, as
+/// the Python bindings hold them).
+fn of_positions(
+    positions: &[f64],
+    dim: usize,
+    r_ext: f64,
+    seed: u64,
+) -> Result<Cluster<impl Fn(&mut Visit<'_>) -> Result<(), OutputError>>, OutputError> {
+    if !(2..=5).contains(&dim) || positions.len() % dim != 0 || positions.is_empty() {
+        return Err(std::io::Error::other(format!(
+            "positions of {} numbers do not hold whole particles of {dim} coordinates (2 to 5)",
+            positions.len()
+        ))
+        .into());
+    }
+    Ok(Cluster {
+        dim,
+        r_ext,
+        total: (positions.len() / dim) as u64,
+        seed,
+        each: move |f: &mut Visit<'_>| {
+            for (i, p) in positions.chunks_exact(dim).enumerate() {
+                f(i as u64, p)?;
+            }
+            Ok(())
+        },
+    })
+}
+
 /// Writes `dla.png` of `side` x `side` pixels of picture (plus axes and legend) to `path`.
 ///
 /// # Errors
@@ -226,19 +349,28 @@ pub fn write_png<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
-    let mut canvas = Canvas::new(side, sim.r_ext(), sim.particles(), D);
-    each_position(sim, dir, |i, p: &[f64; D]| {
-        canvas.add(i, p);
-        Ok(())
-    })?;
-    let map = Sequential::magma_on_white();
-    let top = canvas.max_count();
-    let raster = canvas.raster(&map, top);
-    canvas
-        .figure(&raster, D, sim.seed(), sim.particles(), top)
-        .write_png(path)?;
-    Ok(())
+    of_sim(sim, dir).write_png(path, side)
 }
+
+/// Writes the figure [`write_png`] draws for a cluster held as `positions`: `dim` coordinates
+/// a particle, in arrival order, row-major; `r_ext` and `seed` are the run's (its
+/// `run.json`'s). For the same cluster the file is byte for byte the binary's `dla.png`.
+///
+/// # Errors
+/// The positions are not whole particles of 2 to 5 coordinates, or the file cannot be written.
+pub fn write_png_of_positions(
+    positions: &[f64],
+    dim: usize,
+    r_ext: f64,
+    seed: u64,
+    path: &Path,
+    side: u32,
+) -> Result<(), OutputError> {
+    of_positions(positions, dim, r_ext, seed)?.write_png(path, side)
+}
+
+/// Side of the picture in `dla.gif` when none is asked for (`--png-size`).
+pub const ANIMATION_DEFAULT_SIDE: u32 = 512;
 
 /// Particles between frames of the animation when none is asked for: about 100 frames.
 pub fn default_animation_every(particles: u64) -> u64 {
@@ -262,48 +394,78 @@ pub fn write_animation<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
-    let total = sim.particles();
-    let mut canvas = Canvas::new(side, sim.r_ext(), total, D);
-    // A density picture's colours run to the finished cluster's densest pixel, so that a
-    // colour means the same count in every frame: one pass first to find it.
-    let top = if canvas.mode == Mode::Density {
-        let mut full = Canvas::new(side, sim.r_ext(), total, D);
-        each_position(sim, dir, |i, p: &[f64; D]| {
-            full.add(i, p);
-            Ok(())
-        })?;
-        full.max_count()
-    } else {
-        0
-    };
-    let map = Sequential::magma_on_white();
-    let every = every.max(1);
-    let mut gif: Option<Gif> = None;
-    let mut frame = |canvas: &Canvas, shown: u64| -> Result<(), OutputError> {
-        let raster = canvas.raster(&map, top);
-        let image = canvas.figure(&raster, D, sim.seed(), shown, top).render()?;
-        let g = match &mut gif {
-            Some(g) => g,
-            None => gif.insert(Gif::create(path, image.width, image.height)?),
-        };
-        g.push(&image)?;
-        Ok(())
-    };
-    each_position(sim, dir, |i, p: &[f64; D]| {
-        canvas.add(i, p);
-        let shown = i + 1;
-        if shown % every == 0 && shown < total {
-            frame(&canvas, shown)?;
-        }
-        Ok(())
-    })?;
-    frame(&canvas, total)?;
-    Ok(gif.map(Gif::finish).transpose()?.unwrap_or(0))
+    of_sim(sim, dir).write_animation(path, side, every)
+}
+
+/// [`write_animation`] of a cluster held as `positions` (as [`write_png_of_positions`]): the
+/// binary's `dla.gif` for the same cluster, `side` and `every`.
+///
+/// # Errors
+/// The positions are not whole particles of 2 to 5 coordinates, or the file cannot be written.
+pub fn write_animation_of_positions(
+    positions: &[f64],
+    dim: usize,
+    r_ext: f64,
+    seed: u64,
+    path: &Path,
+    side: u32,
+    every: u64,
+) -> Result<u64, OutputError> {
+    of_positions(positions, dim, r_ext, seed)?.write_animation(path, side, every)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A cluster of `n` particles in `D` dimensions, its positions kept, and them flattened.
+    fn grown<const D: usize>(n: u64) -> (Simulation<D>, Vec<f64>)
+    where
+        Dim<D>: Space<D>,
+    {
+        let p = crate::Params {
+            dim: D,
+            particles: n,
+            keep_positions: true,
+            ..crate::Params::default()
+        };
+        let mut sim = Simulation::<D>::new(p, 5).unwrap();
+        sim.run().unwrap();
+        let flat = sim.positions().unwrap().iter().flatten().copied().collect();
+        (sim, flat)
+    }
+
+    #[test]
+    fn figures_of_positions_are_the_simulations_byte_for_byte() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        let (sim2, flat2) = grown::<2>(300);
+        let (sim3, flat3) = grown::<3>(200);
+        // Discs, spheres and density (a picture narrower than the cluster).
+        for (side, dim) in [(64, 2), (512, 2), (48, 3), (16, 2)] {
+            if dim == 2 {
+                write_png(&sim2, dir.path(), &a, side).unwrap();
+                write_png_of_positions(&flat2, 2, sim2.r_ext(), sim2.seed(), &b, side).unwrap();
+            } else {
+                write_png(&sim3, dir.path(), &a, side).unwrap();
+                write_png_of_positions(&flat3, 3, sim3.r_ext(), sim3.seed(), &b, side).unwrap();
+            }
+            assert_eq!(
+                std::fs::read(&a).unwrap(),
+                std::fs::read(&b).unwrap(),
+                "{side}"
+            );
+        }
+        let (ga, gb) = (dir.path().join("a.gif"), dir.path().join("b.gif"));
+        assert_eq!(write_animation(&sim2, dir.path(), &ga, 24, 50).unwrap(), 6);
+        let frames =
+            write_animation_of_positions(&flat2, 2, sim2.r_ext(), sim2.seed(), &gb, 24, 50);
+        assert_eq!(frames.unwrap(), 6);
+        assert_eq!(std::fs::read(&ga).unwrap(), std::fs::read(&gb).unwrap());
+        // Positions that are not whole particles are refused.
+        assert!(write_png_of_positions(&flat2[1..], 2, 1.0, 1, &b, 16).is_err());
+        assert!(write_png_of_positions(&[], 2, 1.0, 1, &b, 16).is_err());
+    }
 
     #[test]
     fn the_mode_follows_the_scale_and_dimension() {

@@ -150,7 +150,8 @@ struct Cli {
     /// Longer side of the picture in dlca.png and dlca.gif in pixels (the axes and legend come
     /// on top), 16 to 65536, at most 16384 with --animate (default: dlca.png a whole number of
     /// pixels per site and at least 512, or one per site up to 8192; dlca.gif 512).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(16..=65536))]
+    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
+        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write dlca.gif: the aggregation, a frame of the start, one every --animate-every sweeps

@@ -24,12 +24,62 @@ pub const PNG_MIN_SIDE: u64 = 512;
 /// Largest default longer side of the picture: a larger lattice is scaled down.
 pub const PNG_MAX_SIDE: u64 = 8192;
 
-/// Width and height of the picture of `sim`'s lattice whose longer side is `side` pixels
+/// What the figures show of a lattice's state: its sizes, the run's progress and seed, and a
+/// pass over its particles in the order of `particles.csv` (clusters by increasing id, each
+/// cluster's sites by increasing k-index), `each(f)` calling `f(x1, x2, cluster id)` with the
+/// site's first two coordinates (`x2` 0 on a 1D lattice). Where sites share a pixel the last
+/// one drawn shows, so the order is part of the picture.
+pub struct View<'a, F> {
+    /// The lattice's side along each axis.
+    pub sizes: &'a [u64],
+    /// Sweeps made.
+    pub sweeps: u64,
+    /// Live clusters.
+    pub clusters: u64,
+    /// Particles.
+    pub particles: u64,
+    /// The run's seed.
+    pub seed: u64,
+    /// The pass over the particles.
+    pub each: F,
+}
+
+/// A callback over the particles of a [`View`]: site coordinates on the first two axes and
+/// cluster id.
+pub type Visit<'v> = dyn FnMut(u64, u64, u32) + 'v;
+
+/// The view of `sim`'s state (its particles straight from the simulation).
+pub fn view(sim: &Simulation, seed: u64) -> View<'_, impl Fn(&mut Visit<'_>) + '_> {
+    let l = sim.lattice();
+    View {
+        sizes: l.sizes(),
+        sweeps: sim.sweeps(),
+        clusters: sim.clusters(),
+        particles: sim.particles(),
+        seed,
+        each: move |f: &mut Visit<'_>| {
+            let _ = sim.try_for_each_particle(|id, k| {
+                f(
+                    l.coord(k, 0),
+                    if l.dim() >= 2 { l.coord(k, 1) } else { 0 },
+                    id,
+                );
+                Ok::<(), std::convert::Infallible>(())
+            });
+        },
+    }
+}
+
+/// The first two sides of a lattice (the second 1 on a 1D lattice).
+fn plane(sizes: &[u64]) -> (u64, u64) {
+    (sizes[0], sizes.get(1).copied().unwrap_or(1))
+}
+
+/// Width and height of the picture of a lattice of `sizes` whose longer side is `side` pixels
 /// (default: a whole number of pixels per site, at least [`PNG_MIN_SIDE`], or one pixel per
 /// site up to [`PNG_MAX_SIDE`]); the shorter side keeps the lattice's proportions.
-pub fn picture_size(sim: &Simulation, side: Option<u32>) -> (u32, u32) {
-    let l = sim.lattice();
-    let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
+pub fn picture_size(sizes: &[u64], side: Option<u32>) -> (u32, u32) {
+    let (w0, h0) = plane(sizes);
     let long = w0.max(h0);
     let side = match side {
         Some(s) => u64::from(s),
@@ -48,27 +98,22 @@ pub fn png_memory_bytes(w: u64, h: u64) -> u64 {
 
 /// The cluster id shown at each pixel of a `w` x `h` picture (`u32::MAX`: no particle), row 0
 /// at the top. Sites map to the pixels of their share of the picture (at least one each).
-fn labels(sim: &Simulation, (w, h): (u32, u32)) -> Vec<u32> {
-    let l = sim.lattice();
-    let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
+fn labels<F: Fn(&mut Visit<'_>)>(view: &View<'_, F>, (w, h): (u32, u32)) -> Vec<u32> {
+    let (w0, h0) = plane(view.sizes);
     let span = |c: u64, n: u64, px: u32| {
         let a = (c as f64 * f64::from(px) / n as f64) as u32;
         let b = ((((c + 1) as f64 * f64::from(px) / n as f64) as u32).max(a + 1)).min(px);
         a.min(px - 1)..b
     };
     let mut ids = vec![u32::MAX; w as usize * h as usize];
-    for &id in sim.sets().live() {
-        for &k in sim.sets().sites(id) {
-            let x = l.coord(k, 0);
-            let y = if l.dim() >= 2 { l.coord(k, 1) } else { 0 };
-            // Row 0 at the top: flip y so the last axis points up, as gravity pulls down.
-            for py in span(h0 - 1 - y, h0, h) {
-                for px in span(x, w0, w) {
-                    ids[py as usize * w as usize + px as usize] = id;
-                }
+    (view.each)(&mut |x, y, id| {
+        // Row 0 at the top: flip y so the last axis points up, as gravity pulls down.
+        for py in span(h0 - 1 - y, h0, h) {
+            for px in span(x, w0, w) {
+                ids[py as usize * w as usize + px as usize] = id;
             }
         }
-    }
+    });
     ids
 }
 
@@ -79,15 +124,15 @@ fn reach((w, h): (u32, u32)) -> usize {
     (w.max(h) as usize / 32).max(3)
 }
 
-/// The picture of `sim` and the colour (index into [`ON_BLACK`]) of each cluster in it, each
+/// The picture of `view` and the colour (index into [`ON_BLACK`]) of each cluster in it, each
 /// cluster keeping its colour in `previous` where no neighbour has it; the last value counts
 /// clusters that had to share a colour with a neighbour (none on a 2D lattice in practice).
-fn draw(
-    sim: &Simulation,
+fn draw<F: Fn(&mut Visit<'_>)>(
+    view: &View<'_, F>,
     size: (u32, u32),
     previous: &HashMap<u32, usize>,
 ) -> (Raster, HashMap<u32, usize>, usize) {
-    let ids = labels(sim, size);
+    let ids = labels(view, size);
     let (colours, clashes) = colour_regions(
         &ids,
         size.0 as usize,
@@ -105,17 +150,16 @@ fn draw(
     (r, colours, clashes)
 }
 
-/// The figure of a picture of `sim`.
-fn figure<'a>(sim: &Simulation, seed: u64, raster: &'a Raster) -> Figure<'a> {
-    let l = sim.lattice();
-    let sizes: Vec<String> = l.sizes().iter().map(u64::to_string).collect();
-    let (w0, h0) = (l.size(0), if l.dim() >= 2 { l.size(1) } else { 1 });
+/// The figure of a picture of `view`.
+fn figure<'a, F>(view: &View<'_, F>, raster: &'a Raster) -> Figure<'a> {
+    let sizes: Vec<String> = view.sizes.iter().map(u64::to_string).collect();
+    let (w0, h0) = plane(view.sizes);
     let mut note = vec![
         "one colour per cluster;".to_string(),
         "neighbouring clusters".to_string(),
         "always differ".to_string(),
     ];
-    if l.dim() >= 3 {
+    if view.sizes.len() >= 3 {
         note.push(String::new());
         note.push("projection on x1, x2".into());
     }
@@ -128,11 +172,12 @@ fn figure<'a>(sim: &Simulation, seed: u64, raster: &'a Raster) -> Figure<'a> {
         unit: "lattice cells".into(),
         axes: ("x1".into(), "x2".into()),
         header: format!(
-            "DLCA {}, sweep {}: {} clusters, {} particles, seed {seed}",
+            "DLCA {}, sweep {}: {} clusters, {} particles, seed {}",
             sizes.join("x"),
-            group_digits(sim.sweeps()),
-            group_digits(sim.clusters()),
-            group_digits(sim.particles()),
+            group_digits(view.sweeps),
+            group_digits(view.clusters),
+            group_digits(view.particles),
+            view.seed,
         ),
         legend: Legend::Note(note),
     }
@@ -149,11 +194,50 @@ pub fn write_png(
     path: &Path,
     side: Option<u32>,
 ) -> Result<(), OutputError> {
-    let (raster, _, clashes) = draw(sim, picture_size(sim, side), &HashMap::new());
+    png(&view(sim, seed), path, side)
+}
+
+/// Writes the figure of `view` as [`write_png`] does: for the view of a state (its particles
+/// in the order of `particles.csv`, as the Python bindings hold them), the binary's `dlca.png`
+/// byte for byte.
+///
+/// # Errors
+/// The view has no axis or a site outside the lattice, or the file cannot be written.
+pub fn write_png_of<F: Fn(&mut Visit<'_>)>(
+    view: &View<'_, F>,
+    path: &Path,
+    side: Option<u32>,
+) -> Result<(), OutputError> {
+    if view.sizes.is_empty() || view.sizes.contains(&0) {
+        return Err(std::io::Error::other("a lattice picture needs sides of 1 or more").into());
+    }
+    let (w0, h0) = plane(view.sizes);
+    let mut outside = None;
+    (view.each)(&mut |x, y, _| {
+        if x >= w0 || y >= h0 {
+            outside.get_or_insert((x, y));
+        }
+    });
+    if let Some((x, y)) = outside {
+        return Err(std::io::Error::other(format!(
+            "site ({x}, {y}) is outside the {w0}x{h0} lattice"
+        ))
+        .into());
+    }
+    png(view, path, side)
+}
+
+/// [`write_png_of`] without the checks of the view (a simulation's always passes them).
+fn png<F: Fn(&mut Visit<'_>)>(
+    view: &View<'_, F>,
+    path: &Path,
+    side: Option<u32>,
+) -> Result<(), OutputError> {
+    let (raster, _, clashes) = draw(view, picture_size(view.sizes, side), &HashMap::new());
     if clashes > 0 {
         tracing::warn!("{clashes} clusters in dlca.png share a colour with a neighbour");
     }
-    figure(sim, seed, &raster).write_png(path)?;
+    figure(view, &raster).write_png(path)?;
     Ok(())
 }
 
@@ -174,9 +258,10 @@ impl Animation {
     /// # Errors
     /// The file cannot be created or the frame not drawn.
     pub fn start(sim: &Simulation, seed: u64, path: &Path, side: u32) -> Result<Self, OutputError> {
-        let size = picture_size(sim, Some(side));
-        let (raster, colours, _) = draw(sim, size, &HashMap::new());
-        let image = figure(sim, seed, &raster).render()?;
+        let view = view(sim, seed);
+        let size = picture_size(view.sizes, Some(side));
+        let (raster, colours, _) = draw(&view, size, &HashMap::new());
+        let image = figure(&view, &raster).render()?;
         let mut gif = Gif::create(path, image.width, image.height)?;
         gif.push(&image)?;
         Ok(Animation {
@@ -192,9 +277,10 @@ impl Animation {
     /// # Errors
     /// The frame cannot be drawn or written.
     pub fn frame(&mut self, sim: &Simulation) -> Result<(), OutputError> {
-        let (raster, colours, _) = draw(sim, self.size, &self.colours);
+        let view = view(sim, self.seed);
+        let (raster, colours, _) = draw(&view, self.size, &self.colours);
         self.colours = colours;
-        let image = figure(sim, self.seed, &raster).render()?;
+        let image = figure(&view, &raster).render()?;
         self.gif.push(&image)?;
         Ok(())
     }
@@ -228,10 +314,10 @@ mod tests {
     #[test]
     fn neighbouring_clusters_have_different_colours() {
         let sim = small_run();
-        let size = picture_size(&sim, Some(96));
+        let size = picture_size(sim.lattice().sizes(), Some(96));
         assert_eq!(size, (96, 64));
-        let ids = labels(&sim, size);
-        let (r, colours, clashes) = draw(&sim, size, &HashMap::new());
+        let ids = labels(&view(&sim, 7), size);
+        let (r, colours, clashes) = draw(&view(&sim, 7), size, &HashMap::new());
         assert_eq!(clashes, 0);
         assert!(
             colours
@@ -280,10 +366,61 @@ mod tests {
     }
 
     #[test]
+    fn figures_of_a_view_from_arrays_are_the_simulations_byte_for_byte() {
+        let mut sim3 = Simulation::new(
+            Params {
+                size: vec![12, 10, 8],
+                boundary: vec![core_lattice::Boundary::Periodic; 3],
+                init: Init::Fill(0.1),
+                target_clusters: 20,
+                ..Params::default()
+            },
+            4,
+        )
+        .unwrap();
+        sim3.run();
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
+        for (sim, seed) in [(small_run(), 7), (sim3, 4)] {
+            // The particles as the Python bindings hold them: (x1, x2, id) in the order of
+            // particles.csv.
+            let mut rows = Vec::new();
+            (view(&sim, seed).each)(&mut |x, y, id| rows.push((x, y, id)));
+            let arrays = View {
+                sizes: sim.lattice().sizes(),
+                sweeps: sim.sweeps(),
+                clusters: sim.clusters(),
+                particles: sim.particles(),
+                seed,
+                each: |f: &mut Visit<'_>| {
+                    for &(x, y, id) in &rows {
+                        f(x, y, id);
+                    }
+                },
+            };
+            // The default size, and one with several sites a pixel.
+            for side in [None, Some(20)] {
+                write_png(&sim, seed, &a, side).unwrap();
+                write_png_of(&arrays, &b, side).unwrap();
+                assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+            }
+        }
+        let outside = View {
+            sizes: &[4, 4],
+            sweeps: 0,
+            clusters: 1,
+            particles: 1,
+            seed: 1,
+            each: |f: &mut Visit<'_>| f(1, 4, 0),
+        };
+        assert!(write_png_of(&outside, &b, None).is_err());
+    }
+
+    #[test]
     fn the_default_size_keeps_the_proportions() {
         let sim = small_run();
         // 48 x 32 sites: 11 pixels a site, so the longer side reaches 512.
-        assert_eq!(picture_size(&sim, None), (528, 352));
+        assert_eq!(picture_size(sim.lattice().sizes(), None), (528, 352));
     }
 
     #[test]

@@ -3,12 +3,14 @@
 //! log-log gradients (Table I).
 
 use super::Ctx;
+use super::csvfile::Csv;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, pm, sig};
 use animat::bench::{SCALING_DENSITY, scaling_params, step_throughput};
 use animat::{GridBox, World};
 use anyhow::Result;
 use core_lattice::Fit;
+use std::path::{Path, PathBuf};
 
 /// Hawick, James & Scogings (2006), Table I: fitted gradients and their errors, as printed.
 const TABLE_I: [(&str, f64, f64); 4] = [
@@ -67,6 +69,46 @@ pub fn measure(animats: u64, grid: GridBox, cells: bool, steps: u64, seed: u64) 
         items_scanned: scanned / n,
         step_seconds: start.elapsed().as_secs_f64() / n,
     })
+}
+
+/// The search structure of a row of `animat_fig9.csv` (its `grid` and `cell_index`).
+fn structure(grid: &str, cells: bool) -> &'static str {
+    match (grid, cells) {
+        ("none", _) => "exhaustive scan",
+        (_, false) => "boxes",
+        _ => "cells + boxes (default)",
+    }
+}
+
+/// Draws `animat_fig9.png` from `animat_fig9.csv` in `dir`: search seconds per step against
+/// the population, one line per grid box side and search structure.
+pub fn fig9_chart(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("animat_fig9.csv"))?;
+    let (n, t) = (data.num("animats")?, data.num("search_seconds_per_step")?);
+    let series = data
+        .groups(&["grid", "cell_index"])?
+        .into_iter()
+        .map(|(key, rows)| {
+            Series::new(
+                format!("grid {}, {}", key[0], structure(&key[0], key[1] == "true")),
+                rows.iter().map(|&i| (n[i], t[i])).collect(),
+                Style::LinePoints,
+            )
+        })
+        .collect();
+    let path = dir.join("animat_fig9.png");
+    plot::write_png(
+        &Chart {
+            title: "Animats: neighbour-search seconds per step against population".into(),
+            x_label: "animats".into(),
+            y_label: "search seconds per step".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        },
+        &path,
+    )?;
+    Ok(vec![path])
 }
 
 /// Run Fig. 9 / Table I and write `animat.md`.
@@ -134,13 +176,8 @@ pub fn run(ctx: &Ctx) -> Result<()> {
         "gradient of items examined by the grid (ours)",
         "gradient (paper, Table I)",
     ]);
-    let mut series = Vec::new();
     for (grid, cells, max_n) in configs {
-        let structure = match (grid, cells) {
-            (GridBox::None, _) => "exhaustive scan",
-            (_, false) => "boxes",
-            _ => "cells + boxes (default)",
-        };
+        let structure = structure(&grid_name(grid), cells);
         let mut pts = Vec::new();
         for &n in ladder.iter().filter(|&&n| n <= max_n) {
             ctx.log(&format!(
@@ -185,11 +222,6 @@ pub fn run(ctx: &Ctx) -> Result<()> {
             },
             paper,
         ]);
-        series.push(Series::new(
-            format!("grid {}, {structure}", grid_name(grid)),
-            x.iter().copied().zip(t.iter().copied()).collect(),
-            Style::LinePoints,
-        ));
     }
     ctx.table(&mut doc, &table, "animat_table1.csv")?;
     doc.p(
@@ -199,17 +231,7 @@ pub fn run(ctx: &Ctx) -> Result<()> {
          point's population is the mean over them. Target for 60-cell boxes: gradient <= 1.10.",
     );
     data.write_csv(&ctx.path("animat_fig9.csv"))?;
-    plot::write_png(
-        &Chart {
-            title: "Animats: neighbour-search seconds per step against population".into(),
-            x_label: "animats".into(),
-            y_label: "search seconds per step".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        },
-        &ctx.path("animat_fig9.png"),
-    )?;
+    fig9_chart(&ctx.out)?;
     doc.image("search time against population", "animat_fig9.png");
     doc.p("Data: [`animat_fig9.csv`](animat_fig9.csv).");
 

@@ -4,12 +4,14 @@
 //! fraction from Amdahl's law.
 
 use super::Ctx;
+use super::csvfile::Csv;
 use super::ensemble::Stats;
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;
 use core_lattice::Fit;
 use dla_pdla::{Dim, Params, Sample, Simulation, Space};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// What one DLA/PDLA run gives the experiments.
@@ -82,6 +84,53 @@ pub fn run(ctx: &Ctx) -> Result<()> {
     doc.write(&ctx.path("dla.md"))
 }
 
+/// Draws `dla_fig3.png` from `dla_fig3.csv` in `dir`: run time against N for every
+/// dimension and search, and after each dimension's the paper's fitted cost per particle.
+pub fn fig3_chart(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("dla_fig3.csv"))?;
+    let (n, seconds) = (data.num("n")?, data.num("seconds")?);
+    let groups = data.groups(&["d", "search"])?;
+    let mut series = Vec::new();
+    for (k, (key, rows)) in groups.iter().enumerate() {
+        let d = &key[0];
+        series.push(Series::new(
+            format!("{d}D {}", key[1]),
+            rows.iter().map(|&i| (n[i], seconds[i])).collect(),
+            Style::Line,
+        ));
+        if groups.get(k + 1).is_some_and(|g| g.0[0] == *d) {
+            continue;
+        }
+        // The paper's fitted cost per particle (its Fig. 3, 2008 hardware) as T = a N, without
+        // its intercept, which was fitted over 1e6-1e9 particles; drawn to the largest N of
+        // the dimension.
+        let a = if d == "2" { 3e-5 } else { 1e-4 };
+        let top = groups
+            .iter()
+            .filter(|g| g.0[0] == *d)
+            .flat_map(|g| g.1.iter().map(|&i| n[i]))
+            .fold(0.0, f64::max);
+        series.push(Series::new(
+            format!("{d}D paper: {} us per particle (2008 hardware)", a * 1e6),
+            vec![(100.0, a * 100.0), (top, a * top)],
+            Style::Thin,
+        ));
+    }
+    let path = dir.join("dla_fig3.png");
+    plot::write_png(
+        &Chart {
+            title: "DLA run time against N".into(),
+            x_label: "particles N".into(),
+            y_label: "seconds".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        },
+        &path,
+    )?;
+    Ok(vec![path])
+}
+
 fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
     let n2 = ctx.scale.pick(3_000, 100_000, 1_000_000);
     let n3 = ctx.scale.pick(1_000, 20_000, 200_000);
@@ -97,7 +146,6 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
         "paper (Fig. 3, 2008 hardware)",
     ]);
     let mut data = Table::new(&["d", "search", "n", "seconds"]);
-    let mut series = Vec::new();
     for (d, n) in [(2usize, n2), (3, n3)] {
         for (name, precision, distance_map) in [
             (
@@ -148,34 +196,11 @@ fn fig3(ctx: &Ctx, doc: &mut Doc) -> Result<()> {
                 sig(fit.r2, 4),
                 paper.into(),
             ]);
-            series.push(Series::new(
-                format!("{d}D {name}"),
-                x.into_iter().zip(y).collect(),
-                Style::Line,
-            ));
         }
-        // The paper's fitted cost per particle (its Fig. 3, 2008 hardware) as T = a N, without
-        // its intercept, which was fitted over 1e6-1e9 particles.
-        let a = if d == 2 { 3e-5 } else { 1e-4 };
-        series.push(Series::new(
-            format!("{d}D paper: {} us per particle (2008 hardware)", a * 1e6),
-            vec![(100.0, a * 100.0), (n as f64, a * n as f64)],
-            Style::Thin,
-        ));
     }
     ctx.table(doc, &table, "dla_fig3_summary.csv")?;
     data.write_csv(&ctx.path("dla_fig3.csv"))?;
-    plot::write_png(
-        &Chart {
-            title: "DLA run time against N".into(),
-            x_label: "particles N".into(),
-            y_label: "seconds".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        },
-        &ctx.path("dla_fig3.png"),
-    )?;
+    fig3_chart(&ctx.out)?;
     doc.p(
         "One cluster per row, timed as it grows (about 1000 log-spaced samples); the linear fit \
          uses every sample, as the paper fitted T against N. The standard error of a comes from \

@@ -4,6 +4,7 @@
 //! cost against N for each strategy, and the fractal dimension in 2D to 5D beside the
 //! literature's (`dlca_dimension`).
 
+use super::csvfile::Csv;
 use super::ensemble::columns;
 use super::{Ctx, log_spaced};
 use crate::plot::{self, Chart, Series, Style};
@@ -12,6 +13,7 @@ use anyhow::{Context, Result, bail};
 use core_lattice::{Boundary, Fit};
 use dlca::record::SweepRecord;
 use dlca::{Init, Params, Search, Simulation};
+use std::path::{Path, PathBuf};
 
 const FILLS: [f64; 2] = [0.01, 0.05];
 
@@ -53,6 +55,177 @@ pub fn run(ctx: &Ctx) -> Result<()> {
 }
 
 /// Fig. 5: number of clusters against sweeps at 1% and 5% fill.
+/// `0.01` (a fill as the CSVs write it) as `1%`.
+fn pct_of(fill: &str) -> Result<String> {
+    Ok(pct(fill.parse::<f64>().with_context(|| {
+        format!("fill {fill:?} is not a number")
+    })?))
+}
+
+/// The lattice (`1024x512`) of an experiment's summary CSV in `dir`.
+fn lattice(dir: &Path, summary: &str) -> Result<String> {
+    Csv::read(&dir.join(summary))?.single("lattice")
+}
+
+/// Draws `dlca_fig5.png` from `dlca_fig5_mean.csv` (and the lattice from
+/// `dlca_fig5_summary.csv`) in `dir`: each fill's mean cluster count over its runs against
+/// sweeps, its standard error as a band.
+pub fn fig5_chart(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("dlca_fig5_mean.csv"))?;
+    let (sweep, mean, se) = (
+        data.num("sweep")?,
+        data.num("clusters_mean")?,
+        data.num("clusters_stderr")?,
+    );
+    let series = data
+        .groups(&["fill", "runs"])?
+        .into_iter()
+        .map(|(key, rows)| -> Result<Series> {
+            Ok(Series::new(
+                format!(
+                    "{} fill, mean of {} runs ± standard error",
+                    pct_of(&key[0])?,
+                    key[1]
+                ),
+                rows.iter().map(|&i| (sweep[i], mean[i])).collect(),
+                Style::Line,
+            )
+            .with_band(
+                rows.iter()
+                    .map(|&i| (sweep[i], mean[i] - se[i], mean[i] + se[i]))
+                    .collect(),
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let path = dir.join("dlca_fig5.png");
+    plot::write_png(
+        &Chart {
+            title: format!(
+                "DLCA clusters against sweeps, {}",
+                lattice(dir, "dlca_fig5_summary.csv")?
+            ),
+            x_label: "sweep".into(),
+            y_label: "clusters".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        },
+        &path,
+    )?;
+    Ok(vec![path])
+}
+
+/// Draws `dlca_fig6.png` from `dlca_fig6.csv` (and the lattice from `dlca_fig6_summary.csv`)
+/// in `dir`: seconds per sweep over clusters against sweeps, per fill and strategy.
+pub fn fig6_chart(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("dlca_fig6.csv"))?;
+    let (sweep, per) = (data.num("sweep")?, data.num("seconds_per_cluster")?);
+    let series = data
+        .groups(&["fill", "strategy"])?
+        .into_iter()
+        .map(|(key, rows)| -> Result<Series> {
+            Ok(Series::new(
+                format!("{} fill, {}", pct_of(&key[0])?, key[1]),
+                rows.iter().map(|&i| (sweep[i], per[i])).collect(),
+                Style::Line,
+            ))
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let path = dir.join("dlca_fig6.png");
+    plot::write_png(
+        &Chart {
+            title: format!(
+                "DLCA seconds per sweep / clusters, {}",
+                lattice(dir, "dlca_fig6_summary.csv")?
+            ),
+            x_label: "sweep".into(),
+            y_label: "seconds per sweep / clusters".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        },
+        &path,
+    )?;
+    Ok(vec![path])
+}
+
+/// Draws `dlca_histogram_<fill>pct.png` for every fill of `dlca_histograms.csv` (and the
+/// lattice from `dlca_histograms_summary.csv`) in `dir`: moves against candidates examined,
+/// one line per sweep. Returns the charts in the order of the fills.
+pub fn histogram_charts(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("dlca_histograms.csv"))?;
+    let sweeps = data.text("sweep")?;
+    let (candidates, moves) = (data.num("candidates")?, data.num("moves")?);
+    let size = lattice(dir, "dlca_histograms_summary.csv")?;
+    let mut written = Vec::new();
+    for (key, rows) in data.groups(&["fill"])? {
+        let fill: f64 = key[0]
+            .parse()
+            .with_context(|| format!("fill {:?} is not a number", key[0]))?;
+        let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+        for i in rows {
+            let name = format!("sweep {}", sweeps[i]);
+            let point = (candidates[i], moves[i]);
+            match series.iter_mut().find(|s| s.0 == name) {
+                Some(s) => s.1.push(point),
+                None => series.push((name, vec![point])),
+            }
+        }
+        let path = dir.join(format!("dlca_histogram_{}pct.png", (fill * 100.0).round()));
+        plot::write_png(
+            &Chart {
+                title: format!("Candidates examined per move, {} fill, {size}", pct(fill)),
+                x_label: "candidate clusters examined".into(),
+                y_label: "moves".into(),
+                log_x: false,
+                log_y: true,
+                series: series
+                    .into_iter()
+                    .map(|(name, pts)| Series::new(name, pts, Style::LinePoints))
+                    .collect(),
+            },
+            &path,
+        )?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// Draws `dlca_cost.png` from `dlca_cost.csv` in `dir`: seconds per sweep against N, one line
+/// per strategy.
+pub fn cost_chart(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("dlca_cost.csv"))?;
+    let (n, per) = (data.num("particles")?, data.num("seconds_per_sweep")?);
+    let (sweeps, fill) = (data.single("sweeps")?, data.single("fill")?);
+    let series = data
+        .groups(&["strategy"])?
+        .into_iter()
+        .map(|(key, rows)| {
+            Series::new(
+                key[0].clone(),
+                rows.iter().map(|&i| (n[i], per[i])).collect(),
+                Style::LinePoints,
+            )
+        })
+        .collect();
+    let path = dir.join("dlca_cost.png");
+    plot::write_png(
+        &Chart {
+            title: format!(
+                "DLCA seconds per sweep against N ({} fill, first {sweeps} sweeps)",
+                pct_of(&fill)?
+            ),
+            x_label: "particles N".into(),
+            y_label: "seconds per sweep".into(),
+            log_x: true,
+            log_y: true,
+            series,
+        },
+        &path,
+    )?;
+    Ok(vec![path])
+}
+
 fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     let size = ctx.scale.pick([256, 128], [1024, 512], [1024, 512]);
     let seeds = ctx.scale.pick(2u64, 3, 8);
@@ -71,7 +244,8 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "paper (Fig. 5)",
     ]);
     let mut data = Table::new(&["fill", "seed", "sweep", "clusters", "largest"]);
-    let mut series = Vec::new();
+    // What the chart shows: the ensembles' mean cluster counts with their standard errors.
+    let mut means = Table::new(&["fill", "runs", "sweep", "clusters_mean", "clusters_stderr"]);
     for fill in FILLS {
         // The model's own ensemble: one `dlca` run per seed, in parallel on the cores.
         let ens = ctx.ensemble(
@@ -131,22 +305,15 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             .map(|k| k as usize)
             .filter(|&k| k < mean[0].len())
             .collect();
-        series.push(
-            Series::new(
-                format!(
-                    "{} fill, mean of {} runs ± standard error",
-                    pct(fill),
-                    ens.members.len()
-                ),
-                keep.iter().map(|&k| (mean[0][k], mean[1][k])).collect(),
-                Style::Line,
-            )
-            .with_band(
-                keep.iter()
-                    .map(|&k| (mean[0][k], mean[1][k] - mean[2][k], mean[1][k] + mean[2][k]))
-                    .collect(),
-            ),
-        );
+        for &k in &keep {
+            means.row(vec![
+                fill.to_string(),
+                ens.members.len().to_string(),
+                mean[0][k].to_string(),
+                mean[1][k].to_string(),
+                mean[2][k].to_string(),
+            ]);
+        }
         let (zm, zse) = mean_stderr(&exponents);
         table.row(vec![
             pct(fill),
@@ -160,23 +327,14 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     }
     ctx.table(doc, &table, "dlca_fig5_summary.csv")?;
     data.write_csv(&ctx.path("dlca_fig5.csv"))?;
-    plot::write_png(
-        &Chart {
-            title: format!("DLCA clusters against sweeps, {}", size_name(size)),
-            x_label: "sweep".into(),
-            y_label: "clusters".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        },
-        &ctx.path("dlca_fig5.png"),
-    )?;
+    means.write_csv(&ctx.path("dlca_fig5_mean.csv"))?;
+    fig5_chart(&ctx.out)?;
     doc.p(
         "Each run stops at 100 clusters. z is the log-log slope of clusters against sweeps from \
          sweep 10 on, per run, then averaged (± standard error over runs). The plot shows the \
          mean cluster count over the runs, up to the sweep every run reached, with its \
-         standard error as a band. Per-sweep data at about 200 log-spaced sweeps per run: \
-         [`dlca_fig5.csv`](dlca_fig5.csv).",
+         standard error as a band ([`dlca_fig5_mean.csv`](dlca_fig5_mean.csv)). Per-sweep data \
+         at about 200 log-spaced sweeps per run: [`dlca_fig5.csv`](dlca_fig5.csv).",
     );
     doc.image("clusters against sweeps", "dlca_fig5.png");
     Ok(())
@@ -233,7 +391,6 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "seconds",
         "seconds_per_cluster",
     ]);
-    let mut series = Vec::new();
     for fill in FILLS {
         let strategies = [
             (Search::AllPairs, ap_sweeps),
@@ -267,19 +424,6 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                     format!("{:e}", secs / s.clusters as f64),
                 ]);
             }
-            series.push(Series::new(
-                format!("{} fill, {}", pct(fill), strategy.name()),
-                run.iter()
-                    .filter(|s| s.sweep >= 1)
-                    .map(|s| {
-                        (
-                            s.sweep as f64,
-                            s.seconds.unwrap_or(f64::NAN) / s.clusters as f64,
-                        )
-                    })
-                    .collect(),
-                Style::Line,
-            ));
             let mine = common(run);
             let same = mine.len() == ap.len()
                 && mine
@@ -326,17 +470,7 @@ fn fig6(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     }
     ctx.table(doc, &table, "dlca_fig6_summary.csv")?;
     data.write_csv(&ctx.path("dlca_fig6.csv"))?;
-    plot::write_png(
-        &Chart {
-            title: format!("DLCA seconds per sweep / clusters, {}", size_name(size)),
-            x_label: "sweep".into(),
-            y_label: "seconds per sweep / clusters".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        },
-        &ctx.path("dlca_fig6.png"),
-    )?;
+    fig6_chart(&ctx.out)?;
     doc.p(&format!(
         "Every strategy starts from the same seed and so the same state; the all-pairs search \
          is timed over sweeps 1-{ap_sweeps} only (it is the slow one), the others over sweeps \
@@ -375,7 +509,6 @@ fn histograms(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "paper",
     ]);
     let mut data = Table::new(&["fill", "sweep", "candidates", "moves"]);
-    let mut charts = Vec::new();
     for fill in FILLS {
         let p = Params {
             max_sweeps: Some(*at.last().expect("non-empty")),
@@ -384,7 +517,6 @@ fn histograms(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         };
         let mut sim = Simulation::new(p, ctx.seed)?;
         sim.run();
-        let mut series = Vec::new();
         for (sweep, h) in sim.records().histograms() {
             let clusters = sim
                 .records()
@@ -419,34 +551,16 @@ fn histograms(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                     c.to_string(),
                 ]);
             }
-            series.push(Series::new(
-                format!("sweep {sweep}"),
-                h.iter().map(|(v, c)| (v as f64, c as f64)).collect(),
-                Style::LinePoints,
-            ));
         }
-        charts.push((fill, series));
     }
     ctx.table(doc, &table, "dlca_histograms_summary.csv")?;
     data.write_csv(&ctx.path("dlca_histograms.csv"))?;
-    for (fill, series) in charts {
-        let file = format!("dlca_histogram_{}pct.png", (fill * 100.0).round());
-        plot::write_png(
-            &Chart {
-                title: format!(
-                    "Candidates examined per move, {} fill, {}",
-                    pct(fill),
-                    size_name(size)
-                ),
-                x_label: "candidate clusters examined".into(),
-                y_label: "moves".into(),
-                log_x: false,
-                log_y: true,
-                series,
-            },
-            &ctx.path(&file),
-        )?;
-        doc.image(&format!("histogram at {} fill", pct(fill)), &file);
+    for (fill, path) in FILLS.iter().zip(histogram_charts(&ctx.out)?) {
+        let file = path
+            .file_name()
+            .and_then(|f| f.to_str())
+            .unwrap_or_default();
+        doc.image(&format!("histogram at {} fill", pct(*fill)), file);
     }
     doc.p(
         "The paper histograms, per grid box, the clusters a move must test; we histogram, per \
@@ -471,7 +585,14 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "sweep cost against N: L = {sides:?}, {k} sweeps each"
     ));
     doc.h2("Sweep cost against the number of particles");
-    let mut data = Table::new(&["strategy", "lattice", "particles", "seconds_per_sweep"]);
+    let mut data = Table::new(&[
+        "strategy",
+        "lattice",
+        "particles",
+        "seconds_per_sweep",
+        "sweeps",
+        "fill",
+    ]);
     let mut table = Table::new(&[
         "strategy",
         "lattices",
@@ -479,7 +600,6 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
         "r^2",
         "expected",
     ]);
-    let mut series = Vec::new();
     for strategy in [
         Search::AllPairs,
         Search::GridDoubling,
@@ -505,6 +625,8 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                 size_name(size),
                 n.to_string(),
                 format!("{per:e}"),
+                k.to_string(),
+                fill.to_string(),
             ]);
             pts.push((n, per));
         }
@@ -531,24 +653,10 @@ fn cost_against_n(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
                 _ => "1 (one occupancy lookup per leading-face site)".into(),
             },
         ]);
-        series.push(Series::new(strategy.name(), pts, Style::LinePoints));
     }
     ctx.table(doc, &table, "dlca_cost_summary.csv")?;
     data.write_csv(&ctx.path("dlca_cost.csv"))?;
-    plot::write_png(
-        &Chart {
-            title: format!(
-                "DLCA seconds per sweep against N ({}% fill, first {k} sweeps)",
-                fill * 100.0
-            ),
-            x_label: "particles N".into(),
-            y_label: "seconds per sweep".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        },
-        &ctx.path("dlca_cost.png"),
-    )?;
+    cost_chart(&ctx.out)?;
     doc.p(&format!(
         "Mean wall time of sweeps 1-{k} at {}% fill on L x L/2 lattices; gradient ± its \
          least-squares standard error. The paper gives no such gradient for DLCA (its Table I is \

@@ -8,10 +8,12 @@
 
 pub mod accuracy;
 pub mod animat;
+pub mod csvfile;
 pub mod dla;
 pub mod dlca;
 pub mod dlca_dimension;
 pub mod ensemble;
+pub mod replot;
 
 use crate::report::{Doc, Table, build_id, machine, sig, utc_now};
 use anyhow::{Context, Result};

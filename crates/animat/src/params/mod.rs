@@ -38,6 +38,13 @@ impl Species {
             Species::Rabbit => 1,
         }
     }
+
+    /// The species of `code` ([`Species::code`]), if it is one.
+    pub fn from_code(code: u64) -> Option<Self> {
+        [Species::Fox, Species::Rabbit]
+            .into_iter()
+            .find(|s| s.code() == code)
+    }
 }
 
 /// A fox rule (`docs/animat.md`, "Rules"). Priority is the position in [`Params::fox_rules`].

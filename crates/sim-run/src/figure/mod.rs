@@ -25,6 +25,12 @@ impl From<anyhow::Error> for crate::io::OutputError {
     }
 }
 
+/// Smallest side of a figure's picture in pixels that may be asked for (`--png-size`).
+pub const PNG_SIZE_MIN: u32 = 16;
+/// Largest side of a figure's picture in pixels that may be asked for (`--png-size`; an
+/// animation's is at most [`animation::ANIMATION_MAX_SIDE`]).
+pub const PNG_SIZE_MAX: u32 = 65536;
+
 /// An RGB image, row-major, top row first, three bytes a pixel.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Raster {

@@ -8,6 +8,7 @@ mod sweep;
 mod vpdist;
 
 pub use sweep::{Setting, Sweep, pareto, replot};
+pub use vpdist::vpdist_chart;
 
 use super::Ctx;
 use anyhow::Result;

@@ -4,9 +4,11 @@
 use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, sig};
 use crate::scaling::Ctx;
+use crate::scaling::csvfile::Csv;
 use anyhow::Result;
 use core_lattice::rng::{stream, uniform01};
 use dla_pdla::{Params, Simulation};
+use std::path::{Path, PathBuf};
 
 /// The distribution of `(d - vpdist) / d` over query points around a grown cluster.
 pub fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
@@ -45,7 +47,8 @@ pub fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
         "bound 2/(2 kappa + 1)",
     ]);
     let mut hist = Table::new(&["kappa", "bin_low", "bin_high", "fraction"]);
-    let mut series = Vec::new();
+    // The chart's data: the complementary CDF at log-spaced error levels.
+    let mut ccdf = Table::new(&["kappa", "level", "fraction_above"]);
     for kappa in [1.0, 2.0, 4.0, 8.0] {
         let mut errs: Vec<f64> = pts
             .iter()
@@ -84,11 +87,13 @@ pub fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
             let above = errs.len() - errs.partition_point(|&e| e <= level);
             pts_cdf.push((level, above as f64 / errs.len() as f64));
         }
-        series.push(Series::new(
-            format!("kappa = {kappa}"),
-            pts_cdf,
-            Style::Line,
-        ));
+        for (level, above) in pts_cdf {
+            ccdf.row(vec![
+                kappa.to_string(),
+                level.to_string(),
+                above.to_string(),
+            ]);
+        }
     }
     doc.h2("Distribution of vpdist errors");
     doc.p(&format!(
@@ -100,6 +105,33 @@ pub fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
     ));
     ctx.table(doc, &table, "accuracy_vpdist.csv")?;
     hist.write_csv(&ctx.path("accuracy_vpdist_hist.csv"))?;
+    ccdf.write_csv(&ctx.path("accuracy_vpdist_ccdf.csv"))?;
+    vpdist_chart(&ctx.out)?;
+    doc.image("vpdist error distribution", "accuracy_vpdist.png");
+    doc.p(
+        "Binned distribution: [`accuracy_vpdist_hist.csv`](accuracy_vpdist_hist.csv); the \
+         plotted fractions: [`accuracy_vpdist_ccdf.csv`](accuracy_vpdist_ccdf.csv).",
+    );
+    Ok(())
+}
+
+/// Draws `accuracy_vpdist.png` from `accuracy_vpdist_ccdf.csv` in `dir`: for each precision,
+/// the fraction of queries whose relative error exceeds a level.
+pub fn vpdist_chart(dir: &Path) -> Result<Vec<PathBuf>> {
+    let data = Csv::read(&dir.join("accuracy_vpdist_ccdf.csv"))?;
+    let (level, above) = (data.num("level")?, data.num("fraction_above")?);
+    let series = data
+        .groups(&["kappa"])?
+        .into_iter()
+        .map(|(key, rows)| {
+            Series::new(
+                format!("kappa = {}", key[0]),
+                rows.iter().map(|&i| (level[i], above[i])).collect(),
+                Style::Line,
+            )
+        })
+        .collect();
+    let path = dir.join("accuracy_vpdist.png");
     plot::write_png(
         &Chart {
             title: "vpdist: fraction of queries with relative error above a level".into(),
@@ -109,9 +141,7 @@ pub fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
             log_y: false,
             series,
         },
-        &ctx.path("accuracy_vpdist.png"),
+        &path,
     )?;
-    doc.image("vpdist error distribution", "accuracy_vpdist.png");
-    doc.p("Binned distribution: [`accuracy_vpdist_hist.csv`](accuracy_vpdist_hist.csv).");
-    Ok(())
+    Ok(vec![path])
 }

@@ -1,0 +1,148 @@
+//! The binaries' figures from results: `dla.png`, `dla.gif`, `dlca.png` and the animat
+//! snapshots, drawn by the libraries' own picture code (`dla_pdla::picture`,
+//! `dlca::picture`, `animat::output::SnapshotFrame`, all framed by `sim_run::figure`) from the
+//! arrays and results a result object holds, so that a file equals the binary's for the same
+//! run byte for byte.
+
+use crate::convert::{Count, count, value_error};
+use numpy::{PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyOSError;
+use pyo3::prelude::*;
+use sim_run::figure::animation::ANIMATION_MAX_SIDE;
+use sim_run::figure::{PNG_SIZE_MAX, PNG_SIZE_MIN};
+use sim_run::io::OutputError;
+
+/// The side of a picture in pixels, as `--png-size` takes it: a count in
+/// [`PNG_SIZE_MIN`]..=`max` (`name` is the keyword argument, for messages).
+pub fn side(name: &str, v: Option<Count>, max: u32) -> PyResult<Option<u32>> {
+    let Some(v) = v else { return Ok(None) };
+    let range = format!("{PNG_SIZE_MIN}..={max}");
+    let shown = v.to_string();
+    let s: u32 = count(&[], name, v).map_err(|e| {
+        // `count`'s own range is u32's; the message names the picture's.
+        let m = e.to_string();
+        if m.contains("outside the accepted range") {
+            value_error(format!(
+                "{name} = {shown} is outside the accepted range {range}"
+            ))
+        } else if m.contains("not a whole number") {
+            value_error(format!(
+                "{name} = {shown} is not a whole number; a size in pixels is, in the accepted \
+                 range {range}"
+            ))
+        } else {
+            e
+        }
+    })?;
+    if !(PNG_SIZE_MIN..=max).contains(&s) {
+        return Err(value_error(format!(
+            "{name} = {s} is outside the accepted range {range}"
+        )));
+    }
+    Ok(Some(s))
+}
+
+/// The side of a PNG's picture (`--png-size`).
+pub fn png_side(v: Option<Count>) -> PyResult<Option<u32>> {
+    side("size", v, PNG_SIZE_MAX)
+}
+
+/// The side of an animation's pictures (`--png-size` with `--animate`).
+pub fn gif_side(v: Option<Count>) -> PyResult<Option<u32>> {
+    side("size", v, ANIMATION_MAX_SIDE)
+}
+
+/// A figure that could not be written: `OSError` with the library's message.
+pub fn write_error(path: &std::path::Path, e: OutputError) -> PyErr {
+    PyOSError::new_err(format!("writing {}: {e}", path.display()))
+}
+
+/// The `(N, D)` float64 positions of a DLA result, C-contiguous as the result holds them.
+pub fn dla_positions<'py>(obj: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    let a: PyReadonlyArray2<'py, f64> = obj
+        .getattr("positions")?
+        .extract()
+        .map_err(|_| value_error("positions is not a float64 array of shape (N, D)"))?;
+    if a.as_slice().is_err() {
+        return Err(value_error("positions is not a C-contiguous array"));
+    }
+    Ok(a)
+}
+
+/// The particles of a DLCA result as (x1, x2, cluster id) rows in the order of its arrays,
+/// checked against the lattice's `sizes`.
+pub fn dlca_rows(obj: &Bound<'_, PyAny>, sizes: &[u64]) -> PyResult<Vec<(u64, u64, u32)>> {
+    let x: PyReadonlyArray2<'_, i64> = obj
+        .getattr("positions")?
+        .extract()
+        .map_err(|_| value_error("positions is not an int64 array of shape (N, D)"))?;
+    let cluster: PyReadonlyArray1<'_, i64> = obj
+        .getattr("cluster")?
+        .extract()
+        .map_err(|_| value_error("cluster is not an int64 array of shape (N,)"))?;
+    let (x, cluster) = (x.as_array(), cluster.as_array());
+    let d = sizes.len();
+    if x.ncols() != d || x.nrows() != cluster.len() {
+        return Err(value_error(format!(
+            "positions of shape ({}, {}) and cluster of shape ({},) do not fit a {d}D lattice",
+            x.nrows(),
+            x.ncols(),
+            cluster.len()
+        )));
+    }
+    let mut rows = Vec::with_capacity(cluster.len());
+    for (row, &id) in x.rows().into_iter().zip(cluster.iter()) {
+        let coord = |a: usize| {
+            u64::try_from(row[a])
+                .ok()
+                .filter(|&c| c < sizes[a])
+                .ok_or_else(|| {
+                    value_error(format!(
+                        "site {row} is outside the lattice of sides {sizes:?}"
+                    ))
+                })
+        };
+        let id = u32::try_from(id)
+            .ok()
+            .filter(|&i| i != u32::MAX)
+            .ok_or_else(|| value_error(format!("cluster id {id} is not a cluster id")))?;
+        rows.push((coord(0)?, if d >= 2 { coord(1)? } else { 0 }, id));
+    }
+    Ok(rows)
+}
+
+/// The animats of an animat result as (cell, species) rows.
+pub fn animat_rows(obj: &Bound<'_, PyAny>) -> PyResult<Vec<([i64; 2], ::animat::Species)>> {
+    let x: PyReadonlyArray2<'_, i64> = obj
+        .getattr("positions")?
+        .extract()
+        .map_err(|_| value_error("positions is not an int64 array of shape (M, 2)"))?;
+    let species: PyReadonlyArray1<'_, i64> = obj
+        .getattr("species")?
+        .extract()
+        .map_err(|_| value_error("species is not an int64 array of shape (M,)"))?;
+    let (x, species) = (x.as_array(), species.as_array());
+    if x.ncols() != 2 || x.nrows() != species.len() {
+        return Err(value_error(format!(
+            "positions of shape ({}, {}) and species of shape ({},) do not fit",
+            x.nrows(),
+            x.ncols(),
+            species.len()
+        )));
+    }
+    x.rows()
+        .into_iter()
+        .zip(species.iter())
+        .map(|(row, &code)| {
+            let s = u64::try_from(code)
+                .ok()
+                .and_then(::animat::Species::from_code)
+                .ok_or_else(|| {
+                    value_error(format!(
+                        "species code {code}: aggsim.FOX (0) or aggsim.RABBIT (1)"
+                    ))
+                })?;
+            Ok(([row[0], row[1]], s))
+        })
+        .collect()
+}
