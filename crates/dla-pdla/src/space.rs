@@ -120,16 +120,21 @@ fn marsaglia_4d<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
 }
 
 impl Space<2> for Dim<2> {
-    /// A fine map of 8-diameter cells capped at 64, then coarse ones of 64, 128 and 512
-    /// capped at 512, 1024 and 4096 (about 200 cells lowered per insert and map; the coarse
-    /// maps by the box of each new tree leaf). Finer cells cost more memory than they save
-    /// time. The two coarsest levels answer the walkers in the wide empty regions of a large
-    /// cluster (beyond 512 of it), which would otherwise ask the tree at every move: at 1e7
-    /// particles 3.9 tree queries per particle instead of 10.8 (`docs/benchmarks.md`, "DLA at
-    /// scale"). They are read first and are small (half a megabyte at 1e8 particles), so
-    /// such a walker's move reads no uncached memory.
-    const MAP_LEVELS: &'static [(f64, f64)] =
-        &[(8.0, 64.0), (64.0, 512.0), (128.0, 1024.0), (512.0, 4096.0)];
+    /// A fine map of 8-diameter cells capped at 64, then coarse ones of 64, 128, 512 and
+    /// 2048 capped at 512, 1024, 4096 and 16384 (about 200 cells lowered per insert and map;
+    /// the coarse maps by the box of each new tree leaf). Finer cells cost more memory than
+    /// they save time. The three coarsest levels answer the walkers in the wide empty regions
+    /// of a large cluster (beyond 512 of it), which would otherwise ask the tree at every
+    /// move: at 1e7 particles 3.9 tree queries per particle instead of 10.8
+    /// (`docs/benchmarks.md`, "DLA at scale"). They are read first and are small (half a
+    /// megabyte at 1e8 particles), so such a walker's move reads no uncached memory.
+    const MAP_LEVELS: &'static [(f64, f64)] = &[
+        (8.0, 64.0),
+        (64.0, 512.0),
+        (128.0, 1024.0),
+        (512.0, 4096.0),
+        (2048.0, 16384.0),
+    ];
 
     const AXES: [&'static str; 2] = ["x", "y"];
 

@@ -120,14 +120,18 @@ where
                     VpEstimate {
                         distance,
                         half_diagonal: None,
+                        nodes: 0,
                     },
                     Some(x),
                 )
             }
             None => {
                 state.counts.tree_queries += 1;
-                tree.vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
-                    .expect("the cluster is never empty")
+                let answer = tree
+                    .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
+                    .expect("the cluster is never empty");
+                state.counts.tree_nodes += u64::from(answer.0.nodes);
+                answer
             }
         };
         state.anchor = nearest;
@@ -282,6 +286,8 @@ pub struct WalkCounts {
     pub near_rebuilds: u64,
     /// Nearest-distance queries of the tree (variable-precision search).
     pub tree_queries: u64,
+    /// Tree nodes and leaves those queries read (see `spatial::orthtree::VpEstimate::nodes`).
+    pub tree_nodes: u64,
     /// Contact searches of a `step_min` step answered by the near cache.
     pub contact_near: u64,
     /// Contact searches of a `step_min` step answered by the tree.
@@ -299,6 +305,7 @@ impl WalkCounts {
         self.near_answers += other.near_answers;
         self.near_rebuilds += other.near_rebuilds;
         self.tree_queries += other.tree_queries;
+        self.tree_nodes += other.tree_nodes;
         self.contact_near += other.contact_near;
         self.contact_tree += other.contact_tree;
     }

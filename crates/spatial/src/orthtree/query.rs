@@ -63,6 +63,9 @@ pub struct VpEstimate {
     /// the half diagonal `r` of the far node whose centre gave `distance = |p - c| - r`. The
     /// exact distance then lies in `[distance, distance + 2 r]`.
     pub half_diagonal: Option<f64>,
+    /// Nodes and leaves the search read (those not pruned by their box or as far nodes
+    /// before their memory was touched): the query's share of the tree's memory traffic.
+    pub nodes: u32,
 }
 
 /// State of one query walk.
@@ -80,6 +83,8 @@ struct Search<const D: usize> {
     source: f64,
     /// Stored position of the best point (`TRACK` only).
     point: [f64; D],
+    /// Nodes and leaves read ([`VpEstimate::nodes`]).
+    nodes: u32,
 }
 
 impl<const D: usize> Orthtree<D> {
@@ -141,6 +146,7 @@ impl<const D: usize> Orthtree<D> {
         Some(VpEstimate {
             distance: s.best,
             half_diagonal: (s.source > 0.0).then_some(s.source),
+            nodes: s.nodes,
         })
     }
 
@@ -213,7 +219,7 @@ impl<const D: usize> Orthtree<D> {
             return None;
         }
         let s = if !(0.0..f64::INFINITY).contains(&upper) {
-            None
+            Err(0)
         } else if kappa == f64::INFINITY || kappa.is_nan() {
             // SAFETY: the tree is not empty (checked above).
             unsafe { self.walk_bounded::<false>(p, f64::INFINITY, upper) }
@@ -222,24 +228,30 @@ impl<const D: usize> Orthtree<D> {
             unsafe { self.walk_bounded::<true>(p, far_factor::<D>(kappa), upper) }
         };
         let s = match s {
-            Some(s) => s,
-            None if kappa == f64::INFINITY || kappa.is_nan() => {
-                self.walk::<false, true>(p, f64::INFINITY)?
+            Ok(s) => s,
+            Err(read) => {
+                let mut s = if kappa == f64::INFINITY || kappa.is_nan() {
+                    self.walk::<false, true>(p, f64::INFINITY)?
+                } else {
+                    self.walk::<true, true>(p, far_factor::<D>(kappa))?
+                };
+                s.nodes += read;
+                s
             }
-            None => self.walk::<true, true>(p, far_factor::<D>(kappa))?,
         };
         let exact = s.source == 0.0;
         Some((
             VpEstimate {
                 distance: s.best,
                 half_diagonal: (!exact).then_some(s.source),
+                nodes: s.nodes,
             },
             exact.then_some(s.point),
         ))
     }
 
-    /// The walk of [`vpdist_bounded`](Self::vpdist_bounded); `None` if nothing nearer than
-    /// `upper` was found.
+    /// The walk of [`vpdist_bounded`](Self::vpdist_bounded); `Err` with the nodes it read if
+    /// nothing nearer than `upper` was found.
     ///
     /// # Safety
     ///
@@ -249,7 +261,7 @@ impl<const D: usize> Orthtree<D> {
         p: &[f64; D],
         far_factor: f64,
         upper: f64,
-    ) -> Option<Search<D>> {
+    ) -> Result<Search<D>, u32> {
         let mut s = Search {
             p: *p,
             far_factor,
@@ -257,6 +269,7 @@ impl<const D: usize> Orthtree<D> {
             best_sq: upper * upper,
             source: 0.0,
             point: [f64::NAN; D],
+            nodes: 0,
         };
         let cell = |tree: &Self, node, level, c, half| {
             if box_dist_sq(p, &c, half) >= s.best_sq {
@@ -274,7 +287,7 @@ impl<const D: usize> Orthtree<D> {
         };
         // SAFETY: the tree is not empty (the caller's contract).
         unsafe { self.for_each_cover_cell(p, upper, cell) };
-        (s.best < upper).then_some(s)
+        if s.best < upper { Ok(s) } else { Err(s.nodes) }
     }
 
     /// Calls `f(tree, node, level, centre, half side)` for each existing node of a set of at
@@ -429,6 +442,7 @@ impl<const D: usize> Orthtree<D> {
             best_sq: f64::INFINITY,
             source: 0.0,
             point: [f64::NAN; D],
+            nodes: 0,
         };
         let (c, half) = self.root_geometry();
         // SAFETY: the root of a non-empty tree (checked above) at its level.
@@ -478,6 +492,7 @@ impl<const D: usize> Orthtree<D> {
         if APPROX && self.try_far(s, &c, half) {
             return;
         }
+        s.nodes += 1;
         let q = half * 0.5;
         let mut home = 0usize;
         // Per axis, the squared distance from p to the lower and the upper half of the node:
@@ -545,6 +560,7 @@ impl<const D: usize> Orthtree<D> {
         if APPROX && self.try_far(s, &c, half) {
             return;
         }
+        s.nodes += 1;
         let origin = c.map(|x| x - half);
         // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
         let pts = unsafe { self.leaf_points(leaf) };
