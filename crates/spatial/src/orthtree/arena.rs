@@ -49,36 +49,6 @@ use super::sync::{AtomicU32, AtomicU64, Ordering};
 use std::alloc::{self, Layout};
 use std::ptr::NonNull;
 
-/// Buffers at least this large ask for transparent huge pages.
-const HUGE_PAGES_FROM: usize = 4 << 20;
-
-/// Asks the kernel to back the whole 4 KiB pages of a buffer of `bytes` bytes at `ptr` with
-/// transparent huge pages (`madvise(MADV_HUGEPAGE)`, which the usual `madvise` setting of
-/// `/sys/kernel/mm/transparent_hugepage/enabled` requires). A large tree is read at random:
-/// with 4 KiB pages nearly every node visit of a query also misses the TLB and walks page
-/// tables that no longer fit in cache (a dependent load in 1 GiB: about 300 ns with 4 KiB
-/// pages and 170 ns with huge pages on the reference machine, `cargo xtask latency`). Pages
-/// already touched stay small until the kernel collapses them; an arena grows by
-/// reallocation, which keeps the advice, so most of a large tree ends up in huge pages. Only
-/// advice: a refusal (another page size, THP off) is ignored, and the contents never change.
-fn advise_huge_pages(ptr: *mut u8, bytes: usize) {
-    #[cfg(target_os = "linux")]
-    if bytes >= HUGE_PAGES_FROM {
-        const PAGE: usize = 4096;
-        let start = (ptr as usize).next_multiple_of(PAGE);
-        let end = (ptr as usize + bytes) / PAGE * PAGE;
-        if end > start {
-            // SAFETY: the range lies inside the buffer just allocated at `ptr`; MADV_HUGEPAGE
-            // changes only how the kernel backs the pages, never their contents.
-            unsafe {
-                libc::madvise(start as *mut libc::c_void, end - start, libc::MADV_HUGEPAGE);
-            }
-        }
-    }
-    #[cfg(not(target_os = "linux"))]
-    let _ = (ptr, bytes);
-}
-
 /// Element types an [`Arena`] holds: plain old data without drop glue, copied by value.
 pub(super) trait Element: Send + Sync + Sized {
     /// A copy of the element's current value (used by `Clone` of the tree).
@@ -236,7 +206,6 @@ impl<T: Element> Arena<T> {
             unsafe { alloc::realloc(self.ptr.as_ptr().cast(), old, new.size()) }
         };
         let p = NonNull::new(ptr.cast::<T>()).ok_or(refused)?;
-        advise_huge_pages(ptr, new.size());
         self.ptr = p;
         self.cap = cap;
         #[cfg(loom)]
