@@ -52,12 +52,13 @@ pub struct ScaleRun {
 
 /// The walk counts reported per particle (keys of `results.walk_counts`) and their column
 /// names.
-pub const WALK_COUNTS: [(&str, &str); 8] = [
+pub const WALK_COUNTS: [(&str, &str); 9] = [
     ("moves", "moves"),
     ("far_field", "far field"),
     ("map_reads", "map reads"),
     ("map_jumps", "map jumps"),
     ("tree_queries", "tree queries"),
+    ("tree_nodes", "tree nodes read"),
     ("near_answers", "near-cache answers"),
     ("near_rebuilds", "near-cache rebuilds"),
     ("contact_tree", "contact searches in the tree"),
@@ -359,8 +360,9 @@ pub fn run(root: &Path, cargo: &str, quick: bool, out: Option<PathBuf>) -> Resul
          of: a far-field return, a jump by a distance map's bound, a jump by the tree's or the \
          near cache's distance, or a short step with a contact search. A map read is one per \
          near-field move (it reads one cell of each map level it needs); tree queries are the \
-         variable-precision nearest-distance searches; near-cache rebuilds are range queries \
-         of the tree around a walker close to the cluster.",
+         variable-precision nearest-distance searches, and tree nodes read the nodes and \
+         leaves they touched; near-cache rebuilds are range queries of the tree around a \
+         walker close to the cluster.",
     );
     doc.table(&counts);
     counts.write_csv(&out.join("scale_counts.csv"))?;
@@ -369,8 +371,9 @@ pub fn run(root: &Path, cargo: &str, quick: bool, out: Option<PathBuf>) -> Resul
         "From the largest one-thread run of each dimension: the marginal cost of a particle \
          over its last decade, fitted as a + b ln N and integrated to the projected size; the \
          two-thread time divides that by the speed-up measured at the largest size; memory is a \
-         fixed part plus a part per particle, both from the peak memory of the two sizes (one \
-         thread; two threads hold a replica of the tree per thread). The paper \
+         fixed part plus a part per particle, both from the peak memory of the two largest \
+         sizes with one thread (two threads share one tree and one set of maps, and peak a few \
+         percent higher). The paper \
          (Sosa-Herrera & Rodriguez-Romo) reports its own hardware's times.",
     );
     doc.table(&proj);

@@ -160,9 +160,11 @@ impl Space<2> for Dim<2> {
 }
 
 impl Space<3> for Dim<3> {
-    /// A fine map of 8-diameter cells capped at 32 and a coarse one of 32-diameter cells
-    /// capped at 128 (about 270 cells lowered per insert and map).
-    const MAP_LEVELS: &'static [(f64, f64)] = &[(8.0, 32.0), (32.0, 128.0)];
+    /// A fine map of 8-diameter cells capped at 32 and coarse ones of 32 and 128-diameter
+    /// cells capped at 128 and 512 (about 270 cells lowered per insert and map; the coarse
+    /// ones by the box of each new tree leaf). The coarsest answers the walkers more than 128
+    /// from a cluster of 1e7 or more, which otherwise asked the tree at every move.
+    const MAP_LEVELS: &'static [(f64, f64)] = &[(8.0, 32.0), (32.0, 128.0), (128.0, 512.0)];
 
     /// Cells of 2 diameters capped at 8, in blocks of 8^3 cells (512 bytes, 16 diameters a
     /// side): about 270 cells visited per insert, and about 6 bytes per particle at 1e6 (the
