@@ -98,14 +98,12 @@ pub fn fig9_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         .collect();
     let path = dir.join("animat_fig9.png");
     plot::write_png(
-        &Chart {
-            title: "Animats: neighbour-search seconds per step against population".into(),
-            x_label: "animats".into(),
-            y_label: "search seconds per step".into(),
-            log_x: true,
-            log_y: true,
+        &Chart::log_log(
+            "Animats: neighbour-search seconds per step against population",
+            "animats",
+            "search seconds per step",
             series,
-        },
+        ),
         &path,
     )?;
     Ok(vec![path])

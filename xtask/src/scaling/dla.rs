@@ -118,14 +118,7 @@ pub fn fig3_chart(dir: &Path) -> Result<Vec<PathBuf>> {
     }
     let path = dir.join("dla_fig3.png");
     plot::write_png(
-        &Chart {
-            title: "DLA run time against N".into(),
-            x_label: "particles N".into(),
-            y_label: "seconds".into(),
-            log_x: true,
-            log_y: true,
-            series,
-        },
+        &Chart::log_log("DLA run time against N", "particles N", "seconds", series),
         &path,
     )?;
     Ok(vec![path])

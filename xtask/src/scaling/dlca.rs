@@ -99,17 +99,15 @@ pub fn fig5_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         .collect::<Result<Vec<_>>>()?;
     let path = dir.join("dlca_fig5.png");
     plot::write_png(
-        &Chart {
-            title: format!(
+        &Chart::log_log(
+            format!(
                 "DLCA clusters against sweeps, {}",
                 lattice(dir, "dlca_fig5_summary.csv")?
             ),
-            x_label: "sweep".into(),
-            y_label: "clusters".into(),
-            log_x: true,
-            log_y: true,
+            "sweep",
+            "clusters",
             series,
-        },
+        ),
         &path,
     )?;
     Ok(vec![path])
@@ -133,17 +131,15 @@ pub fn fig6_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         .collect::<Result<Vec<_>>>()?;
     let path = dir.join("dlca_fig6.png");
     plot::write_png(
-        &Chart {
-            title: format!(
+        &Chart::log_log(
+            format!(
                 "DLCA seconds per sweep / clusters, {}",
                 lattice(dir, "dlca_fig6_summary.csv")?
             ),
-            x_label: "sweep".into(),
-            y_label: "seconds per sweep / clusters".into(),
-            log_x: true,
-            log_y: true,
+            "sweep",
+            "seconds per sweep / clusters",
             series,
-        },
+        ),
         &path,
     )?;
     Ok(vec![path])
@@ -210,17 +206,15 @@ pub fn cost_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         .collect();
     let path = dir.join("dlca_cost.png");
     plot::write_png(
-        &Chart {
-            title: format!(
+        &Chart::log_log(
+            format!(
                 "DLCA seconds per sweep against N ({} fill, first {sweeps} sweeps)",
                 pct_of(&fill)?
             ),
-            x_label: "particles N".into(),
-            y_label: "seconds per sweep".into(),
-            log_x: true,
-            log_y: true,
+            "particles N",
+            "seconds per sweep",
             series,
-        },
+        ),
         &path,
     )?;
     Ok(vec![path])
