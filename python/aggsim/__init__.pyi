@@ -250,6 +250,9 @@ def dlca(
     gyration: bool = False,
     fit_min_size: Count = ...,
     progress: Progress = None,
+    animate: Union[None, str, PathLike[str]] = None,
+    animate_every: Optional[Count] = None,
+    animate_size: Optional[Count] = None,
 ) -> DlcaResult:
     """Run DLCA to the end; see ``help(aggsim.dlca)``."""
 
@@ -379,6 +382,10 @@ def animat(
     rabbit_rules: Optional[Sequence[str]] = None,
     timing: bool = False,
     progress: Progress = None,
+    animate: Union[None, str, PathLike[str]] = None,
+    animate_every: Optional[Count] = None,
+    animate_size: Optional[Count] = None,
+    frame_radius: Optional[Count] = None,
 ) -> AnimatResult:
     """Run the animat model; see ``help(aggsim.animat)``."""
 

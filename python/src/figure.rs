@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use sim_run::figure::animation::ANIMATION_MAX_SIDE;
 use sim_run::figure::{PNG_SIZE_MAX, PNG_SIZE_MIN};
 use sim_run::io::OutputError;
+use std::path::PathBuf;
 
 /// The side of a picture in pixels, as `--png-size` takes it: a count in
 /// [`PNG_SIZE_MIN`]..=`max` (`name` is the keyword argument, for messages).
@@ -50,6 +51,65 @@ pub fn png_side(v: Option<Count>) -> PyResult<Option<u32>> {
 /// The side of an animation's pictures (`--png-size` with `--animate`).
 pub fn gif_side(v: Option<Count>) -> PyResult<Option<u32>> {
     side("size", v, ANIMATION_MAX_SIDE)
+}
+
+/// `frame_radius` (the animat binary's `--frame-radius`): half a frame's side in cells, 1..
+pub fn frame_radius(v: Option<Count>) -> PyResult<Option<i64>> {
+    v.map(|v| count::<u64>(&[], "frame_radius", v))
+        .transpose()?
+        .map(|r| {
+            i64::try_from(r).ok().filter(|&r| r >= 1).ok_or_else(|| {
+                value_error(format!(
+                    "frame_radius = {r} is outside the accepted range 1..={}",
+                    i64::MAX
+                ))
+            })
+        })
+        .transpose()
+}
+
+/// An animation a run writes as it goes: the `animate`, `animate_every` and `animate_size`
+/// keywords of `aggsim.dlca` and `aggsim.animat`, which are the binaries' `--animate`,
+/// `--animate-every` and `--png-size` (the binary writes to `OUT/<model>.gif`, Python to
+/// `path`).
+#[derive(Debug)]
+pub struct Animate {
+    /// The GIF file, written atomically when the run ends.
+    pub path: PathBuf,
+    /// Steps or sweeps between frames (default: the binary's).
+    pub every: Option<u64>,
+    /// Side of the pictures in pixels (default: the binary's).
+    pub side: Option<u32>,
+}
+
+impl Animate {
+    /// The keywords checked as the binaries check their flags: `animate_every` at least 1,
+    /// `animate_size` in 16..=16384, and neither without `animate`. `model` names the file in
+    /// the message.
+    pub fn from_args(
+        path: Option<PathBuf>,
+        every: Option<Count>,
+        size: Option<Count>,
+        model: &str,
+    ) -> PyResult<Option<Self>> {
+        let side = side("animate_size", size, ANIMATION_MAX_SIDE)?;
+        let every = every
+            .map(|v| count::<u64>(&[], "animate_every", v))
+            .transpose()?;
+        if every == Some(0) {
+            return Err(value_error(
+                "animate_every = 0 is outside the accepted range 1..",
+            ));
+        }
+        match path {
+            Some(path) => Ok(Some(Animate { path, every, side })),
+            None if every.is_some() || side.is_some() => Err(value_error(format!(
+                "animate_every and animate_size set up the animation written to animate; give \
+                 animate a path (for example animate=\"{model}.gif\")"
+            ))),
+            None => Ok(None),
+        }
+    }
 }
 
 /// A figure that could not be written: `OSError` with the library's message.

@@ -112,6 +112,117 @@ def test_an_animat_world_draws_its_state_now(cli, tmp_path):
     assert same_bytes(tmp_path / "five.png", out / "snapshot_000005.png")
 
 
+def gif_frames(path):
+    """The number of images (frames) in a GIF, walking its blocks."""
+    data = path.read_bytes()
+    assert data[:6] == b"GIF89a"
+
+    def table(flags):
+        return 3 * 2 ** ((flags & 7) + 1) if flags & 0x80 else 0
+
+    def sub_blocks(i):
+        while data[i]:
+            i += data[i] + 1
+        return i + 1
+
+    i = 13 + table(data[10])
+    frames = 0
+    while data[i] != 0x3B:
+        if data[i] == 0x21:  # extension: label, then sub-blocks
+            i = sub_blocks(i + 2)
+        else:
+            assert data[i] == 0x2C, f"unknown block {data[i]:#x} at {i}"
+            frames += 1
+            i += 10 + table(data[i + 9])
+            i = sub_blocks(i + 1)  # after the LZW minimum code size
+    return frames
+
+
+@pytest.mark.parametrize(
+    "flags, kwargs",
+    [
+        # The defaults: a frame every 10 sweeps, 512 pixels.
+        (["--size", 40, "--fill", 0.1, "--seed", 2, "--target-clusters", 12],
+         dict(size=40, fill=0.1, seed=2, target_clusters=12)),
+        (["--size", "48x32", "--fill", 0.12, "--seed", 5, "--target-clusters", 8,
+          "--animate-every", 3, "--png-size", 96],
+         dict(size="48x32", fill=0.12, seed=5, target_clusters=8, animate_every=3,
+              animate_size=96)),
+    ],
+)
+def test_dlca_animation_is_the_binarys(cli, tmp_path, flags, kwargs):
+    out, run = cli.run("dlca", *flags, "--animate")
+    r = aggsim.dlca(**kwargs, animate=tmp_path / "dlca.gif")
+    assert r.state_hash == run["results"]["state_hash"]
+    assert same_bytes(tmp_path / "dlca.gif", out / "dlca.gif")
+
+
+@pytest.mark.parametrize(
+    "flags, kwargs",
+    [
+        # The defaults: a frame every hundredth of the steps, on three start radii.
+        (["--steps", 30, "--seed", 4], dict(steps=30, seed=4)),
+        # A last step off the frame grid gets its own frame; a small frame, animats outside.
+        (["--steps", 11, "--seed", 2, "--foxes", 50, "--rabbits", 400, "--animate-every", 4,
+          "--png-size", 64, "--frame-radius", 20],
+         dict(steps=11, seed=2, foxes=50, rabbits=400, animate_every=4, animate_size=64,
+              frame_radius=20)),
+    ],
+)
+def test_animat_animation_is_the_binarys(cli, tmp_path, flags, kwargs):
+    out, run = cli.run("animat", *flags, "--animate")
+    r = aggsim.animat(**kwargs, animate=str(tmp_path / "animat.gif"))
+    assert r.state_hash == run["results"]["state_hash"]
+    assert same_bytes(tmp_path / "animat.gif", out / "animat.gif")
+
+
+def test_an_animation_has_a_frame_for_the_start_every_k_and_the_end(tmp_path):
+    # 11 steps, a frame every 4: the start, steps 4 and 8, and step 11.
+    aggsim.animat(steps=11, seed=2, animate=tmp_path / "a.gif", animate_every=4,
+                  animate_size=32)
+    assert gif_frames(tmp_path / "a.gif") == 4
+
+
+@pytest.mark.parametrize(
+    "run",
+    [
+        lambda **kw: aggsim.dlca(30, fill=0.1, seed=1, target_clusters=10, **kw),
+        lambda **kw: aggsim.animat(steps=3, seed=1, **kw),
+    ],
+)
+def test_animation_keywords_are_checked(tmp_path, run):
+    gif = tmp_path / "x.gif"
+    with pytest.raises(ValueError, match=r"^animate_every and animate_size .*give animate a path"):
+        run(animate_every=2)
+    with pytest.raises(ValueError, match=r"^animate_every and animate_size"):
+        run(animate_size=64)
+    with pytest.raises(ValueError, match=r"^animate_every = 0 is outside the accepted range 1\.\."):
+        run(animate=gif, animate_every=0)
+    with pytest.raises(ValueError, match=r"^animate_every = 1\.5 is not a whole number"):
+        run(animate=gif, animate_every=1.5)
+    with pytest.raises(ValueError, match=r"^animate_size = 16385 is outside the accepted range 16\.\.=16384"):
+        run(animate=gif, animate_size=16385)
+    with pytest.raises(ValueError, match=r"^animate_size = 15 is outside"):
+        run(animate=gif, animate_size=15)
+    # Nothing was written by a refused run.
+    assert not gif.exists()
+    # Counts as physicists write them.
+    run(animate=gif, animate_every=1e1, animate_size=3.2e1)
+    assert gif.exists()
+
+
+def test_animat_frame_radius_needs_an_animation(tmp_path):
+    with pytest.raises(ValueError, match=r"^frame_radius frames the animation"):
+        aggsim.animat(steps=3, frame_radius=5)
+    with pytest.raises(ValueError, match=r"^frame_radius = 0 is outside the accepted range 1\.\."):
+        aggsim.animat(steps=3, animate=tmp_path / "a.gif", frame_radius=0)
+
+
+def test_an_unwritable_animation_is_an_oserror(tmp_path):
+    with pytest.raises(OSError, match="no-such-dir"):
+        aggsim.animat(steps=3, animate=tmp_path / "no-such-dir" / "a.gif")
+
+
 @pytest.fixture(scope="module")
 def results():
     return [

@@ -403,20 +403,18 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         Ok(())
     };
     let mut animation = if cli.animate {
-        let image = frame.render(&world)?;
-        let mut gif = sim_run::figure::animation::Gif::create(
+        let every = cli
+            .animate_every
+            .unwrap_or_else(|| output::default_animate_every(cli.steps));
+        Some(output::Animation::start(
+            &world,
             &cli.out().join("animat.gif"),
-            image.width,
-            image.height,
-        )?;
-        gif.push(&image)?;
-        Some(gif)
+            frame,
+            every,
+        )?)
     } else {
         None
     };
-    let animate_every = cli
-        .animate_every
-        .unwrap_or_else(|| cli.steps.div_ceil(100).max(1));
     let progress = cli.log.progress(
         "animat",
         cli.steps,
@@ -461,10 +459,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             );
         }
         rows.push(PopulationRow::of(&world, s));
-        if let Some(gif) = animation.as_mut()
-            && world.steps() % animate_every == 0
-        {
-            gif.push(&frame.render(&world)?)?;
+        if let Some(a) = animation.as_mut() {
+            a.step(&world)?;
         }
         if let Some(k) = cli.snapshot_every {
             if world.steps() % k == 0 {
@@ -495,11 +491,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             snapshot(&world)?;
         }
     }
-    if let Some(mut gif) = animation {
-        if world.steps() % animate_every != 0 {
-            gif.push(&frame.render(&world)?)?;
-        }
-        let frames = gif.finish()?;
+    if let Some(a) = animation {
+        let frames = a.finish(&world)?;
         tracing::info!(frames, "animat.gif");
     }
     output::write_populations(cli.out(), &rows, cli.timing)?;

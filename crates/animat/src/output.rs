@@ -11,6 +11,7 @@
 
 use crate::params::Species;
 use crate::world::{StepStats, World};
+use sim_run::figure::animation::Gif;
 use sim_run::figure::palette;
 use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
 use sim_run::io::{
@@ -317,6 +318,68 @@ impl SnapshotFrame {
     pub fn render(&self, world: &World) -> Result<Raster, OutputError> {
         let (r, outside) = self.raster(world);
         Ok(self.figure(world, &r, outside).render()?)
+    }
+}
+
+/// Steps between frames of `animat.gif` without `--animate-every`: a hundredth of the run's
+/// `steps`, at least 1.
+pub fn default_animate_every(steps: u64) -> u64 {
+    steps.div_ceil(100).max(1)
+}
+
+/// `animat.gif` being written: the world at the start, after every `every`-th step, and at the
+/// end, all on one [`SnapshotFrame`]. The `animat` binary's `--animate` and Python's
+/// `aggsim.animat(animate=...)` both write through it, so their files agree byte for byte.
+#[derive(Debug)]
+pub struct Animation {
+    gif: Gif,
+    frame: SnapshotFrame,
+    every: u64,
+}
+
+impl Animation {
+    /// Starts an animation of `world` at `path` on `frame`, a frame every `every` steps (at
+    /// least 1), and adds the frame of `world` as it is now.
+    ///
+    /// # Errors
+    /// The file cannot be created or the frame not drawn.
+    pub fn start(
+        world: &World,
+        path: &Path,
+        frame: SnapshotFrame,
+        every: u64,
+    ) -> Result<Self, OutputError> {
+        let image = frame.render(world)?;
+        let mut gif = Gif::create(path, image.width, image.height)?;
+        gif.push(&image)?;
+        Ok(Animation {
+            gif,
+            frame,
+            every: every.max(1),
+        })
+    }
+
+    /// After a step of `world`: adds its frame if the step is a multiple of `every`.
+    ///
+    /// # Errors
+    /// The frame cannot be drawn or written.
+    pub fn step(&mut self, world: &World) -> Result<(), OutputError> {
+        if world.steps() % self.every == 0 {
+            self.gif.push(&self.frame.render(world)?)?;
+        }
+        Ok(())
+    }
+
+    /// Adds the last frame of `world` (unless [`Animation::step`] just added it) and writes the
+    /// file; returns the number of frames.
+    ///
+    /// # Errors
+    /// The frame cannot be drawn or the file not written.
+    pub fn finish(mut self, world: &World) -> Result<u64, OutputError> {
+        if world.steps() % self.every != 0 {
+            self.gif.push(&self.frame.render(world)?)?;
+        }
+        Ok(self.gif.finish()?)
     }
 }
 

@@ -373,10 +373,6 @@ const RUN_FILES: &[&str] = &[
     "dlca.gif",
 ];
 
-/// Longer side of the picture in dlca.gif without --png-size.
-const ANIMATION_DEFAULT_SIDE: u32 = 512;
-/// Sweeps between frames of dlca.gif without --animate-every.
-const ANIMATION_DEFAULT_EVERY: u64 = 10;
 /// The largest default side of a picture, for the memory estimate before the run.
 const PICTURE_MAX_DEFAULT_SIDE: u32 = dlca::picture::PNG_MAX_SIDE as u32;
 
@@ -446,7 +442,9 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             .context("writing a checkpoint")
     };
     let mut animation = if cli.animate {
-        let side = cli.png_size.unwrap_or(ANIMATION_DEFAULT_SIDE);
+        let side = cli
+            .png_size
+            .unwrap_or(dlca::picture::ANIMATION_DEFAULT_SIDE);
         Some(dlca::picture::Animation::start(
             &sim,
             cli.seed,
@@ -456,12 +454,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     } else {
         None
     };
-    let every = cli.animate_every.unwrap_or(ANIMATION_DEFAULT_EVERY);
+    let every = cli
+        .animate_every
+        .unwrap_or(dlca::picture::ANIMATION_DEFAULT_EVERY);
     while !sim.is_done() {
         sim.sweep();
         let s = &sim;
         if let Some(a) = animation.as_mut()
-            && (s.sweeps() % every == 0 || s.is_done())
+            && dlca::picture::Animation::due(s, every)
         {
             a.frame(s)?;
         }

@@ -241,6 +241,11 @@ fn png<F: Fn(&mut Visit<'_>)>(
     Ok(())
 }
 
+/// Longer side of the pictures in `dlca.gif` without `--png-size`.
+pub const ANIMATION_DEFAULT_SIDE: u32 = 512;
+/// Sweeps between frames of `dlca.gif` without `--animate-every`.
+pub const ANIMATION_DEFAULT_EVERY: u64 = 10;
+
 /// `dlca.gif` being written: one frame per call of [`Animation::frame`], each cluster keeping its
 /// colour from frame to frame where it can.
 #[derive(Debug)]
@@ -270,6 +275,12 @@ impl Animation {
             seed,
             colours,
         })
+    }
+
+    /// Whether a run that frames every `every` sweeps adds a frame after the sweep `sim` just
+    /// made: on every multiple of `every`, and at the end.
+    pub fn due(sim: &Simulation, every: u64) -> bool {
+        sim.sweeps() % every.max(1) == 0 || sim.is_done()
     }
 
     /// Adds a frame of `sim` as it is now.

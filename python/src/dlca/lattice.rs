@@ -121,7 +121,7 @@ impl DlcaLattice {
     #[pyo3(signature = (progress = None))]
     fn run(&self, py: Python<'_>, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
         let progress = Progress::from_arg(progress, "dlca", "merges")?;
-        self.lock()?.until_done(py, &progress)
+        self.lock()?.until_done(py, &progress, None)
     }
 
     /// The state now as a :class:`DlcaResult`, with ``run.json``'s results (times since the

@@ -3,16 +3,19 @@
 //! Performance Optimisation").
 
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
+use crate::figure::Animate;
 use crate::run::{Progress, interruptible};
 use ::dlca::analysis::{gyration, size_distribution};
 use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, PARAMS, flags};
+use ::dlca::picture::{ANIMATION_DEFAULT_EVERY, ANIMATION_DEFAULT_SIDE, Animation};
 use ::dlca::{Params, Search, Simulation};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
-use sim_run::io::RunClock;
+use sim_run::io::{OutputError, RunClock};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
@@ -162,21 +165,54 @@ impl Run {
     }
 
     /// Sweeps until the run is done (as the binary); returns the sweeps made. Progress counts
-    /// merges, as the binary's.
-    fn until_done(&mut self, py: Python<'_>, progress: &Progress) -> PyResult<u64> {
+    /// merges, as the binary's. With `animate` the run writes the binary's `dlca.gif` of these
+    /// sweeps to its path, unless it is interrupted.
+    fn until_done(
+        &mut self,
+        py: Python<'_>,
+        progress: &Progress,
+        animate: Option<&Animate>,
+    ) -> PyResult<u64> {
         let sim = &mut self.sim;
         let target = sim.params().target_clusters;
         let initial = sim.clusters();
         let merges = |sim: &Simulation| initial - sim.clusters().max(target).min(initial);
-        interruptible(py, progress, initial.saturating_sub(target), |shared| {
+        let made = interruptible(py, progress, initial.saturating_sub(target), |shared| {
+            let mut animation = match animate {
+                Some(a) => Some(Animation::start(
+                    sim,
+                    sim.seed(),
+                    &a.path,
+                    a.side.unwrap_or(ANIMATION_DEFAULT_SIDE),
+                )?),
+                None => None,
+            };
+            let every = animate
+                .and_then(|a| a.every)
+                .unwrap_or(ANIMATION_DEFAULT_EVERY);
             let mut k = 0;
             shared.done.store(0, Ordering::Relaxed);
             while !sim.is_done() && !shared.stop.load(Ordering::Relaxed) {
                 sim.sweep();
                 k += 1;
+                if let Some(a) = animation.as_mut()
+                    && Animation::due(sim, every)
+                {
+                    a.frame(sim)?;
+                }
                 shared.done.store(merges(sim), Ordering::Relaxed);
             }
-            k
+            // An interrupted run raises KeyboardInterrupt: its animation is dropped unwritten.
+            if let Some(a) = animation
+                && !shared.stop.load(Ordering::Relaxed)
+            {
+                a.finish()?;
+            }
+            Ok::<u64, OutputError>(k)
+        })?;
+        made.map_err(|e| {
+            let path = animate.map(|a| a.path.as_path()).unwrap_or(Path::new(""));
+            crate::figure::write_error(path, e)
         })
     }
 
@@ -331,7 +367,7 @@ impl DlcaResult {
     #[pyo3(signature = (path, size = None))]
     fn save_png(
         slf: &Bound<'_, Self>,
-        path: std::path::PathBuf,
+        path: PathBuf,
         size: Option<Count>,
     ) -> PyResult<()> {
         let side = crate::figure::png_side(size)?;
@@ -426,6 +462,17 @@ impl DlcaResult {
 /// progress : bool or callable
 ///     True prints progress (merges) to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
+/// animate : str, os.PathLike or None
+///     Write the aggregation as a GIF to this path as the run goes: the same file, byte for
+///     byte, as ``dlca --animate`` writes (``dlca.gif``) for the same run. A frame of the
+///     start, one every ``animate_every`` sweeps and one of the end, on one frame (the
+///     lattice's first two axes), each cluster keeping its colour; no more memory than two
+///     frames. An interrupted run writes no file (default None: no animation).
+/// animate_every : int or None
+///     Sweeps between frames (``--animate-every``), 1.. (default 10).
+/// animate_size : int or None
+///     Longer side of the pictures in pixels (``--png-size`` with ``--animate``), 16..=16384
+///     (default 512).
 ///
 /// Returns
 /// -------
@@ -463,6 +510,9 @@ impl DlcaResult {
     gyration = false,
     fit_min_size = Count::Int(i128::from(defaults().fit_min_size)),
     progress = None,
+    animate = None,
+    animate_every = None,
+    animate_size = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn dlca(
@@ -487,8 +537,12 @@ pub fn dlca(
     gyration: bool,
     fit_min_size: Count,
     progress: Option<&Bound<'_, PyAny>>,
+    animate: Option<PathBuf>,
+    animate_every: Option<Count>,
+    animate_size: Option<Count>,
 ) -> PyResult<Py<DlcaResult>> {
     let progress = Progress::from_arg(progress, "dlca", "merges")?;
+    let animate = Animate::from_args(animate, animate_every, animate_size, "dlca")?;
     let lattice = DlcaLattice::new(
         py,
         size,
@@ -512,7 +566,7 @@ pub fn dlca(
         fit_min_size,
     )?;
     let mut run = lattice.lock()?;
-    run.until_done(py, &progress)?;
+    run.until_done(py, &progress, animate.as_ref())?;
     run.result(py)
 }
 

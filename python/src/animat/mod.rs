@@ -3,8 +3,9 @@
 //! Performance Optimisation", section II.B).
 
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
+use crate::figure::Animate;
 use crate::run::{Progress, interruptible};
-use ::animat::output::PopulationRow;
+use ::animat::output::{Animation, PopulationRow, SnapshotFrame, default_animate_every};
 use ::animat::params::{DEFAULT_STEPS, FLAGS, PARAMS, error_message};
 use ::animat::{GridBox, Params, World, WorldError};
 use numpy::IntoPyArray;
@@ -12,10 +13,14 @@ use numpy::ndarray::Array2;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
+use sim_run::io::OutputError;
 use sim_run::io::RunClock;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
+
+mod world;
+pub use world::AnimatWorld;
 
 /// `--grid-box`: an int side, `"vision"` or `"none"`.
 fn grid_box(arg: &Bound<'_, PyAny>) -> PyResult<GridBox> {
@@ -166,10 +171,26 @@ impl Run {
     }
 
     /// Up to `n` steps, fewer once every animat has died (as the binary); returns the steps
-    /// made.
-    fn steps(&mut self, py: Python<'_>, n: u64, progress: &Progress) -> PyResult<u64> {
+    /// made. With `animate` (and the frame's half-side in cells) the run writes the binary's
+    /// `animat.gif` for these steps to its path, unless it is interrupted.
+    fn steps(
+        &mut self,
+        py: Python<'_>,
+        n: u64,
+        progress: &Progress,
+        animate: Option<(&Animate, Option<i64>)>,
+    ) -> PyResult<u64> {
         let (world, rows) = (&mut self.world, &mut self.rows);
-        interruptible(py, progress, n, |shared| {
+        let made = interruptible(py, progress, n, |shared| -> Result<u64, OutputError> {
+            let mut animation = match animate {
+                Some((a, radius)) => Some(Animation::start(
+                    world,
+                    &a.path,
+                    SnapshotFrame::new(world.params(), radius, a.side),
+                    a.every.unwrap_or_else(|| default_animate_every(n)),
+                )?),
+                None => None,
+            };
             let mut k = 0;
             while k < n && !shared.stop.load(Ordering::Relaxed) {
                 if world.foxes() + world.rabbits() == 0 {
@@ -177,10 +198,25 @@ impl Run {
                 }
                 let s = world.step();
                 rows.push(PopulationRow::of(world, s));
+                if let Some(a) = animation.as_mut() {
+                    a.step(world)?;
+                }
                 k += 1;
                 shared.done.store(k, Ordering::Relaxed);
             }
-            k
+            // An interrupted run raises KeyboardInterrupt: its animation is dropped unwritten.
+            if let Some(a) = animation
+                && !shared.stop.load(Ordering::Relaxed)
+            {
+                a.finish(world)?;
+            }
+            Ok(k)
+        })?;
+        made.map_err(|e| {
+            let path = animate
+                .map(|(a, _)| a.path.as_path())
+                .unwrap_or(Path::new(""));
+            crate::figure::write_error(path, e)
         })
     }
 
@@ -307,18 +343,7 @@ impl AnimatResult {
         frame_radius: Option<Count>,
     ) -> PyResult<()> {
         let side = crate::figure::png_side(size)?;
-        let radius = frame_radius
-            .map(|v| count::<u64>(&[], "frame_radius", v))
-            .transpose()?
-            .map(|r| {
-                i64::try_from(r).ok().filter(|&r| r >= 1).ok_or_else(|| {
-                    value_error(format!(
-                        "frame_radius = {r} is outside the accepted range 1..={}",
-                        i64::MAX
-                    ))
-                })
-            })
-            .transpose()?;
+        let radius = crate::figure::frame_radius(frame_radius)?;
         let start_radius: i64 = slf.getattr("params")?.get_item("start_radius")?.extract()?;
         let rows = crate::figure::animat_rows(slf.as_any())?;
         let census = ::animat::output::Census {
@@ -343,212 +368,6 @@ impl AnimatResult {
         Ok(format!(
             "<aggsim.AnimatResult: {f} foxes, {r} rabbits after {s} steps, state_hash {hash}>"
         ))
-    }
-}
-
-/// An animat world to step forward and look at between steps.
-///
-/// Takes the model parameters of :func:`aggsim.animat` (all but ``steps`` and
-/// ``progress``), places the start population and waits: :meth:`step` runs steps, the
-/// properties show the state, :meth:`result` gives what :func:`aggsim.animat` returns.
-/// Stepping one step at a time gives the very run ``animat`` makes (the same ``state_hash``).
-/// Ctrl-C during :meth:`step` stops after the current step with ``KeyboardInterrupt`` and
-/// leaves the world valid. One thread at a time may use a world (another gets
-/// ``RuntimeError`` while it runs).
-#[pyclass(module = "aggsim")]
-pub struct AnimatWorld {
-    run: Mutex<Run>,
-}
-
-impl AnimatWorld {
-    fn lock(&self) -> PyResult<MutexGuard<'_, Run>> {
-        match self.run.try_lock() {
-            Ok(g) => Ok(g),
-            Err(TryLockError::Poisoned(e)) => Ok(e.into_inner()),
-            Err(TryLockError::WouldBlock) => Err(PyRuntimeError::new_err(
-                "the world is running in another thread",
-            )),
-        }
-    }
-}
-
-#[pymethods]
-impl AnimatWorld {
-    #[new]
-    #[pyo3(signature = (
-        seed = 1,
-        *,
-        config = None,
-        foxes = None,
-        rabbits = None,
-        start_radius = None,
-        density = None,
-        vision = None,
-        grid_box = None,
-        hungry_at = None,
-        starve = None,
-        fox_max_age = None,
-        rabbit_max_age = None,
-        fox_breed_p = None,
-        rabbit_breed_p = None,
-        prey_needed = None,
-        crowd_max = None,
-        crowd_radius = None,
-        fox_rules = None,
-        rabbit_rules = None,
-        timing = false,
-    ))]
-    #[allow(clippy::too_many_arguments)]
-    fn new(
-        py: Python<'_>,
-        seed: u64,
-        config: Option<PathBuf>,
-        foxes: Option<Count>,
-        rabbits: Option<Count>,
-        start_radius: Option<i64>,
-        density: Option<f64>,
-        vision: Option<i64>,
-        grid_box: Option<&Bound<'_, PyAny>>,
-        hungry_at: Option<Count>,
-        starve: Option<Count>,
-        fox_max_age: Option<Count>,
-        rabbit_max_age: Option<Count>,
-        fox_breed_p: Option<f64>,
-        rabbit_breed_p: Option<f64>,
-        prey_needed: Option<Count>,
-        crowd_max: Option<Count>,
-        crowd_radius: Option<i64>,
-        fox_rules: Option<Vec<String>>,
-        rabbit_rules: Option<Vec<String>>,
-        timing: bool,
-    ) -> PyResult<Self> {
-        let args = Args {
-            config,
-            foxes,
-            rabbits,
-            start_radius,
-            density,
-            vision,
-            grid_box,
-            hungry_at,
-            starve,
-            fox_max_age,
-            rabbit_max_age,
-            fox_breed_p,
-            rabbit_breed_p,
-            prey_needed,
-            crowd_max,
-            crowd_radius,
-            fox_rules,
-            rabbit_rules,
-        };
-        Ok(AnimatWorld {
-            run: Mutex::new(Run::new(py, &args, seed, timing)?),
-        })
-    }
-
-    /// Run up to ``n`` steps (fewer once every animat has died) and return how many ran. In a
-    /// step every animat alive at its start, in a fresh random order, runs the first rule of
-    /// its species' list whose condition holds. ``progress`` as in :func:`aggsim.animat`.
-    /// Ctrl-C stops after the current step (``KeyboardInterrupt``).
-    #[pyo3(signature = (n = Count::Int(1), progress = None))]
-    fn step(&self, py: Python<'_>, n: Count, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
-        let n = count(&[], "n", n)?;
-        let progress = Progress::from_arg(progress, "animat", "steps")?;
-        self.lock()?.steps(py, n, &progress)
-    }
-
-    /// The state now as an :class:`AnimatResult`, with ``run.json``'s results (times since
-    /// the world was made).
-    fn result(&self, py: Python<'_>) -> PyResult<Py<AnimatResult>> {
-        self.lock()?.result(py)
-    }
-
-    /// Steps made.
-    #[getter]
-    fn steps(&self) -> PyResult<u64> {
-        Ok(self.lock()?.world.steps())
-    }
-
-    /// Live foxes.
-    #[getter]
-    fn foxes(&self) -> PyResult<u64> {
-        Ok(self.lock()?.world.foxes())
-    }
-
-    /// Live rabbits.
-    #[getter]
-    fn rabbits(&self) -> PyResult<u64> {
-        Ok(self.lock()?.world.rabbits())
-    }
-
-    /// Hash of every live animat (the binary's ``state_hash``).
-    #[getter]
-    fn state_hash(&self) -> PyResult<String> {
-        Ok(self.lock()?.world.state_hash())
-    }
-
-    /// The validated parameters, as ``run.json`` records them.
-    #[getter]
-    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let v = serde_json::to_value(self.lock()?.world.params()).map_err(run_error)?;
-        crate::convert::json(py, &v)
-    }
-
-    /// int64 array (M, 2): the cell of every live animat, by increasing id.
-    #[getter]
-    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "positions")
-    }
-
-    /// int64 array (M,): ``FOX`` (0) or ``RABBIT`` (1) for every live animat.
-    #[getter]
-    fn species<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "species")
-    }
-
-    /// int64 array (M,): every live animat's id.
-    #[getter]
-    fn id<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "id")
-    }
-
-    /// int64 array (M,): steps lived.
-    #[getter]
-    fn age<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "age")
-    }
-
-    /// int64 array (M,): steps since the last meal (0 for rabbits).
-    #[getter]
-    fn hunger<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        self.column(py, "hunger")
-    }
-
-    /// Foxes and rabbits after every step so far (dict of arrays, as
-    /// :attr:`AnimatResult.populations`).
-    #[getter]
-    fn populations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        self.lock()?.populations(py)
-    }
-
-    fn __repr__(&self) -> PyResult<String> {
-        let r = self.lock()?;
-        Ok(format!(
-            "<aggsim.AnimatWorld: {} foxes, {} rabbits after {} steps>",
-            r.world.foxes(),
-            r.world.rabbits(),
-            r.world.steps()
-        ))
-    }
-}
-
-impl AnimatWorld {
-    fn column<'py>(&self, py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-        self.lock()?
-            .animats(py)?
-            .get_item(name)?
-            .ok_or_else(|| run_error(format!("no column {name}")))
     }
 }
 
@@ -601,6 +420,20 @@ impl AnimatWorld {
 /// progress : bool or callable
 ///     True prints progress (steps) to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
+/// animate : str, os.PathLike or None
+///     Write the world as a GIF to this path as the run goes: the same file, byte for byte,
+///     as ``animat --animate`` writes (``animat.gif``) for the same run. The world at the
+///     start, every ``animate_every`` steps and at the end, all on one fixed frame (as
+///     :meth:`AnimatResult.save_png` draws it); no more memory than two frames. An
+///     interrupted run writes no file (default None: no animation).
+/// animate_every : int or None
+///     Steps between frames (``--animate-every``), 1.. (default: a hundredth of ``steps``).
+/// animate_size : int or None
+///     Side of the pictures in pixels (``--png-size`` with ``--animate``), 16..=16384
+///     (default: a whole number of pixels per cell and at least 512, or one pixel per cell up
+///     to 1024).
+/// frame_radius : int or None
+///     Half the frame's side in cells (``--frame-radius``), 1.. (default: three start radii).
 ///
 /// ``aggsim.defaults("animat")`` lists every default.
 ///
@@ -642,6 +475,10 @@ impl AnimatWorld {
     rabbit_rules = None,
     timing = false,
     progress = None,
+    animate = None,
+    animate_every = None,
+    animate_size = None,
+    frame_radius = None,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn animat(
@@ -668,9 +505,21 @@ pub fn animat(
     rabbit_rules: Option<Vec<String>>,
     timing: bool,
     progress: Option<&Bound<'_, PyAny>>,
+    animate: Option<PathBuf>,
+    animate_every: Option<Count>,
+    animate_size: Option<Count>,
+    frame_radius: Option<Count>,
 ) -> PyResult<Py<AnimatResult>> {
     let steps = count(&[], "steps", steps)?;
     let progress = Progress::from_arg(progress, "animat", "steps")?;
+    let animate = Animate::from_args(animate, animate_every, animate_size, "animat")?;
+    let frame_radius = crate::figure::frame_radius(frame_radius)?;
+    if frame_radius.is_some() && animate.is_none() {
+        return Err(value_error(
+            "frame_radius frames the animation written to animate; give animate a path (for \
+             example animate=\"animat.gif\")",
+        ));
+    }
     let world = AnimatWorld::new(
         py,
         seed,
@@ -695,7 +544,12 @@ pub fn animat(
         timing,
     )?;
     let mut run = world.lock()?;
-    run.steps(py, steps, &progress)?;
+    run.steps(
+        py,
+        steps,
+        &progress,
+        animate.as_ref().map(|a| (a, frame_radius)),
+    )?;
     run.result(py)
 }
 
