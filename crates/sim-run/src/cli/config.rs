@@ -228,17 +228,7 @@ pub fn effective(cmd: &clap::Command, matches: &clap::ArgMatches) -> String {
             let Some(raw) = matches.get_raw(&id) else {
                 continue;
             };
-            let values: Vec<toml::Value> = raw
-                .map(|v| {
-                    let s = v.to_string_lossy();
-                    // Numbers stay numbers; words such as `inf` stay strings.
-                    match (s.parse::<i64>(), s.parse::<f64>()) {
-                        (Ok(i), _) => toml::Value::Integer(i),
-                        (_, Ok(f)) if f.is_finite() => toml::Value::Float(f),
-                        _ => toml::Value::String(s.into_owned()),
-                    }
-                })
-                .collect();
+            let values: Vec<toml::Value> = raw.map(|v| toml_value(&v.to_string_lossy())).collect();
             match <[toml::Value; 1]>::try_from(values) {
                 Ok([one]) => one,
                 Err(many) => toml::Value::Array(many),
@@ -260,6 +250,34 @@ pub fn effective(cmd: &clap::Command, matches: &clap::ArgMatches) -> String {
         }
     }
     text
+}
+
+/// A flag's value as `config.toml` writes it: whole numbers as integers, also where they were
+/// typed as physicists write counts (`1e6`, `1_000_000`), so that the file shows
+/// `particles = 1000000`; other finite numbers as floats (`0.1`, `5.0` as typed); words such as
+/// `inf` or `1..=10` as strings. Every value reads back to the flag's own value.
+fn toml_value(s: &str) -> toml::Value {
+    if let Ok(i) = s.parse::<i64>() {
+        return toml::Value::Integer(i);
+    }
+    let digits = s.strip_prefix(['-', '+']).unwrap_or(s);
+    let grouped = digits.contains('_')
+        && !digits.starts_with('_')
+        && !digits.ends_with('_')
+        && digits.chars().all(|c| c.is_ascii_digit() || c == '_');
+    if grouped && let Ok(i) = s.replace('_', "").parse::<i64>() {
+        return toml::Value::Integer(i);
+    }
+    match s.parse::<f64>() {
+        // 2^53: every whole float up to it is an exact integer.
+        Ok(f)
+            if s.contains(['e', 'E']) && f.fract() == 0.0 && f.abs() <= 9_007_199_254_740_992.0 =>
+        {
+            toml::Value::Integer(f as i64)
+        }
+        Ok(f) if f.is_finite() => toml::Value::Float(f),
+        _ => toml::Value::String(s.to_owned()),
+    }
 }
 
 /// Parses the command line of `C` with `--config` expanded (flags given more than once: the
@@ -338,7 +356,7 @@ mod tests {
 
     #[derive(Parser, Debug)]
     struct T {
-        #[arg(long, default_value_t = 10)]
+        #[arg(long, default_value_t = 10, value_parser = crate::cli::count::<u64>)]
         particles: u64,
         #[arg(long, default_value_t = 0.5)]
         step_min: f64,
@@ -418,6 +436,34 @@ mod tests {
             (t.particles, t.step_min, t.png, t.sweeps)
         );
         assert_eq!(text, again);
+    }
+
+    #[test]
+    fn counts_as_typed_are_written_as_integers() {
+        for (typed, written) in [
+            ("1e6", "particles = 1000000\n"),
+            ("2.5e5", "particles = 250000\n"),
+            ("1_000_000", "particles = 1000000\n"),
+            ("42", "particles = 42\n"),
+        ] {
+            let (t, text) = parse(&["--particles", typed], "").unwrap();
+            assert!(text.contains(written), "{typed}: {text}");
+            let (u, again) = parse(&["--config", "FILE"], &text).unwrap();
+            assert_eq!((u.particles, &again), (t.particles, &text));
+        }
+        // Other numbers as typed, words as strings; all read back.
+        let (t, text) = parse(&["--step-min", "1e-1", "--size", "1..=10"], "").unwrap();
+        assert!(
+            text.contains("step-min = 0.1\n") && text.contains("size = \"1..=10\"\n"),
+            "{text}"
+        );
+        let (u, _) = parse(&["--config", "FILE"], &text).unwrap();
+        assert_eq!((u.step_min, u.size), (t.step_min, t.size));
+        assert_eq!(toml_value("5.0"), toml::Value::Float(5.0));
+        assert_eq!(toml_value("inf"), toml::Value::String("inf".into()));
+        assert_eq!(toml_value("1e30"), toml::Value::Float(1e30));
+        assert_eq!(toml_value("_1"), toml::Value::String("_1".into()));
+        assert_eq!(toml_value("-1_0"), toml::Value::Integer(-10));
     }
 
     #[test]
