@@ -56,6 +56,33 @@ pub fn dlca_pooled_table(csv: &str) -> Result<String, String> {
     Ok(out)
 }
 
+/// The headline figures of a long DLA run as its report quotes them, from its `run.json`: the
+/// wall time in hours, the peak memory in GiB and GB, the fractal dimension and R_g.
+///
+/// # Errors
+/// The manifest is not JSON or lacks a figure.
+pub fn dla_run_figures(run_json: &str) -> Result<Vec<String>, String> {
+    let v: serde_json::Value = serde_json::from_str(run_json).map_err(|e| e.to_string())?;
+    let num = |path: &[&str]| {
+        path.iter()
+            .try_fold(&v, |v, k| v.get(k))
+            .and_then(serde_json::Value::as_f64)
+            .ok_or_else(|| format!("run.json has no {}", path.join(".")))
+    };
+    let wall = num(&["wall_seconds"])?;
+    let peak = num(&["peak_rss_bytes"])?;
+    let d = num(&["results", "fractal_dimension"])?;
+    let rg = num(&["results", "radius_of_gyration"])?;
+    let rg = rg.round() as u64;
+    Ok(vec![
+        format!("{:.2} h", wall / 3600.0),
+        format!("{:.1} GiB", peak / (1u64 << 30) as f64),
+        format!("{:.2} GB", peak / 1e9),
+        format!("{d:.4}"),
+        format!("{} {:03}", rg / 1000, rg % 1000),
+    ])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -70,5 +97,19 @@ mod tests {
             doc.contains(&table),
             "docs/dlca.md does not hold the table of docs/results/dlca_pooled_df.csv:\n{table}"
         );
+    }
+
+    #[test]
+    fn the_1e9_report_quotes_its_run() {
+        let root = crate::workspace_root();
+        let dir = root.join("docs/results/dla_1e9");
+        let run = std::fs::read_to_string(dir.join("run.json")).unwrap();
+        let report = std::fs::read_to_string(dir.join("README.md")).unwrap();
+        for figure in dla_run_figures(&run).unwrap() {
+            assert!(
+                report.contains(&figure),
+                "docs/results/dla_1e9/README.md does not quote `{figure}` from its run.json"
+            );
+        }
     }
 }
