@@ -365,11 +365,7 @@ impl DlcaResult {
     ///     axes and legend come around it. Default: a whole number of pixels per site and at
     ///     least 512, or one pixel per site up to 8192.
     #[pyo3(signature = (path, size = None))]
-    fn save_png(
-        slf: &Bound<'_, Self>,
-        path: PathBuf,
-        size: Option<Count>,
-    ) -> PyResult<()> {
+    fn save_png(slf: &Bound<'_, Self>, path: PathBuf, size: Option<Count>) -> PyResult<()> {
         let side = crate::figure::png_side(size)?;
         let sizes: Vec<u64> = slf.getattr("params")?.get_item("size")?.extract()?;
         let rows = crate::figure::dlca_rows(slf.as_any(), &sizes)?;
