@@ -22,6 +22,9 @@ ENTRY_POINTS = {
 
 # Keyword arguments that are not model parameters.
 PYTHON_ONLY = {"seed", "progress", "paper_settings", "config", "steps", "timing"}
+# The animation a run writes: the binaries' figure flags (--animate, --animate-every,
+# --png-size, --frame-radius), which are outputs, not model parameters.
+PYTHON_ONLY |= {"animate", "animate_every", "animate_size", "frame_radius"}
 
 # Documented differences from the library default: ``aggsim.dla`` grows 1e5 particles when
 # none are given (the binary requires ``--particles``); ``aggsim.dlca``'s ``dim`` defaults to
