@@ -83,6 +83,12 @@ pub struct Animate {
 }
 
 impl Animate {
+    /// The `OSError` of a run whose animation `a` could not be written (a run without one
+    /// writes no file, so cannot fail this way; its error names no path).
+    pub fn error(a: Option<&Animate>, e: OutputError) -> PyErr {
+        write_error(a.map_or(std::path::Path::new(""), |a| a.path.as_path()), e)
+    }
+
     /// The keywords checked as the binaries check their flags: `animate_every` at least 1,
     /// `animate_size` in 16..=16384, and neither without `animate`. `model` names the file in
     /// the message.

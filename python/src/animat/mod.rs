@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
 use sim_run::io::OutputError;
 use sim_run::io::RunClock;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
@@ -212,12 +212,7 @@ impl Run {
             }
             Ok(k)
         })?;
-        made.map_err(|e| {
-            let path = animate
-                .map(|(a, _)| a.path.as_path())
-                .unwrap_or(Path::new(""));
-            crate::figure::write_error(path, e)
-        })
+        made.map_err(|e| Animate::error(animate.map(|(a, _)| a), e))
     }
 
     /// The live animats' columns, named and typed as the binary's positions files

@@ -15,7 +15,7 @@ use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 use sim_run::io::{OutputError, RunClock};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
@@ -210,10 +210,7 @@ impl Run {
             }
             Ok::<u64, OutputError>(k)
         })?;
-        made.map_err(|e| {
-            let path = animate.map(|a| a.path.as_path()).unwrap_or(Path::new(""));
-            crate::figure::write_error(path, e)
-        })
+        made.map_err(|e| Animate::error(animate, e))
     }
 
     /// Every particle's site (int64, (N, D)) and cluster id (int64, (N,)), in the order of
