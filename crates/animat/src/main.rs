@@ -7,12 +7,11 @@ use animat::output::{self, PopulationRow};
 use animat::{GridBox, Params, ParamsError, Snapshot, World};
 use anyhow::Context;
 use clap::Parser;
-use sim_run::cli::{Interrupted, LogArgs, flag_differences, usage};
+use sim_run::cli::{CheckpointArgs, LogArgs, flag_differences, usage};
 use sim_run::ensemble::{Curve, EnsembleArgs};
 use sim_run::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::Ordering;
 
 /// Foxes and rabbits on an unbounded plane, each running its rule list in priority order.
 ///
@@ -118,13 +117,15 @@ struct Cli {
     #[arg(long, value_enum, value_name = "FORMAT", num_args = 0..=1, default_value_t = Positions::None, default_missing_value = "csv")]
     positions: Positions,
 
-    /// Save the run to OUT/checkpoint.bin every N steps and at the end (atomically), for
-    /// --resume; SIGINT or SIGTERM then save it after the current step and stop (exit code
-    /// 130).
+    /// Also save the run to OUT/checkpoint.bin every N steps, and keep one at the end
+    /// (atomically), so that --resume with a larger --steps goes on from there.
     #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
-    /// Continue the run saved in DIR/checkpoint.bin (by --checkpoint-every) to the same state
+    #[command(flatten)]
+    checkpoints: CheckpointArgs,
+
+    /// Continue the run saved in DIR/checkpoint.bin (a checkpoint, or a stopped run) to the same state
     /// as an uninterrupted run: the model parameters and --seed must be those of the saved run
     /// (--steps may grow; output flags may change).
     #[arg(long, value_name = "DIR")]
@@ -210,6 +211,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             "raise --density (or lower --start-radius)",
         )?;
     }
+    cli.checkpoints.check(cli.checkpoint_every)?;
     if let Some(out) = &cli.out {
         sim_run::cli::check_out_dir(out)?;
     }
@@ -425,22 +427,24 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         snapshot(&world)?;
     }
     progress.set_position(world.steps().min(cli.steps));
-    // With checkpoints, SIGINT/SIGTERM save the run after the current step and stop it.
-    let stop = match cli.checkpoint_every {
-        Some(_) => Some(sim_run::cli::stop_on_signals().context("installing signal handlers")?),
-        None => None,
-    };
+    // Timed checkpoints, signals and the memory watch. A checkpoint holds a copy of the world
+    // and its encoding while it is written: twice the world's memory is kept free for it.
+    let enabled = cli.checkpoints.enabled();
+    let (guard, _watch, memory) = cli
+        .checkpoints
+        .start(2 * world.memory_bytes())
+        .context("installing signal handlers")?;
     while world.steps() < cli.steps {
-        if stop.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
-            progress.finish();
-            save(&world, &rows)?;
-            return Err(Interrupted(format!(
-                "interrupted after step {}; checkpoint in {}: continue with --resume {}",
-                world.steps(),
-                cli.out().display(),
-                cli.out().display()
-            ))
-            .into());
+        if guard.is_set() {
+            let at = || format!("after step {}", world.steps());
+            sim_run::cli::checkpoints::honour(
+                &guard,
+                enabled,
+                cli.out(),
+                || save(&world, &rows),
+                at,
+            )
+            .inspect_err(|_| progress.finish())?;
         }
         if world.foxes() + world.rabbits() == 0 {
             tracing::info!(step = world.steps(), "every animat has died");
@@ -449,15 +453,28 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         let s = world.step();
         if world.memory_bytes() > limit.bytes {
             progress.finish();
+            let then = if enabled {
+                rows.push(PopulationRow::of(&world, s));
+                save(&world, &rows)?;
+                format!(
+                    "raise --max-memory and continue with --resume {} (checkpointed at this step)",
+                    cli.out().display()
+                )
+            } else {
+                "raise --max-memory".to_string()
+            };
             anyhow::bail!(
-                "after step {} the world holds {} animats and takes about {}, over {}; \
-                 raise --max-memory (with --checkpoint-every, --resume continues from the last checkpoint)",
+                "after step {} the world holds {} animats and takes about {}, over {}; {then}",
                 world.steps(),
                 world.foxes() + world.rabbits(),
                 show_bytes(world.memory_bytes()),
                 limit.describe()
             );
         }
+        memory.reserve.store(
+            2 * world.memory_bytes(),
+            std::sync::atomic::Ordering::Relaxed,
+        );
         rows.push(PopulationRow::of(&world, s));
         if let Some(a) = animation.as_mut() {
             a.step(&world)?;
@@ -485,6 +502,11 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     progress.finish();
     if cli.checkpoint_every.is_some() {
         save(&world, &rows)?;
+    } else {
+        // A checkpoint the run did not ask for (a timed one, or the one it was resumed from)
+        // goes.
+        sim_run::cli::checkpoints::remove_unasked_checkpoint(cli.out(), false)
+            .context("removing checkpoint.bin")?;
     }
     if let Some(k) = cli.snapshot_every {
         if world.steps() % k != 0 {

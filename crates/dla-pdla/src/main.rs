@@ -7,7 +7,9 @@ use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
-use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, OverwriteArgs, flag_differences, usage};
+use sim_run::cli::{
+    CheckpointArgs, ConfigArgs, LogArgs, OverwriteArgs, flag_differences, stopped, usage,
+};
 use sim_run::ensemble::{Curve, EnsembleArgs};
 use sim_run::io::RunClock;
 use std::path::{Path, PathBuf};
@@ -123,14 +125,17 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
     positions: PositionsFormat,
 
-    /// Write DIR/checkpoint.bin (DIR = --out) every N particles and at the end, atomically: a
-    /// few kilobytes, as the positions stream to positions.npy (so this writes that too).
-    /// SIGINT or SIGTERM then checkpoint and stop (exit code 130). With one thread a run
-    /// continued with --resume ends with the same state_hash; with more (PDLA), every N
-    /// particles is a parallel phase ending at a quiescent point, and a resumed run is a valid
-    /// PDLA cluster.
+    /// Also write DIR/checkpoint.bin (DIR = --out) every N particles, and keep one at the end
+    /// (so that --resume with a larger --particles grows the finished cluster further). A
+    /// checkpoint is a few kilobytes: the positions stream to positions.npy, which it refers
+    /// to. With one thread a run continued with --resume ends with the same state_hash; with
+    /// more (PDLA), a checkpoint ends a parallel phase at a quiescent point, and a resumed run
+    /// is a valid PDLA cluster.
     #[arg(long, value_parser = sim_run::cli::count::<u64>, value_name = "N")]
     checkpoint_every: Option<u64>,
+
+    #[command(flatten)]
+    checkpoints: CheckpointArgs,
 
     /// Continue the run checkpointed in DIR (checkpoint.bin and positions.npy). The run flags
     /// (and --seed) must be those of the checkpointed run, except --particles, which may grow:
@@ -230,9 +235,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             p.dim
         ));
     }
-    if cli.checkpoint_every == Some(0) {
-        return Err("--checkpoint-every 0 is outside the accepted range 1..".into());
-    }
+    cli.checkpoints.check(cli.checkpoint_every)?;
     sim_run::figure::animation::check_picture_flags(
         cli.png_size,
         cli.animate,
@@ -281,6 +284,10 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
         "lower --particles",
     )
 }
+
+/// Memory the final checkpoint needs beyond the run's own: the streams' buffers are flushed
+/// and the checkpoint itself is a few kilobytes.
+const CHECKPOINT_RESERVE: u64 = 16 << 20;
 
 /// The progress bar of a run on a terminal.
 const PROGRESS_TEMPLATE: &str =
@@ -384,10 +391,13 @@ where
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
     sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
-    let positions = cli.png
+    // The positions stream to positions.npy when asked for, and for the checkpoints, which
+    // refer to them; a run that ends normally removes what was not asked for.
+    let asked_positions = cli.png
         || cli.animate
         || cli.positions != PositionsFormat::None
         || cli.checkpoint_every.is_some();
+    let checkpoints = cli.checkpoints.enabled();
     if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {
         tracing::warn!(
             "--positions {} for {total} particles writes about {} GB of text; positions.npy holds them in {} GB",
@@ -396,26 +406,23 @@ where
             total * 8 * D as u64 / 1_000_000_000
         );
     }
-    sim.stream_into(&cli.out, positions)?;
+    sim.stream_into(&cli.out, asked_positions || checkpoints)?;
     let progress = cli
         .log
         .progress("dla", total, "particles", PROGRESS_TEMPLATE);
     let report = |n| progress.set_position(n);
-    match cli.checkpoint_every {
-        Some(every) => {
-            let stop = sim_run::cli::stop_on_signals().context("installing signal handlers")?;
-            if !sim.run_checkpointed(every, &stop, &report)? {
-                progress.finish();
-                return Err(Interrupted(format!(
-                    "interrupted at {} of {total} particles; checkpoint in {}: continue with --resume {}",
-                    sim.particles(),
-                    cli.out.display(),
-                    cli.out.display()
-                ))
-                .into());
-            }
-        }
-        None => sim.run_with(&report)?,
+    // Timed checkpoints, signals and the memory watch; a checkpoint needs a few kilobytes
+    // beyond the buffers already flushed.
+    let (guard, watch, _) = cli
+        .checkpoints
+        .start(CHECKPOINT_RESERVE)
+        .context("installing signal handlers")?;
+    let end = sim.run_guarded(cli.checkpoint_every, &guard, checkpoints, &report)?;
+    drop(watch);
+    if let Some(reason) = end {
+        progress.finish();
+        let at = format!("at {} of {total} particles", sim.particles());
+        return Err(stopped(&reason, &at, &cli.out, checkpoints));
     }
     progress.finish();
     sim.sync_streams()?;
@@ -440,6 +447,18 @@ where
         tracing::info!(frames, "dla.gif");
     }
     let m = write_outputs(&sim, &clock, &cli.out, cli.positions, png)?;
+    // What only the checkpoints needed goes; what was asked for stays.
+    sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.out, cli.checkpoint_every.is_some())
+        .context("removing checkpoint.bin")?;
+    if !asked_positions {
+        match std::fs::remove_file(cli.out.join(dla_pdla::sim::POSITIONS_FILE)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(anyhow::Error::from(e)
+                    .context("removing positions.npy, which only the checkpoints needed"));
+            }
+            _ => {}
+        }
+    }
     if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
         tracing::warn!("no fractal dimension: {e}");
     }

@@ -37,7 +37,7 @@ fn a_run_larger_than_any_machine_is_refused_naming_the_memory_available() {
         ),
         (
             &["--dim", "5", "--particles", "2500000000", "--out", "o"],
-            "give --max-memory BYTES",
+            "than the machine's",
         ),
         (
             &[

@@ -7,11 +7,10 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use dlca::params::flags;
 use dlca::{Params, Search, Simulation, Snapshot};
-use sim_run::cli::{ConfigArgs, Interrupted, LogArgs, flag_differences, usage};
+use sim_run::cli::{CheckpointArgs, ConfigArgs, LogArgs, flag_differences, usage};
 use sim_run::ensemble::{Combine, Curve, EnsembleArgs, MemberRun, Pooled, PooledResult};
 use sim_run::io::{Positions, RunClock};
 use sim_run::io::{read_checkpoint, write_checkpoint};
-use std::sync::atomic::Ordering;
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
@@ -59,12 +58,15 @@ struct Cli {
     #[arg(long)]
     out: PathBuf,
 
-    /// Save the run's state to OUT/checkpoint.bin every N sweeps (atomically), for --resume;
-    /// SIGINT or SIGTERM then save it after the current sweep and stop (exit code 130).
+    /// Also save the run's state to OUT/checkpoint.bin every N sweeps (atomically), and keep
+    /// it at the end.
     #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
-    /// Continue the run saved in DIR/checkpoint.bin (by --checkpoint-every) to the same final
+    #[command(flatten)]
+    checkpoints: CheckpointArgs,
+
+    /// Continue the run saved in DIR/checkpoint.bin (a checkpoint, or a stopped run) to the same final
     /// state as an uninterrupted run. The other flags must be those of the saved run, except
     /// --target-clusters and --max-sweeps.
     #[arg(long, value_name = "DIR")]
@@ -246,6 +248,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         ),
         "lower --size or --fill/--particles",
     )?;
+    cli.checkpoints.check(cli.checkpoint_every)?;
     sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
@@ -432,11 +435,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         "merges",
         "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
     );
-    // With checkpoints, SIGINT/SIGTERM save the run after the current sweep and stop it.
-    let stop = match cli.checkpoint_every {
-        Some(_) => Some(sim_run::cli::stop_on_signals().context("installing signal handlers")?),
-        None => None,
-    };
+    // Timed checkpoints, signals and the memory watch: a checkpoint holds a copy of the state
+    // while it is encoded, about the run's memory again.
+    let reserve = dlca::sim::peak_memory_bytes(sim.params());
+    let enabled = cli.checkpoints.enabled();
+    let (guard, _watch, _) = cli
+        .checkpoints
+        .start(reserve)
+        .context("installing signal handlers")?;
     let save = |s: &Simulation| {
         write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot())
             .context("writing a checkpoint")
@@ -475,17 +481,10 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             progress.set_message(format!("sweep {}, {} clusters", s.sweeps(), s.clusters()));
             progress.set_position(initial - s.clusters().max(target).min(initial));
         }
-        if !s.is_done() && stop.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
-            progress.finish();
-            save(s)?;
-            return Err(Interrupted(format!(
-                "interrupted after sweep {} ({} clusters); checkpoint in {}: continue with --resume {}",
-                s.sweeps(),
-                s.clusters(),
-                cli.out.display(),
-                cli.out.display()
-            ))
-            .into());
+        if !s.is_done() && guard.is_set() {
+            let at = || format!("after sweep {} ({} clusters)", s.sweeps(), s.clusters());
+            sim_run::cli::checkpoints::honour(&guard, enabled, &cli.out, || save(s), at)
+                .inspect_err(|_| progress.finish())?;
         }
     }
     progress.finish();
@@ -507,6 +506,9 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         let frames = a.finish()?;
         tracing::info!(frames, "dlca.gif");
     }
+    // A checkpoint the run did not ask for (a timed one, or the one it was resumed from) goes.
+    sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.out, cli.checkpoint_every.is_some())
+        .context("removing checkpoint.bin")?;
     let m = dlca::output::write_outputs(
         &sim,
         cli.seed,

@@ -43,7 +43,7 @@ fn a_run_larger_than_any_machine_is_refused_naming_the_memory_available() {
         ),
         (
             &["--size", "60000", "--fill", "0.5", "--out", "o"],
-            "give --max-memory BYTES",
+            "than the machine's",
         ),
     ];
     let failures = refusals(Path::new(DLCA), "dlca", tmp.path(), cases);

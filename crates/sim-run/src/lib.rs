@@ -49,6 +49,7 @@ pub mod ensemble;
 pub mod figure;
 #[cfg(any(test, feature = "test-support"))]
 pub mod fuzz;
+pub mod guard;
 pub mod io;
 pub mod memory;
 #[cfg(feature = "plot")]

@@ -85,11 +85,30 @@ impl Limit {
                 "{need}, over {}; {smaller}, or raise --max-memory",
                 self.describe()
             ),
-            _ => format!(
-                "{need}, more than {}; {smaller}, or give --max-memory BYTES (such as 64G) to \
-                 run anyway",
-                self.describe()
-            ),
+            _ => {
+                let flag = show_bytes_flag(estimate);
+                match total_memory() {
+                    Some(total) if estimate > total => format!(
+                        "{need}, more than {} and more than the machine's {} in all; {smaller}, \
+                         or use a larger machine (--max-memory {flag} would start the run, to \
+                         checkpoint and stop when memory runs out)",
+                        self.describe(),
+                        show_bytes(total)
+                    ),
+                    Some(total) => format!(
+                        "{need}, more than {} (other processes hold the rest of the machine's \
+                         {}); {smaller}, or give --max-memory {flag} to run anyway, at the risk \
+                         of running out (the run then checkpoints and stops)",
+                        self.describe(),
+                        show_bytes(total)
+                    ),
+                    None => format!(
+                        "{need}, more than {}; {smaller}, or give --max-memory {flag} to run \
+                         anyway, at the risk of running out (the run then checkpoints and stops)",
+                        self.describe()
+                    ),
+                }
+            }
         })
     }
 }
@@ -149,8 +168,41 @@ pub fn available() -> Limit {
     Limit { bytes, source }
 }
 
+/// `MemTotal` of `/proc/meminfo`, or the cgroup limit if lower.
+pub fn total_memory() -> Option<u64> {
+    let total = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|t| meminfo_field(&t, "MemTotal"));
+    let cgroup = [
+        "/sys/fs/cgroup/memory.max",
+        "/sys/fs/cgroup/memory/memory.limit_in_bytes",
+    ]
+    .iter()
+    .find_map(|p| cgroup_limit(&std::fs::read_to_string(p).ok()?));
+    match (total, cgroup) {
+        (Some(t), Some(c)) => Some(t.min(c)),
+        (t, c) => t.or(c),
+    }
+}
+
+/// `bytes` rounded up to a value of `--max-memory` that covers it: `23G`, `512M`.
+fn show_bytes_flag(bytes: u64) -> String {
+    const UNITS: [(u64, &str); 4] = [
+        (1 << 40, "T"),
+        (1 << 30, "G"),
+        (1 << 20, "M"),
+        (1 << 10, "K"),
+    ];
+    for (scale, unit) in UNITS {
+        if bytes >= scale {
+            return format!("{}{unit}", bytes.div_ceil(scale));
+        }
+    }
+    bytes.to_string()
+}
+
 /// A `Name:  1234 kB` line of `/proc/meminfo`, in bytes.
-fn meminfo_field(text: &str, name: &str) -> Option<u64> {
+pub(crate) fn meminfo_field(text: &str, name: &str) -> Option<u64> {
     let line = text.lines().find(|l| l.split(':').next() == Some(name))?;
     let mut words = line.split(':').nth(1)?.split_whitespace();
     let value: u64 = words.next()?.parse().ok()?;
@@ -163,7 +215,7 @@ fn meminfo_field(text: &str, name: &str) -> Option<u64> {
 
 /// The content of a cgroup memory limit file: a byte count, `max` (no limit) or, in cgroup
 /// v1, a huge number meaning none.
-fn cgroup_limit(text: &str) -> Option<u64> {
+pub(crate) fn cgroup_limit(text: &str) -> Option<u64> {
     let v: u64 = text.trim().parse().ok()?;
     (v < 1 << 60).then_some(v)
 }
@@ -249,7 +301,15 @@ mod tests {
         };
         let e = avail.check(31 << 30, "y", "lower --particles").unwrap_err();
         assert!(e.contains("31.0 GiB") && e.contains("1.0 GiB of memory available"));
-        assert!(e.contains("--max-memory BYTES") && !e.contains('\n'), "{e}");
+        assert!(e.contains("--max-memory 31G") && !e.contains('\n'), "{e}");
+        assert!(!e.contains("such as"), "{e}");
+        if let Some(total) = total_memory() {
+            assert!(e.contains(&show_bytes(total)), "{e}");
+        }
+        assert_eq!(show_bytes_flag(31 << 30), "31G");
+        assert_eq!(show_bytes_flag((31 << 30) + 1), "32G");
+        assert_eq!(show_bytes_flag(1500 << 20), "2G");
+        assert_eq!(show_bytes_flag(100), "100");
         let capped = Limit::with_default_cap(None, 1 << 10);
         assert_eq!(capped.source, LimitSource::FlagDefault);
         assert_eq!(Limit::with_default_cap(Some(5), 1 << 10).bytes, 5);

@@ -16,6 +16,8 @@ pub const SHARED_RUN_FLAGS: &[&str] = &[
     "out",
     "positions",
     "checkpoint-every",
+    "checkpoint-interval",
+    "no-checkpoint",
     "resume",
     "config",
     "dump-config",

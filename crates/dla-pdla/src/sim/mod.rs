@@ -36,6 +36,7 @@ use crate::cluster::Cluster;
 use crate::params::Params;
 use crate::space::{Dim, Space};
 use core_lattice::Fit;
+use sim_run::guard::{Guard, Request, StopReason};
 use sim_run::io::NpyWriter;
 use spatial::orthtree::Orthtree;
 use std::path::{Path, PathBuf};
@@ -180,37 +181,122 @@ where
         stop: &AtomicBool,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<bool, SimError> {
-        if every == 0 {
+        let poll = || {
+            if stop.load(Ordering::Relaxed) {
+                Request::Stop(StopReason::Signal(sim_run::guard::PROGRAM_STOP))
+            } else {
+                Request::None
+            }
+        };
+        let stopped = self.grow_polled(Some(every), stop, &poll, true, &|| {}, progress)?;
+        Ok(stopped.is_none())
+    }
+
+    /// Grows to the target while honouring `guard`'s requests (a front end's timed
+    /// checkpoints, signals and memory watch: `sim_run::guard`): a requested checkpoint is
+    /// written and the run goes on; a requested stop writes one and returns its reason. With
+    /// `every`, a checkpoint every `every` particles and one at the end as well. With `write`
+    /// false nothing is written (a stop just stops). Returns `None` when the target was
+    /// reached. The same `state_hash` as [`run`](Self::run) with one thread, whenever the
+    /// checkpoints fall; with more, a checkpoint ends the parallel phase at a quiescent point,
+    /// as in [`run_checkpointed`](Self::run_checkpointed).
+    ///
+    /// # Errors
+    /// `every == Some(0)`, `write` without the positions streamed, I/O errors.
+    pub fn run_guarded(
+        &mut self,
+        every: Option<u64>,
+        guard: &Guard,
+        write: bool,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Option<StopReason>, SimError> {
+        let counted = || guard.count_checkpoint();
+        self.grow_polled(
+            every,
+            guard.flag(),
+            &|| guard.take(),
+            write,
+            &counted,
+            progress,
+        )
+    }
+
+    /// The loop of [`run_checkpointed`](Self::run_checkpointed) and
+    /// [`run_guarded`](Self::run_guarded): `flag` set means `poll()` has a request.
+    fn grow_polled(
+        &mut self,
+        every: Option<u64>,
+        flag: &AtomicBool,
+        poll: &dyn Fn() -> Request,
+        write: bool,
+        written: &dyn Fn(),
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<Option<StopReason>, SimError> {
+        if every == Some(0) {
             return Err(SimError::CheckpointUsage(
                 "checkpoints need every >= 1".into(),
             ));
         }
-        if !self.streams_positions() {
+        if write && !self.streams_positions() {
             return Err(SimError::CheckpointUsage(
                 "a checkpoint needs the positions streamed to positions.npy (Simulation::stream_into)"
                     .into(),
             ));
         }
+        let checkpoint = |s: &mut Self| -> Result<(), SimError> {
+            if write {
+                s.write_checkpoint()?;
+                written();
+            }
+            Ok(())
+        };
+        // What the run does with a request: `Some(reason)` to stop, after its checkpoint.
+        let honour = |s: &mut Self| -> Result<Option<StopReason>, SimError> {
+            match poll() {
+                Request::Stop(r) => {
+                    checkpoint(s)?;
+                    progress(s.growth.n);
+                    Ok(Some(r))
+                }
+                Request::Checkpoint => checkpoint(s).map(|()| None),
+                Request::None => Ok(None),
+            }
+        };
         let target = self.params.particles;
-        while self.growth.n < self.serial_to() && !stop.load(Ordering::Relaxed) {
+        while self.growth.n < self.serial_to() {
+            if flag.load(Ordering::Relaxed)
+                && let Some(r) = honour(self)?
+            {
+                return Ok(Some(r));
+            }
             self.add_one()?;
             if self.growth.n % 1024 == 0 {
                 progress(self.growth.n);
             }
-            if self.growth.n % every == 0 && self.growth.n < target {
-                self.write_checkpoint()?;
+            if let Some(e) = every
+                && self.growth.n % e == 0
+                && self.growth.n < target
+            {
+                checkpoint(self)?;
             }
         }
-        while self.growth.n < target && !stop.load(Ordering::Relaxed) {
-            let until = ((self.growth.n / every + 1) * every).min(target);
-            self.grow_parallel(until, stop, progress)?;
-            if self.growth.n < target {
-                self.write_checkpoint()?;
+        while self.growth.n < target {
+            let until = every.map_or(target, |e| ((self.growth.n / e + 1) * e).min(target));
+            // Ends at a quiescent point at `until` or once `flag` is set.
+            self.grow_parallel(until, flag, progress)?;
+            if flag.load(Ordering::Relaxed) {
+                if let Some(r) = honour(self)? {
+                    return Ok(Some(r));
+                }
+            } else if self.growth.n < target {
+                checkpoint(self)?;
             }
         }
-        self.write_checkpoint()?;
+        if every.is_some() {
+            checkpoint(self)?;
+        }
         progress(self.growth.n);
-        Ok(self.growth.n == target)
+        Ok(None)
     }
 
     /// Whether `positions.npy` is being written ([`stream_into`](Self::stream_into) with

@@ -8,19 +8,22 @@
 //!   [`UsageError`] (see [`usage`]) from its `run` step before it creates `--out`.
 //! - **Runtime failures** (a full disk mid-run, a livelock guard) print one line
 //!   `PROGRAM: run failed: ...` and exit with code 1.
-//! - **Interrupted runs** (SIGINT or SIGTERM, where a binary polls [`stop_on_signals`]) save
-//!   what they can, print one line saying how to continue, and exit with code 130.
+//! - **Interrupted runs** (SIGINT, SIGTERM, SIGUSR1 or SIGXCPU: [`guard_signals`]) write a
+//!   checkpoint, print one line saying how to continue, and exit with code 130; a run whose
+//!   memory is about to run out does the same with exit code 1 ([`checkpoints`]).
 //! - **Logging**: warnings only by default, `-v` info, `-vv` debug, `RUST_LOG` overrides; a
 //!   progress bar on a terminal, and a one-line heartbeat every `--heartbeat` seconds when
 //!   there is no bar (a redirected log, or `--quiet`), so a long run is told from a hang;
 //!   `-qq` silences it ([`LogArgs`], [`Progress`]).
 
+pub mod checkpoints;
 pub mod config;
 mod out_dir;
 mod progress;
 mod resume;
 
 pub use crate::count::{count, count_at_least_1, seed};
+pub use checkpoints::{CheckpointArgs, guard_signals, stopped};
 pub use config::ConfigArgs;
 pub(crate) use out_dir::held;
 pub use out_dir::{
@@ -169,7 +172,7 @@ pub fn is_member() -> bool {
     std::env::var_os(MEMBER_OF).is_some()
 }
 
-/// A flag that SIGINT and SIGTERM set instead of killing the process, for a run that polls it
+/// A flag that SIGINT, SIGTERM and SIGXCPU set instead of killing the process, for a run that polls it
 /// to checkpoint and stop cleanly. A second signal of the same kind ends the process at once,
 /// as usual, so a run that does not stop can still be interrupted; except in an ensemble's
 /// member, which may get the same signal twice (from a batch system that signals every process
@@ -179,10 +182,10 @@ pub fn is_member() -> bool {
 /// # Errors
 /// The handlers could not be installed.
 pub fn stop_on_signals() -> std::io::Result<std::sync::Arc<std::sync::atomic::AtomicBool>> {
-    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::consts::{SIGINT, SIGTERM, SIGXCPU};
     let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let member = is_member();
-    for sig in [SIGINT, SIGTERM] {
+    for sig in [SIGINT, SIGTERM, SIGXCPU] {
         // Registered first, so it runs when the flag is already set: the second signal.
         if !member {
             signal_hook::flag::register_conditional_default(sig, std::sync::Arc::clone(&stop))?;
