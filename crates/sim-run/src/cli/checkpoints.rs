@@ -57,8 +57,7 @@ impl CheckpointArgs {
             if every.is_some() {
                 return Err("--no-checkpoint and --checkpoint-every contradict each other".into());
             }
-            let default = Interval(Some(crate::guard::DEFAULT_INTERVAL));
-            if super::config::given("checkpoint_interval") || self.checkpoint_interval != default {
+            if self.checkpoint_interval != Interval(Some(crate::guard::DEFAULT_INTERVAL)) {
                 return Err(
                     "--no-checkpoint and --checkpoint-interval contradict each other".into(),
                 );

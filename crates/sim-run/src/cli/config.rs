@@ -5,7 +5,8 @@
 //! it as `OUT/config.toml`, so `--config OUT/config.toml --out NEW` repeats the run.
 //!
 //! Keys may be written with dashes or underscores. Flags that say where or how a process runs
-//! rather than what it computes (`--out`, `--resume`, `--seeds`, `--jobs`, logging) are not
+//! rather than what it computes (`--out`, `--resume`, `--seeds`, `--jobs`, logging,
+//! `--checkpoint-interval`, `--no-checkpoint`) are not
 //! config keys. An unknown key, a key that is not allowed or a value of the wrong kind is a
 //! usage error naming the file and the line.
 
@@ -30,8 +31,10 @@ pub struct ConfigArgs {
 
 /// Argument ids that are never config keys: where and how the process runs, not what it
 /// computes.
-const NOT_CONFIG: [&str; 14] = [
+const NOT_CONFIG: [&str; 16] = [
     "help",
+    "checkpoint_interval",
+    "no_checkpoint",
     "overwrite",
     "version",
     "out",

@@ -15,8 +15,9 @@
 //!   one.
 //! - **Failures.** A failed member is reported with its seed and the last line it printed
 //!   (kept in `DIR/seed-NNNN/member.log`); the others go on; the exit code is 1 if any failed.
-//! - **Signals.** SIGINT or SIGTERM stop launching members and pass SIGTERM on to the running
-//!   ones (which checkpoint if they were asked to); the ensemble exits with code 130.
+//! - **Signals.** SIGINT, SIGTERM, SIGUSR1 or SIGXCPU stop launching members and pass SIGTERM on
+//!   to the running ones (which checkpoint, unless run with `--no-checkpoint`); the ensemble
+//!   exits with code 130.
 //! - **Combined result** ([`merge`]): `DIR/ensemble.json`, `DIR/ensemble.md` and averaged
 //!   curves with error bands, rebuilt from whatever members exist by `PROG --merge DIR`.
 

@@ -2,6 +2,9 @@
 //! only): drive a binary with bad inputs and check the usage-error contract of
 //! [`cli`](crate::cli): exit code 2, one line on stderr naming the culprit, nothing created.
 
+mod stops;
+pub use stops::{state_hash, stop_contract};
+
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
