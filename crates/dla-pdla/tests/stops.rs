@@ -75,3 +75,54 @@ fn an_ensemble_signalled_mid_member_continues_to_the_same_members() {
         assert!(!member.join("checkpoint.bin").exists(), "seed {seed}");
     }
 }
+
+/// PDLA started without a checkpoint flag and stopped by SIGTERM mid-run checkpoints at a
+/// quiescent point (exit code 130); `--resume` ends it as a valid cluster of the full size.
+#[cfg(unix)]
+#[test]
+fn a_pdla_run_signalled_mid_growth_resumes_to_a_full_cluster() {
+    use std::process::{Command, Stdio};
+    let dla = env!("CARGO_BIN_EXE_dla");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("pdla");
+    let flags = [
+        "--particles",
+        "150000",
+        "--threads",
+        "2",
+        "--serial-until",
+        "1000",
+        "-qq",
+    ];
+    let mut child = Command::new(dla)
+        .args(flags)
+        .arg("--out")
+        .arg(&out)
+        .stdin(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(400));
+    let running = child.try_wait().unwrap().is_none();
+    sim_run::testing::send_sigterm(child.id());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(running, "the run ended before the signal: {err}");
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.starts_with("dla: SIGTERM: interrupted at "), "{err}");
+    assert!(out.join("checkpoint.bin").exists());
+    let o = Command::new(dla)
+        .args(flags)
+        .arg("--resume")
+        .arg(&out)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(m["results"]["particles"], 150000, "{m}");
+    assert!(!out.join("checkpoint.bin").exists());
+    assert!(!out.join("positions.npy").exists());
+}
