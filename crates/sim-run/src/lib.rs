@@ -58,6 +58,8 @@ pub mod schema;
 pub mod spec_check;
 #[cfg(feature = "test-support")]
 pub mod testing;
+#[cfg(feature = "plot")]
+mod text;
 
 /// The README's examples, compiled and run as doctests so that they stay true.
 #[cfg(doctest)]
