@@ -76,6 +76,20 @@ pub const STEPS: &[Step] = &[
             &[],
         ),
     },
+    // ... and with their pictures (feature `figures`) but still without the command line, as
+    // the Python bindings build them. How many packages each library alone needs is held by
+    // xtask/tests/library_deps.rs (the tests step).
+    Step {
+        name: "libraries-figures",
+        needs: Needs::Rust,
+        run: Run::Cargo(
+            concat!(
+                "clippy -p dlca -p dla-pdla -p animat",
+                " --no-default-features --features figures -- -D warnings"
+            ),
+            &[],
+        ),
+    },
     Step {
         name: "rustdoc",
         needs: Needs::Rust,

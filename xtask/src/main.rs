@@ -39,8 +39,8 @@ enum Cmd {
         #[arg(long)]
         no_tests: bool,
         /// Skip these steps (repeat or comma-separate): format, clippy, libraries-alone,
-        /// rustdoc, tests, loom, package, python-format, python-clippy, python-install,
-        /// python-tests, mpi-clippy, mpi-tests.
+        /// libraries-figures, rustdoc, tests, loom, package, python-format, python-clippy,
+        /// python-install, python-tests, mpi-clippy, mpi-tests.
         #[arg(long, value_delimiter = ',')]
         skip: Vec<String>,
     },

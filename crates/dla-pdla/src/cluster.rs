@@ -15,7 +15,7 @@
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use spatial::distmap::{DistanceMap, SparseDistanceMap};
+use spatial::distmap::{DistanceMap, DistanceMapError, PointMap, SparseDistanceMap};
 use spatial::orthtree::Orthtree;
 use std::sync::Arc;
 
@@ -136,16 +136,10 @@ impl<const D: usize> Cluster<D> {
         match Arc::get_mut(&mut self.maps) {
             Some(maps) => {
                 if let Some(sparse) = &mut maps.sparse {
-                    match touched {
-                        Some(t) => sparse.insert_beside(&q, t)?,
-                        None => sparse.insert(&q)?,
-                    }
+                    insert_point(sparse, &q, touched)?;
                 }
                 if let Some((fine, coarse)) = maps.levels.split_first_mut() {
-                    match touched {
-                        Some(t) => fine.insert_beside(&q, t)?,
-                        None => fine.insert(&q)?,
-                    }
+                    insert_point(fine, &q, touched)?;
                     // The coarser maps hold the boxes of the tree's leaves: lowered once, by
                     // the first particle of a leaf, for every particle the leaf will hold.
                     if new_leaf {
@@ -198,16 +192,10 @@ impl<const D: usize> Cluster<D> {
         new_leaf: bool,
     ) -> Result<(), SimError> {
         if let Some(sparse) = &self.maps.sparse {
-            match touched {
-                Some(t) => sparse.insert_shared_beside(q, t)?,
-                None => sparse.insert_shared(q)?,
-            };
+            insert_point_shared(sparse, q, touched)?;
         }
         if let Some((fine, coarse)) = self.maps.levels.split_first() {
-            match touched {
-                Some(t) => fine.insert_shared_beside(q, t)?,
-                None => fine.insert_shared(q)?,
-            };
+            insert_point_shared(fine, q, touched)?;
             if new_leaf {
                 let (lo, hi) = self.leaf_box(q);
                 for map in coarse {
@@ -223,10 +211,10 @@ impl<const D: usize> Cluster<D> {
     pub fn reserve_maps(&mut self, r: f64) -> Result<(), SimError> {
         if let Some(maps) = Arc::get_mut(&mut self.maps) {
             if let Some(sparse) = &mut maps.sparse {
-                sparse.reserve(r + sparse.cap() + sparse.cell_side())?;
+                reserve_around(sparse, r)?;
             }
             for map in maps.levels.iter_mut() {
-                map.reserve(r + map.cap() + map.cell_side())?;
+                reserve_around(map, r)?;
             }
         }
         Ok(())
@@ -352,18 +340,49 @@ impl<const D: usize> Cluster<D> {
     /// Heap bytes of the tree and the maps.
     pub fn memory_bytes(&self) -> usize {
         self.tree.memory_bytes()
-            + self
-                .maps
-                .sparse
-                .as_ref()
-                .map_or(0, SparseDistanceMap::memory_bytes)
+            + self.maps.sparse.as_ref().map_or(0, PointMap::memory_bytes)
             + self
                 .maps
                 .levels
                 .iter()
-                .map(DistanceMap::memory_bytes)
+                .map(PointMap::memory_bytes)
                 .sum::<usize>()
     }
+}
+
+/// Inserts the stored position `q` into `map` (exclusive access), beside the stored particle
+/// `touched` when known (the same map, fewer cells visited).
+fn insert_point<const D: usize>(
+    map: &mut impl PointMap<D>,
+    q: &[f64; D],
+    touched: Option<&[f64; D]>,
+) -> Result<(), DistanceMapError> {
+    match touched {
+        Some(t) => map.insert_beside(q, t),
+        None => map.insert(q),
+    }
+}
+
+/// [`insert_point`] through a shared reference, while other threads read and insert (PDLA).
+fn insert_point_shared<const D: usize>(
+    map: &impl PointMap<D>,
+    q: &[f64; D],
+    touched: Option<&[f64; D]>,
+) -> Result<(), DistanceMapError> {
+    match touched {
+        Some(t) => map.insert_shared_beside(q, t)?,
+        None => map.insert_shared(q)?,
+    };
+    Ok(())
+}
+
+/// Grows `map` to cover `|x_i| < r + cap + cell`: every cell a particle within `r` of the
+/// origin can lower.
+fn reserve_around<const D: usize>(
+    map: &mut impl PointMap<D>,
+    r: f64,
+) -> Result<(), DistanceMapError> {
+    map.reserve(r + map.cap() + map.cell_side())
 }
 
 #[cfg(test)]

@@ -40,6 +40,7 @@ pub mod farfield;
 mod near;
 pub mod output;
 pub mod params;
+#[cfg(feature = "figures")]
 pub mod picture;
 pub mod sim;
 pub mod space;

@@ -13,7 +13,7 @@
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
 //! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C`; 2D and 3D only |
 //! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView); 2D and 3D only |
-//! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (see [`crate::picture`]) |
+//! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (feature `figures`, see [`crate::picture`]) |
 //! | `dla.gif` | `--animate`: the growth of the cluster, one frame every `--animate-every` particles |
 
 use crate::sim::{GROWTH, GROWTH_COLUMNS, Simulation};
@@ -81,7 +81,8 @@ impl PositionsFormat {
 }
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest; `png` is
-/// the side of `dla.png` in pixels, if one is wanted. When the fractal dimension cannot be
+/// the side of `dla.png` in pixels, if one is wanted (feature `figures`: without it, asking for
+/// one is an error and nothing is written). When the fractal dimension cannot be
 /// fitted, its results are null and `fit_error` says why. Call [`Simulation::sync_streams`]
 /// first when the run streams into `dir`.
 pub fn write_outputs<const D: usize>(
@@ -94,6 +95,14 @@ pub fn write_outputs<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
+    // Without feature `figures` the library cannot draw: refused before any file is written.
+    if png.is_some() && !cfg!(feature = "figures") {
+        let e = std::io::Error::new(
+            std::io::ErrorKind::Unsupported,
+            "dla.png needs feature `figures`",
+        );
+        return Err(e.into());
+    }
     // The simulation's peak, before the output stage (the PNG's pixels, a positions file
     // converted from positions.npy) can raise the process's high-water mark.
     let simulation_peak = ProcessUsage::now().map(|u| u.peak_rss_bytes);
@@ -143,6 +152,7 @@ where
             })?;
         }
     }
+    #[cfg(feature = "figures")]
     if let Some(side) = png {
         crate::picture::write_png(sim, dir, &dir.join("dla.png"), side)?;
     }

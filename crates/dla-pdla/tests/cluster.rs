@@ -2,6 +2,7 @@
 
 use dla_pdla::space::{Dim, Space};
 use dla_pdla::{Params, Simulation};
+use spatial::distmap::PointMap;
 
 /// Asserts that the walker's bound from the maps never exceeds the exact distance to the
 /// nearest particle (brute force), and their upper bound is never below it, at 4000 random

@@ -30,6 +30,7 @@
 pub mod analysis;
 pub mod output;
 pub mod params;
+#[cfg(feature = "figures")]
 pub mod picture;
 pub mod record;
 mod rigid;

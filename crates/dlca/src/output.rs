@@ -9,7 +9,7 @@
 //! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`sim_run::io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
-//! | `dlca.png` | with `--png`: the figure of the final state, touching clusters in different colours (see [`crate::picture`]) |
+//! | `dlca.png` | with `--png`: the figure of the final state, touching clusters in different colours (feature `figures`, see [`crate::picture`]) |
 //! | `dlca.gif` | with `--animate`: the aggregation, a frame every `--animate-every` sweeps |
 
 use crate::analysis::{
@@ -90,7 +90,8 @@ pub const SCHEMA: &[Output] = &[
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest written;
 /// the particles' sites and cluster ids go into `particles.<format>` if `positions` names one,
 /// and `dlca.png` is drawn if `png` is `Some` (the longer side of its picture, or `None` inside
-/// for the default, see [`crate::picture::picture_size`]).
+/// for the default, see [`crate::picture::picture_size`]; feature `figures`: without it, asking
+/// for one is an error and nothing is written).
 pub fn write_outputs(
     sim: &Simulation,
     seed: u64,
@@ -99,6 +100,14 @@ pub fn write_outputs(
     png: Option<Option<u32>>,
     positions: Option<PointFormat>,
 ) -> Result<sim_run::io::RunManifest, OutputError> {
+    // Without feature `figures` the library cannot draw: refused before any file is written.
+    if png.is_some() && !cfg!(feature = "figures") {
+        let e = std::io::Error::new(
+            std::io::ErrorKind::Unsupported,
+            "dlca.png needs feature `figures`",
+        );
+        return Err(e.into());
+    }
     let params = sim.params();
     let dim = sim.lattice().dim();
 
@@ -186,6 +195,7 @@ pub fn write_outputs(
         write_clusters(dir, measures)?;
     }
 
+    #[cfg(feature = "figures")]
     if let Some(side) = png {
         crate::picture::write_png(sim, seed, &dir.join("dlca.png"), side)?;
     }

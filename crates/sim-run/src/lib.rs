@@ -6,8 +6,8 @@
 //! - [`count`]: counts as physicists write them (`1e6`, `2.5e5`, `1_000_000`), exactly.
 //! - [`io`]: atomic file writes, the run manifest `run.json` (parameters, seed, wall and CPU
 //!   time, peak memory, provenance), the versioned and checksummed checkpoint envelope,
-//!   NumPy `.npy` files streamed row by row, PNG and CSV writers, point files (CSV, `.npy`,
-//!   VTK, XYZ) and the stable state hash.
+//!   NumPy `.npy` files streamed row by row, PNG (feature `plot`) and CSV writers, point files
+//!   (CSV, `.npy`, VTK, XYZ) and the stable state hash.
 //! - `cli` (feature `cli`): the model binaries' contract (usage errors: one line, exit code 2,
 //!   nothing created; failed runs: exit code 1), `--out` checks, config files, logging,
 //!   progress and heartbeat.
@@ -59,6 +59,8 @@ pub mod schema;
 pub mod spec_check;
 #[cfg(feature = "test-support")]
 pub mod testing;
+#[cfg(feature = "plot")]
+mod text;
 
 /// The README's examples, compiled and run as doctests so that they stay true.
 #[cfg(doctest)]

@@ -3,24 +3,11 @@
 //! Text uses the DejaVu Sans font committed under `crates/sim-run/assets/fonts/` and
 //! registered with plotters' `ab_glyph` backend, so no system font library is needed.
 
+use crate::figure::palette::{OKABE_ITO, Rgb};
+use crate::text::{register_font, tick};
 use anyhow::{Context, Result, anyhow};
 use plotters::prelude::*;
 use std::path::Path;
-use std::sync::Once;
-
-/// The font file committed with the repository (Bitstream Vera licence, see
-/// `crates/sim-run/assets/fonts/DejaVu-LICENSE.txt`).
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-
-/// Registers the committed font as `sans-serif` with plotters (once).
-pub(crate) fn register_font() {
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-            .map_err(|_| ())
-            .expect("the committed DejaVu Sans font parses");
-    });
-}
 
 /// How a series is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -133,16 +120,23 @@ impl Chart {
     }
 }
 
+/// The colours of series without their own, in order: Okabe-Ito blue, vermillion, bluish
+/// green, reddish purple, orange, sky blue ([`OKABE_ITO`]), a grey, and black.
 const PALETTE: [RGBColor; 8] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
+    rgb(OKABE_ITO[5]),
+    rgb(OKABE_ITO[6]),
+    rgb(OKABE_ITO[3]),
+    rgb(OKABE_ITO[7]),
+    rgb(OKABE_ITO[1]),
+    rgb(OKABE_ITO[2]),
     RGBColor(120, 120, 120),
-    RGBColor(0, 0, 0),
+    rgb(OKABE_ITO[0]),
 ];
+
+/// A palette colour as plotters' colour.
+const fn rgb(c: Rgb) -> RGBColor {
+    RGBColor(c[0], c[1], c[2])
+}
 
 const WIDTH: u32 = 960;
 const HEIGHT: u32 = 640;
@@ -165,19 +159,6 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
         let m = ((hi - lo) * 0.05).max(hi.abs().max(1e-12) * 0.05);
         (lo - m, hi + m)
     })
-}
-
-/// A short tick label: `0.05`, `10`, `2.5e-6`.
-pub(crate) fn tick(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        "0".into()
-    } else if !(1e-3..1e5).contains(&a) {
-        format!("{v:.1e}").replace(".0e", "e")
-    } else {
-        let s = format!("{v:.3}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    }
 }
 
 /// A rectangle of pixels: left, top, right, bottom (right and bottom exclusive).
@@ -269,9 +250,7 @@ macro_rules! draw_chart {
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
         for (i, s) in spec.series.iter().enumerate() {
-            let color = s
-                .colour
-                .map_or(PALETTE[i % PALETTE.len()], |c| RGBColor(c[0], c[1], c[2]));
+            let color = s.colour.map_or(PALETTE[i % PALETTE.len()], rgb);
             let pts: Vec<(f64, f64)> = s
                 .points
                 .iter()
@@ -661,15 +640,6 @@ fn render(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn tick_labels() {
-        assert_eq!(tick(10.0), "10");
-        assert_eq!(tick(0.05), "0.05");
-        assert_eq!(tick(9.99999999e-6), "1e-5");
-        assert_eq!(tick(2.5e-6), "2.5e-6");
-        assert_eq!(tick(1e6), "1e6");
-    }
 
     #[test]
     fn the_legend_goes_where_it_covers_least_data() {

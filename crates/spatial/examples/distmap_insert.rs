@@ -1,7 +1,7 @@
 //! Times `DistanceMap::insert` on the positions of a DLA run (`dla --positions bin`), arrival
 //! order: `cargo run --release -p spatial --example distmap_insert -- OUT/positions.bin [cell:cap
 //! ...]`.
-use spatial::distmap::DistanceMap;
+use spatial::distmap::{DistanceMap, PointMap};
 use std::time::Instant;
 
 fn main() {

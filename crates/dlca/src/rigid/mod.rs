@@ -137,14 +137,16 @@ impl RigidStore {
         each!(self, r => r.contains(id))
     }
 
-    /// See [`Rigid::try_move`].
+    /// See [`Rigid::try_move`]; returns the number of contacts found. The move and the contact
+    /// search are one pass, so every contact found counts as a candidate examined.
     pub(crate) fn try_move(
         &mut self,
         id: ItemId,
         dir: Direction,
         out: &mut Vec<ItemId>,
-    ) -> Result<(), Blocked> {
-        each!(self, r => r.try_move(id, dir, out))
+    ) -> Result<usize, Blocked> {
+        each!(self, r => r.try_move(id, dir, out))?;
+        Ok(out.len())
     }
 
     /// See [`Rigid::merge`].

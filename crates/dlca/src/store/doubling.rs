@@ -146,37 +146,14 @@ fn extent(dim: usize, b: &BBox) -> u64 {
 }
 
 impl ClusterStore for DoublingGrid {
+    forward_clusters!(s => s.inner);
+
     fn kind(&self) -> Search {
         Search::GridDoubling
     }
 
     fn grid_side(&self) -> Option<u64> {
         Some(self.inner.search().side())
-    }
-
-    #[inline]
-    fn live(&self) -> &[ItemId] {
-        self.inner.sets().live()
-    }
-
-    #[inline]
-    fn contains(&self, id: ItemId) -> bool {
-        self.inner.sets().contains(id)
-    }
-
-    #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
-        self.inner.sets().sites(id).len()
-    }
-
-    #[inline]
-    fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        contacts: &mut Vec<ItemId>,
-    ) -> Result<usize, Blocked> {
-        self.inner.try_move(id, dir, contacts)
     }
 
     fn merge(&mut self, survivor: ItemId, others: &[ItemId], notes: &mut Vec<String>) -> Merged {

@@ -47,37 +47,14 @@ impl HaloStore {
 }
 
 impl ClusterStore for HaloStore {
+    forward_clusters!(s => s.grid);
+
     fn kind(&self) -> Search {
         Search::Grid
     }
 
     fn grid_side(&self) -> Option<u64> {
         Some(self.grid.side())
-    }
-
-    #[inline]
-    fn live(&self) -> &[ItemId] {
-        self.grid.live()
-    }
-
-    #[inline]
-    fn contains(&self, id: ItemId) -> bool {
-        self.grid.contains(id)
-    }
-
-    #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
-        self.grid.len_of(id)
-    }
-
-    #[inline]
-    fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        contacts: &mut Vec<ItemId>,
-    ) -> Result<usize, Blocked> {
-        self.grid.try_move(id, dir, contacts)
     }
 
     fn merge(&mut self, survivor: ItemId, others: &[ItemId], notes: &mut Vec<String>) -> Merged {

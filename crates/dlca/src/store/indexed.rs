@@ -64,6 +64,24 @@ impl<S: ContactSearch> Indexed<S> {
         &self.arrays.sets
     }
 
+    /// See [`ClusterStore::live`].
+    #[inline]
+    pub(crate) fn live(&self) -> &[ItemId] {
+        self.arrays.sets.live()
+    }
+
+    /// See [`ClusterStore::contains`].
+    #[inline]
+    pub(crate) fn contains(&self, id: ItemId) -> bool {
+        self.arrays.sets.contains(id)
+    }
+
+    /// See [`ClusterStore::len_of`].
+    #[inline]
+    pub(crate) fn len_of(&self, id: ItemId) -> usize {
+        self.arrays.sets.sites(id).len()
+    }
+
     /// See [`ClusterStore::try_move`].
     #[inline]
     pub(crate) fn try_move(
@@ -107,37 +125,14 @@ impl<S: ContactSearch> Indexed<S> {
 }
 
 impl<S: SetSearch> ClusterStore for Indexed<S> {
+    forward_clusters!(s => s);
+
     fn kind(&self) -> Search {
         S::KIND
     }
 
     fn grid_side(&self) -> Option<u64> {
         None
-    }
-
-    #[inline]
-    fn live(&self) -> &[ItemId] {
-        self.arrays.sets.live()
-    }
-
-    #[inline]
-    fn contains(&self, id: ItemId) -> bool {
-        self.arrays.sets.contains(id)
-    }
-
-    #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
-        self.arrays.sets.sites(id).len()
-    }
-
-    #[inline]
-    fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        contacts: &mut Vec<ItemId>,
-    ) -> Result<usize, Blocked> {
-        Indexed::try_move(self, id, dir, contacts)
     }
 
     fn merge(&mut self, survivor: ItemId, others: &[ItemId], _: &mut Vec<String>) -> Merged {

@@ -11,6 +11,42 @@
 //! simulation never asks which one is installed. The doubling grid may hand its clusters over to
 //! all-pairs during a merge ([`Merged::to_all_pairs`]); [`Engine`] makes the switch.
 
+/// Inside an `impl ClusterStore`: the methods that query and move the clusters (`live`,
+/// `contains`, `len_of`, `try_move`), forwarded to the structure that holds them, `$e` (an
+/// expression of `$s`, the store), which has methods of the same names and signatures.
+macro_rules! forward_clusters {
+    ($s:ident => $e:expr) => {
+        #[inline]
+        fn live(&self) -> &[ItemId] {
+            let $s = self;
+            $e.live()
+        }
+
+        #[inline]
+        fn contains(&self, id: ItemId) -> bool {
+            let $s = self;
+            $e.contains(id)
+        }
+
+        #[inline]
+        fn len_of(&self, id: ItemId) -> usize {
+            let $s = self;
+            $e.len_of(id)
+        }
+
+        #[inline]
+        fn try_move(
+            &mut self,
+            id: ItemId,
+            dir: Direction,
+            contacts: &mut Vec<ItemId>,
+        ) -> Result<usize, Blocked> {
+            let $s = self;
+            $e.try_move(id, dir, contacts)
+        }
+    };
+}
+
 mod arrays;
 mod doubling;
 mod halo;

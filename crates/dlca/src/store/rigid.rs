@@ -33,39 +33,14 @@ impl RigidClusters {
 }
 
 impl ClusterStore for RigidClusters {
+    forward_clusters!(s => s.store);
+
     fn kind(&self) -> Search {
         Search::Lattice
     }
 
     fn grid_side(&self) -> Option<u64> {
         None
-    }
-
-    #[inline]
-    fn live(&self) -> &[ItemId] {
-        self.store.live()
-    }
-
-    #[inline]
-    fn contains(&self, id: ItemId) -> bool {
-        self.store.contains(id)
-    }
-
-    #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
-        self.store.len_of(id)
-    }
-
-    /// Translates and finds the contacts in one go; every contact found counts as examined.
-    #[inline]
-    fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        contacts: &mut Vec<ItemId>,
-    ) -> Result<usize, Blocked> {
-        self.store.try_move(id, dir, contacts)?;
-        Ok(contacts.len())
     }
 
     fn merge(&mut self, survivor: ItemId, others: &[ItemId], _: &mut Vec<String>) -> Merged {

@@ -11,7 +11,7 @@
 pub mod animation;
 pub mod palette;
 
-use crate::plot::register_font;
+use crate::text::register_font;
 use anyhow::{Context, Result, anyhow};
 use palette::{Rgb, Sequential};
 use plotters::element::BitMapElement;
@@ -308,8 +308,8 @@ impl Figure<'_> {
             .y_labels((f64::from(r.height) / (60.0 * u)).clamp(2.0, 8.0) as usize)
             .x_desc(format!("{} ({})", self.axes.0, self.unit))
             .y_desc(format!("{} ({})", self.axes.1, self.unit))
-            .x_label_formatter(&|v| crate::plot::tick(*v))
-            .y_label_formatter(&|v| crate::plot::tick(*v))
+            .x_label_formatter(&|v| crate::text::tick(*v))
+            .y_label_formatter(&|v| crate::text::tick(*v))
             .label_style(font(14.0))
             .axis_desc_style(font(16.0))
             .set_all_tick_mark_size((5.0 * u) as u32)
@@ -341,7 +341,7 @@ impl Figure<'_> {
         ))?;
         let tick = (5.0 * u) as i32;
         root.draw(&Text::new(
-            format!("{} {}", crate::plot::tick(length), self.unit),
+            format!("{} {}", crate::text::tick(length), self.unit),
             (xs.end - bar_px - (8.0 * u) as i32, mid),
             font(15.0).pos(Pos::new(HPos::Right, VPos::Center)),
         ))?;
@@ -375,7 +375,7 @@ impl Figure<'_> {
                     let text = if v.fract() == 0.0 && v.abs() < 1e15 {
                         group_digits(v.abs() as u64)
                     } else {
-                        crate::plot::tick(v)
+                        crate::text::tick(v)
                     };
                     root.draw(&PathElement::new(
                         vec![(x0 + bar_w, y), (x0 + bar_w + tick, y)],

@@ -1,6 +1,7 @@
 //! Colours of the figures, chosen to be read by everyone: the Okabe-Ito categorical palette
 //! (Okabe & Ito, "Color Universal Design", 2002/2008; recommended by Wong, "Points of view:
-//! Color blindness", Nature Methods 2011) for species and clusters, perceptual sequential maps
+//! Color blindness", Nature Methods 2011) for species, clusters and the series of charts
+//! (`sim_run::plot` takes its colours from [`OKABE_ITO`]), perceptual sequential maps
 //! (viridis, magma: van der Walt & Smith, 2015) for ordered quantities such as arrival order,
 //! each restricted to the part that stands out from the figure's background, and a colouring of
 //! touching regions that gives neighbours different colours.

@@ -6,7 +6,7 @@
 //! - [`manifest`]: `run.json`, the record of one run (model, version, seed, threads, parameters,
 //!   wall and CPU seconds, peak memory from the operating system, results).
 //! - [`checkpoint`]: a versioned, checksummed envelope around a model's serde state.
-//! - [`image`]: grayscale and RGB PNG.
+//! - `image` (feature `plot`): grayscale and RGB PNG.
 //! - [`table`]: CSV with a header line.
 //! - [`hash`]: the stable 64-bit state hash models report as `state_hash`.
 //! - [`points`]: point sets (particles, animats) as CSV, `.npy`, legacy VTK or extended XYZ.
@@ -19,6 +19,7 @@ pub mod atomic;
 pub mod bytes;
 pub mod checkpoint;
 pub mod hash;
+#[cfg(feature = "plot")]
 pub mod image;
 pub mod manifest;
 pub mod npy;
@@ -30,6 +31,7 @@ pub use atomic::{AtomicFile, remove_stale_temporaries, write_atomic};
 pub use bytes::{parse_bytes, show_bytes};
 pub use checkpoint::{CheckpointError, read_checkpoint, write_checkpoint};
 pub use hash::StateHasher;
+#[cfg(feature = "plot")]
 pub use image::{write_png_gray, write_png_rgb};
 pub use manifest::{ProcessUsage, RunClock, RunManifest};
 pub use npy::{NpyError, NpyReader, NpyWriter};
@@ -44,7 +46,8 @@ pub enum OutputError {
     /// Creating, writing or renaming a file.
     #[error(transparent)]
     Io(#[from] std::io::Error),
-    /// Encoding a picture.
+    /// Encoding a picture (feature `plot`).
+    #[cfg(feature = "plot")]
     #[error(transparent)]
     Image(#[from] image::ImageError),
     /// Serialising the manifest or the parameters in it.

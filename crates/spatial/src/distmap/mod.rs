@@ -49,6 +49,7 @@ use std::fmt;
 mod beside;
 mod sparse;
 use beside::Beside;
+use sealed::Cells;
 pub use sparse::{SparseDistanceMap, UNKNOWN};
 
 use std::sync::atomic::{AtomicU8, Ordering};
@@ -90,6 +91,146 @@ pub enum DistanceMapError {
         /// Bytes asked for.
         bytes: u64,
     },
+}
+
+/// The interface the dense [`DistanceMap`] and the [`SparseDistanceMap`] share: the same cells,
+/// bound and inserts, stored densely or in blocks. Callers that hold either kind (the DLA
+/// cluster holds both) write one generic function; it dispatches statically, so it costs what
+/// the map's own methods cost. Sealed: only the maps of this module implement it.
+pub trait PointMap<const D: usize>: Cells<D> {
+    /// The cell side.
+    fn cell_side(&self) -> f64;
+
+    /// The cap distance: cells farther than this from every point only know "at least `cap`".
+    fn cap(&self) -> f64;
+
+    /// Points inserted through [`insert`](Self::insert) and
+    /// [`insert_beside`](Self::insert_beside) (shared inserts are not counted).
+    fn len(&self) -> u64;
+
+    /// Whether no point has been counted by [`len`](Self::len).
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Half the side of the covered cube: positions with every `|x_i|` below this are inside.
+    fn reach(&self) -> f64;
+
+    /// Heap bytes held.
+    fn memory_bytes(&self) -> usize;
+
+    /// The stored distance byte of the cell holding `p` (for tests and diagnostics).
+    fn value(&self, p: &[f64; D]) -> Option<u8>;
+
+    /// Grows the map (if needed) so that it covers `|x_i| < reach`.
+    fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError>;
+
+    /// A lower bound of the distance from `p` to the nearest inserted point, with `true` when
+    /// the cell is capped (farther than `cap` from every point: a tree query may do better), or
+    /// `None` when `p` lies outside the map (or nothing was inserted). The bound may be
+    /// negative (no information).
+    #[inline]
+    fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
+        let (m, e, v) = self.read(p)?;
+        Some((lower_from(m, e), v == CAPPED))
+    }
+
+    /// [`lower_bound`](Self::lower_bound) and, for a cell that is not capped, an upper bound
+    /// of the same distance: the nearest point is less than one quantum above the stored
+    /// value from the cell's centre `z`, so less than that plus `|p - z|` from `p` (widened by
+    /// a relative `2^-40` for rounding); `+inf` for a capped cell. As `(lower, upper,
+    /// capped)`. After [`DistanceMap::insert_box`] the upper bound is one to the nearest box:
+    /// add the boxes' diagonal for one to the points in them.
+    #[inline]
+    fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+        let (m, e, v) = self.read(p)?;
+        let capped = v == CAPPED;
+        let upper = if capped {
+            f64::INFINITY
+        } else {
+            (m + self.quantum() + e) * (1.0 + SHRINK) + 1e-12
+        };
+        Some((lower_from(m, e), upper, capped))
+    }
+
+    /// Adds the point `q`: lowers every cell whose centre lies within `cap` of it, growing the
+    /// map first if `q` comes within `cap + c` of its edge (the sparse map allocates the
+    /// blocks it writes).
+    fn insert(&mut self, q: &[f64; D]) -> Result<(), DistanceMapError> {
+        self.insert_with(q, None)
+    }
+
+    /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
+    /// the same map, visiting only the cells nearer `q` than `p` (about half), since no other
+    /// cell can be lowered by `q`.
+    fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
+        self.insert_with(q, Some(p))
+    }
+
+    /// Adds the point `q` through a shared reference, for several threads adding points to one
+    /// map while others read it (PDLA): every cell is lowered atomically (the dense map's
+    /// `fetch_min` of the distance, the sparse map's `fetch_max` of the nearness), so
+    /// concurrent inserts never undo each other. The map does not grow: cells outside it are
+    /// skipped (every stored cell stays a valid bound; positions outside simply get no bound).
+    /// Returns `false` when part of `q`'s ball fell outside the map. [`len`](Self::len) does
+    /// not count these points.
+    fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
+        self.insert_shared_with(q, None)
+    }
+
+    /// [`insert_shared`](Self::insert_shared) of a point `q` that touches `p`, visiting the cells
+    /// [`insert_beside`](Self::insert_beside) visits. If `p`'s own insert is still under way
+    /// in another thread, the cells skipped here are lowered by it when it completes.
+    fn insert_shared_beside(&self, q: &[f64; D], p: &[f64; D]) -> Result<bool, DistanceMapError> {
+        self.insert_shared_with(q, Some(p))
+    }
+}
+
+/// What [`PointMap`]'s provided methods are made of, private to this module.
+mod sealed {
+    use super::DistanceMapError;
+
+    pub trait Cells<const D: usize> {
+        /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and
+        /// its distance byte; `None` where the map has no answer.
+        fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)>;
+
+        /// `cap / 255`, the distance one step of a stored byte stands for.
+        fn quantum(&self) -> f64;
+
+        /// Inserts `q`, beside the point `touched` if given (see `PointMap::insert_beside`).
+        fn insert_with(
+            &mut self,
+            q: &[f64; D],
+            touched: Option<&[f64; D]>,
+        ) -> Result<(), DistanceMapError>;
+
+        /// Inserts `q` through a shared reference (see `PointMap::insert_shared_beside`).
+        fn insert_shared_with(
+            &self,
+            q: &[f64; D],
+            touched: Option<&[f64; D]>,
+        ) -> Result<bool, DistanceMapError>;
+    }
+}
+
+/// The lower bound from a cell's stored distance `m` and `|p - centre|` `e`, shrunk for
+/// rounding.
+#[inline(always)]
+fn lower_from(m: f64, e: f64) -> f64 {
+    m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12
+}
+
+/// `reach` if it is finite, else the error [`PointMap::reserve`] returns.
+fn finite_reach(reach: f64) -> Result<f64, DistanceMapError> {
+    if reach.is_finite() {
+        Ok(reach)
+    } else {
+        Err(DistanceMapError::NonFinite {
+            axis: 0,
+            value: reach,
+        })
+    }
 }
 
 /// The coarse distance map (see the module docs).
@@ -219,36 +360,6 @@ impl<const D: usize> DistanceMap<D> {
         })
     }
 
-    /// The cell side.
-    pub fn cell_side(&self) -> f64 {
-        self.cell
-    }
-
-    /// The cap distance: cells farther than this from every point only know "at least `cap`".
-    pub fn cap(&self) -> f64 {
-        self.cap
-    }
-
-    /// Points inserted.
-    pub fn len(&self) -> u64 {
-        self.points
-    }
-
-    /// Whether no point has been inserted.
-    pub fn is_empty(&self) -> bool {
-        self.points == 0
-    }
-
-    /// Half the side of the covered cube: positions with every `|x_i|` below this are inside.
-    pub fn reach(&self) -> f64 {
-        self.half as f64 * self.cell
-    }
-
-    /// Heap bytes held (one byte per cell, counting the vector's capacity).
-    pub fn memory_bytes(&self) -> usize {
-        self.values.capacity()
-    }
-
     /// The cell index of `p`, or `None` outside the map.
     #[inline]
     fn index(&self, p: &[f64; D]) -> Option<(usize, [f64; D])> {
@@ -271,128 +382,6 @@ impl<const D: usize> DistanceMap<D> {
             centre[i] = (k + 0.5) * self.cell;
         }
         Some((idx, centre))
-    }
-
-    /// A lower bound of the distance from `p` to the nearest inserted point, with `true` when
-    /// the cell is capped (farther than `cap` from every point: a tree query may do better), or
-    /// `None` when `p` lies outside the map (or nothing was inserted). The bound may be
-    /// negative (no information).
-    #[inline]
-    pub fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
-        let (m, e, v) = self.read(p)?;
-        Some((Self::lower_from(m, e), v == CAPPED))
-    }
-
-    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and the
-    /// stored byte.
-    #[inline(always)]
-    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
-        let (idx, z) = self.index(p)?;
-        let v = self.values[idx].load(Ordering::Relaxed);
-        let mut e2 = 0.0;
-        for i in 0..D {
-            let e = p[i] - z[i];
-            e2 += e * e;
-        }
-        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
-    }
-
-    /// The lower bound from a cell's stored distance `m` and `|p - centre|` `e`, shrunk for
-    /// rounding.
-    #[inline(always)]
-    fn lower_from(m: f64, e: f64) -> f64 {
-        m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12
-    }
-
-    /// [`lower_bound`](Self::lower_bound) and, for a cell that is not capped, an upper bound
-    /// of the same distance: the nearest point is less than one quantum above the stored
-    /// value from the cell's centre `z`, so less than that plus `|p - z|` from `p` (widened by
-    /// a relative `2^-40` for rounding); `+inf` for a capped cell. As `(lower, upper,
-    /// capped)`. After [`insert_box`](Self::insert_box) the upper bound is one to the nearest
-    /// box: add the boxes' diagonal for one to the points in them.
-    #[inline]
-    pub fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
-        let (m, e, v) = self.read(p)?;
-        let capped = v == CAPPED;
-        let upper = if capped {
-            f64::INFINITY
-        } else {
-            (m + self.quantum + e) * (1.0 + SHRINK) + 1e-12
-        };
-        Some((Self::lower_from(m, e), upper, capped))
-    }
-
-    /// The stored byte of the cell holding `p` (for tests and diagnostics).
-    pub fn value(&self, p: &[f64; D]) -> Option<u8> {
-        self.index(p)
-            .map(|(i, _)| self.values[i].load(Ordering::Relaxed))
-    }
-
-    /// Adds the point `q`: lowers every cell whose centre lies within `cap` of it, growing the
-    /// map first if `q` comes within `cap + c` of its edge.
-    pub fn insert(&mut self, q: &[f64; D]) -> Result<(), DistanceMapError> {
-        self.insert_with(q, None)
-    }
-
-    /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
-    /// the same map, visiting only the cells nearer `q` than `p` (about half), since no other
-    /// cell can be lowered by `q`.
-    pub fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
-        self.insert_with(q, Beside::new(q, p, self.cap, self.cell))
-    }
-
-    fn insert_with(
-        &mut self,
-        q: &[f64; D],
-        side: Option<Beside<D>>,
-    ) -> Result<(), DistanceMapError> {
-        let need = finite_max_norm(q)? + self.cap + self.cell;
-        if need >= self.reach() {
-            self.grow(need)?;
-        }
-        self.points += 1;
-        // Exclusive access: plain loads and stores (relaxed atomics compile to plain moves).
-        self.lower_rows(q, side.as_ref(), |v, w| {
-            if w < v.load(Ordering::Relaxed) {
-                v.store(w, Ordering::Relaxed);
-            }
-        });
-        Ok(())
-    }
-
-    /// Adds the point `q` through a shared reference, for several threads adding points to one
-    /// map while others read it (PDLA): every cell is lowered with an atomic `fetch_min`, so
-    /// concurrent inserts never undo each other. The map does not grow: cells outside it are
-    /// skipped (every stored cell stays a valid bound; positions outside simply get no bound).
-    /// Returns `false` when part of `q`'s disk fell outside the map. [`len`](Self::len) does
-    /// not count these points.
-    pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
-        self.insert_shared_with(q, None)
-    }
-
-    /// [`insert_shared`](Self::insert_shared) of a point `q` that touches `p`, visiting the cells
-    /// [`insert_beside`](Self::insert_beside) visits. If `p`'s own insert is still under way
-    /// in another thread, the cells skipped here are lowered by it when it completes.
-    pub fn insert_shared_beside(
-        &self,
-        q: &[f64; D],
-        p: &[f64; D],
-    ) -> Result<bool, DistanceMapError> {
-        self.insert_shared_with(q, Beside::new(q, p, self.cap, self.cell))
-    }
-
-    fn insert_shared_with(
-        &self,
-        q: &[f64; D],
-        side: Option<Beside<D>>,
-    ) -> Result<bool, DistanceMapError> {
-        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, side.as_ref(), |v, w| {
-            if w < v.load(Ordering::Relaxed) {
-                v.fetch_min(w, Ordering::Relaxed);
-            }
-        });
-        Ok(inside)
     }
 
     /// Adds every point of the closed box `[lo, hi]` at once: lowers each cell to the
@@ -494,20 +483,6 @@ impl<const D: usize> DistanceMap<D> {
                 return;
             }
         }
-    }
-
-    /// Grows the map (if needed) so that it covers `|x_i| < reach`.
-    pub fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
-        if !reach.is_finite() {
-            return Err(DistanceMapError::NonFinite {
-                axis: 0,
-                value: reach,
-            });
-        }
-        if reach >= self.reach() {
-            self.grow(reach)?;
-        }
-        Ok(())
     }
 
     /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of `q`,
@@ -648,6 +623,97 @@ impl<const D: usize> DistanceMap<D> {
         self.half = half;
         self.side = side;
         Ok(())
+    }
+}
+
+impl<const D: usize> PointMap<D> for DistanceMap<D> {
+    fn cell_side(&self) -> f64 {
+        self.cell
+    }
+
+    fn cap(&self) -> f64 {
+        self.cap
+    }
+
+    fn len(&self) -> u64 {
+        self.points
+    }
+
+    fn reach(&self) -> f64 {
+        self.half as f64 * self.cell
+    }
+
+    /// Heap bytes held (one byte per cell, counting the vector's capacity).
+    fn memory_bytes(&self) -> usize {
+        self.values.capacity()
+    }
+
+    fn value(&self, p: &[f64; D]) -> Option<u8> {
+        self.index(p)
+            .map(|(i, _)| self.values[i].load(Ordering::Relaxed))
+    }
+
+    fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
+        if finite_reach(reach)? >= self.reach() {
+            self.grow(reach)?;
+        }
+        Ok(())
+    }
+}
+
+impl<const D: usize> Cells<D> for DistanceMap<D> {
+    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and the
+    /// stored byte.
+    #[inline(always)]
+    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
+        let (idx, z) = self.index(p)?;
+        let v = self.values[idx].load(Ordering::Relaxed);
+        let mut e2 = 0.0;
+        for i in 0..D {
+            let e = p[i] - z[i];
+            e2 += e * e;
+        }
+        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
+    }
+
+    #[inline(always)]
+    fn quantum(&self) -> f64 {
+        self.quantum
+    }
+
+    fn insert_with(
+        &mut self,
+        q: &[f64; D],
+        touched: Option<&[f64; D]>,
+    ) -> Result<(), DistanceMapError> {
+        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
+        let need = finite_max_norm(q)? + self.cap + self.cell;
+        if need >= self.reach() {
+            self.grow(need)?;
+        }
+        self.points += 1;
+        // Exclusive access: plain loads and stores (relaxed atomics compile to plain moves).
+        self.lower_rows(q, side.as_ref(), |v, w| {
+            if w < v.load(Ordering::Relaxed) {
+                v.store(w, Ordering::Relaxed);
+            }
+        });
+        Ok(())
+    }
+
+    fn insert_shared_with(
+        &self,
+        q: &[f64; D],
+        touched: Option<&[f64; D]>,
+    ) -> Result<bool, DistanceMapError> {
+        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
+        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
+        self.lower_rows(q, side.as_ref(), |v, w| {
+            if w < v.load(Ordering::Relaxed) {
+                v.fetch_min(w, Ordering::Relaxed);
+            }
+        });
+        Ok(inside)
     }
 }
 

@@ -49,7 +49,10 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::{Beside, CAPPED, DistanceMapError, SHRINK, Tables, finite_max_norm, next_row, tables};
+use super::{
+    Beside, CAPPED, Cells, DistanceMapError, PointMap, Tables, finite_max_norm, finite_reach,
+    next_row, tables,
+};
 use crate::round::{ceil, floor};
 use std::fmt;
 use std::sync::OnceLock;
@@ -164,42 +167,9 @@ impl<const D: usize> SparseDistanceMap<D> {
         })
     }
 
-    /// The cell side.
-    pub fn cell_side(&self) -> f64 {
-        self.cell
-    }
-
-    /// The cap distance.
-    pub fn cap(&self) -> f64 {
-        self.cap
-    }
-
-    /// Points inserted through [`insert`](Self::insert).
-    pub fn len(&self) -> u64 {
-        self.points
-    }
-
-    /// Whether no point has been inserted through [`insert`](Self::insert).
-    pub fn is_empty(&self) -> bool {
-        self.points == 0
-    }
-
-    /// Half the side of the covered cube.
-    pub fn reach(&self) -> f64 {
-        self.half as f64 * self.cell
-    }
-
     /// Blocks handed out (allocated, including any lost to a race between shared inserts).
     pub fn blocks(&self) -> usize {
         self.next.load(Ordering::Relaxed)
-    }
-
-    /// Heap bytes held: the table and the chunks created.
-    pub fn memory_bytes(&self) -> usize {
-        let chunk = self.block_cells << self.chunk_shift;
-        self.table.capacity() * 4
-            + self.chunks.capacity() * size_of::<OnceLock<Box<[AtomicU8]>>>()
-            + self.chunks.iter().filter(|c| c.get().is_some()).count() * chunk
     }
 
     /// The cells of block `entry` (a table entry other than [`ABSENT`] and [`UNKNOWN`]).
@@ -211,153 +181,6 @@ impl<const D: usize> SparseDistanceMap<D> {
             .expect("a block is published after its chunk is created");
         let start = (n & ((1 << self.chunk_shift) - 1)) * self.block_cells;
         &chunk[start..start + self.block_cells]
-    }
-
-    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and its
-    /// distance byte `v`; `None` outside the table or in an [`UNKNOWN`] block.
-    #[inline(always)]
-    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
-        let mut bidx = 0usize;
-        let mut cidx = 0usize;
-        let mut stride = 1usize;
-        let mut e2 = 0.0;
-        for i in 0..D {
-            let k = floor(p[i] * self.inv_cell);
-            // `side = 2 half`, tested through the signed `half` as the dense map does.
-            let half = self.half as f64;
-            if !(k >= -half && k < half) {
-                return None;
-            }
-            let j = k + half;
-            let j = j as i64 as usize;
-            bidx += (j >> self.shift) * stride;
-            stride *= self.bside;
-            cidx |= (j & self.mask) << (self.shift as usize * i);
-            let e = p[i] - (k + 0.5) * self.cell;
-            e2 += e * e;
-        }
-        let v = match self.table[bidx].load(Ordering::Acquire) {
-            ABSENT => CAPPED,
-            UNKNOWN => return None,
-            entry => CAPPED - self.block(entry)[cidx].load(Ordering::Relaxed),
-        };
-        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
-    }
-
-    /// A lower bound of the distance from `p` to the nearest inserted point and whether the
-    /// cell is capped (see [`DistanceMap::lower_bound`](super::DistanceMap::lower_bound)).
-    #[inline]
-    pub fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
-        let (m, e, v) = self.read(p)?;
-        Some((m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12, v == CAPPED))
-    }
-
-    /// The lower bound, an upper bound (`+inf` for a capped cell) and whether the cell is
-    /// capped, as [`DistanceMap::bounds`](super::DistanceMap::bounds).
-    #[inline]
-    pub fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
-        let (m, e, v) = self.read(p)?;
-        let capped = v == CAPPED;
-        let upper = if capped {
-            f64::INFINITY
-        } else {
-            (m + self.quantum + e) * (1.0 + SHRINK) + 1e-12
-        };
-        Some((
-            m * (1.0 - SHRINK) - e * (1.0 + SHRINK) - 1e-12,
-            upper,
-            capped,
-        ))
-    }
-
-    /// The distance byte of the cell holding `p` (255 in an absent block), for tests.
-    pub fn value(&self, p: &[f64; D]) -> Option<u8> {
-        self.read(p).map(|(_, _, v)| v)
-    }
-
-    /// Adds the point `q`: lowers every cell whose centre lies within `cap` of it, allocating
-    /// blocks as needed and growing the table first if `q` comes within `cap + cell` of its
-    /// edge.
-    pub fn insert(&mut self, q: &[f64; D]) -> Result<(), DistanceMapError> {
-        self.insert_with(q, None)
-    }
-
-    /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
-    /// the same cells and blocks, visiting only the cells nearer `q` than `p` (about half), since
-    /// no other cell can be lowered by `q` (see
-    /// [`DistanceMap::insert_beside`](super::DistanceMap::insert_beside)).
-    pub fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
-        self.insert_with(q, Beside::new(q, p, self.cap, self.cell))
-    }
-
-    fn insert_with(
-        &mut self,
-        q: &[f64; D],
-        side: Option<Beside<D>>,
-    ) -> Result<(), DistanceMapError> {
-        let need = finite_max_norm(q)? + self.cap + self.cell;
-        if need >= self.reach() {
-            self.grow(need)?;
-        }
-        // Room for every block the point's ball can touch.
-        let per_axis = (2.0 * self.cap * self.inv_cell) as usize / (self.mask + 1) + 2;
-        self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
-        self.points += 1;
-        self.lower_rows(q, side.as_ref(), |v, s| {
-            if s > v.load(Ordering::Relaxed) {
-                v.store(s, Ordering::Relaxed);
-            }
-        });
-        Ok(())
-    }
-
-    /// Adds `q` through a shared reference while other threads read and insert: cells are
-    /// lowered by an atomic `fetch_max` of their nearness, blocks allocated lock-free (module
-    /// documentation). The table does not grow: cells outside it are skipped. Returns `false`
-    /// when part of `q`'s ball fell outside the table.
-    pub fn insert_shared(&self, q: &[f64; D]) -> Result<bool, DistanceMapError> {
-        self.insert_shared_with(q, None)
-    }
-
-    /// [`insert_shared`](Self::insert_shared) of a point `q` that touches `p`, visiting the cells
-    /// [`insert_beside`](Self::insert_beside) visits (see
-    /// [`DistanceMap::insert_shared_beside`](super::DistanceMap::insert_shared_beside)).
-    pub fn insert_shared_beside(
-        &self,
-        q: &[f64; D],
-        p: &[f64; D],
-    ) -> Result<bool, DistanceMapError> {
-        self.insert_shared_with(q, Beside::new(q, p, self.cap, self.cell))
-    }
-
-    fn insert_shared_with(
-        &self,
-        q: &[f64; D],
-        side: Option<Beside<D>>,
-    ) -> Result<bool, DistanceMapError> {
-        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, side.as_ref(), |v, s| {
-            if s > v.load(Ordering::Relaxed) {
-                v.fetch_max(s, Ordering::Relaxed);
-            }
-        });
-        Ok(inside)
-    }
-
-    /// Grows the table (if needed) to cover `|x_i| < reach`, and reserves chunk slots for
-    /// every block of the table, so that shared inserts can allocate any block.
-    pub fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
-        if !reach.is_finite() {
-            return Err(DistanceMapError::NonFinite {
-                axis: 0,
-                value: reach,
-            });
-        }
-        if reach >= self.reach() {
-            self.grow(reach)?;
-        }
-        self.ensure_slots(self.blocks() + self.table.len());
-        Ok(())
     }
 
     /// Makes room for chunk slots up to slab number `blocks` (exclusive access).
@@ -562,6 +385,122 @@ impl<const D: usize> SparseDistanceMap<D> {
         self.side = side as usize;
         self.bside = bside;
         Ok(())
+    }
+}
+
+impl<const D: usize> PointMap<D> for SparseDistanceMap<D> {
+    fn cell_side(&self) -> f64 {
+        self.cell
+    }
+
+    fn cap(&self) -> f64 {
+        self.cap
+    }
+
+    fn len(&self) -> u64 {
+        self.points
+    }
+
+    fn reach(&self) -> f64 {
+        self.half as f64 * self.cell
+    }
+
+    /// Heap bytes held: the table and the chunks created.
+    fn memory_bytes(&self) -> usize {
+        let chunk = self.block_cells << self.chunk_shift;
+        self.table.capacity() * 4
+            + self.chunks.capacity() * size_of::<OnceLock<Box<[AtomicU8]>>>()
+            + self.chunks.iter().filter(|c| c.get().is_some()).count() * chunk
+    }
+
+    /// The distance byte of the cell holding `p` (255 in an absent block), for tests.
+    fn value(&self, p: &[f64; D]) -> Option<u8> {
+        self.read(p).map(|(_, _, v)| v)
+    }
+
+    /// As [`PointMap::reserve`], and reserves chunk slots for every block of the table, so
+    /// that shared inserts can allocate any block.
+    fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
+        if finite_reach(reach)? >= self.reach() {
+            self.grow(reach)?;
+        }
+        self.ensure_slots(self.blocks() + self.table.len());
+        Ok(())
+    }
+}
+
+impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
+    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and its
+    /// distance byte `v`; `None` outside the table or in an [`UNKNOWN`] block.
+    #[inline(always)]
+    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
+        let mut bidx = 0usize;
+        let mut cidx = 0usize;
+        let mut stride = 1usize;
+        let mut e2 = 0.0;
+        for i in 0..D {
+            let k = floor(p[i] * self.inv_cell);
+            // `side = 2 half`, tested through the signed `half` as the dense map does.
+            let half = self.half as f64;
+            if !(k >= -half && k < half) {
+                return None;
+            }
+            let j = k + half;
+            let j = j as i64 as usize;
+            bidx += (j >> self.shift) * stride;
+            stride *= self.bside;
+            cidx |= (j & self.mask) << (self.shift as usize * i);
+            let e = p[i] - (k + 0.5) * self.cell;
+            e2 += e * e;
+        }
+        let v = match self.table[bidx].load(Ordering::Acquire) {
+            ABSENT => CAPPED,
+            UNKNOWN => return None,
+            entry => CAPPED - self.block(entry)[cidx].load(Ordering::Relaxed),
+        };
+        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
+    }
+
+    #[inline(always)]
+    fn quantum(&self) -> f64 {
+        self.quantum
+    }
+
+    fn insert_with(
+        &mut self,
+        q: &[f64; D],
+        touched: Option<&[f64; D]>,
+    ) -> Result<(), DistanceMapError> {
+        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
+        let need = finite_max_norm(q)? + self.cap + self.cell;
+        if need >= self.reach() {
+            self.grow(need)?;
+        }
+        // Room for every block the point's ball can touch.
+        let per_axis = (2.0 * self.cap * self.inv_cell) as usize / (self.mask + 1) + 2;
+        self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
+        self.points += 1;
+        self.lower_rows(q, side.as_ref(), |v, s| {
+            if s > v.load(Ordering::Relaxed) {
+                v.store(s, Ordering::Relaxed);
+            }
+        });
+        Ok(())
+    }
+
+    fn insert_shared_with(
+        &self,
+        q: &[f64; D],
+        touched: Option<&[f64; D]>,
+    ) -> Result<bool, DistanceMapError> {
+        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
+        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
+        self.lower_rows(q, side.as_ref(), |v, s| {
+            if s > v.load(Ordering::Relaxed) {
+                v.fetch_max(s, Ordering::Relaxed);
+            }
+        });
+        Ok(inside)
     }
 }
 
