@@ -42,8 +42,9 @@ from ._aggsim import (
 
 def _signature(obj, model):
     """``obj``'s signature with the defaults the compiled module shows as ``...`` filled in
-    from the library (``defaults(model)``), so that ``help()`` shows the values."""
-    values = defaults(model)
+    from the library (``defaults(model)``, and the binaries' checkpoint interval), so that
+    ``help()`` shows the values."""
+    values = {**defaults(model), "checkpoint_interval": _aggsim._CHECKPOINT_INTERVAL}
     sig = _inspect.signature(obj)
     params = [
         p.replace(default=values[p.name])

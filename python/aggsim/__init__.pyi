@@ -115,6 +115,8 @@ def dla(
     serial_until: Count = ...,
     fit_from: Count = ...,
     progress: Progress = None,
+    checkpoint: Union[None, str, PathLike[str]] = None,
+    checkpoint_interval: Optional[float] = 300.0,
 ) -> DlaResult:
     """Grow an off-lattice DLA cluster (PDLA with ``threads`` > 1); see ``help(aggsim.dla)``."""
 
@@ -253,6 +255,8 @@ def dlca(
     animate: Union[None, str, PathLike[str]] = None,
     animate_every: Optional[Count] = None,
     animate_size: Optional[Count] = None,
+    checkpoint: Union[None, str, PathLike[str]] = None,
+    checkpoint_interval: Optional[float] = 300.0,
 ) -> DlcaResult:
     """Run DLCA to the end; see ``help(aggsim.dlca)``."""
 
@@ -386,6 +390,8 @@ def animat(
     animate_every: Optional[Count] = None,
     animate_size: Optional[Count] = None,
     frame_radius: Optional[Count] = None,
+    checkpoint: Union[None, str, PathLike[str]] = None,
+    checkpoint_interval: Optional[float] = 300.0,
 ) -> AnimatResult:
     """Run the animat model; see ``help(aggsim.animat)``."""
 

@@ -2,9 +2,11 @@
 //! Rodriguez-Romo, "Variable precision distance search for random fractal cluster
 //! simulations").
 
+use crate::checkpoint::{Checkpoint, differences, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
-use crate::run::{Progress, interruptible};
+use crate::run::{Progress, interruptible, interruptible_guarded};
 use dla_pdla::params::PARAMS;
+use dla_pdla::sim::{GROWTH, POSITIONS_FILE};
 use dla_pdla::{Dim, FarField, Params, SimError, Simulation, Space};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
@@ -194,6 +196,21 @@ impl DlaResult {
 /// progress : bool or callable
 ///     True prints progress to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
+/// checkpoint : str, os.PathLike or None
+///     A directory for the run's checkpoint (default None: no checkpoints). If it holds a
+///     ``checkpoint.bin``, the run continues from it: the same parameters and seed are required
+///     (else ``ValueError`` naming what differs; ``particles`` may grow); else the run starts
+///     afresh, creating the directory. It checkpoints every ``checkpoint_interval``, and when it is
+///     stopped (Ctrl-C, SIGTERM, an exception of ``progress``, memory about to run out) before the
+///     exception propagates, so the same call, run again, continues it. A run that ends removes
+///     ``checkpoint.bin`` and the ``positions.npy`` and ``growth.csv`` it needed, and returns as
+///     without a checkpoint; with one thread it ends with the ``state_hash`` of an uninterrupted
+///     run (with more, PDLA, a valid cluster, as PDLA never repeats itself). The files are the
+///     ``dla`` binary's: ``dla --resume DIR`` continues a run checkpointed here, and this continues
+///     one the binary checkpointed.
+/// checkpoint_interval : float or None
+///     Seconds of wall time between checkpoints, > 0 (default 300, the binaries'
+///     ``--checkpoint-interval``); None: checkpoints only when the run is stopped.
 ///
 /// Returns
 /// -------
@@ -204,8 +221,13 @@ impl DlaResult {
 /// ValueError
 ///     A parameter outside its accepted range, with the binary's message.
 /// KeyboardInterrupt
-///     Ctrl-C (SIGINT): the run stops within a particle (PDLA: at the phase's next quiescent
-///     point) and nothing is returned.
+///     Ctrl-C (SIGINT), and with ``checkpoint`` SIGTERM too: the run stops within a particle
+///     (PDLA: at the phase's next quiescent point), writes its checkpoint if it has one, and
+///     nothing is returned.
+/// MemoryError
+///     With ``checkpoint``: memory about to run out (the machine's or the cgroup's; the figures in
+///     the message). The run writes its checkpoint and stops within a particle its checkpoint:
+///     continue it on a machine with more memory.
 ///
 /// The run releases the GIL: other Python threads run meanwhile.
 #[pyfunction]
@@ -227,6 +249,8 @@ impl DlaResult {
     serial_until = Count::Int(i128::from(defaults().serial_until)),
     fit_from = Count::Int(i128::from(defaults().fit_from)),
     progress = None,
+    checkpoint = None,
+    checkpoint_interval = Some(crate::checkpoint::DEFAULT_INTERVAL),
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn dla(
@@ -247,8 +271,11 @@ pub fn dla(
     serial_until: Count,
     fit_from: Count,
     progress: Option<&Bound<'_, PyAny>>,
+    checkpoint: Option<PathBuf>,
+    checkpoint_interval: Option<f64>,
 ) -> PyResult<Py<DlaResult>> {
     let clock = RunClock::start();
+    let checkpoint = Checkpoint::from_args(checkpoint, checkpoint_interval)?;
     let params = Params {
         dim,
         particles: count(PARAMS, "particles", particles)?,
@@ -290,7 +317,8 @@ pub fn dla(
         .map_err(value_error)?;
     let progress = Progress::from_arg(progress, "dla", "particles")?;
     // The library's one run-time dimension dispatch, as in the binary.
-    dla_pdla::with_dim!(params.dim, D => grow::<D>(py, params, seed, &progress, &clock), d => {
+    let ck = checkpoint.as_ref();
+    dla_pdla::with_dim!(params.dim, D => grow::<D>(py, params, seed, &progress, &clock, ck), d => {
         Err(value_error(dla_pdla::ParamsError::Dim(d)))
     })
 }
@@ -301,21 +329,64 @@ fn grow<const D: usize>(
     seed: u64,
     progress: &Progress,
     clock: &RunClock,
+    checkpoint: Option<&Checkpoint>,
 ) -> PyResult<Py<DlaResult>>
 where
     Dim<D>: Space<D>,
 {
     let total = params.particles;
-    let mut sim = Simulation::<D>::new(params, seed).map_err(|e| match e {
-        SimError::Params(e) => value_error(e),
-        other => run_error(other),
-    })?;
-    let reached = interruptible(py, progress, total, |shared| {
-        sim.run_until(&shared.stop, &|n| shared.done.store(n, Ordering::Relaxed))
-    })?
-    .map_err(run_error)?;
-    if !reached {
-        return Err(run_error("stopped before the target size"));
+    let resuming = checkpoint.filter(|c| c.exists());
+    let mut sim = match resuming {
+        Some(ck) => resume::<D>(ck, &params, seed)?,
+        None => Simulation::<D>::new(params, seed).map_err(|e| match e {
+            SimError::Params(e) => value_error(e),
+            other => run_error(other),
+        })?,
+    };
+    match checkpoint {
+        None => {
+            let reached = interruptible(py, progress, total, |shared| {
+                sim.run_until(&shared.stop, &|n| shared.done.store(n, Ordering::Relaxed))
+            })?
+            .map_err(run_error)?;
+            if !reached {
+                return Err(run_error("stopped before the target size"));
+            }
+        }
+        Some(ck) => {
+            if resuming.is_none() {
+                ck.create_dir()?;
+            }
+            // The checkpoint refers to the positions streamed to DIR/positions.npy (the
+            // binary's format); growth.csv streams beside them.
+            sim.stream_into(&ck.dir, true).map_err(run_error)?;
+            let session = ck.start(py, CHECKPOINT_RESERVE)?;
+            let guard = &session.guard;
+            let (end, failure) =
+                interruptible_guarded(py, progress, total, Some(guard), |shared| {
+                    sim.run_guarded(None, guard, true, &|n| {
+                        shared.done.store(n, Ordering::Relaxed);
+                    })
+                })?;
+            if let Some(e) = failure {
+                let finished = end
+                    .as_ref()
+                    .map(Option::is_none)
+                    .map_err(ToString::to_string);
+                let save = || sim.write_checkpoint().map_err(|e| e.to_string());
+                return Err(raise_after_saving(py, e, finished, save));
+            }
+            let end = end.map_err(run_error)?;
+            if let Some(reason) = end {
+                let at = format!("at {} of {total} particles", sim.particles());
+                return Err(session.stopped(&reason, &at));
+            }
+            if sim.positions().is_none() {
+                // Resumed from a checkpoint of the binary, which keeps no positions in memory:
+                // positions.npy holds them.
+                sim.sync_streams().map_err(run_error)?;
+            }
+        }
     }
     let m = dla_pdla::output::manifest(&sim, clock).map_err(run_error)?;
     let samples = sim.samples();
@@ -329,9 +400,24 @@ where
         .add(py, "r_ext", samples.iter().map(|s| s.r_ext).collect())
         .add(py, "seconds", samples.iter().map(|s| s.seconds).collect())
         .into_dict(py)?;
-    let positions = sim
-        .into_positions()
-        .ok_or_else(|| run_error("the positions were not kept"))?;
+    let positions = match (sim.positions().is_some(), checkpoint) {
+        (false, Some(ck)) => {
+            let mut v = Vec::with_capacity(usize::try_from(sim.particles()).unwrap_or(0));
+            dla_pdla::sim::each_position(&sim, &ck.dir, |_, p| {
+                v.push(*p);
+                Ok(())
+            })
+            .map_err(run_error)?;
+            v
+        }
+        _ => sim
+            .into_positions()
+            .ok_or_else(|| run_error("the positions were not kept"))?,
+    };
+    // The run is over (its streams closed): what only the checkpoint needed goes.
+    if let Some(ck) = checkpoint {
+        ck.remove(&[POSITIONS_FILE, GROWTH.file])?;
+    }
     // `Vec<[f64; D]>` becomes an (N, D) array and NumPy takes it over: no copy.
     let positions = Array2::from(positions).into_pyarray(py);
     let out = Bound::new(py, DlaResult {})?;
@@ -339,6 +425,28 @@ where
     out.setattr("positions", positions)?;
     out.setattr("growth", growth)?;
     Ok(out.unbind())
+}
+
+/// Memory the final checkpoint needs beyond the run's own, as the binary keeps: the streams'
+/// buffers are flushed and the checkpoint itself is a few kilobytes.
+const CHECKPOINT_RESERVE: u64 = 16 << 20;
+
+/// The run checkpointed in `ck`, if this call continues it: the same parameters and seed
+/// (`particles` may grow), as the binary's `--resume`.
+fn resume<const D: usize>(ck: &Checkpoint, params: &Params, seed: u64) -> PyResult<Simulation<D>>
+where
+    Dim<D>: Space<D>,
+{
+    let sim =
+        Simulation::<D>::resume(&ck.dir, Some(params.particles)).map_err(|e| ck.refused(e))?;
+    // Python keeps the positions in memory, the binary does not: not a parameter of the run.
+    let differ = differences(
+        serde_json::to_value(sim.params()),
+        serde_json::to_value(params),
+        &[("keep_positions", None)],
+    );
+    ck.check_same(differ, (sim.seed(), seed))?;
+    Ok(sim)
 }
 
 /// What frames a result's figure: its `r_ext`, `seed` and dimension (`params["dim"]`).

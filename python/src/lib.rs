@@ -7,11 +7,13 @@
 //! | module | owns |
 //! |---|---|
 //! | `run` | running on a worker thread without the GIL: Ctrl-C, progress |
+//! | `checkpoint` | `checkpoint=DIR`: the guard, SIGTERM, resuming, cleaning up |
 //! | `convert` | `run.json` onto result attributes, count arguments, columns as arrays |
 //! | `dla`, `dlca`, `animat` | one model each: its function, result class and step-wise class |
 //! | `figure` | the binaries' figures from a result's arrays, by the libraries' picture code |
 
 mod animat;
+mod checkpoint;
 mod convert;
 mod dla;
 mod dlca;
@@ -116,6 +118,8 @@ fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FOX", ::animat::Species::Fox.code())?;
     m.add("RABBIT", ::animat::Species::Rabbit.code())?;
     m.add("SPECIES", ::animat::output::SPECIES_NAMES.to_vec())?;
+    // The default of `checkpoint_interval`, which the signatures show as `...`.
+    m.add("_CHECKPOINT_INTERVAL", checkpoint::DEFAULT_INTERVAL)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

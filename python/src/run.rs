@@ -1,11 +1,13 @@
 //! Running a model from Python: the work runs on a worker thread without the GIL while the
 //! calling thread waits, checks for signals (Ctrl-C) every [`POLL`] and reports progress. On a
 //! signal the worker is told to stop at its next consistent point (a stop flag the model
-//! polls), joined, and the signal's exception (`KeyboardInterrupt`) raised.
+//! polls, and with `checkpoint=` a stop request of its guard, which writes a checkpoint
+//! first), joined, and the signal's exception (`KeyboardInterrupt`) raised.
 
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyAny;
+use sim_run::guard::Guard;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -142,6 +144,25 @@ pub fn interruptible<T: Send>(
     total: u64,
     work: impl FnOnce(&Shared) -> T + Send,
 ) -> PyResult<T> {
+    let (out, failure) = interruptible_guarded(py, progress, total, None, work)?;
+    match failure {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
+}
+
+/// [`interruptible`] for a run that checkpoints (`checkpoint=`): a signal's exception or one
+/// of the progress callback also asks `guard` for a stop, which the run honours by writing a
+/// checkpoint before it returns. Returns what `work` returned and that exception, if any
+/// (also one of the last progress report, after `work` has finished), for the caller to
+/// raise once the run's state is saved.
+pub fn interruptible_guarded<T: Send>(
+    py: Python<'_>,
+    progress: &Progress,
+    total: u64,
+    guard: Option<&Guard>,
+    work: impl FnOnce(&Shared) -> T + Send,
+) -> PyResult<(T, Option<PyErr>)> {
     let shared = Shared {
         stop: AtomicBool::new(false),
         done: AtomicU64::new(0),
@@ -183,6 +204,9 @@ pub fn interruptible<T: Send>(
                 }
                 if let Err(e) = check {
                     shared.stop.store(true, Ordering::Relaxed);
+                    if let Some(g) = guard {
+                        g.request_stop(0);
+                    }
                     failure = Some(e);
                 }
             }
@@ -198,12 +222,12 @@ pub fn interruptible<T: Send>(
                     let stderr = py.import("sys")?.getattr("stderr")?;
                     stderr.call_method1("write", ("\n",))?;
                 }
-                Err(e)
+                Ok((out, Some(e)))
             }
             None => {
                 let n = shared.done.load(Ordering::Relaxed);
-                progress.report(py, n, total, started, true)?;
-                Ok(out)
+                let last = progress.report(py, n, total, started, true);
+                Ok((out, last.err()))
             }
         }
     })

@@ -25,6 +25,9 @@ PYTHON_ONLY = {"seed", "progress", "paper_settings", "config", "steps", "timing"
 # The animation a run writes: the binaries' figure flags (--animate, --animate-every,
 # --png-size, --frame-radius), which are outputs, not model parameters.
 PYTHON_ONLY |= {"animate", "animate_every", "animate_size", "frame_radius"}
+# Where a run keeps its checkpoint and how often (the binaries' --out, --resume and
+# --checkpoint-interval): how the run is kept, not a model parameter.
+PYTHON_ONLY |= {"checkpoint", "checkpoint_interval"}
 
 # Documented differences from the library default: ``aggsim.dla`` grows 1e5 particles when
 # none are given (the binary requires ``--particles``); ``aggsim.dlca``'s ``dim`` defaults to

@@ -20,6 +20,7 @@
 //! ```
 
 pub mod bench;
+pub mod checkpoint;
 pub mod config;
 mod hint;
 pub mod output;

@@ -3,8 +3,9 @@
 //! layer over the `animat` library: parse flags and the config file, validate, run, write
 //! outputs. Built with the `cli` feature (on by default).
 
+use animat::checkpoint::Saved;
 use animat::output::{self, PopulationRow};
-use animat::{GridBox, Params, ParamsError, Snapshot, World};
+use animat::{GridBox, Params, ParamsError, World};
 use anyhow::Context;
 use clap::Parser;
 use sim_run::cli::{CheckpointArgs, LogArgs, flag_differences, usage};
@@ -302,13 +303,6 @@ fn main() -> ExitCode {
 const CHECKPOINT: &str = "checkpoint.bin";
 /// Model name in the checkpoint envelope.
 const CHECKPOINT_MODEL: &str = "animat";
-
-/// What a checkpoint of the binary holds: the world and the population rows so far.
-#[derive(serde::Serialize, serde::Deserialize)]
-struct Saved {
-    world: Snapshot,
-    rows: Vec<PopulationRow>,
-}
 
 /// The run saved in `DIR/checkpoint.bin`, if it is one these flags continue; anything else is
 /// a usage error naming the file, or the parameters that differ with both values.

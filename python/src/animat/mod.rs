@@ -2,9 +2,11 @@
 //! `animat` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 //! Performance Optimisation", section II.B).
 
+use crate::checkpoint::{Checkpoint, Session, differences, honour, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::figure::Animate;
-use crate::run::{Progress, interruptible};
+use crate::run::{Progress, interruptible_guarded};
+use ::animat::checkpoint::{CHECKPOINT_MODEL, Saved};
 use ::animat::output::{Animation, PopulationRow, SnapshotFrame, default_animate_every};
 use ::animat::params::{DEFAULT_STEPS, FLAGS, PARAMS, error_message};
 use ::animat::{GridBox, Params, World, WorldError};
@@ -13,8 +15,8 @@ use numpy::ndarray::Array2;
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
-use sim_run::io::OutputError;
-use sim_run::io::RunClock;
+use sim_run::io::{OutputError, RunClock, read_checkpoint, write_checkpoint};
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
@@ -170,49 +172,137 @@ impl Run {
         })
     }
 
+    /// The run checkpointed in `ck`, if this call continues it: the same parameters and seed,
+    /// and at most `steps` steps made (`steps` may grow), as the binary's `--resume`.
+    fn resume(
+        py: Python<'_>,
+        ck: &Checkpoint,
+        args: &Args<'_, '_>,
+        seed: u64,
+        timing: bool,
+        steps: u64,
+    ) -> PyResult<Self> {
+        let clock = RunClock::start();
+        let params = args.params()?;
+        let saved: Saved =
+            read_checkpoint(ck.file(), CHECKPOINT_MODEL).map_err(|e| ck.refused(e))?;
+        let differ = differences(
+            serde_json::to_value(saved.world.params()),
+            serde_json::to_value(&params),
+            &[],
+        );
+        ck.check_same(differ, (saved.world.seed(), seed))?;
+        if saved.world.steps() > steps {
+            return Err(ck.refused(format!(
+                "the saved run has made {} steps, more than steps = {steps}",
+                saved.world.steps()
+            )));
+        }
+        let Saved { world, rows } = saved;
+        let mut world = py
+            .detach(|| World::restore(world))
+            .map_err(|e| ck.refused(e))?;
+        if rows.last().map(|r| r.step) != Some(world.steps()) {
+            return Err(ck.refused(format!(
+                "the population rows do not end at step {}",
+                world.steps()
+            )));
+        }
+        world.set_timing(timing);
+        Ok(Run {
+            world,
+            rows,
+            clock,
+            timing,
+        })
+    }
+
     /// Up to `n` steps, fewer once every animat has died (as the binary); returns the steps
     /// made. With `animate` (and the frame's half-side in cells) the run writes the binary's
-    /// `animat.gif` for these steps to its path, unless it is interrupted.
+    /// `animat.gif` for these steps to its path, unless it is interrupted. With `checkpoint`
+    /// the run honours its session's requests between steps, writing `checkpoint.bin` as the
+    /// binary does; a stop raises after the checkpoint.
     fn steps(
         &mut self,
         py: Python<'_>,
         n: u64,
         progress: &Progress,
         animate: Option<(&Animate, Option<i64>)>,
+        checkpoint: Option<(&Checkpoint, &Session)>,
     ) -> PyResult<u64> {
         let (world, rows) = (&mut self.world, &mut self.rows);
-        let made = interruptible(py, progress, n, |shared| -> Result<u64, OutputError> {
-            let mut animation = match animate {
-                Some((a, radius)) => Some(Animation::start(
-                    world,
-                    &a.path,
-                    SnapshotFrame::new(world.params(), radius, a.side),
-                    a.every.unwrap_or_else(|| default_animate_every(n)),
-                )?),
-                None => None,
+        let drawn = |e: OutputError| Animate::error(animate.map(|(a, _)| a), e);
+        let save = |world: &World, rows: &[PopulationRow], ck: &Checkpoint| {
+            let saved = Saved {
+                world: world.snapshot(),
+                rows: rows.to_vec(),
             };
-            let mut k = 0;
-            while k < n && !shared.stop.load(Ordering::Relaxed) {
-                if world.foxes() + world.rabbits() == 0 {
-                    break;
+            write_checkpoint(ck.file(), CHECKPOINT_MODEL, &saved).map_err(|e| ck.write_error(e))
+        };
+        let guard = checkpoint.map(|(_, s)| &*s.guard);
+        let (made, failure) =
+            interruptible_guarded(py, progress, n, guard, |shared| -> PyResult<_> {
+                let mut animation = match animate {
+                    Some((a, radius)) => Some(
+                        Animation::start(
+                            world,
+                            &a.path,
+                            SnapshotFrame::new(world.params(), radius, a.side),
+                            a.every.unwrap_or_else(|| default_animate_every(n)),
+                        )
+                        .map_err(drawn)?,
+                    ),
+                    None => None,
+                };
+                let mut k = 0;
+                let mut stopped = None;
+                while k < n {
+                    let next = honour(checkpoint, &shared.stop, |ck| save(world, rows, ck))?;
+                    if let ControlFlow::Break(r) = next {
+                        stopped = r;
+                        break;
+                    }
+                    if world.foxes() + world.rabbits() == 0 {
+                        break;
+                    }
+                    let s = world.step();
+                    rows.push(PopulationRow::of(world, s));
+                    if let Some((_, session)) = checkpoint {
+                        let reserve = checkpoint_reserve(world, rows.len());
+                        session.memory.reserve.store(reserve, Ordering::Relaxed);
+                    }
+                    if let Some(a) = animation.as_mut() {
+                        a.step(world).map_err(drawn)?;
+                    }
+                    k += 1;
+                    shared.done.store(k, Ordering::Relaxed);
                 }
-                let s = world.step();
-                rows.push(PopulationRow::of(world, s));
-                if let Some(a) = animation.as_mut() {
-                    a.step(world)?;
+                // A stopped run raises KeyboardInterrupt: its animation is dropped unwritten.
+                if let Some(a) = animation
+                    && !shared.stop.load(Ordering::Relaxed)
+                    && stopped.is_none()
+                {
+                    a.finish(world).map_err(drawn)?;
                 }
-                k += 1;
-                shared.done.store(k, Ordering::Relaxed);
-            }
-            // An interrupted run raises KeyboardInterrupt: its animation is dropped unwritten.
-            if let Some(a) = animation
-                && !shared.stop.load(Ordering::Relaxed)
-            {
-                a.finish(world)?;
-            }
-            Ok(k)
-        })?;
-        made.map_err(|e| Animate::error(animate.map(|(a, _)| a), e))
+                Ok((k, stopped))
+            })?;
+        if let Some(e) = failure {
+            return Err(match checkpoint {
+                Some((ck, _)) => {
+                    let finished = made.as_ref().map(|(_, r)| r.is_none());
+                    let finished = finished.map_err(ToString::to_string);
+                    let save = || save(world, rows, ck).map_err(|e| e.to_string());
+                    raise_after_saving(py, e, finished, save)
+                }
+                None => e,
+            });
+        }
+        let (k, stopped) = made?;
+        if let (Some(r), Some((_, session))) = (stopped, checkpoint) {
+            let at = format!("after step {}", self.world.steps());
+            return Err(session.stopped(&r, &at));
+        }
+        Ok(k)
     }
 
     /// The live animats' columns, named and typed as the binary's positions files
@@ -429,6 +519,20 @@ impl AnimatResult {
 ///     to 1024).
 /// frame_radius : int or None
 ///     Half the frame's side in cells (``--frame-radius``), 1.. (default: three start radii).
+/// checkpoint : str, os.PathLike or None
+///     A directory for the run's checkpoint (default None: no checkpoints). If it holds a
+///     ``checkpoint.bin``, the run continues from it: the same parameters and seed are required
+///     (else ``ValueError`` naming what differs; ``steps`` may grow); else the run starts afresh,
+///     creating the directory. It checkpoints every ``checkpoint_interval``, and when it is stopped
+///     (Ctrl-C, SIGTERM, an exception of ``progress``, memory about to run out) before the
+///     exception propagates, so the same call, run again, continues it. A run that ends removes
+///     ``checkpoint.bin`` and returns as without a checkpoint, with the ``state_hash`` and
+///     ``populations`` of an uninterrupted run (a resumed run's animation starts at the
+///     checkpoint). The files are the ``animat`` binary's: ``animat --resume DIR`` continues a run
+///     checkpointed here, and this continues one the binary checkpointed.
+/// checkpoint_interval : float or None
+///     Seconds of wall time between checkpoints, > 0 (default 300, the binaries'
+///     ``--checkpoint-interval``); None: checkpoints only when the run is stopped.
 ///
 /// ``aggsim.defaults("animat")`` lists every default.
 ///
@@ -441,8 +545,12 @@ impl AnimatResult {
 /// ValueError
 ///     A parameter outside its accepted range, with the binary's message.
 /// KeyboardInterrupt
-///     Ctrl-C: the run stops after the current step (use :class:`AnimatWorld` to keep the
-///     state).
+///     Ctrl-C, and with ``checkpoint`` SIGTERM too: the run stops after the current step and
+///     writes its checkpoint if it has one (or use :class:`AnimatWorld` to keep the state).
+/// MemoryError
+///     With ``checkpoint``: memory about to run out (the machine's or the cgroup's; the figures in
+///     the message). The run writes its checkpoint and stops after the current step: continue it on
+///     a machine with more memory.
 ///
 /// The run releases the GIL: other Python threads run meanwhile.
 #[pyfunction]
@@ -474,6 +582,8 @@ impl AnimatResult {
     animate_every = None,
     animate_size = None,
     frame_radius = None,
+    checkpoint = None,
+    checkpoint_interval = Some(crate::checkpoint::DEFAULT_INTERVAL),
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn animat(
@@ -504,8 +614,11 @@ pub fn animat(
     animate_every: Option<Count>,
     animate_size: Option<Count>,
     frame_radius: Option<Count>,
+    checkpoint: Option<PathBuf>,
+    checkpoint_interval: Option<f64>,
 ) -> PyResult<Py<AnimatResult>> {
     let steps = count(&[], "steps", steps)?;
+    let checkpoint = Checkpoint::from_args(checkpoint, checkpoint_interval)?;
     let progress = Progress::from_arg(progress, "animat", "steps")?;
     let animate = Animate::from_args(animate, animate_every, animate_size, "animat")?;
     let frame_radius = crate::figure::frame_radius(frame_radius)?;
@@ -515,9 +628,7 @@ pub fn animat(
              example animate=\"animat.gif\")",
         ));
     }
-    let world = AnimatWorld::new(
-        py,
-        seed,
+    let args = Args {
         config,
         foxes,
         rabbits,
@@ -536,16 +647,33 @@ pub fn animat(
         crowd_radius,
         fox_rules,
         rabbit_rules,
-        timing,
-    )?;
-    let mut run = world.lock()?;
-    run.steps(
-        py,
-        steps,
-        &progress,
-        animate.as_ref().map(|a| (a, frame_radius)),
-    )?;
-    run.result(py)
+    };
+    let animate = animate.as_ref().map(|a| (a, frame_radius));
+    let Some(ck) = checkpoint else {
+        let mut run = Run::new(py, &args, seed, timing)?;
+        run.steps(py, steps, &progress, animate, None)?;
+        return run.result(py);
+    };
+    let mut run = if ck.exists() {
+        Run::resume(py, &ck, &args, seed, timing, steps)?
+    } else {
+        ck.create_dir()?;
+        Run::new(py, &args, seed, timing)?
+    };
+    let session = ck.start(py, checkpoint_reserve(&run.world, run.rows.len()))?;
+    let more = steps - run.world.steps();
+    run.steps(py, more, &progress, animate, Some((&ck, &session)))?;
+    drop(session);
+    let out = run.result(py)?;
+    ck.remove(&[])?;
+    Ok(out)
+}
+
+/// Memory a checkpoint of `world` and `rows` population rows needs while it is written, as
+/// the binary keeps free: the snapshot and its encoding, 128 bytes an animat and 128 a row,
+/// and 16 MiB for buffers.
+fn checkpoint_reserve(world: &World, rows: usize) -> u64 {
+    (16 << 20) + 128 * (world.foxes() + world.rabbits()) + 128 * rows as u64
 }
 
 /// The `animat` binary's defaults, from the library's parameter table (`density`: none, the

@@ -112,7 +112,7 @@ impl AnimatWorld {
     fn step(&self, py: Python<'_>, n: Count, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
         let n = count(&[], "n", n)?;
         let progress = Progress::from_arg(progress, "animat", "steps")?;
-        self.lock()?.steps(py, n, &progress, None)
+        self.lock()?.steps(py, n, &progress, None, None)
     }
 
     /// The state now as an :class:`AnimatResult`, with ``run.json``'s results (times since

@@ -78,14 +78,12 @@ impl DlcaLattice {
         gyration: bool,
         fit_min_size: Count,
     ) -> PyResult<Self> {
-        let periodic = PyString::new(py, &defaults().boundary[0].to_string());
-        let memory = defaults().max_memory.into_pyobject(py)?.into_any();
         let p = params(
             size,
             fill,
             particles,
             dim,
-            boundary.unwrap_or(periodic.as_any()),
+            boundary,
             temperature,
             gravity,
             mobility_exponent,
@@ -93,7 +91,7 @@ impl DlcaLattice {
             max_sweeps,
             search,
             grid_box,
-            max_memory.unwrap_or(&memory),
+            max_memory,
             timing,
             histogram,
             histogram_sweeps,
@@ -121,7 +119,7 @@ impl DlcaLattice {
     #[pyo3(signature = (progress = None))]
     fn run(&self, py: Python<'_>, progress: Option<&Bound<'_, PyAny>>) -> PyResult<u64> {
         let progress = Progress::from_arg(progress, "dlca", "merges")?;
-        self.lock()?.until_done(py, &progress, None)
+        self.lock()?.until_done(py, &progress, None, None)
     }
 
     /// The state now as a :class:`DlcaResult`, with ``run.json``'s results (times since the

@@ -2,25 +2,30 @@
 //! the `dlca` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 //! Performance Optimisation").
 
+use crate::checkpoint::{Checkpoint, Session, differences, honour, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::figure::Animate;
-use crate::run::{Progress, interruptible};
+use crate::run::{Progress, interruptible, interruptible_guarded};
 use ::dlca::analysis::{gyration, size_distribution};
 use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, PARAMS, flags};
 use ::dlca::picture::{ANIMATION_DEFAULT_EVERY, ANIMATION_DEFAULT_SIDE, Animation};
-use ::dlca::{Params, Search, Simulation};
+use ::dlca::{Params, Search, Simulation, Snapshot};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
-use sim_run::io::{OutputError, RunClock};
+use sim_run::io::{OutputError, RunClock, read_checkpoint, write_checkpoint};
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 use std::sync::{Mutex, MutexGuard, TryLockError};
 
 mod lattice;
 pub use lattice::DlcaLattice;
+
+/// Model name in the checkpoint envelope: the `dlca` binary's.
+const CHECKPOINT_MODEL: &str = "dlca";
 
 /// The library's defaults, which are the `dlca` binary's.
 fn defaults() -> Params {
@@ -65,14 +70,15 @@ fn bytes(arg: &Bound<'_, PyAny>) -> PyResult<u64> {
     count(PARAMS, "max_memory", arg.extract()?)
 }
 
-/// The parameters of the keyword arguments, checked as the binary checks its flags.
+/// The parameters of the keyword arguments, checked as the binary checks its flags (`None`
+/// for `boundary` and `max_memory`: the defaults).
 #[allow(clippy::too_many_arguments)]
 fn params(
     size: &Bound<'_, PyAny>,
     fill: Option<f64>,
     particles: Option<Count>,
     dim: Option<usize>,
-    boundary: &Bound<'_, PyAny>,
+    boundary: Option<&Bound<'_, PyAny>>,
     temperature: f64,
     gravity: f64,
     mobility_exponent: f64,
@@ -80,7 +86,7 @@ fn params(
     max_sweeps: Option<Count>,
     search: &str,
     grid_box: Option<Count>,
-    max_memory: &Bound<'_, PyAny>,
+    max_memory: Option<&Bound<'_, PyAny>>,
     timing: bool,
     histogram: bool,
     histogram_sweeps: Option<Vec<Count>>,
@@ -90,8 +96,11 @@ fn params(
     let given = sizes(size)?;
     // A sequence of lengths gives the dimension; one length takes the binary's default, 2.
     let dim = dim.unwrap_or(if given.len() > 1 { given.len() } else { 2 });
-    let (size, boundary) =
-        flags::axes(dim, &given, &self::boundary(boundary)?).map_err(value_error)?;
+    let boundary = match boundary {
+        Some(b) => self::boundary(b)?,
+        None => defaults().boundary[0].to_string(),
+    };
+    let (size, boundary) = flags::axes(dim, &given, &boundary).map_err(value_error)?;
     let particles = particles
         .map(|n| count(PARAMS, "particles", n))
         .transpose()?;
@@ -124,7 +133,7 @@ fn params(
             .transpose()?,
         search: search.parse::<Search>().map_err(value_error)?,
         grid_box: grid_box.map(|n| count(PARAMS, "grid_box", n)).transpose()?,
-        max_memory: bytes(max_memory)?,
+        max_memory: max_memory.map_or(Ok(defaults().max_memory), bytes)?,
         timing,
         histogram_sweeps,
         gyration,
@@ -150,6 +159,29 @@ impl Run {
         Ok(Run { sim, clock })
     }
 
+    /// The run checkpointed in `ck`, if this call continues it: the same parameters and seed
+    /// (`target_clusters` and `max_sweeps` may change), as the binary's `--resume`.
+    fn resume(py: Python<'_>, ck: &Checkpoint, params: Params, seed: u64) -> PyResult<Self> {
+        let clock = RunClock::start();
+        let mut snapshot: Snapshot =
+            read_checkpoint(ck.file(), CHECKPOINT_MODEL).map_err(|e| ck.refused(e))?;
+        snapshot.set_stop(params.target_clusters, params.max_sweeps);
+        let differ = differences(
+            serde_json::to_value(snapshot.params()),
+            serde_json::to_value(&params),
+            &[
+                ("init", Some("fill/particles")),
+                ("histogram_sweeps", Some("histogram/histogram_sweeps")),
+            ],
+        );
+        ck.check_same(differ, (snapshot.seed(), seed))?;
+        // Rebuilding a large lattice takes a while: without the GIL.
+        let sim = py
+            .detach(|| Simulation::restore(snapshot))
+            .map_err(|e| ck.refused(e))?;
+        Ok(Run { sim, clock })
+    }
+
     /// Up to `n` sweeps, fewer once the run is done; returns the sweeps made.
     fn sweeps(&mut self, py: Python<'_>, n: u64, progress: &Progress) -> PyResult<u64> {
         let sim = &mut self.sim;
@@ -166,51 +198,91 @@ impl Run {
 
     /// Sweeps until the run is done (as the binary); returns the sweeps made. Progress counts
     /// merges, as the binary's. With `animate` the run writes the binary's `dlca.gif` of these
-    /// sweeps to its path, unless it is interrupted.
+    /// sweeps to its path, unless it is interrupted. With `checkpoint` the run honours its
+    /// session's requests between sweeps, writing `checkpoint.bin` as the binary does; a
+    /// stop raises after the checkpoint.
     fn until_done(
         &mut self,
         py: Python<'_>,
         progress: &Progress,
         animate: Option<&Animate>,
+        checkpoint: Option<(&Checkpoint, &Session)>,
     ) -> PyResult<u64> {
         let sim = &mut self.sim;
         let target = sim.params().target_clusters;
         let initial = sim.clusters();
         let merges = |sim: &Simulation| initial - sim.clusters().max(target).min(initial);
-        let made = interruptible(py, progress, initial.saturating_sub(target), |shared| {
+        let guard = checkpoint.map(|(_, s)| &*s.guard);
+        let save = |sim: &Simulation, ck: &Checkpoint| {
+            write_checkpoint(ck.file(), CHECKPOINT_MODEL, &sim.snapshot())
+                .map_err(|e| ck.write_error(e))
+        };
+        let drawn = |e: OutputError| Animate::error(animate, e);
+        let total = initial.saturating_sub(target);
+        let (made, failure) = interruptible_guarded(py, progress, total, guard, |shared| {
+            let mut stopped = None;
             let mut animation = match animate {
-                Some(a) => Some(Animation::start(
-                    sim,
-                    sim.seed(),
-                    &a.path,
-                    a.side.unwrap_or(ANIMATION_DEFAULT_SIDE),
-                )?),
+                Some(a) => Some(
+                    Animation::start(
+                        sim,
+                        sim.seed(),
+                        &a.path,
+                        a.side.unwrap_or(ANIMATION_DEFAULT_SIDE),
+                    )
+                    .map_err(drawn)?,
+                ),
                 None => None,
             };
             let every = animate
                 .and_then(|a| a.every)
                 .unwrap_or(ANIMATION_DEFAULT_EVERY);
             let mut k = 0;
-            shared.done.store(0, Ordering::Relaxed);
-            while !sim.is_done() && !shared.stop.load(Ordering::Relaxed) {
+            shared.done.store(merges(sim), Ordering::Relaxed);
+            while !sim.is_done() {
+                let next = honour(checkpoint, &shared.stop, |ck| save(sim, ck))?;
+                if let ControlFlow::Break(r) = next {
+                    stopped = r;
+                    break;
+                }
                 sim.sweep();
                 k += 1;
                 if let Some(a) = animation.as_mut()
                     && Animation::due(sim, every)
                 {
-                    a.frame(sim)?;
+                    a.frame(sim).map_err(drawn)?;
                 }
                 shared.done.store(merges(sim), Ordering::Relaxed);
             }
             // An interrupted run raises KeyboardInterrupt: its animation is dropped unwritten.
             if let Some(a) = animation
                 && !shared.stop.load(Ordering::Relaxed)
+                && stopped.is_none()
             {
-                a.finish()?;
+                a.finish().map_err(drawn)?;
             }
-            Ok::<u64, OutputError>(k)
+            Ok::<_, PyErr>((k, stopped))
         })?;
-        made.map_err(|e| Animate::error(animate, e))
+        if let Some(e) = failure {
+            return Err(match checkpoint {
+                Some((ck, _)) => {
+                    let finished = made.as_ref().map(|(_, r)| r.is_none());
+                    let finished = finished.map_err(ToString::to_string);
+                    let save = || save(sim, ck).map_err(|e| e.to_string());
+                    raise_after_saving(py, e, finished, save)
+                }
+                None => e,
+            });
+        }
+        let (k, stopped) = made?;
+        if let (Some(r), Some((_, session))) = (stopped, checkpoint) {
+            let at = format!(
+                "after sweep {} ({} clusters)",
+                self.sim.sweeps(),
+                self.sim.clusters()
+            );
+            return Err(session.stopped(&r, &at));
+        }
+        Ok(k)
     }
 
     /// Every particle's site (int64, (N, D)) and cluster id (int64, (N,)), in the order of
@@ -466,6 +538,21 @@ impl DlcaResult {
 /// animate_size : int or None
 ///     Longer side of the pictures in pixels (``--png-size`` with ``--animate``), 16..=16384
 ///     (default 512).
+/// checkpoint : str, os.PathLike or None
+///     A directory for the run's checkpoint (default None: no checkpoints). If it holds a
+///     ``checkpoint.bin``, the run continues from it: the same parameters and seed are required
+///     (else ``ValueError`` naming what differs; ``target_clusters`` and ``max_sweeps`` may change,
+///     as with the binary); else the run starts afresh, creating the directory. It checkpoints
+///     every ``checkpoint_interval``, and when it is stopped (Ctrl-C, SIGTERM, an exception of
+///     ``progress``, memory about to run out) before the exception propagates, so the same call,
+///     run again, continues it. A run that ends removes ``checkpoint.bin`` and returns as without a
+///     checkpoint, with the ``state_hash`` and ``per_sweep`` of an uninterrupted run (a resumed
+///     run's animation starts at the checkpoint). The files are the ``dlca`` binary's: ``dlca
+///     --resume DIR`` continues a run checkpointed here, and this continues one the binary
+///     checkpointed.
+/// checkpoint_interval : float or None
+///     Seconds of wall time between checkpoints, > 0 (default 300, the binaries'
+///     ``--checkpoint-interval``); None: checkpoints only when the run is stopped.
 ///
 /// Returns
 /// -------
@@ -476,8 +563,13 @@ impl DlcaResult {
 /// ValueError
 ///     A parameter outside its accepted range, with the binary's message.
 /// KeyboardInterrupt
-///     Ctrl-C: the run stops after the current sweep (use :class:`DlcaLattice` to keep the
+///     Ctrl-C, and with ``checkpoint`` SIGTERM too: the run stops after the current sweep
+///     and writes its checkpoint if it has one (or use :class:`DlcaLattice` to keep the
 ///     state).
+/// MemoryError
+///     With ``checkpoint``: memory about to run out (the machine's or the cgroup's; the figures in
+///     the message). The run writes its checkpoint and stops after the current sweep: continue it
+///     on a machine with more memory.
 ///
 /// The run releases the GIL: other Python threads run meanwhile.
 #[pyfunction]
@@ -506,6 +598,8 @@ impl DlcaResult {
     animate = None,
     animate_every = None,
     animate_size = None,
+    checkpoint = None,
+    checkpoint_interval = Some(crate::checkpoint::DEFAULT_INTERVAL),
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn dlca(
@@ -533,16 +627,17 @@ pub fn dlca(
     animate: Option<PathBuf>,
     animate_every: Option<Count>,
     animate_size: Option<Count>,
+    checkpoint: Option<PathBuf>,
+    checkpoint_interval: Option<f64>,
 ) -> PyResult<Py<DlcaResult>> {
     let progress = Progress::from_arg(progress, "dlca", "merges")?;
     let animate = Animate::from_args(animate, animate_every, animate_size, "dlca")?;
-    let lattice = DlcaLattice::new(
-        py,
+    let checkpoint = Checkpoint::from_args(checkpoint, checkpoint_interval)?;
+    let p = params(
         size,
         fill,
         particles,
         dim,
-        seed,
         boundary,
         temperature,
         gravity,
@@ -558,9 +653,25 @@ pub fn dlca(
         gyration,
         fit_min_size,
     )?;
-    let mut run = lattice.lock()?;
-    run.until_done(py, &progress, animate.as_ref())?;
-    run.result(py)
+    let Some(ck) = checkpoint else {
+        let mut run = Run::new(py, p, seed)?;
+        run.until_done(py, &progress, animate.as_ref(), None)?;
+        return run.result(py);
+    };
+    let mut run = if ck.exists() {
+        Run::resume(py, &ck, p, seed)?
+    } else {
+        ck.create_dir()?;
+        Run::new(py, p, seed)?
+    };
+    // While a checkpoint is written its snapshot (8 bytes a site and a little per cluster) and
+    // encoding are held besides the run: 16 MiB and 50 bytes a particle, as the binary keeps.
+    let session = ck.start(py, (16 << 20) + 50 * run.sim.particles())?;
+    run.until_done(py, &progress, animate.as_ref(), Some((&ck, &session)))?;
+    drop(session);
+    let out = run.result(py)?;
+    ck.remove(&[])?;
+    Ok(out)
 }
 
 /// The `dlca` binary's defaults, from the library's parameter table (`size` and
