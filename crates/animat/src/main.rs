@@ -299,6 +299,13 @@ fn main() -> ExitCode {
     )
 }
 
+/// Memory a checkpoint of `world` and `rows` population rows needs while it is written: the
+/// snapshot and its encoding, 128 bytes an animat and 128 a row (each holds a few dozen), and
+/// 16 MiB for buffers.
+fn checkpoint_reserve(world: &World, rows: usize) -> u64 {
+    (16 << 20) + 128 * (world.foxes() + world.rabbits()) + 128 * rows as u64
+}
+
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
 /// Model name in the checkpoint envelope.
@@ -421,12 +428,12 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         snapshot(&world)?;
     }
     progress.set_position(world.steps().min(cli.steps));
-    // Timed checkpoints, signals and the memory watch. A checkpoint holds a copy of the world
-    // and its encoding while it is written: twice the world's memory is kept free for it.
+    // Timed checkpoints, signals and the memory watch. While a checkpoint is written its
+    // snapshot and encoding are held besides the world: what `checkpoint_reserve` keeps free.
     let enabled = cli.checkpoints.enabled();
     let (guard, _watch, memory) = cli
         .checkpoints
-        .start(2 * world.memory_bytes())
+        .start(checkpoint_reserve(&world, rows.len()))
         .context("installing signal handlers")?;
     while world.steps() < cli.steps {
         if guard.is_set() {
@@ -466,7 +473,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             );
         }
         memory.reserve.store(
-            2 * world.memory_bytes(),
+            checkpoint_reserve(&world, rows.len()),
             std::sync::atomic::Ordering::Relaxed,
         );
         rows.push(PopulationRow::of(&world, s));
