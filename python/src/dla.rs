@@ -360,7 +360,7 @@ where
             // The checkpoint refers to the positions streamed to DIR/positions.npy (the
             // binary's format); growth.csv streams beside them.
             sim.stream_into(&ck.dir, true).map_err(run_error)?;
-            let session = ck.start(py, CHECKPOINT_RESERVE)?;
+            let session = ck.start(py, dla_pdla::params::CHECKPOINT_RESERVE_BYTES)?;
             let guard = &session.guard;
             let (end, failure) =
                 interruptible_guarded(py, progress, total, Some(guard), |shared| {
@@ -426,10 +426,6 @@ where
     out.setattr("growth", growth)?;
     Ok(out.unbind())
 }
-
-/// Memory the final checkpoint needs beyond the run's own, as the binary keeps: the streams'
-/// buffers are flushed and the checkpoint itself is a few kilobytes.
-const CHECKPOINT_RESERVE: u64 = 16 << 20;
 
 /// The run checkpointed in `ck`, if this call continues it: the same parameters and seed
 /// (`particles` may grow), as the binary's `--resume`.

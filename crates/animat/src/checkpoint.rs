@@ -20,3 +20,11 @@ pub struct Saved {
     /// One row per step from step 0.
     pub rows: Vec<PopulationRow>,
 }
+
+/// Memory a checkpoint of `world` with `rows` population rows needs while it is written,
+/// beside the world itself: the snapshot and its encoding, 128 bytes an animat and 128 a row
+/// (each holds a few dozen), and 16 MiB for buffers. Front ends keep this free
+/// (`sim_run::guard::MemoryWatch::reserve`).
+pub fn reserve_bytes(world: &crate::World, rows: usize) -> u64 {
+    (16 << 20) + 128 * (world.foxes() + world.rabbits()) + 128 * rows as u64
+}

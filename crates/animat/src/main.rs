@@ -299,13 +299,6 @@ fn main() -> ExitCode {
     )
 }
 
-/// Memory a checkpoint of `world` and `rows` population rows needs while it is written: the
-/// snapshot and its encoding, 128 bytes an animat and 128 a row (each holds a few dozen), and
-/// 16 MiB for buffers.
-fn checkpoint_reserve(world: &World, rows: usize) -> u64 {
-    (16 << 20) + 128 * (world.foxes() + world.rabbits()) + 128 * rows as u64
-}
-
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
 /// Model name in the checkpoint envelope.
@@ -428,12 +421,11 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         snapshot(&world)?;
     }
     progress.set_position(world.steps().min(cli.steps));
-    // Timed checkpoints, signals and the memory watch. While a checkpoint is written its
-    // snapshot and encoding are held besides the world: what `checkpoint_reserve` keeps free.
+    // Timed checkpoints, signals and the memory watch, which keeps room for a checkpoint.
     let enabled = cli.checkpoints.enabled();
     let (guard, _watch, memory) = cli
         .checkpoints
-        .start(checkpoint_reserve(&world, rows.len()))
+        .start(animat::checkpoint::reserve_bytes(&world, rows.len()))
         .context("installing signal handlers")?;
     while world.steps() < cli.steps {
         if guard.is_set() {
@@ -473,7 +465,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             );
         }
         memory.reserve.store(
-            checkpoint_reserve(&world, rows.len()),
+            animat::checkpoint::reserve_bytes(&world, rows.len()),
             std::sync::atomic::Ordering::Relaxed,
         );
         rows.push(PopulationRow::of(&world, s));

@@ -285,10 +285,6 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
     )
 }
 
-/// Memory the final checkpoint needs beyond the run's own: the streams' buffers are flushed
-/// and the checkpoint itself is a few kilobytes.
-const CHECKPOINT_RESERVE: u64 = 16 << 20;
-
 /// The progress bar of a run on a terminal.
 const PROGRESS_TEMPLATE: &str =
     "{elapsed_precise} [{bar:40}] {pos}/{len} particles ({per_sec}, eta {eta})";
@@ -415,7 +411,7 @@ where
     // beyond the buffers already flushed.
     let (guard, watch, _) = cli
         .checkpoints
-        .start(CHECKPOINT_RESERVE)
+        .start(dla_pdla::params::CHECKPOINT_RESERVE_BYTES)
         .context("installing signal handlers")?;
     let end = sim.run_guarded(cli.checkpoint_every, &guard, checkpoints, &report)?;
     drop(watch);

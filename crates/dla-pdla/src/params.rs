@@ -342,6 +342,11 @@ pub enum ParamsError {
     SerialUntilUnused(u64),
 }
 
+/// Memory a checkpoint needs while it is written, beside the run: the streams' buffers are
+/// flushed and the checkpoint itself is a few kilobytes. Front ends keep this free
+/// (`sim_run::guard::MemoryWatch::reserve`).
+pub const CHECKPOINT_RESERVE_BYTES: u64 = 16 << 20;
+
 /// Peak memory of a run, bytes per particle by dimension (2 to 5): an upper bound of the peak
 /// RSS per particle measured at 1e5 to 3e6 particles (docs/dla.md, "Memory", has the
 /// calibration table), tree, distance maps and walkers included; the positions stream to disk.

@@ -14,9 +14,6 @@ use sim_run::io::{read_checkpoint, write_checkpoint};
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
-
-/// Memory a checkpoint needs besides its per-particle part: the records, buffers.
-const CHECKPOINT_RESERVE_BASE: u64 = 16 << 20;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -438,10 +435,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         "merges",
         "{elapsed_precise} [{bar:40}] {pos}/{len} merged, {msg}",
     );
-    // Timed checkpoints, signals and the memory watch. While a checkpoint is written the
-    // snapshot (8 bytes a site and a little per cluster) and its encoding are held besides the
-    // run: 50 bytes a particle covers both.
-    let reserve = CHECKPOINT_RESERVE_BASE + 50 * sim.particles();
+    // Timed checkpoints, signals and the memory watch, which keeps room for a checkpoint.
+    let reserve = dlca::sim::checkpoint_reserve_bytes(sim.particles());
     let enabled = cli.checkpoints.enabled();
     let (guard, _watch, _) = cli
         .checkpoints

@@ -268,7 +268,7 @@ impl Run {
                     let s = world.step();
                     rows.push(PopulationRow::of(world, s));
                     if let Some((_, session)) = checkpoint {
-                        let reserve = checkpoint_reserve(world, rows.len());
+                        let reserve = ::animat::checkpoint::reserve_bytes(world, rows.len());
                         session.memory.reserve.store(reserve, Ordering::Relaxed);
                     }
                     if let Some(a) = animation.as_mut() {
@@ -660,20 +660,16 @@ pub fn animat(
         ck.create_dir()?;
         Run::new(py, &args, seed, timing)?
     };
-    let session = ck.start(py, checkpoint_reserve(&run.world, run.rows.len()))?;
+    let session = ck.start(
+        py,
+        ::animat::checkpoint::reserve_bytes(&run.world, run.rows.len()),
+    )?;
     let more = steps - run.world.steps();
     run.steps(py, more, &progress, animate, Some((&ck, &session)))?;
     drop(session);
     let out = run.result(py)?;
     ck.remove(&[])?;
     Ok(out)
-}
-
-/// Memory a checkpoint of `world` and `rows` population rows needs while it is written, as
-/// the binary keeps free: the snapshot and its encoding, 128 bytes an animat and 128 a row,
-/// and 16 MiB for buffers.
-fn checkpoint_reserve(world: &World, rows: usize) -> u64 {
-    (16 << 20) + 128 * (world.foxes() + world.rabbits()) + 128 * rows as u64
 }
 
 /// The `animat` binary's defaults, from the library's parameter table (`density`: none, the

@@ -664,9 +664,8 @@ pub fn dlca(
         ck.create_dir()?;
         Run::new(py, p, seed)?
     };
-    // While a checkpoint is written its snapshot (8 bytes a site and a little per cluster) and
-    // encoding are held besides the run: 16 MiB and 50 bytes a particle, as the binary keeps.
-    let session = ck.start(py, (16 << 20) + 50 * run.sim.particles())?;
+    let reserve = ::dlca::sim::checkpoint_reserve_bytes(run.sim.particles());
+    let session = ck.start(py, reserve)?;
     run.until_done(py, &progress, animate.as_ref(), Some((&ck, &session)))?;
     drop(session);
     let out = run.result(py)?;

@@ -22,6 +22,14 @@ pub(crate) fn chosen_search(params: &Params, lattice: &Lattice, particles: u64) 
     strategy::choose(params, lattice, particles).0
 }
 
+/// Memory a checkpoint of a run with `particles` particles needs while it is written, beside
+/// the run itself: the snapshot (8 bytes a site and a little per cluster) and its encoding,
+/// 50 bytes a particle for both, and 16 MiB for buffers. Front ends keep this free
+/// (`sim_run::guard::MemoryWatch::reserve`).
+pub fn checkpoint_reserve_bytes(particles: u64) -> u64 {
+    (16 << 20) + 50 * particles
+}
+
 /// Peak memory of a run of `params`, estimated before it starts, in bytes:
 /// [`PEAK_FIXED_BYTES`], then per particle `(d + 1)` [`PEAK_BYTES_PER_PARTICLE_AXIS`] and per
 /// site [`PEAK_BYTES_PER_SITE_LATTICE`] when the run uses the occupancy lattice (`--search
