@@ -421,6 +421,8 @@ where
         return Err(stopped(&reason, &at, &cli.out, checkpoints));
     }
     progress.finish();
+    // Positions streamed only for the checkpoints are not synced: they go at the end.
+    let discard = !asked_positions && sim.discard_positions();
     sim.sync_streams()?;
     let png = cli.png.then(|| {
         cli.png_size
@@ -443,17 +445,12 @@ where
         tracing::info!(frames, "dla.gif");
     }
     let m = write_outputs(&sim, &clock, &cli.out, cli.positions, png)?;
-    // What only the checkpoints needed goes; what was asked for stays.
+    // What only the checkpoints needed goes, the checkpoint first (it refers to the
+    // positions); what was asked for stays.
     sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.out, cli.checkpoint_every.is_some())
         .context("removing checkpoint.bin")?;
-    if !asked_positions {
-        match std::fs::remove_file(cli.out.join(dla_pdla::sim::POSITIONS_FILE)) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(anyhow::Error::from(e)
-                    .context("removing positions.npy, which only the checkpoints needed"));
-            }
-            _ => {}
-        }
+    if discard {
+        sim.remove_positions_file()?;
     }
     if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
         tracing::warn!("no fractal dimension: {e}");

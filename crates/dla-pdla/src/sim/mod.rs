@@ -299,6 +299,37 @@ where
         Ok(None)
     }
 
+    /// Stops streaming the positions without syncing `positions.npy` (its header keeps the
+    /// rows of the last checkpoint, which a resume reads up to): for a run that streamed them
+    /// only for its checkpoints and has ended (the binary's default), which then removes the
+    /// file, after its outputs and `checkpoint.bin`, with
+    /// [`remove_positions_file`](Self::remove_positions_file). `growth.csv` streams on.
+    /// Returns whether positions were streamed.
+    pub fn discard_positions(&mut self) -> bool {
+        self.growth
+            .streams
+            .as_mut()
+            .is_some_and(|s| s.positions.take().is_some())
+    }
+
+    /// Removes `positions.npy` from the directory the run streams into, if it is there.
+    ///
+    /// # Errors
+    /// The file exists but cannot be removed.
+    pub fn remove_positions_file(&self) -> Result<(), SimError> {
+        let Some(dir) = &self.stream_dir else {
+            return Ok(());
+        };
+        let path = dir.join(POSITIONS_FILE);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(SimError::Stream(format!(
+                "removing {}: {e}",
+                path.display()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     /// Whether `positions.npy` is being written ([`stream_into`](Self::stream_into) with
     /// positions).
     pub fn streams_positions(&self) -> bool {
