@@ -53,16 +53,6 @@ pub enum StopReason {
     Memory(String),
 }
 
-impl StopReason {
-    /// The signal's name, or `memory`.
-    pub fn name(&self) -> String {
-        match self {
-            StopReason::Signal(s) => signal_name(*s).to_string(),
-            StopReason::Memory(_) => "memory".into(),
-        }
-    }
-}
-
 /// The name of a signal number (SIGTERM ...), or `a stop request`.
 pub fn signal_name(sig: usize) -> &'static str {
     match sig {
@@ -96,7 +86,6 @@ pub struct Guard {
     /// The signal that asked for a stop (0: none; [`PROGRAM_STOP`]: the program's own).
     signal: Arc<AtomicUsize>,
     memory: std::sync::Mutex<Option<String>>,
-    checkpoints: AtomicU64,
 }
 
 impl Guard {
@@ -186,16 +175,6 @@ impl Guard {
         } else {
             None
         }
-    }
-
-    /// Counts a checkpoint written (for the run's report).
-    pub fn count_checkpoint(&self) {
-        self.checkpoints.fetch_add(1, Ordering::Relaxed);
-    }
-
-    /// Checkpoints written so far ([`count_checkpoint`](Self::count_checkpoint)).
-    pub fn checkpoints(&self) -> u64 {
-        self.checkpoints.load(Ordering::Relaxed)
     }
 
     /// Starts the watch thread: a checkpoint request every `interval` (none if `None`) and,

@@ -188,7 +188,7 @@ where
                 Request::None
             }
         };
-        let stopped = self.grow_polled(Some(every), stop, &poll, true, &|| {}, progress)?;
+        let stopped = self.grow_polled(Some(every), stop, &poll, true, progress)?;
         Ok(stopped.is_none())
     }
 
@@ -210,15 +210,7 @@ where
         write: bool,
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Option<StopReason>, SimError> {
-        let counted = || guard.count_checkpoint();
-        self.grow_polled(
-            every,
-            guard.flag(),
-            &|| guard.take(),
-            write,
-            &counted,
-            progress,
-        )
+        self.grow_polled(every, guard.flag(), &|| guard.take(), write, progress)
     }
 
     /// The loop of [`run_checkpointed`](Self::run_checkpointed) and
@@ -229,7 +221,6 @@ where
         flag: &AtomicBool,
         poll: &dyn Fn() -> Request,
         write: bool,
-        written: &dyn Fn(),
         progress: &(dyn Fn(u64) + Sync),
     ) -> Result<Option<StopReason>, SimError> {
         if every == Some(0) {
@@ -246,7 +237,6 @@ where
         let checkpoint = |s: &mut Self| -> Result<(), SimError> {
             if write {
                 s.write_checkpoint()?;
-                written();
             }
             Ok(())
         };

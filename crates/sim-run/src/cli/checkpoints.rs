@@ -175,15 +175,10 @@ pub fn honour(
     match guard.take() {
         Request::None => Ok(()),
         Request::Checkpoint if !enabled => Ok(()),
-        Request::Checkpoint => {
-            save()?;
-            guard.count_checkpoint();
-            Ok(())
-        }
+        Request::Checkpoint => save(),
         Request::Stop(reason) => {
             if enabled {
                 save()?;
-                guard.count_checkpoint();
             }
             Err(stopped(&reason, &at(), out, enabled))
         }
