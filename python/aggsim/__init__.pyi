@@ -34,6 +34,11 @@ def _params(model: Literal["dla", "dlca", "animat"]) -> List[Dict[str, Any]]:
     """The library's parameter table of ``model``: name, flag, unit, doc, range, choices and
     default of each parameter (the consistency tests check the keywords against it)."""
 
+def _declared(model: Literal["dla", "dlca", "animat"]) -> Dict[str, Any]:
+    """The declared parameters of ``model`` that ``aggsim`` makes keyword arguments of:
+    ``params`` (name, type, help, why, optional of each) and ``positional`` (the names the
+    function takes as its own arguments)."""
+
 class DlaResult:
     """A grown DLA/PDLA cluster: :func:`dla`'s result."""
 
@@ -103,17 +108,19 @@ def dla(
     seed: int = 1,
     threads: Count = ...,
     *,
+    # BEGIN GENERATED dla-keywords: written by `cargo xtask generate` from the declaration; do not edit
     birth_gap: float = ...,
     far_field: Literal["return", "jump"] = ...,
     death_ratio: Optional[float] = None,
     step_min: float = ...,
     precision: float = ...,
     leaf_side: float = ...,
-    distance_map: bool = ...,
     near_cache: bool = ...,
-    paper_settings: bool = False,
+    distance_map: bool = ...,
     serial_until: Count = ...,
     fit_from: Count = ...,
+    # END GENERATED dla-keywords
+    paper_settings: bool = False,
     progress: Progress = None,
     checkpoint: Union[None, str, PathLike[str]] = None,
     checkpoint_interval: Optional[float] = 300.0,

@@ -4,13 +4,15 @@
 
 use crate::checkpoint::{Checkpoint, differences, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
+use crate::declared::set_keywords;
 use crate::run::{Progress, interruptible, interruptible_guarded};
 use dla_pdla::params::PARAMS;
 use dla_pdla::sim::{GROWTH, POSITIONS_FILE};
-use dla_pdla::{Dim, FarField, Params, SimError, Simulation, Space};
+use dla_pdla::{Dim, Params, SimError, Simulation, Space};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use sim_run::io::RunClock;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -151,6 +153,10 @@ impl DlaResult {
 /// simulations"), take steps of step_min near it, and stick at exact contact. With one thread
 /// the run is a pure function of (parameters, seed) and its ``state_hash`` is the binary's.
 ///
+/// The model's parameters (``birth_gap``, ``step_min``, ...) are keyword arguments made from
+/// the library's declaration of them, listed last below; ``dim``, ``particles`` and ``threads``
+/// may also be given by position.
+///
 /// Parameters
 /// ----------
 /// dim : int
@@ -162,37 +168,10 @@ impl DlaResult {
 ///     Seed of every random stream (default 1).
 /// threads : int
 ///     Walkers moving at once (PDLA), 1..=1024 (default 1, which is DLA and deterministic).
-/// birth_gap : float
-///     R_b - R_ext in diameters, in [1, 1e4] (default 5).
-/// far_field : str
-///     ``"return"`` (default): a walker outside the birth sphere returns to it exactly where
-///     Brownian motion would first hit it; ``"jump"``: the paper's jump with relaunch beyond
-///     the death radius.
-/// death_ratio : float or None
-///     R_d / R_b for ``far_field="jump"``, in (1, 1e100] (default None: 100). Refused with
-///     ``"return"``, as by the binary.
-/// step_min : float
-///     Near-field step in diameters, in [1e-6, 1e3] (default 0.1; the paper's 0.5 biases
-///     the R_g prefactor about 5 % low).
-/// precision : float
-///     kappa of the variable-precision distance, in (0.5, inf] (default 2; ``math.inf`` is the
-///     exact search).
-/// leaf_side : float
-///     Side of the orthtree's leaves, a power of two in {1, 2, 4, 8, 16, 32, 64} (default 8):
-///     speed and memory only.
-/// distance_map : bool
-///     The coarse distance maps in front of the orthtree (default True, the binary's
-///     ``--distance-map on``): speed only, but another trajectory.
-/// near_cache : bool
-///     Each walker's exact near cache (default True): speed only, same trajectory.
 /// paper_settings : bool
 ///     The variable-precision paper's walk (the binary's ``--paper-settings``):
 ///     ``far_field="jump"``, ``death_ratio=100``, ``step_min=0.5``, ``precision=2``,
-///     ``distance_map=False`` (default False). Those five must then stay at their defaults.
-/// serial_until : int
-///     With threads > 1: grow with one walker up to this many particles (default 0).
-/// fit_from : int
-///     Smallest N of the fractal-dimension fit log N = D log R_g + c, in 2.. (default 1000).
+///     ``distance_map=False`` (default False). Those five may then not be given.
 /// progress : bool or callable
 ///     True prints progress to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
@@ -237,20 +216,11 @@ impl DlaResult {
     seed = 1,
     threads = Count::Int(defaults().threads as i128),
     *,
-    birth_gap = defaults().birth_gap,
-    far_field = defaults().far_field.name(),
-    death_ratio = None,
-    step_min = defaults().step_min,
-    precision = defaults().precision,
-    leaf_side = defaults().leaf_side,
-    distance_map = defaults().distance_map,
-    near_cache = defaults().near_cache,
     paper_settings = false,
-    serial_until = Count::Int(i128::from(defaults().serial_until)),
-    fit_from = Count::Int(i128::from(defaults().fit_from)),
     progress = None,
     checkpoint = None,
     checkpoint_interval = Some(crate::checkpoint::DEFAULT_INTERVAL),
+    **params,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn dla(
@@ -259,69 +229,44 @@ pub fn dla(
     particles: Count,
     seed: u64,
     threads: Count,
-    birth_gap: f64,
-    far_field: &str,
-    death_ratio: Option<f64>,
-    step_min: f64,
-    precision: f64,
-    leaf_side: f64,
-    distance_map: bool,
-    near_cache: bool,
     paper_settings: bool,
-    serial_until: Count,
-    fit_from: Count,
     progress: Option<&Bound<'_, PyAny>>,
     checkpoint: Option<PathBuf>,
     checkpoint_interval: Option<f64>,
+    params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<DlaResult>> {
     let clock = RunClock::start();
     let checkpoint = Checkpoint::from_args(checkpoint, checkpoint_interval)?;
-    let params = Params {
+    let mut p = Params {
         dim,
         particles: count(PARAMS, "particles", particles)?,
-        birth_gap,
-        far_field: far_field.parse::<FarField>().map_err(value_error)?,
-        death_ratio: death_ratio.unwrap_or(defaults().death_ratio),
-        step_min,
-        precision,
         threads: count::<u64>(PARAMS, "threads", threads)? as usize,
-        serial_until: count(PARAMS, "serial_until", serial_until)?,
-        fit_from: count(PARAMS, "fit_from", fit_from)?,
         // The positions are returned.
         keep_positions: true,
-        leaf_side,
-        distance_map,
-        near_cache,
+        ..defaults()
     };
+    let given = set_keywords(&mut p, PARAMS, "dla", POSITIONAL, params)?;
+    let given = |name: &str| given.iter().any(|g| g == name);
     let params = if paper_settings {
         // The library's rule, as the binary's: the fields it sets may not be given beside it.
-        // A keyword left at its default counts as not given (Python cannot tell them apart).
-        let d = defaults();
-        let given = |name: &str| match name {
-            "far_field" => params.far_field != d.far_field,
-            "death_ratio" => death_ratio.is_some(),
-            "step_min" => params.step_min != d.step_min,
-            "precision" => params.precision != d.precision,
-            "distance_map" => params.distance_map != d.distance_map,
-            _ => false,
-        };
-        params
-            .clone()
-            .with_paper_settings(given)
-            .map_err(value_error)?
+        p.with_paper_settings(given).map_err(value_error)?
     } else {
-        params
+        p
     };
     params
-        .validate_given(death_ratio.is_some())
+        .validate_given(given("death_ratio"))
         .map_err(value_error)?;
     let progress = Progress::from_arg(progress, "dla", "particles")?;
     // The library's one run-time dimension dispatch, as in the binary.
     let ck = checkpoint.as_ref();
     dla_pdla::with_dim!(params.dim, D => grow::<D>(py, params, seed, &progress, &clock, ck), d => {
-        Err(value_error(dla_pdla::ParamsError::Dim(d)))
+        Err(value_error(dla_pdla::ParamsError::dim(d)))
     })
 }
+
+/// Declared parameters `aggsim.dla` takes as its own arguments (by position too), not as
+/// keywords of the declaration.
+pub const POSITIONAL: &[&str] = &["dim", "particles", "threads"];
 
 fn grow<const D: usize>(
     py: Python<'_>,

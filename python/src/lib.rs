@@ -15,6 +15,7 @@
 mod animat;
 mod checkpoint;
 mod convert;
+mod declared;
 mod dla;
 mod dlca;
 mod figure;
@@ -70,6 +71,30 @@ fn params_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>
     convert::json(py, &serde_json::Value::Array(rows))
 }
 
+/// The declared parameters of ``model`` that ``aggsim`` builds keyword arguments from
+/// (``"dla"``): a list of dicts with ``name``, ``type`` (``float``, ``int``, ``bool``, ``str``),
+/// ``help`` (the whole description), ``why`` (the reason for the range) and ``optional`` (None
+/// by default), in declaration order, and the names taken as positional arguments
+/// (``positional``). Empty for a model whose keywords are not generated yet.
+#[pyfunction]
+#[pyo3(name = "_declared")]
+fn declared_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
+    let (rows, positional): (Vec<serde_json::Value>, &[&str]) = match model {
+        "dla" => (
+            declared::declared_rows::<dla_pdla::Params>(),
+            dla::POSITIONAL,
+        ),
+        "dlca" | "animat" => (Vec::new(), &[]),
+        other => {
+            return Err(convert::value_error(format!(
+                "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
+            )));
+        }
+    };
+    let v = serde_json::json!({ "params": rows, "positional": positional });
+    convert::json(py, &v)
+}
+
 /// The output schema of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``), from the library
 /// (``sim_run::schema``): a list of dicts, one per file, with ``file`` (a positions set: its
 /// stem), ``form`` (``kind`` ``"csv"`` or ``"points"``, with the coordinates' ``axes``, ``dtype``
@@ -103,6 +128,7 @@ fn _aggsim(m: &Bound<'_, PyModule>) -> PyResult<()> {
             "aggsim: {why}"
         )));
     }
+    m.add_function(wrap_pyfunction!(declared_table, m)?)?;
     m.add_function(wrap_pyfunction!(dla::dla, m)?)?;
     m.add_function(wrap_pyfunction!(dlca::dlca, m)?)?;
     m.add_function(wrap_pyfunction!(dlca::dlca_pooled_fit, m)?)?;

@@ -176,3 +176,34 @@ def test_a_negative_count_names_the_tables_range(name):
     with pytest.raises(ValueError) as e:
         aggsim.AnimatWorld(**{name: -1})
     assert str(e.value) == f"{name} = -1 is outside the accepted range {row['range']}"
+
+
+def test_declared_keywords_come_from_the_declaration():
+    """``aggsim.dla``'s model keywords are made from the library's declaration: the signature,
+    the docstring's list and the checks of unknown keywords and wrong types."""
+    declared = aggsim._declared("dla")
+    names = [r["name"] for r in declared["params"] if r["name"] not in declared["positional"]]
+    sig = inspect.signature(aggsim.dla).parameters
+    for name in names:
+        assert sig[name].kind is inspect.Parameter.KEYWORD_ONLY, name
+    doc = inspect.getdoc(aggsim.dla)
+    for row in table("dla"):
+        if row["name"] in names:
+            assert f"\n{row['name']} : " in doc, row["name"]
+            if row["range"] not in ("any",) and not row["choices"]:
+                assert f"accepted {row['range']}" in doc, row["name"]
+    with pytest.raises(TypeError, match="unexpected keyword argument 'birth_gapp'"):
+        aggsim.dla(particles=10, birth_gapp=5)
+    with pytest.raises(TypeError, match="birth_gap = fast: expected float, not str"):
+        aggsim.dla(particles=10, birth_gap="fast")
+    with pytest.raises(TypeError, match="near_cache = 1: expected bool"):
+        aggsim.dla(particles=10, near_cache=1)
+    with pytest.raises(TypeError, match="step_min = None"):
+        aggsim.dla(particles=10, step_min=None)
+    # An optional parameter given as None is not given.
+    assert aggsim.dla(particles=10, death_ratio=None).particles == 10
+    with pytest.raises(ValueError, match="--death-ratio is used by --far-field jump only"):
+        aggsim.dla(particles=10, death_ratio=100)
+    # A real parameter takes an int; a count takes a whole float.
+    r = aggsim.dla(particles=10, birth_gap=7, fit_from=2e3, far_field="jump", death_ratio=50)
+    assert r.params["birth_gap"] == 7.0 and r.params["fit_from"] == 2000

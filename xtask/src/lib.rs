@@ -8,6 +8,7 @@ pub mod bench;
 pub mod ci;
 pub mod codemap;
 pub mod fuzz;
+pub mod generate;
 pub mod plot;
 pub mod probe;
 pub mod quoted;

@@ -7,6 +7,8 @@
 //!   and figures from our own runs (see `docs/results/README.md`).
 //! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and
 //!   memory figures as JSON, and their ratios to a saved baseline.
+//! - `cargo xtask generate`: the docs' flag tables and the Python stubs' keyword arguments
+//!   written from the models' parameter declarations (`xtask::generate`).
 //! - `cargo xtask fuzz [--cases N] [--only TEXT]`: every reader of user files fuzzed with N
 //!   cases (default 1e5; `xtask::fuzz`).
 
@@ -113,6 +115,10 @@ enum Cmd {
         #[arg(long, default_value_t = 20_000_000)]
         loads: u64,
     },
+    /// Write what is generated from the models' parameter declarations into the files people
+    /// read: the docs' flag tables and the Python stubs' keyword arguments, between their
+    /// marker lines (the test suite fails while they are stale).
+    Generate,
     /// Fuzz every reader of a file a user can hand the programs (checkpoints, positions.npy,
     /// config files, ensemble members for --merge) with many cases of arbitrary bytes and
     /// mutated valid files; prints cases and seconds per reader (xtask/src/fuzz.rs).
@@ -214,6 +220,16 @@ fn main() -> Result<()> {
         .map(|_| ()),
         Cmd::Latency { max, loads } => {
             print!("{}", xtask::probe::latency_table(max as usize, loads));
+            Ok(())
+        }
+        Cmd::Generate => {
+            let changed = xtask::generate::run(&workspace_root())?;
+            for f in &changed {
+                eprintln!("==> {f}");
+            }
+            if changed.is_empty() {
+                eprintln!("==> every generated block is current");
+            }
             Ok(())
         }
         Cmd::Fuzz { cases, only } => {

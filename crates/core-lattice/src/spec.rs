@@ -10,6 +10,14 @@
 
 use std::fmt;
 
+mod declare;
+#[cfg(feature = "serde")]
+pub use declare::as_text;
+pub use declare::{
+    Declared, DeclaredParams, Input, Kind, ParamValue, RangeError, first_sentence, help_text,
+    spec_table, trim_doc,
+};
+
 /// One model parameter as the front ends see it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParamSpec {

@@ -6,9 +6,10 @@
 use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
-use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
+use dla_pdla::{Dim, Params, ParamsError, SimError, Simulation, Space};
 use sim_run::cli::{
-    CheckpointArgs, ConfigArgs, LogArgs, OverwriteArgs, flag_differences, stopped, usage,
+    CheckpointArgs, ConfigArgs, LogArgs, OverwriteArgs, ParamFlags, flag_differences, stopped,
+    usage,
 };
 use sim_run::ensemble::{Curve, EnsembleArgs};
 use sim_run::io::RunClock;
@@ -21,21 +22,13 @@ use std::process::ExitCode;
 /// radius R_b = R_ext + birth-gap, jump by the variable-precision distance to the cluster when
 /// far from it, take steps of step-min near it, and stick at exact contact. Outputs go into
 /// --out DIR (see docs/dla.md).
-// Defaults come from the library (`Params::default()`); `cli_spec_tests` checks the rest
-// (flags, choices, ranges in the help) against `dla_pdla::params::PARAMS`.
+// The model's flags are made from its one declaration (`ParamFlags<Params>`); `cli_spec_tests`
+// checks them and the docs' table against `dla_pdla::params::PARAMS`.
 #[derive(Parser, Debug)]
 #[command(name = "dla", version = sim_run::cli::version(), allow_negative_numbers = true)]
 struct Cli {
-    /// Space dimension, one of {2, 3, 4, 5}.
-    #[arg(long, default_value_t = Params::default().dim)]
-    dim: usize,
-
-    /// Particles in the final cluster, seed particle included: 1..=3000000000 in 2D and 3D,
-    /// 1..=2500000000 in 4D and 5D (the orthtree's 32-bit indices). Memory: about 11 bytes per
-    /// particle in 2D and 15 in 3D at 1e7; the tree and distance map take about 25 in 4D at
-    /// 1e5 and 300 in 5D at 3e4 (mostly the map).
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
-    particles: u64,
+    #[command(flatten)]
+    params: ParamFlags<Params>,
 
     /// Seed of every random stream of the run: same seed and flags, same run (one thread).
     #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
@@ -48,74 +41,11 @@ struct Cli {
     #[arg(long)]
     out: PathBuf,
 
-    // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
-    // clap would read `-inf` as an unknown short flag.
-    /// Distance of the birth sphere outside the cluster, R_b - R_ext, in diameters, in [1, 1e4].
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().birth_gap)]
-    birth_gap: f64,
-
-    /// Far field (|p| > R_b): `return` puts the walker exactly where Brownian motion would first
-    /// hit the birth sphere (harmonic measure; see docs/dla.md); `jump` is the paper's jump of
-    /// |p| - R_ext - 1 with relaunch beyond the death radius.
-    #[arg(long, value_enum, default_value_t = Params::default().far_field)]
-    far_field: FarField,
-
-    /// Death radius R_d = death-ratio * R_b for `--far-field jump`, in birth radii, in
-    /// (1, 1e100] [default: 100].
-    #[arg(long, allow_hyphen_values = true)]
-    death_ratio: Option<f64>,
-
-    /// Near-field step length in diameters, in [1e-6, 1e3]: used when the distance to the
-    /// cluster minus one is at most this. Smaller is closer to Brownian motion. The default is
-    /// where the accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor
-    /// about 5 % low (docs/dla.md, "Accuracy").
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().step_min)]
-    step_min: f64,
-
-    /// Precision kappa of the variable-precision distance, in (0.5, inf] (the paper uses 2;
-    /// `inf` is the exact search). Larger is more exact and slower.
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().precision)]
-    precision: f64,
-
-    /// Side of the orthtree's leaf cells in diameters, a power of two in
-    /// {1, 2, 4, 8, 16, 32, 64}: speed and memory only, not the physics.
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().leaf_side)]
-    leaf_side: f64,
-
-    /// The distance maps in front of the orthtree (one byte per cell of side 8 diameters plus a
-    /// coarser map; under 1 byte per particle at 1e6 in 2D; in 3D also a sparse map of
-    /// 2-diameter cells near the cluster, about 6 bytes per particle at 1e6): walkers away from
-    /// the cluster jump by their bound without a tree query. Speed and memory only, not the
-    /// physics (but another trajectory and state hash); `off` is the paper's tree-only walk.
-    #[arg(long, value_enum, default_value_t = Toggle::from(Params::default().distance_map))]
-    distance_map: Toggle,
-
-    /// Each walker copies the particles within 5 diameters out of the tree and answers its
-    /// moves close to the cluster from that short list. Exact: the same answers as the tree,
-    /// so the same trajectory and state hash on or off; speed only. Used when the tree is
-    /// exact at those distances anyway ((precision - 1/2) leaf diagonals >= 5, as by
-    /// default).
-    #[arg(long, value_enum, default_value_t = Toggle::from(Params::default().near_cache))]
-    near_cache: Toggle,
-
     /// The variable-precision paper's walk, to reproduce its numbers: --far-field jump
     /// --death-ratio 100 --step-min 0.5 --precision 2 --distance-map off (the step of 0.5
     /// biases the R_g prefactor about 5 % low against the default; docs/dla.md, "Accuracy").
     #[arg(long, conflicts_with_all = dla_pdla::params::PAPER_SETTINGS)]
     paper_settings: bool,
-
-    /// Walkers moving at once on the shared cluster (PDLA), 1..=1024; 1 is exactly DLA and
-    /// deterministic.
-    #[arg(long, value_parser = sim_run::cli::count::<usize>, default_value_t = Params::default().threads)]
-    threads: usize,
-
-    /// With --threads > 1: grow with one walker until the cluster has this many particles.
-    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().serial_until)]
-    serial_until: u64,
-
-    /// Smallest N (particles) used in the fractal-dimension fit log N = D log R_g + c, in 2..
-    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().fit_from)]
-    fit_from: u64,
 
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
     /// (N, D), NumPy's format) as the cluster grows, never held in memory; csv, bin, xyz
@@ -186,37 +116,9 @@ struct Cli {
     overwrite: OverwriteArgs,
 }
 
-/// An on/off switch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum Toggle {
-    On,
-    Off,
-}
-
-impl From<bool> for Toggle {
-    fn from(on: bool) -> Self {
-        if on { Toggle::On } else { Toggle::Off }
-    }
-}
-
 fn params(cli: &Cli) -> Result<Params, String> {
-    let p = Params {
-        dim: cli.dim,
-        particles: cli.particles,
-        birth_gap: cli.birth_gap,
-        far_field: cli.far_field,
-        death_ratio: cli.death_ratio.unwrap_or(Params::default().death_ratio),
-        step_min: cli.step_min,
-        precision: cli.precision,
-        threads: cli.threads,
-        serial_until: cli.serial_until,
-        fit_from: cli.fit_from,
-        // Positions stream to positions.npy instead (see `run`).
-        keep_positions: false,
-        leaf_side: cli.leaf_side,
-        distance_map: cli.distance_map == Toggle::On,
-        near_cache: cli.near_cache == Toggle::On,
-    };
+    // Positions stream to positions.npy instead of `keep_positions` (see `run`).
+    let p = cli.params.params();
     let p = if cli.paper_settings {
         // clap has refused the flags it sets (`conflicts_with_all`, the same list).
         p.with_paper_settings(|_| false)
@@ -225,7 +127,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         p
     };
     // Flags that would be silently ignored are refused too.
-    p.validate_given(cli.death_ratio.is_some())
+    p.validate_given(cli.params.given("death_ratio"))
         .map_err(|e| e.to_string())?;
     if p.dim > 3 && matches!(cli.positions, PositionsFormat::Xyz | PositionsFormat::Vtk) {
         return Err(format!(
@@ -355,7 +257,7 @@ fn main() -> ExitCode {
                 cli.ensemble
                     .run("dla", params.threads, &cli.out, CURVES, &cli.log, &owner);
             ensemble.unwrap_or_else(|| {
-                dla_pdla::with_dim!(params.dim, D => run::<D>(cli, params), d => Err(ParamsError::Dim(d).into()))
+                dla_pdla::with_dim!(params.dim, D => run::<D>(cli, params), d => Err(ParamsError::dim(d).into()))
             })
         },
     )

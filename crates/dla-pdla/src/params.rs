@@ -5,6 +5,7 @@
 //! [`DIMENSIONS`]).
 
 use crate::space::DIMENSIONS;
+use core_lattice::spec::{DeclaredParams, End, Input, Kind, ParamValue, Range, RangeError};
 use serde::{Deserialize, Serialize};
 
 mod spec;
@@ -88,58 +89,122 @@ impl clap::ValueEnum for FarField {
     }
 }
 
-/// Every parameter of a run, with its default.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Params {
-    /// Space dimension, one of [`DIMENSIONS`] (`--dim`, default 2).
-    pub dim: usize,
-    /// Number of particles of the final cluster, seed included (`--particles`).
-    pub particles: u64,
-    /// `R_b - R_ext`, distance of the birth sphere outside the cluster (`--birth-gap`, default 5).
-    pub birth_gap: f64,
-    /// Far-field rule (`--far-field`, default `return`).
-    pub far_field: FarField,
-    /// `R_d / R_b` for `--far-field jump` (`--death-ratio`, default 100).
-    pub death_ratio: f64,
-    /// Near-field step length in diameters (`--step-min`, default [`DEFAULT_STEP_MIN`]; the
-    /// paper's 0.5 biases the R_g prefactor about 5 % low).
-    pub step_min: f64,
-    /// `vpdist` precision kappa (`--precision`, default 2, the paper's value; `inf` = exact).
-    pub precision: f64,
-    /// Walkers moving at once (`--threads`, default 1 = DLA).
-    pub threads: usize,
-    /// Grow serially (one walker) until the cluster has this many particles (`--serial-until`).
-    pub serial_until: u64,
-    /// Smallest N used in the fractal-dimension fit (`--fit-from`, default 1000).
-    pub fit_from: u64,
-    /// Keep every position in arrival order (needed for position files and pictures). Costs
-    /// `8 D` bytes per particle; off by default.
-    pub keep_positions: bool,
-    /// Side of the orthtree's leaf cells in diameters, a power of two in [1, 64]
-    /// (`--leaf-side`, default [`DLA_LEAF_SIDE`]). Changes speed and memory, not the
-    /// physics: see `docs/dla.md`.
-    #[serde(default = "default_leaf_side")]
-    pub leaf_side: f64,
-    /// Put the coarse distance map in front of the orthtree (`--distance-map`, default on).
-    /// Changes speed and memory, not the physics (every jump stays within a lower bound of the
-    /// distance to the cluster), but it changes the random trajectory: see `docs/dla.md`.
-    #[serde(default = "default_distance_map")]
-    pub distance_map: bool,
-    /// Give each walker a near cache: the particles within 5 diameters, copied out of the
-    /// tree, which answer its moves close to the cluster (`--near-cache`, default on). Exact:
-    /// the same answers as the tree, so the same trajectory and state hash with it on or off;
-    /// only speed changes (`docs/dla.md`). Used only where the tree's answers are exact
-    /// anyway (`(precision - 1/2)` leaf diagonals of at least 5 diameters, as by default).
-    #[serde(default = "default_near_cache")]
-    pub near_cache: bool,
+core_lattice::declare_params! {
+    /// Every parameter of a run, with its default: declared once here, from which the `dla`
+    /// binary's flags and config keys, the Python keyword arguments and stubs, the range
+    /// checks and their messages, and the docs' flag table are made
+    /// (`docs/architecture.md`, "Adding a parameter"). Fields missing from a checkpoint or
+    /// config file written before they existed take their defaults.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(default)]
+    pub struct Params {
+        /// Space dimension.
+        dim: usize = 2 => { flag: "dim", unit: "", range: Range::Values(DIMENSIONS) },
+        /// Particles in the final cluster, seed particle included (at most 2.5e9 in 4D and
+        /// 5D, the orthtree's 32-bit indices). Memory: about 11 bytes per particle in 2D and 15
+        /// in 3D at 1e7; the tree and distance map take about 25 in 4D at 1e5 and 300 in 5D at
+        /// 3e4 (mostly the map).
+        particles: u64 = 10_000 => {
+            flag: "particles", unit: "particles",
+            range: Range::Int { min: 1, max: Some(MAX_PARTICLES as i128) },
+            why: "the orthtree's 32-bit indices", required: true,
+        },
+        /// R_b - R_ext, the distance of the birth sphere outside the cluster.
+        birth_gap: f64 = 5.0 => {
+            flag: "birth-gap", unit: "diameters",
+            range: Range::Real(End::Closed(1.0), End::Closed(MAX_BIRTH_GAP)),
+            why: "a walker born closer than one diameter could overlap the cluster; a larger gap does not change where walkers arrive, only makes each one wander longer: in 3D about gap / R_ext times longer",
+        },
+        /// What happens to a walker outside the birth sphere. `return` puts it exactly where
+        /// Brownian motion would first hit the birth sphere (harmonic measure); `jump` is the
+        /// variable-precision paper's jump of |p| - R_ext - 1 with relaunch beyond the death
+        /// radius.
+        far_field: FarField = FarField::Return => {
+            flag: "far-field", unit: "", range: Range::Choices(&FarField::NAMES),
+        },
+        /// R_d / R_b, the death radius of the jump far field: used with far field `jump`
+        /// only, and refused with `return`, which has no death radius.
+        death_ratio: f64 = PAPER_DEATH_RATIO => {
+            flag: "death-ratio", unit: "birth radii",
+            range: Range::Real(End::Open(1.0), End::Closed(MAX_DEATH_RATIO)),
+            why: "a larger death radius would overflow the walkers' coordinates",
+            optional: true,
+        },
+        /// Near-field step length: used when the distance to the cluster minus one is at most
+        /// this. Smaller is closer to Brownian motion. The default is where the accuracy study
+        /// converges at no cost; the paper's 0.5 biases the R_g prefactor about 5 % low.
+        step_min: f64 = DEFAULT_STEP_MIN => {
+            flag: "step-min", unit: "diameters",
+            range: Range::Real(End::Closed(MIN_STEP_MIN), End::Closed(1e3)),
+            why: "a step below the contact tolerance of 1e-6 diameters is lost to rounding at the cluster's coordinates, so the walker would never move",
+        },
+        /// Precision kappa of the variable-precision distance (inf: the exact nearest
+        /// distance). Larger is more exact and slower; the paper uses 2.
+        precision: f64 = PAPER_PRECISION => {
+            flag: "precision", unit: "",
+            range: Range::Real(End::Open(0.5), End::Unbounded),
+            why: "inf = exact search",
+        },
+        /// Side of the orthtree's leaf cells, a power of two: speed and memory only, not the
+        /// physics (8 is faster and smaller than 4: see docs/benchmarks.md).
+        leaf_side: f64 = DLA_LEAF_SIDE => {
+            flag: "leaf-side", unit: "diameters", range: Range::Values(&[1, 2, 4, 8, 16, 32, 64]),
+        },
+        /// Each walker's exact near cache: the particles within 5 diameters, copied out of
+        /// the tree, answer its moves close to the cluster. Speed only: the same answers as
+        /// the tree, so the same trajectory and state hash on or off. Used where the tree is
+        /// exact at those distances anyway ((precision - 1/2) leaf diagonals of at least 5
+        /// diameters, as by default).
+        near_cache: bool = true => { flag: "near-cache", unit: "", range: Range::Any },
+        /// The coarse distance maps in front of the orthtree: speed only, another trajectory.
+        /// One byte per cell of side 8 diameters plus a coarser map (under 1 byte per
+        /// particle at 1e6 in 2D; in 3D also a sparse map of 2-diameter cells near the
+        /// cluster, about 6 bytes per particle at 1e6): walkers away from the cluster jump by
+        /// their bound without a tree query. Off is the paper's tree-only walk.
+        distance_map: bool = true => { flag: "distance-map", unit: "", range: Range::Any },
+        /// Walkers moving at once on the shared cluster (PDLA); 1 is DLA, exact and
+        /// deterministic.
+        threads: usize = 1 => {
+            flag: "threads", unit: "walkers", range: Range::Int { min: 1, max: Some(1024) },
+        },
+        /// With threads > 1, grow with one walker up to this size before going parallel
+        /// (refused with one thread, which is serial throughout).
+        serial_until: u64 = 0 => { flag: "serial-until", unit: "particles", range: Range::Any },
+        /// Smallest N in the fractal-dimension fit log N = D log R_g + c (above the final
+        /// size: no fit, and a warning).
+        fit_from: u64 = 1000 => {
+            flag: "fit-from", unit: "particles", range: Range::Int { min: 2, max: None },
+            why: "a single particle has no radius of gyration",
+        },
+    }
+    internal {
+        /// Keep every position in arrival order (needed for position files and pictures).
+        /// Costs `8 D` bytes per particle; off by default. Set by the front ends: the binary
+        /// streams the positions to a file instead, Python keeps them.
+        keep_positions: bool = false,
+    }
 }
 
-fn default_near_cache() -> bool {
-    true
-}
-
-fn default_distance_map() -> bool {
-    true
+impl ParamValue for FarField {
+    const KIND: Kind = Kind::Choice;
+    fn from_input(v: &Input) -> Result<Self, String> {
+        match v {
+            Input::Choice(s) => s.parse(),
+            other => Err(format!(
+                "expected one of {}, not {other:?}",
+                FarField::NAMES.join(", ")
+            )),
+        }
+    }
+    fn in_range(&self, _: &Range) -> bool {
+        true
+    }
+    fn parse_text(s: &str) -> Result<Self, String> {
+        s.parse()
+    }
+    fn show(&self) -> String {
+        self.name().to_string()
+    }
 }
 
 /// Default leaf side of the orthtree for DLA, in diameters: 8, twice the orthtree's own
@@ -200,37 +265,6 @@ pub const MAX_BIRTH_GAP: f64 = 1e4;
 /// `R_b / R_d`, negligible long before 1e100.
 pub const MAX_DEATH_RATIO: f64 = 1e100;
 
-fn default_leaf_side() -> f64 {
-    DLA_LEAF_SIDE
-}
-
-impl Default for Params {
-    fn default() -> Self {
-        Params {
-            dim: 2,
-            particles: 10_000,
-            birth_gap: 5.0,
-            far_field: FarField::Return,
-            death_ratio: PAPER_DEATH_RATIO,
-            step_min: DEFAULT_STEP_MIN,
-            precision: PAPER_PRECISION,
-            threads: 1,
-            serial_until: 0,
-            fit_from: 1000,
-            keep_positions: false,
-            leaf_side: DLA_LEAF_SIDE,
-            distance_map: true,
-            near_cache: true,
-        }
-    }
-}
-
-/// The accepted dimensions as `2, 3, 4, 5`.
-fn dimension_list() -> String {
-    let dims: Vec<String> = DIMENSIONS.iter().map(usize::to_string).collect();
-    dims.join(", ")
-}
-
 /// Largest accepted particle count in 2D and 3D ([`max_particles`] gives every dimension's).
 /// The orthtree numbers its nodes, leaves and point slots
 /// with 32-bit indices (at most `2^32 - 2` of each). Point slots bound the count: a leaf of `n`
@@ -266,23 +300,14 @@ pub const fn max_particles(dim: usize) -> u64 {
     }
 }
 
-/// A value as a user would type it: `0.25`, `1000`, or `1e-300` for the very small and large.
-fn short(v: f64) -> String {
-    let a = v.abs();
-    if a != 0.0 && a.is_finite() && !(1e-4..1e15).contains(&a) {
-        format!("{v:e}")
-    } else {
-        v.to_string()
-    }
-}
-
-/// A parameter outside its accepted range; the message names the value and the range.
+/// A parameter outside its accepted range, or given where it has no meaning; the message names
+/// the flag, the value and the range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamsError {
-    /// `dim` not one of [`DIMENSIONS`].
-    #[error("--dim {0} is outside the accepted range {{{dims}}}", dims = dimension_list())]
-    Dim(usize),
-    /// `particles` is 0 or above [`max_particles`] for the dimension.
+    /// A declared parameter outside its declared range ([`Params::DECLARED`]).
+    #[error(transparent)]
+    Range(#[from] RangeError),
+    /// `particles` above [`max_particles`] for the dimension (4D and 5D).
     #[error(
         "--particles {particles} is outside the accepted range 1..={max} in {dim}D (the orthtree's 32-bit indices)"
     )]
@@ -294,38 +319,6 @@ pub enum ParamsError {
         /// The largest accepted in that dimension.
         max: u64,
     },
-    /// `birth_gap` below 1, above [`MAX_BIRTH_GAP`] or not finite.
-    #[error(
-        "--birth-gap {} is outside the accepted range [1, 1e4] (a walker born closer than one diameter could overlap the cluster; a larger gap does not change where walkers arrive, only makes each one wander longer: in 3D about gap / R_ext times longer)",
-        short(*.0)
-    )]
-    BirthGap(f64),
-    /// `death_ratio` not > 1, above [`MAX_DEATH_RATIO`] or not finite.
-    #[error(
-        "--death-ratio {} is outside the accepted range (1, 1e100] (a larger death radius would overflow the walkers' coordinates)",
-        short(*.0)
-    )]
-    DeathRatio(f64),
-    /// `step_min` not positive or too large.
-    #[error(
-        "--step-min {} is outside the accepted range [1e-6, 1e3] (a step below the contact tolerance of 1e-6 diameters is lost to rounding at the cluster's coordinates, so the walker would never move)",
-        short(*.0)
-    )]
-    StepMin(f64),
-    /// `precision` not > 1/2 (vpdist needs kappa > 1/2 to be useful).
-    #[error("--precision {0} is outside the accepted range (0.5, inf] (inf = exact search)")]
-    Precision(f64),
-    /// `leaf_side` not a power of two in [1, 64].
-    #[error("--leaf-side {0} is outside the accepted range {{1, 2, 4, 8, 16, 32, 64}}")]
-    LeafSide(f64),
-    /// `fit_from` below 2: a single particle has no radius of gyration to fit.
-    #[error(
-        "--fit-from {0} is outside the accepted range 2.. (a single particle has no radius of gyration)"
-    )]
-    FitFrom(u64),
-    /// `threads` is 0 or absurd.
-    #[error("--threads {0} is outside the accepted range 1..=1024")]
-    Threads(usize),
     /// A death ratio given for the `return` far field, which has no death radius.
     #[error(
         "--death-ratio is used by --far-field jump only (the default `return` has no death radius)"
@@ -340,6 +333,15 @@ pub enum ParamsError {
     /// `serial_until` given with one thread, which is serial throughout.
     #[error("--serial-until {0} is used with --threads > 1 only (one thread is serial throughout)")]
     SerialUntilUnused(u64),
+}
+
+impl ParamsError {
+    /// The error of a dimension the model does not run in (the dispatch's fallback).
+    pub fn dim(dim: usize) -> Self {
+        let d = &Params::DECLARED[0];
+        debug_assert_eq!(d.spec.name, "dim");
+        ParamsError::Range(RangeError::new(d, dim.to_string()))
+    }
 }
 
 /// Memory a checkpoint needs while it is written, beside the run: the streams' buffers are
@@ -399,7 +401,7 @@ impl Params {
     /// Check every field against its accepted range.
     pub fn validate(&self) -> Result<(), ParamsError> {
         if !DIMENSIONS.contains(&self.dim) {
-            return Err(ParamsError::Dim(self.dim));
+            return Err(ParamsError::dim(self.dim));
         }
         let max = max_particles(self.dim);
         if self.particles == 0 || self.particles > max {
@@ -409,28 +411,7 @@ impl Params {
                 max,
             });
         }
-        if !(self.birth_gap >= 1.0 && self.birth_gap <= MAX_BIRTH_GAP) {
-            return Err(ParamsError::BirthGap(self.birth_gap));
-        }
-        if !(self.death_ratio > 1.0 && self.death_ratio <= MAX_DEATH_RATIO) {
-            return Err(ParamsError::DeathRatio(self.death_ratio));
-        }
-        if !(MIN_STEP_MIN..=1e3).contains(&self.step_min) {
-            return Err(ParamsError::StepMin(self.step_min));
-        }
-        if self.precision.is_nan() || self.precision <= 0.5 {
-            return Err(ParamsError::Precision(self.precision));
-        }
-        if self.threads == 0 || self.threads > 1024 {
-            return Err(ParamsError::Threads(self.threads));
-        }
-        if self.fit_from < 2 {
-            return Err(ParamsError::FitFrom(self.fit_from));
-        }
-        let l = self.leaf_side;
-        if !((1.0..=64.0).contains(&l) && l.log2().fract() == 0.0) {
-            return Err(ParamsError::LeafSide(l));
-        }
+        self.check_ranges()?;
         Ok(())
     }
 
@@ -610,9 +591,12 @@ mod tests {
             Ok(())
         );
         // Range errors come first, as from `validate`.
+        let e = Params { threads: 0, ..d() }
+            .validate_given(true)
+            .unwrap_err();
         assert_eq!(
-            Params { threads: 0, ..d() }.validate_given(true),
-            Err(ParamsError::Threads(0))
+            e.to_string(),
+            "--threads 0 is outside the accepted range 1..=1024"
         );
     }
 }

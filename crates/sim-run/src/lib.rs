@@ -4,6 +4,8 @@
 //! the workspace share, usable by any program that runs seeded simulations.
 //!
 //! - [`count`]: counts as physicists write them (`1e6`, `2.5e5`, `1_000_000`), exactly.
+//! - [`declared`]: the docs' flag tables and Python stubs generated from a model's parameter
+//!   declaration, and their check.
 //! - [`io`]: atomic file writes, the run manifest `run.json` (parameters, seed, wall and CPU
 //!   time, peak memory, provenance), the versioned and checksummed checkpoint envelope,
 //!   NumPy `.npy` files streamed row by row, PNG (feature `plot`) and CSV writers, point files
@@ -43,6 +45,7 @@
 #[cfg(feature = "cli")]
 pub mod cli;
 pub mod count;
+pub mod declared;
 #[cfg(feature = "cli")]
 pub mod ensemble;
 #[cfg(feature = "plot")]

@@ -184,6 +184,19 @@ impl<'a> CliSpec<'a> {
         cmd: &Command,
         find_row: impl Fn(&ParamSpec, &[String]) -> bool,
     ) {
+        self.check_params_table(doc, rows, columns, find_row);
+        self.check_listed_flags(doc, rows, columns, cmd);
+    }
+
+    /// The parameter half of [`check_docs_table`](Self::check_docs_table): each parameter's
+    /// row states the library's default and the range or choices.
+    pub fn check_params_table(
+        &self,
+        doc: &str,
+        rows: &[Vec<String>],
+        columns: DocColumns,
+        find_row: impl Fn(&ParamSpec, &[String]) -> bool,
+    ) {
         for s in self.params {
             let row = rows[1..]
                 .iter()
@@ -215,6 +228,17 @@ impl<'a> CliSpec<'a> {
                 ),
             }
         }
+    }
+
+    /// The flag half of [`check_docs_table`](Self::check_docs_table): every flag the table
+    /// names exists in `cmd`, and every long flag of `cmd` is in the table.
+    fn check_listed_flags(
+        &self,
+        doc: &str,
+        rows: &[Vec<String>],
+        columns: DocColumns,
+        cmd: &Command,
+    ) {
         let listed: Vec<String> = rows[1..]
             .iter()
             .flat_map(|r| flags_of(&r[columns.flags]))

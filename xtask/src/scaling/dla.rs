@@ -49,7 +49,7 @@ where
 /// Grow one cluster with `params` (2D to 5D).
 pub fn grow(params: &Params, seed: u64) -> Result<Grown> {
     dla_pdla::with_dim!(params.dim, D => grow_d::<D>(params, seed), d => {
-        Err(dla_pdla::ParamsError::Dim(d).into())
+        Err(dla_pdla::ParamsError::dim(d).into())
     })
 }
 
@@ -70,12 +70,16 @@ struct DimRow {
 pub fn run(ctx: &Ctx) -> Result<()> {
     let mut doc =
         ctx.doc("Sosa-Herrera & Rodriguez-Romo: off-lattice DLA and PDLA (Fig. 3, Table 2)");
+    let d = Params::default();
     doc.p(&format!(
         "Off-lattice DLA on the orthtree (`docs/dla.md`) with the default parameters \
-         (birth gap 5, exact far-field return, step {}, vpdist precision 2) unless a table \
+         (birth gap {}, far field `{}`, step {}, vpdist precision {}) unless a table \
          says otherwise. The paper used a jump-and-kill far field, a near-field step of 0.5 \
          and 64-bit integer coordinates; see `docs/dla.md` for what we changed and why.",
-        dla_pdla::params::DEFAULT_STEP_MIN
+        d.birth_gap,
+        d.far_field.name(),
+        d.step_min,
+        d.precision
     ));
     fig3(ctx, &mut doc)?;
     let serial = table2(ctx, &mut doc)?;

@@ -1,118 +1,17 @@
 //! The table of DLA/PDLA parameters ([`PARAMS`]): name, flag, unit, meaning and accepted range
-//! of every [`Params`] field a front end sets, beside the defaults of [`Params::default`]
-//! ([`defaults`]). The `dla` binary, the Python bindings, xtask and `docs/dla.md` are checked
-//! against it (`docs/architecture.md`, "Parameters: one declaration").
+//! of every [`Params`] field a front end sets, from [`Params`]'s one declaration, beside the
+//! defaults of [`Params::default`] ([`defaults`]).
 
-use super::{FarField, Params};
-use crate::space::DIMENSIONS;
-use core_lattice::spec::{End, ParamSpec, Range};
+use super::Params;
+use core_lattice::spec::{DeclaredParams, ParamSpec, spec_table};
 
-/// Every parameter a front end sets, in the order of `docs/dla.md`'s flag table. The ranges
-/// are those [`Params::validate`] accepts (written as its error messages write them; a unit
-/// test probes each bound).
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "dim",
-        flag: Some("dim"),
-        unit: "",
-        doc: "Space dimension.",
-        range: Range::Values(DIMENSIONS),
-    },
-    ParamSpec {
-        name: "particles",
-        flag: Some("particles"),
-        unit: "particles",
-        doc: "Particles of the final cluster, seed included (at most 2.5e9 in 4D and 5D).",
-        range: Range::Int {
-            min: 1,
-            max: Some(super::MAX_PARTICLES as i128),
-        },
-    },
-    ParamSpec {
-        name: "birth_gap",
-        flag: Some("birth-gap"),
-        unit: "diameters",
-        doc: "R_b - R_ext, the distance of the birth sphere outside the cluster.",
-        range: Range::Real(End::Closed(1.0), End::Closed(super::MAX_BIRTH_GAP)),
-    },
-    ParamSpec {
-        name: "far_field",
-        flag: Some("far-field"),
-        unit: "",
-        doc: "What happens to a walker outside the birth sphere.",
-        range: Range::Choices(&FarField::NAMES),
-    },
-    ParamSpec {
-        name: "death_ratio",
-        flag: Some("death-ratio"),
-        unit: "birth radii",
-        doc: "R_d / R_b, the death radius of the jump far field.",
-        range: Range::Real(End::Open(1.0), End::Closed(super::MAX_DEATH_RATIO)),
-    },
-    ParamSpec {
-        name: "step_min",
-        flag: Some("step-min"),
-        unit: "diameters",
-        doc: "Near-field step length.",
-        range: Range::Real(End::Closed(super::MIN_STEP_MIN), End::Closed(1e3)),
-    },
-    ParamSpec {
-        name: "precision",
-        flag: Some("precision"),
-        unit: "",
-        doc: "Precision kappa of the variable-precision distance (inf: exact search).",
-        range: Range::Real(End::Open(0.5), End::Unbounded),
-    },
-    ParamSpec {
-        name: "leaf_side",
-        flag: Some("leaf-side"),
-        unit: "diameters",
-        doc: "Side of the orthtree's leaf cells: speed and memory only.",
-        range: Range::Values(&[1, 2, 4, 8, 16, 32, 64]),
-    },
-    ParamSpec {
-        name: "near_cache",
-        flag: Some("near-cache"),
-        unit: "",
-        doc: "Each walker's exact near cache: speed only, the same trajectory.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "distance_map",
-        flag: Some("distance-map"),
-        unit: "",
-        doc: "The coarse distance maps in front of the orthtree: speed only, another trajectory.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "threads",
-        flag: Some("threads"),
-        unit: "walkers",
-        doc: "Walkers moving at once (PDLA); 1 is DLA.",
-        range: Range::Int {
-            min: 1,
-            max: Some(1024),
-        },
-    },
-    ParamSpec {
-        name: "serial_until",
-        flag: Some("serial-until"),
-        unit: "particles",
-        doc: "With threads > 1, grow with one walker up to this size.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "fit_from",
-        flag: Some("fit-from"),
-        unit: "particles",
-        doc: "Smallest N in the fractal-dimension fit.",
-        range: Range::Int { min: 2, max: None },
-    },
-];
+/// Every parameter a front end sets, in declaration order: the table of [`Params`]'s
+/// declaration ([`Params::DECLARED`] without what only the front ends need).
+pub const PARAMS: &[ParamSpec] = &spec_table::<{ Params::DECLARED.len() }>(Params::DECLARED);
 
 /// `Params` fields that are not parameters of a front end: set by the front end itself
 /// (`keep_positions`: the binary streams positions to a file, Python keeps them).
-pub const INTERNAL: &[&str] = &["keep_positions"];
+pub const INTERNAL: &[&str] = Params::INTERNAL;
 
 /// The default of every parameter of [`PARAMS`], keyed by name, from [`Params::default`].
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
@@ -129,6 +28,8 @@ pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::FarField;
+    use crate::space::DIMENSIONS;
 
     #[test]
     fn the_table_names_every_field_once() {

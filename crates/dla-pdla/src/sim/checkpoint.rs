@@ -34,6 +34,9 @@ pub const POSITIONS_FILE: &str = "positions.npy";
 /// The state a checkpoint holds.
 #[derive(Serialize, Deserialize)]
 struct Snapshot {
+    /// As `(name, text)` pairs, so that adding a parameter does not change the layout: a
+    /// checkpoint written before it reads with the parameter at its default.
+    #[serde(with = "core_lattice::spec::as_text")]
     params: Params,
     seed: u64,
     rng: SimRng,
