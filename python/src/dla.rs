@@ -292,6 +292,9 @@ pub fn dla(
         leaf_side,
         distance_map,
         near_cache,
+        // Not keywords yet: the plain model.
+        sticking_probability: defaults().sticking_probability,
+        noise_reduction: defaults().noise_reduction,
     };
     let params = if paper_settings {
         // The library's rule, as the binary's: the fields it sets may not be given beside it.

@@ -65,6 +65,17 @@ struct Cli {
     #[arg(long, allow_hyphen_values = true)]
     death_ratio: Option<f64>,
 
+    /// Probability that a walker sticks when it touches the cluster, in (0, 1]; one that does
+    /// not walks on from the contact point. 1 is DLA; smaller values grow more compact
+    /// clusters at small N (reaction-limited aggregation).
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().sticking_probability)]
+    sticking_probability: f64,
+
+    /// Noise reduction f, in (0, 1]: a particle is stored at distance f (diameters) from the
+    /// one it touched, overlapping it when f < 1 (fastDLA's noise reduction factor). 1 is DLA.
+    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().noise_reduction)]
+    noise_reduction: f64,
+
     /// Near-field step length in diameters, in [1e-6, 1e3]: used when the distance to the
     /// cluster minus one is at most this. Smaller is closer to Brownian motion. The default is
     /// where the accuracy study converges at no cost; the paper's 0.5 biases the R_g prefactor
@@ -216,6 +227,8 @@ fn params(cli: &Cli) -> Result<Params, String> {
         leaf_side: cli.leaf_side,
         distance_map: cli.distance_map == Toggle::On,
         near_cache: cli.near_cache == Toggle::On,
+        sticking_probability: cli.sticking_probability,
+        noise_reduction: cli.noise_reduction,
     };
     let p = if cli.paper_settings {
         // clap has refused the flags it sets (`conflicts_with_all`, the same list).

@@ -132,6 +132,25 @@ pub struct Params {
     /// anyway (`(precision - 1/2)` leaf diagonals of at least 5 diameters, as by default).
     #[serde(default = "default_near_cache")]
     pub near_cache: bool,
+    /// Probability that a walker sticks when a move ends in contact, in (0, 1]
+    /// (`--sticking-probability`, default 1: DLA). A walker that does not stick stays at the
+    /// contact point and walks on from there; steps that point away from a particle it
+    /// touches are free. Below 1 the aggregation is reaction-limited at small scales: the
+    /// clusters are more compact at small N (`docs/dla.md`, "Algorithm").
+    #[serde(default = "default_one")]
+    pub sticking_probability: f64,
+    /// Noise reduction factor `f` in (0, 1] (`--noise-reduction`, default 1: DLA): a walker
+    /// that sticks touching the stored particle `t` at the contact point `c` is stored at
+    /// `t + f (c - t)`, at distance `f` from `t` (fastDLA's `noiseReductionFactor`). Below 1
+    /// the stored particles overlap: no two lie closer than `f`.
+    #[serde(default = "default_one")]
+    pub noise_reduction: f64,
+}
+
+/// The default of [`Params::sticking_probability`] and [`Params::noise_reduction`]: today's
+/// model (a missing field in a config file or `run.json` means the model of the time).
+fn default_one() -> f64 {
+    1.0
 }
 
 fn default_near_cache() -> bool {
@@ -221,6 +240,8 @@ impl Default for Params {
             leaf_side: DLA_LEAF_SIDE,
             distance_map: true,
             near_cache: true,
+            sticking_probability: 1.0,
+            noise_reduction: 1.0,
         }
     }
 }
@@ -326,6 +347,18 @@ pub enum ParamsError {
     /// `threads` is 0 or absurd.
     #[error("--threads {0} is outside the accepted range 1..=1024")]
     Threads(usize),
+    /// `sticking_probability` not in (0, 1].
+    #[error(
+        "--sticking-probability {} is outside the accepted range (0, 1] (a probability; at 0 no walker would ever stick)",
+        short(*.0)
+    )]
+    StickingProbability(f64),
+    /// `noise_reduction` not in (0, 1].
+    #[error(
+        "--noise-reduction {} is outside the accepted range (0, 1] (the stored particle's distance to the one it touched, in diameters; at 0 the two would coincide)",
+        short(*.0)
+    )]
+    NoiseReduction(f64),
     /// A death ratio given for the `return` far field, which has no death radius.
     #[error(
         "--death-ratio is used by --far-field jump only (the default `return` has no death radius)"
@@ -430,6 +463,12 @@ impl Params {
         let l = self.leaf_side;
         if !((1.0..=64.0).contains(&l) && l.log2().fract() == 0.0) {
             return Err(ParamsError::LeafSide(l));
+        }
+        if !(self.sticking_probability > 0.0 && self.sticking_probability <= 1.0) {
+            return Err(ParamsError::StickingProbability(self.sticking_probability));
+        }
+        if !(self.noise_reduction > 0.0 && self.noise_reduction <= 1.0) {
+            return Err(ParamsError::NoiseReduction(self.noise_reduction));
         }
         Ok(())
     }
@@ -541,6 +580,38 @@ mod tests {
                 },
                 "--leaf-side 128 ",
                 "{1, 2, 4",
+            ),
+            (
+                Params {
+                    sticking_probability: 0.0,
+                    ..d()
+                },
+                "--sticking-probability 0 ",
+                "(0, 1] (a probability",
+            ),
+            (
+                Params {
+                    sticking_probability: f64::NAN,
+                    ..d()
+                },
+                "--sticking-probability NaN ",
+                "(0, 1]",
+            ),
+            (
+                Params {
+                    noise_reduction: 1.5,
+                    ..d()
+                },
+                "--noise-reduction 1.5 ",
+                "(0, 1] (the stored particle",
+            ),
+            (
+                Params {
+                    noise_reduction: -0.5,
+                    ..d()
+                },
+                "--noise-reduction -0.5 ",
+                "(0, 1]",
             ),
         ];
         for (p, flag, range) in bad {

@@ -50,6 +50,20 @@ pub const PARAMS: &[ParamSpec] = &[
         range: Range::Real(End::Open(1.0), End::Closed(super::MAX_DEATH_RATIO)),
     },
     ParamSpec {
+        name: "sticking_probability",
+        flag: Some("sticking-probability"),
+        unit: "",
+        doc: "Probability that a walker sticks at a contact; one that does not walks on from there.",
+        range: Range::Real(End::Open(0.0), End::Closed(1.0)),
+    },
+    ParamSpec {
+        name: "noise_reduction",
+        flag: Some("noise-reduction"),
+        unit: "diameters",
+        doc: "Distance f of a stuck particle from the one it touched (fastDLA's noise reduction).",
+        range: Range::Real(End::Open(0.0), End::Closed(1.0)),
+    },
+    ParamSpec {
         name: "step_min",
         flag: Some("step-min"),
         unit: "diameters",
