@@ -119,6 +119,8 @@ def dla(
     distance_map: bool = ...,
     serial_until: Count = ...,
     fit_from: Count = ...,
+    sticking_probability: float = ...,
+    noise_reduction: float = ...,
     # END GENERATED dla-keywords
     paper_settings: bool = False,
     progress: Progress = None,

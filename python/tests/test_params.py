@@ -7,6 +7,7 @@ import inspect
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import aggsim
@@ -207,3 +208,19 @@ def test_declared_keywords_come_from_the_declaration():
     # A real parameter takes an int; a count takes a whole float.
     r = aggsim.dla(particles=10, birth_gap=7, fit_from=2e3, far_field="jump", death_ratio=50)
     assert r.params["birth_gap"] == 7.0 and r.params["fit_from"] == 2000
+
+
+def test_the_dla_variants_are_keywords_that_reach_the_run():
+    """``sticking_probability`` and ``noise_reduction``, declared in the library only, are
+    keywords of ``aggsim.dla`` that change the run, checked as the binary checks them."""
+    plain = aggsim.dla(particles=300, seed=4)
+    same = aggsim.dla(particles=300, seed=4, sticking_probability=1.0, noise_reduction=1)
+    assert same.state_hash == plain.state_hash
+    sticky = aggsim.dla(particles=300, seed=4, sticking_probability=0.2)
+    assert sticky.state_hash != plain.state_hash
+    assert sticky.run_json["results"]["walk_counts"]["refused"] > 0
+    reduced = aggsim.dla(particles=300, seed=4, noise_reduction=0.5)
+    d = np.linalg.norm(reduced.positions[1:2] - reduced.positions[0:1], axis=1)
+    assert abs(d[0] - 0.5) < 1e-8
+    with pytest.raises(ValueError, match=r"--noise-reduction 0 is outside the accepted range \(0, 1\]"):
+        aggsim.dla(particles=10, noise_reduction=0)

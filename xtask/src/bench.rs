@@ -189,6 +189,127 @@ pub const WORKLOADS: &[Workload] = &[
     },
 ];
 
+/// Workloads counted in instructions (`cargo xtask bench --instructions`): the same binaries
+/// under `valgrind --tool=cachegrind --cache-sim=no`, one thread, so that the figure is the
+/// same on a busy or quiet host (and on any x86-64 host for the same build): the cost of a
+/// particle without the host's noise. Slow (about 30 times the native run).
+pub const INSTRUCTION_WORKLOADS: &[Workload] = &[
+    Workload {
+        name: "dla-2d-1e6-instructions",
+        bin: "dla",
+        args: &[
+            "--dim",
+            "2",
+            "--particles",
+            "1e6",
+            "--seed",
+            "1",
+            "--no-checkpoint",
+        ],
+        unit: "particles",
+    },
+    Workload {
+        name: "dla-3d-1e5-instructions",
+        bin: "dla",
+        args: &[
+            "--dim",
+            "3",
+            "--particles",
+            "1e5",
+            "--seed",
+            "1",
+            "--no-checkpoint",
+        ],
+        unit: "particles",
+    },
+];
+
+/// The instructions a workload of [`INSTRUCTION_WORKLOADS`] executed.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct InstructionCount {
+    /// Workload name.
+    pub name: String,
+    /// The command that ran.
+    pub command: String,
+    /// Instructions executed, every thread of the process (cachegrind's `I refs`).
+    pub instructions: u64,
+    /// Instructions per item (particle).
+    pub per_item: f64,
+    /// What an item is.
+    pub unit: String,
+    /// The run's state hash: equal hashes, equal work.
+    pub state_hash: Option<String>,
+}
+
+/// Cachegrind's `I refs` count from its report on stderr (`==123== I refs:  2,685,370,135`).
+pub fn parse_i_refs(stderr: &str) -> Option<u64> {
+    let line = stderr.lines().find(|l| l.contains("I refs:"))?;
+    let digits: String = line
+        .split("I refs:")
+        .nth(1)?
+        .chars()
+        .filter(char::is_ascii_digit)
+        .collect();
+    digits.parse().ok()
+}
+
+/// Runs workload `w` under cachegrind (no cache simulation) and counts its instructions.
+pub fn count_instructions(w: &Workload, bin_dir: &Path) -> Result<InstructionCount> {
+    let out = tempfile::tempdir().context("creating a temporary output directory")?;
+    let bin = bin_dir.join(w.bin);
+    let command = format!(
+        "valgrind --tool=cachegrind --cache-sim=no target/release/{} {} -qq --out DIR",
+        w.bin,
+        w.args.join(" ")
+    );
+    eprintln!("==> {}: {command}", w.name);
+    let output = Command::new("valgrind")
+        .arg("--tool=cachegrind")
+        .arg("--cache-sim=no")
+        .arg(format!(
+            "--cachegrind-out-file={}",
+            out.path().join("cachegrind.out").display()
+        ))
+        .arg(&bin)
+        .args(w.args)
+        .arg("-qq")
+        .arg("--out")
+        .arg(out.path().join("run"))
+        .output()
+        .context("could not run valgrind (Debian: apt-get install valgrind)")?;
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if !output.status.success() {
+        bail!(
+            "{} failed under valgrind ({}): {}",
+            w.name,
+            output.status,
+            stderr.trim()
+        );
+    }
+    let instructions = parse_i_refs(&stderr)
+        .with_context(|| format!("no `I refs` line in cachegrind's report: {stderr}"))?;
+    let m =
+        RunManifest::read(out.path().join("run").join("run.json")).context("reading run.json")?;
+    let (count, _) = items(w, &m, &out.path().join("run"))?;
+    let per_item = instructions as f64 / count.max(1.0);
+    eprintln!(
+        "    {instructions} instructions, {per_item:.0} per {}",
+        w.unit.trim_end_matches('s')
+    );
+    Ok(InstructionCount {
+        name: w.name.into(),
+        command,
+        instructions,
+        per_item,
+        unit: w.unit.into(),
+        state_hash: m
+            .results
+            .get("state_hash")
+            .and_then(|v| v.as_str())
+            .map(String::from),
+    })
+}
+
 /// The measured result of one workload.
 #[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
 pub struct Measurement {
@@ -245,6 +366,9 @@ pub struct BenchReport {
     pub build: String,
     /// The measurements.
     pub workloads: Vec<Measurement>,
+    /// Instruction counts (`--instructions`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub instructions: Vec<InstructionCount>,
     /// Ratios to a baseline (`--against`), if one was given.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub against: Vec<Ratio>,
@@ -423,11 +547,13 @@ pub fn compare(now: &[Measurement], base: &[Measurement]) -> Vec<Ratio> {
 /// `cargo xtask bench`: build, run the workloads whose name contains `only` (all if `None`)
 /// `repeat` times each, in rounds (every workload once, then again), keep each workload's
 /// fastest run, print JSON, optionally save it and compare with a baseline.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     root: &Path,
     cargo: &str,
     only: Option<&str>,
     repeat: usize,
+    instructions: bool,
     save: Option<&Path>,
     against: Option<&Path>,
 ) -> Result<BenchReport> {
@@ -445,14 +571,19 @@ pub fn run(
     };
     let chosen: Vec<&Workload> = WORKLOADS
         .iter()
-        .filter(|w| only.is_none_or(|o| w.name.contains(o)))
+        .filter(|w| !instructions && only.is_none_or(|o| w.name.contains(o)))
         .collect();
-    if chosen.is_empty() {
+    let counted: Vec<&Workload> = INSTRUCTION_WORKLOADS
+        .iter()
+        .filter(|w| instructions && only.is_none_or(|o| w.name.contains(o)))
+        .collect();
+    if chosen.is_empty() && counted.is_empty() {
         bail!(
             "--only {} matches no workload; the workloads are: {}",
             only.unwrap_or(""),
             WORKLOADS
                 .iter()
+                .chain(INSTRUCTION_WORKLOADS)
                 .map(|w| w.name)
                 .collect::<Vec<_>>()
                 .join(", ")
@@ -475,6 +606,11 @@ pub fn run(
         .into_iter()
         .map(|r| fastest(r).expect("repeat >= 1"))
         .collect();
+    // Instruction counts do not vary between runs: one each.
+    let instructions = counted
+        .iter()
+        .map(|w| count_instructions(w, &bin_dir))
+        .collect::<Result<Vec<_>>>()?;
     if repeat > 1 {
         eprintln!("==> fastest of {repeat} per workload");
         for m in &workloads {
@@ -498,10 +634,25 @@ pub fn run(
         machine: machine(),
         build: build_id(),
         workloads,
+        instructions,
         against: Vec::new(),
     };
     if let Some(b) = &baseline {
         report.against = compare(&report.workloads, &b.workloads);
+        for n in &report.instructions {
+            if let Some(o) = b.instructions.iter().find(|o| o.name == n.name) {
+                eprintln!(
+                    "    {:<28} instructions x{:.4}{}",
+                    n.name,
+                    n.instructions as f64 / o.instructions as f64,
+                    if n.state_hash != o.state_hash {
+                        " (state hash changed: different trajectory)"
+                    } else {
+                        ""
+                    }
+                );
+            }
+        }
         eprintln!(
             "==> against {} ({})",
             against.expect("set").display(),
@@ -577,6 +728,14 @@ mod tests {
     }
 
     #[test]
+    fn cachegrind_instruction_counts_are_read() {
+        let stderr = "==4242== Cachegrind, a high-precision tracing profiler\n\
+                      ==4242== \n==4242== I refs:        2,685,370,135\n";
+        assert_eq!(parse_i_refs(stderr), Some(2_685_370_135));
+        assert_eq!(parse_i_refs("no report"), None);
+    }
+
+    #[test]
     fn fastest_repeat_is_kept_with_every_time() {
         let runs = vec![
             m("a", 3.0, 10, "h1"),
@@ -619,6 +778,14 @@ mod tests {
             machine: "m".into(),
             build: "b".into(),
             workloads: vec![m("a", 1.0, 2, "h")],
+            instructions: vec![InstructionCount {
+                name: "i".into(),
+                command: "c".into(),
+                instructions: 10,
+                per_item: 2.5,
+                unit: "particles".into(),
+                state_hash: Some("h".into()),
+            }],
             against: Vec::new(),
         };
         let s = serde_json::to_string(&r).unwrap();

@@ -5,8 +5,9 @@
 //!   warnings denied, and the test suite (the README's test command).
 //! - `cargo xtask scaling [--quick] [--only ...] [--out DIR]`: regenerate the papers' tables
 //!   and figures from our own runs (see `docs/results/README.md`).
-//! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R]`: the headline speed and
-//!   memory figures as JSON, and their ratios to a saved baseline.
+//! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R] [--instructions]`: the
+//!   headline speed and memory figures as JSON, and their ratios to a saved baseline; with
+//!   `--instructions`, instructions per particle counted by cachegrind.
 //! - `cargo xtask generate`: the docs' flag tables and the Python stubs' keyword arguments
 //!   written from the models' parameter declarations (`xtask::generate`).
 //! - `cargo xtask fuzz [--cases N] [--only TEXT]`: every reader of user files fuzzed with N
@@ -102,6 +103,11 @@ enum Cmd {
         /// (for shared or noisy machines; every repeat's time is in the JSON).
         #[arg(long, default_value_t = 1, value_parser = sim_run::count::count_at_least_1::<usize>)]
         repeat: usize,
+        /// Count instructions instead of timing: 2D DLA 1e6 and 3D 1e5, one thread, under
+        /// `valgrind --tool=cachegrind --cache-sim=no` (a few minutes; the same count on a busy
+        /// or quiet host), as instructions per particle.
+        #[arg(long)]
+        instructions: bool,
     },
     /// Measure this machine's memory latency: a pointer chase through one random cycle of
     /// cache lines, at working sets from 16 KiB to --max (powers of two), with 4 KiB pages and
@@ -209,11 +215,13 @@ fn main() -> Result<()> {
             against,
             only,
             repeat,
+            instructions,
         } => xtask::bench::run(
             &workspace_root(),
             &cargo(),
             only.as_deref(),
             repeat,
+            instructions,
             save.as_deref(),
             against.as_deref(),
         )

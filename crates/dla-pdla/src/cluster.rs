@@ -123,7 +123,9 @@ impl<const D: usize> Cluster<D> {
     /// [`insert`](Self::insert) of a particle that stuck to the stored particle `touched`: the
     /// per-particle maps visit only the cells nearer the new particle than `touched`, the only
     /// ones it can lower (the maps end up byte for byte as with [`insert`](Self::insert);
-    /// [`spatial::distmap::DistanceMap::insert_beside`]).
+    /// [`spatial::distmap::DistanceMap::insert_beside`]). That holds at any distance between
+    /// the two (at distance 1, or `noise_reduction` with it below 1; below 1/2 the maps
+    /// visit every cell).
     pub fn insert_beside(
         &mut self,
         p: [f64; D],

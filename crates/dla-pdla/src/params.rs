@@ -176,6 +176,24 @@ core_lattice::declare_params! {
             flag: "fit-from", unit: "particles", range: Range::Int { min: 2, max: None },
             why: "a single particle has no radius of gyration",
         },
+        /// Probability that a walker sticks when a move ends in contact (1: DLA). A walker
+        /// that does not stick stays at the contact point and walks on from there; steps that
+        /// point away from a particle it touches are free. Below 1 the aggregation is
+        /// reaction-limited at small scales: the clusters are more compact at small N.
+        sticking_probability: f64 = 1.0 => {
+            flag: "sticking-probability", unit: "",
+            range: Range::Real(End::Open(0.0), End::Closed(1.0)),
+            why: "a probability; at 0 no walker would ever stick",
+        },
+        /// Noise reduction factor f (1: DLA), fastDLA's noiseReductionFactor: a walker that
+        /// sticks touching the stored particle t at the contact point c is stored at
+        /// t + f (c - t), at distance f from t. Below 1 the stored particles overlap: no two lie
+        /// closer than f.
+        noise_reduction: f64 = 1.0 => {
+            flag: "noise-reduction", unit: "",
+            range: Range::Real(End::Open(0.0), End::Closed(1.0)),
+            why: "the stored particle's distance to the one it touched, in diameters; at 0 the two would coincide",
+        },
     }
     internal {
         /// Keep every position in arrival order (needed for position files and pictures).
@@ -522,6 +540,38 @@ mod tests {
                 },
                 "--leaf-side 128 ",
                 "{1, 2, 4",
+            ),
+            (
+                Params {
+                    sticking_probability: 0.0,
+                    ..d()
+                },
+                "--sticking-probability 0 ",
+                "(0, 1] (a probability",
+            ),
+            (
+                Params {
+                    sticking_probability: f64::NAN,
+                    ..d()
+                },
+                "--sticking-probability NaN ",
+                "(0, 1]",
+            ),
+            (
+                Params {
+                    noise_reduction: 1.5,
+                    ..d()
+                },
+                "--noise-reduction 1.5 ",
+                "(0, 1] (the stored particle",
+            ),
+            (
+                Params {
+                    noise_reduction: -0.5,
+                    ..d()
+                },
+                "--noise-reduction -0.5 ",
+                "(0, 1]",
             ),
         ];
         for (p, flag, range) in bad {

@@ -2,21 +2,25 @@
 //! random fractal cluster simulations", section 3.2): born on the birth sphere, returned to it
 //! (or jumping and dying) in the far field, jumping by a lower bound of its distance to the
 //! cluster (distance maps, then the orthtree's `vpdist` or the walker's near cache) and taking
-//! `step_min` steps near it, until a step ends in exact contact.
+//! `step_min` steps near it, until a step ends in exact contact and the walker sticks (always
+//! with `sticking_probability` 1; otherwise with that probability, the walker walking on from
+//! the contact point when it does not).
 //!
 //! Invariants: a move never brings the walker's centre closer than 1 to a particle stored
 //! when the move starts (jumps stay within a lower bound of the distance minus 1, steps stop at
-//! the first contact); the walker's memory (`WalkState`) holds only bounds that stay valid while
-//! particles are added, and is reset for every new walker. The walk is a pure function of the
-//! random stream and the stored particles: the near cache and the tree give the same answers bit
-//! for bit.
+//! the first contact; a walker left in contact by a refused sticking may step away from the
+//! particle it touches, never into it); the walker's memory (`WalkState`) holds only bounds that
+//! stay valid while particles are added, and is reset for every new walker. The walk is a pure
+//! function of the random stream and the stored particles: the near cache and the tree give the
+//! same answers bit for bit. With `sticking_probability` 1 nothing else is drawn from the
+//! stream, so the walk is the one of the plain model bit for bit.
 
 use crate::cluster::Cluster;
 use crate::farfield::norm;
 use crate::near::{NEAR_RADIUS, NearCache, REBUILD_UPPER};
 use crate::params::{FarField, Params};
 use crate::space::{Dim, Space};
-use core_lattice::rng::Rng;
+use core_lattice::rng::{Rng, uniform01};
 use spatial::orthtree::{Orthtree, VpEstimate, dist_sq};
 
 pub use crate::space::MAP_JUMP_MIN;
@@ -43,7 +47,8 @@ where
 
     /// One move on a non-empty cluster whose particles all lie within `r_ext` of the origin.
     /// Returns the sticking position (centre distance 1 to the particle first touched) when
-    /// the move ends in contact.
+    /// the move ends in contact and the walker sticks (with `params.sticking_probability`;
+    /// one that does not stays at the contact point).
     pub fn step<R: Rng + ?Sized>(
         &mut self,
         cluster: &Cluster<D>,
@@ -51,12 +56,20 @@ where
         params: &Params,
         rng: &mut R,
     ) -> Option<[f64; D]> {
-        self.advance(&mut WalkState::new(params), cluster, r_ext, params, rng)
+        let state = &mut WalkState::new(params);
+        let q = self.advance(state, cluster, r_ext, params, rng)?;
+        if state.refuse {
+            return self.settle(q, state, cluster, params, rng);
+        }
+        Some(q)
     }
 
     /// [`step`](Self::step) with the walker's memory `state` (reset it for each new walker):
     /// an upper bound of its distance to the cluster, so the tree query starts from the few
     /// nodes covering that ball ([`Orthtree::vpdist_bounded`]) rather than from the root.
+    ///
+    /// Every contact is returned, whatever `params.sticking_probability`: with it below 1 the
+    /// caller then asks [`settle`](Self::settle) whether the walker sticks.
     pub(crate) fn advance<R: Rng + ?Sized>(
         &mut self,
         state: &mut WalkState<D>,
@@ -154,13 +167,13 @@ where
             state.counts.contact_near += 1;
             // The same particles as the tree's range query (see `near`), so the same contact.
             let mut best = (f64::INFINITY, [0.0; D]);
-            state
-                .near
-                .for_each_within(&self.p, r, |q| contact(&self.p, &u, &q, &mut best));
+            state.near.for_each_within(&self.p, r, |q| {
+                contact::<D, false>(&self.p, &u, &q, &mut best)
+            });
             (best.0 <= params.step_min).then_some(best)
         } else {
             state.counts.contact_tree += 1;
-            first_contact_with(tree, &self.p, &u, params.step_min)
+            first_contact_with::<D, false>(tree, &self.p, &u, params.step_min)
         };
         if let Some((t, touched)) = t {
             let mut q = self.p;
@@ -168,12 +181,73 @@ where
                 q[i] += t * u[i];
             }
             state.touched = Some(touched);
+            state.step = u;
             return Some(q);
         }
         for i in 0..D {
             self.p[i] += params.step_min * u[i];
         }
         None
+    }
+
+    /// What becomes of a walker whose last move ([`advance`](Self::advance)) ended in contact
+    /// at `q`, when contacts may be refused (`params.sticking_probability < 1`, `state`'s
+    /// `refuse`): the sticking position, or `None` when the walker walks on. The callers ask
+    /// only then, so the walk of probability 1 is compiled as it was before the parameter.
+    ///
+    /// A centre at distance <= 1 counts as touched only if the step points into it (see
+    /// [`contact`]): a walker left in contact by a refused sticking sits at distance 1 (or, by
+    /// rounding, just inside) of the particle it touched, and every step would otherwise touch
+    /// it again at once. The plain search counts such a centre at `t = 0` whatever the
+    /// direction, so a contact at the walker's own position is searched again under that rule
+    /// (the same particles, from the near cache or the tree as the move did); one further on
+    /// is the same under both rules. The contact then sticks with probability
+    /// `params.sticking_probability` (one uniform draw from `rng`); otherwise the walker stays
+    /// at the contact point, the move counts as `refused`, and the walk goes on from there.
+    /// The walker's bounds stay valid: the move raised them by a whole step, and the walker
+    /// moves at most that.
+    pub(crate) fn settle<R: Rng + ?Sized>(
+        &mut self,
+        q: [f64; D],
+        state: &mut WalkState<D>,
+        cluster: &Cluster<D>,
+        params: &Params,
+        rng: &mut R,
+    ) -> Option<[f64; D]> {
+        let u = state.step;
+        let (q, touched) = if q == self.p {
+            let len = params.step_min;
+            let found = if state.near.covers(&self.p, len + 1.0) {
+                let mut best = (f64::INFINITY, [0.0; D]);
+                state.near.for_each_within(&self.p, len + 1.0, |x| {
+                    contact::<D, true>(&self.p, &u, &x, &mut best)
+                });
+                (best.0 <= len).then_some(best)
+            } else {
+                first_contact_with::<D, true>(cluster.tree(), &self.p, &u, len)
+            };
+            let Some((t, touched)) = found else {
+                state.touched = None;
+                for i in 0..D {
+                    self.p[i] += len * u[i];
+                }
+                return None;
+            };
+            (std::array::from_fn(|i| self.p[i] + t * u[i]), touched)
+        } else {
+            (
+                q,
+                state.touched.expect("a contact sets the particle touched"),
+            )
+        };
+        if uniform01(rng) >= params.sticking_probability {
+            state.counts.refused += 1;
+            state.touched = None;
+            self.p = q;
+            return None;
+        }
+        state.touched = Some(touched);
+        Some(q)
     }
 
     fn jump<R: Rng + ?Sized>(&mut self, len: f64, rng: &mut R) {
@@ -202,25 +276,34 @@ pub fn first_contact<const D: usize>(
     u: &[f64; D],
     len: f64,
 ) -> Option<f64> {
-    first_contact_with(tree, p, u, len).map(|(t, _)| t)
+    first_contact_with::<D, false>(tree, p, u, len).map(|(t, _)| t)
 }
 
-/// [`first_contact`] and the centre touched.
-fn first_contact_with<const D: usize>(
+/// [`first_contact`] and the centre touched; with `REFUSE`, a centre at distance <= 1 only if
+/// `u` points into it (see [`contact`]).
+fn first_contact_with<const D: usize, const REFUSE: bool>(
     tree: &Orthtree<D>,
     p: &[f64; D],
     u: &[f64; D],
     len: f64,
 ) -> Option<(f64, [f64; D])> {
     let mut best = (f64::INFINITY, [0.0; D]);
-    tree.for_each_within(p, len + 1.0, |q| contact(p, u, &q, &mut best));
+    tree.for_each_within(p, len + 1.0, |q| contact::<D, REFUSE>(p, u, &q, &mut best));
     (best.0 <= len).then_some(best)
 }
 
 /// Lowers `best` (a time and the centre touched then) to the contact time with centre `q`
-/// along `p + t u`, if there is one.
+/// along `p + t u`, if there is one. A centre at distance <= 1 is touched at `t = 0`; with
+/// `REFUSE` (sticking probability below 1) only if the step points into it (`b < 0`), so that
+/// a walker left in contact by a refused sticking moves freely away from the particle
+/// (`REFUSE = false` compiles to the plain test).
 #[inline(always)]
-fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut (f64, [f64; D])) {
+fn contact<const D: usize, const REFUSE: bool>(
+    p: &[f64; D],
+    u: &[f64; D],
+    q: &[f64; D],
+    best: &mut (f64, [f64; D]),
+) {
     let mut b = 0.0;
     let mut w2 = 0.0;
     for i in 0..D {
@@ -230,6 +313,9 @@ fn contact<const D: usize>(p: &[f64; D], u: &[f64; D], q: &[f64; D], best: &mut 
     }
     let c = w2 - 1.0;
     let t = if c <= 0.0 {
+        if REFUSE && b >= 0.0 {
+            return;
+        }
         0.0
     } else {
         let disc = b * b - c;
@@ -257,6 +343,10 @@ pub(crate) struct WalkState<const D: usize> {
     /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
     /// wherever the cache answers (`(kappa - 1/2)` leaf diagonals cover [`NEAR_RADIUS`]).
     near_on: bool,
+    /// Whether a contact may be refused: `params.sticking_probability < 1`.
+    pub(crate) refuse: bool,
+    /// The direction of the step that ended in the last contact.
+    step: [f64; D],
     near: NearCache<D>,
     /// What the walkers of this state did, summed over them.
     pub(crate) counts: WalkCounts,
@@ -266,7 +356,8 @@ pub(crate) struct WalkState<const D: usize> {
 /// behind the cost of a particle, since this machine class exposes no hardware counters.
 /// Counting is a handful of register increments per move, so it is always on. Every move
 /// ends in exactly one of: a far-field return, a map jump, a tree or near-cache jump, or a
-/// step of `step_min` (with a contact search, by the cache or the tree).
+/// step of `step_min` (with a contact search, by the cache or the tree; a step that ends in a
+/// refused contact stops at the contact point).
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 pub struct WalkCounts {
     /// Walkers released (a PDLA walker discarded at the re-check counts as released).
@@ -292,6 +383,9 @@ pub struct WalkCounts {
     pub contact_near: u64,
     /// Contact searches of a `step_min` step answered by the tree.
     pub contact_tree: u64,
+    /// Contacts that did not stick (`sticking_probability < 1`): the walker walked on from
+    /// the contact point. 0 with probability 1.
+    pub refused: u64,
 }
 
 impl WalkCounts {
@@ -308,6 +402,7 @@ impl WalkCounts {
         self.tree_nodes += other.tree_nodes;
         self.contact_near += other.contact_near;
         self.contact_tree += other.contact_tree;
+        self.refused += other.refused;
     }
 }
 
@@ -324,6 +419,8 @@ impl<const D: usize> WalkState<D> {
             anchor: None,
             touched: None,
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
+            refuse: params.sticking_probability < 1.0,
+            step: [0.0; D],
             near: NearCache::new(),
             counts: WalkCounts::default(),
         }

@@ -7,6 +7,15 @@
 //! atomically in `sim_run`'s checksummed `AGGSIMCK` envelope (model
 //! [`CHECKPOINT_MODEL`]) after `positions.npy` has been flushed and synced.
 //!
+//! The payload is bincode, which is positional and not self-describing: a field added to a
+//! struct moves every later byte, and serde's field defaults do not apply. So the parameters are
+//! kept as `(name, text)` pairs ([`TextParams`]), which read with a new parameter at its
+//! default, and the payload opens with a layout number ([`LAYOUT`], bumped with every change of
+//! the snapshot's other fields);
+//! the checkpoints written before it (before `sticking_probability` and `noise_reduction`),
+//! which open with `dim` (2 to 5) instead, are read in their own layout and resume with both
+//! parameters at 1, the model they were grown with.
+//!
 //! Invariant: restoring stores the first `n` rows of `positions.npy` again in arrival order,
 //! which rebuilds the tree, `R_g`, `R_ext` and the state hash bit-identically; the rebuilt
 //! hash must equal the recorded one, so a log that does not belong to the checkpoint is
@@ -16,11 +25,11 @@
 use super::growth::{Growth, Sample};
 use crate::cluster::Cluster;
 use crate::error::SimError;
-use crate::params::Params;
-use crate::space::{Dim, Space};
+use crate::params::{FarField, Params};
+use crate::space::{DIMENSIONS, Dim, Space};
 use core_lattice::rng::SimRng;
 use serde::{Deserialize, Serialize};
-use sim_run::io::{NpyReader, StateHasher};
+use sim_run::io::{CheckpointError, NpyReader, StateHasher};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -31,13 +40,29 @@ pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 /// File name of the streamed positions (the arrival log) in a run's directory.
 pub const POSITIONS_FILE: &str = "positions.npy";
 
-/// The state a checkpoint holds.
+/// The layout of the payload this version writes: the number that opens it, before the
+/// [`Snapshot`]. Never 2 to 5 (the `dim` that opens the checkpoints written before it).
+const LAYOUT: u32 = 1001;
+
+/// What `checkpoint.bin` holds: the layout number, then the snapshot.
 #[derive(Serialize, Deserialize)]
-struct Snapshot {
-    /// As `(name, text)` pairs, so that adding a parameter does not change the layout: a
-    /// checkpoint written before it reads with the parameter at its default.
-    #[serde(with = "core_lattice::spec::as_text")]
-    params: Params,
+struct Payload {
+    layout: u32,
+    snapshot: Snapshot,
+}
+
+/// [`Params`] as `(name, text)` pairs ([`core_lattice::spec::as_text`]): adding a parameter
+/// does not change the layout, and a checkpoint written before it reads with the parameter at
+/// its default.
+#[derive(Serialize, Deserialize)]
+#[serde(transparent)]
+struct TextParams(#[serde(with = "core_lattice::spec::as_text")] Params);
+
+/// The state a checkpoint holds (`P`: the parameters' layout, [`TextParams`] but for the
+/// checkpoints of earlier versions).
+#[derive(Serialize, Deserialize)]
+struct Snapshot<P = TextParams> {
+    params: P,
     seed: u64,
     rng: SimRng,
     /// Parallel (PDLA) phases run so far: a resumed run's phases draw from new streams.
@@ -51,6 +76,83 @@ struct Snapshot {
     last_off_schedule: bool,
     /// Wall seconds of growth so far (the `seconds` column of `growth.csv` continues).
     seconds: f64,
+}
+
+/// [`Params`] as the checkpoints written before `sticking_probability` and `noise_reduction`
+/// hold it (their payload is a bare `Snapshot<ParamsBeforeVariants>`, without a layout
+/// number); they resume with both fields at 1, the model they were grown with.
+#[derive(Deserialize)]
+#[cfg_attr(test, derive(Serialize))]
+struct ParamsBeforeVariants {
+    dim: usize,
+    particles: u64,
+    birth_gap: f64,
+    far_field: FarField,
+    death_ratio: f64,
+    step_min: f64,
+    precision: f64,
+    threads: usize,
+    serial_until: u64,
+    fit_from: u64,
+    keep_positions: bool,
+    leaf_side: f64,
+    distance_map: bool,
+    near_cache: bool,
+}
+
+impl From<Snapshot<ParamsBeforeVariants>> for Snapshot {
+    fn from(s: Snapshot<ParamsBeforeVariants>) -> Self {
+        let p = s.params;
+        Snapshot {
+            params: TextParams(Params {
+                dim: p.dim,
+                particles: p.particles,
+                birth_gap: p.birth_gap,
+                far_field: p.far_field,
+                death_ratio: p.death_ratio,
+                step_min: p.step_min,
+                precision: p.precision,
+                threads: p.threads,
+                serial_until: p.serial_until,
+                fit_from: p.fit_from,
+                keep_positions: p.keep_positions,
+                leaf_side: p.leaf_side,
+                distance_map: p.distance_map,
+                near_cache: p.near_cache,
+                sticking_probability: 1.0,
+                noise_reduction: 1.0,
+            }),
+            seed: s.seed,
+            rng: s.rng,
+            pdla_rounds: s.pdla_rounds,
+            n: s.n,
+            state_hash: s.state_hash,
+            samples: s.samples,
+            next_sample: s.next_sample,
+            last_off_schedule: s.last_off_schedule,
+            seconds: s.seconds,
+        }
+    }
+}
+
+/// The snapshot in `path`: a payload of layout [`LAYOUT`] or, failing that, one written before
+/// layout numbers ([`ParamsBeforeVariants`]). An old payload never passes for a new one: it
+/// opens with its `dim`, 2 to 5, where a new one has its layout. A payload that is neither is
+/// refused with the error of today's layout.
+fn read_snapshot(path: &Path) -> Result<Snapshot, CheckpointError> {
+    let error = match sim_run::io::read_checkpoint::<Payload>(path, CHECKPOINT_MODEL) {
+        Ok(p) if p.layout == LAYOUT => return Ok(p.snapshot),
+        Ok(p) => CheckpointError::Decode(format!(
+            "payload layout {} (this version reads {LAYOUT})",
+            p.layout
+        )),
+        Err(CheckpointError::Decode(e)) => CheckpointError::Decode(e),
+        Err(e) => return Err(e),
+    };
+    match sim_run::io::read_checkpoint::<Snapshot<ParamsBeforeVariants>>(path, CHECKPOINT_MODEL) {
+        Ok(old) if DIMENSIONS.contains(&old.params.dim) => Ok(Snapshot::from(old)),
+        _ => Err(error),
+    }
 }
 
 /// A run rebuilt from a checkpoint.
@@ -87,7 +189,7 @@ pub(crate) fn write<const D: usize>(
         })?;
     streams.sync()?;
     let snap = Snapshot {
-        params: params.clone(),
+        params: TextParams(params.clone()),
         seed,
         rng: rng.clone(),
         pdla_rounds,
@@ -98,7 +200,11 @@ pub(crate) fn write<const D: usize>(
         last_off_schedule: growth.last_off_schedule,
         seconds: growth.started.elapsed().as_secs_f64(),
     };
-    sim_run::io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &snap)?;
+    let payload = Payload {
+        layout: LAYOUT,
+        snapshot: snap,
+    };
+    sim_run::io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &payload)?;
     Ok(())
 }
 
@@ -112,8 +218,8 @@ pub(crate) fn read<const D: usize>(
 where
     Dim<D>: Space<D>,
 {
-    let snap: Snapshot = sim_run::io::read_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL)?;
-    let mut params = snap.params;
+    let snap = read_snapshot(&dir.join(CHECKPOINT_FILE))?;
+    let mut params = snap.params.0;
     params.validate()?;
     if params.dim != D {
         return Err(SimError::CheckpointUsage(format!(
@@ -218,4 +324,93 @@ where
         growth,
         log,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::Simulation;
+
+    impl From<Snapshot> for Snapshot<ParamsBeforeVariants> {
+        fn from(s: Snapshot) -> Self {
+            let p = s.params.0;
+            assert_eq!((p.sticking_probability, p.noise_reduction), (1.0, 1.0));
+            Snapshot {
+                params: ParamsBeforeVariants {
+                    dim: p.dim,
+                    particles: p.particles,
+                    birth_gap: p.birth_gap,
+                    far_field: p.far_field,
+                    death_ratio: p.death_ratio,
+                    step_min: p.step_min,
+                    precision: p.precision,
+                    threads: p.threads,
+                    serial_until: p.serial_until,
+                    fit_from: p.fit_from,
+                    keep_positions: p.keep_positions,
+                    leaf_side: p.leaf_side,
+                    distance_map: p.distance_map,
+                    near_cache: p.near_cache,
+                },
+                seed: s.seed,
+                rng: s.rng,
+                pdla_rounds: s.pdla_rounds,
+                n: s.n,
+                state_hash: s.state_hash,
+                samples: s.samples,
+                next_sample: s.next_sample,
+                last_off_schedule: s.last_off_schedule,
+                seconds: s.seconds,
+            }
+        }
+    }
+
+    /// A checkpoint in the layout written before `sticking_probability` and `noise_reduction`
+    /// resumes, with both at 1, to the uninterrupted run's state hash; a payload that is
+    /// neither layout is refused with today's layout's error.
+    #[test]
+    fn checkpoints_from_before_the_variants_resume() {
+        let params = Params {
+            particles: 800,
+            ..Params::default()
+        };
+        let mut whole = Simulation::<2>::new(params.clone(), 3).unwrap();
+        whole.run().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let mut sim = Simulation::<2>::new(params, 3).unwrap();
+        sim.stream_into(dir.path(), true).unwrap();
+        for _ in 0..400 {
+            sim.add_one().unwrap();
+        }
+        sim.write_checkpoint().unwrap();
+        drop(sim);
+        let path = dir.path().join(CHECKPOINT_FILE);
+        let old = Snapshot::<ParamsBeforeVariants>::from(read_snapshot(&path).unwrap());
+        sim_run::io::write_checkpoint(&path, CHECKPOINT_MODEL, &old).unwrap();
+        // The old payload opens with its dim where today's has its layout.
+        if let Ok(p) = sim_run::io::read_checkpoint::<Payload>(&path, CHECKPOINT_MODEL) {
+            assert_eq!(p.layout, 2);
+        }
+        let mut resumed = Simulation::<2>::resume(dir.path(), None).unwrap();
+        assert_eq!(resumed.particles(), 401);
+        assert_eq!(resumed.params(), whole.params());
+        resumed.run().unwrap();
+        assert_eq!(resumed.state_hash(), whole.state_hash());
+        // A payload of a later layout, or of none, is refused, naming the layout.
+        let later = Payload {
+            layout: LAYOUT + 1,
+            snapshot: Snapshot::from(old),
+        };
+        sim_run::io::write_checkpoint(&path, CHECKPOINT_MODEL, &later).unwrap();
+        let e = read_snapshot(&path).err().unwrap().to_string();
+        assert!(
+            e.contains("payload layout 1002 (this version reads 1001)"),
+            "{e}"
+        );
+        sim_run::io::write_checkpoint(&path, CHECKPOINT_MODEL, &(1u8, "x")).unwrap();
+        assert!(matches!(
+            read_snapshot(&path),
+            Err(CheckpointError::Decode(_))
+        ));
+    }
 }

@@ -132,6 +132,24 @@ impl Streams {
     }
 }
 
+/// Where a walker that stuck at the contact point `p`, touching the stored particle `touched`,
+/// is stored: `p` itself with noise reduction `f = 1` (the plain model, bit for bit: nothing
+/// is computed), else `touched + f (p - touched)`, at distance `f` from `touched` (fastDLA's
+/// `noiseReductionFactor`). The contact point is at distance at least 1 from every stored
+/// particle, so the stored position is at least `f` from every one (it lies within `1 - f` of
+/// the contact point).
+#[inline]
+pub(crate) fn noise_reduced<const D: usize>(
+    p: [f64; D],
+    touched: Option<&[f64; D]>,
+    f: f64,
+) -> [f64; D] {
+    match touched {
+        Some(t) if f < 1.0 => std::array::from_fn(|i| t[i] + f * (p[i] - t[i])),
+        _ => p,
+    }
+}
+
 /// Everything that changes when a particle sticks (kept together under PDLA's write lock).
 #[derive(Debug)]
 pub(crate) struct Growth<const D: usize> {

@@ -6,10 +6,12 @@
 //! Invariants: the stored particles have one total order, the order in which they entered the
 //! tree under the log's lock (their published count, and their entries in the [`Ring`]); a
 //! particle is stored only if no particle stored before it lies within
-//! [`OVERLAP_DISTANCE`]; every stored particle is accounted for once, under the log's lock; a
-//! run that only discards stops with [`SimError::DiscardLivelock`].
+//! [`OVERLAP_DISTANCE`] of its walker's contact point (which is where it is stored, unless noise
+//! reduction `f < 1` stores it at distance `f` from the particle it touched, then at least
+//! `f - 1e-6` from every earlier one); every stored particle is accounted for once, under the
+//! log's lock; a run that only discards stops with [`SimError::DiscardLivelock`].
 
-use super::growth::Growth;
+use super::growth::{Growth, noise_reduced};
 use super::ring::Ring;
 use crate::cluster::Cluster;
 use crate::error::SimError;
@@ -423,7 +425,12 @@ where
             let mut w = Walker::born(me.r_ext + params.birth_gap, rng);
             let stick = loop {
                 if let Some(p) = w.advance(&mut me.walk, self.cluster, me.r_ext, params, rng) {
-                    break p;
+                    if !me.walk.refuse {
+                        break p;
+                    }
+                    if let Some(p) = w.settle(p, &mut me.walk, self.cluster, params, rng) {
+                        break p;
+                    }
                 }
                 if !self.sync(me, &w.p) {
                     return;
@@ -434,7 +441,10 @@ where
             // pre-check covers the particles before `seen`, the check under the lock the ones
             // after: the walker's near cache holds those it has taken from the ring when its
             // ball covers the sticking point (near the cluster, the usual case); else the
-            // tree, which holds every particle published before the load.
+            // tree, which holds every particle published before the load. Both checks are made
+            // at the contact point, at distance 1 from the particle touched, also with noise
+            // reduction: the position stored then, at distance `f` from it, is within `1 - f`
+            // of the contact point, so at least `f` (less the tolerance) from every particle.
             let (seen, mut overlap) = match me.walk.any_within_cached(&stick, OVERLAP_DISTANCE) {
                 Some(found) => (me.applied, found),
                 None => {
@@ -474,11 +484,12 @@ where
             if overlap {
                 continue;
             }
+            let stored = noise_reduced(stick, me.walk.touched(), params.noise_reduction);
             // SAFETY: every thread announces its epoch at a walker's birth only, where it holds
             // nothing from the tree (`walk`, Release store), or u64::MAX once it stops reading;
             // `readers_epoch` is the minimum over all threads' slots (Acquire loads).
             #[allow(unsafe_code)]
-            let inserted = unsafe { tree.insert_shared(stick, || self.readers_epoch()) };
+            let inserted = unsafe { tree.insert_shared(stored, || self.readers_epoch()) };
             let (q, new_leaf) = match inserted {
                 Ok(stored) => stored,
                 Err(OrthtreeError::NeedsExclusive) => {

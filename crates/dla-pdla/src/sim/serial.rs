@@ -1,10 +1,11 @@
 //! Serial DLA: one walker at a time, each released on the birth sphere and walked until it
-//! sticks, on one random stream (`stream_id(PURPOSE_WALK, 0)`).
+//! sticks, on one random stream (`stream_id(PURPOSE_WALK, 0)`), then stored at its contact
+//! point (or, with noise reduction `f < 1`, at distance `f` from the particle it touched).
 //!
 //! Invariant: a serial run is a pure function of `(Params, seed)`: the walker's moves depend
 //! only on the stream and the stored particles, and nothing else draws from the stream.
 
-use super::growth::Growth;
+use super::growth::{Growth, noise_reduced};
 use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::params::Params;
@@ -54,7 +55,17 @@ impl<const D: usize> Serial<D> {
         loop {
             if let Some(p) = w.advance(&mut self.walk, cluster, growth.r_ext, params, &mut self.rng)
             {
-                return growth.add(cluster, p, self.walk.touched(), params.particles);
+                let p = if self.walk.refuse {
+                    match w.settle(p, &mut self.walk, cluster, params, &mut self.rng) {
+                        Some(p) => p,
+                        None => continue,
+                    }
+                } else {
+                    p
+                };
+                let touched = self.walk.touched();
+                let p = noise_reduced(p, touched, params.noise_reduction);
+                return growth.add(cluster, p, touched, params.particles);
             }
         }
     }

@@ -8,7 +8,9 @@ use crate::round::{ceil, floor};
 /// `(c - m) . w < MARGIN` with `m` the midpoint and `w = p - q`. Every other cell already holds
 /// at most its distance to `p` (quantised down), which is at most its distance to `q`, so an
 /// insert that skips them leaves the map, and a sparse map's blocks, exactly as a full insert
-/// would: about half the cells and rows of the ball for the same result.
+/// would: about half the cells and rows of the ball for the same result. The argument holds
+/// whatever `|p - q|` is (DLA's noise reduction stores `q` closer than 1 to `p`); the half-space
+/// is used between half a diameter and two, where the bound `slack` holds.
 ///
 /// `MARGIN` (1e-6 squared diameters, far above the rounding of the centres' coordinates) keeps
 /// every skipped cell strictly nearer `p`, so the rounding of the distances cannot make `q`'s

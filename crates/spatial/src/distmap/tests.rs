@@ -325,7 +325,8 @@ fn bad_parameters_and_points_are_refused() {
 #[test]
 fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
     /// A random aggregate: each point one diameter from an earlier one (some along an axis,
-    /// where the half-space's normal has a zero component), with the earlier one.
+    /// where the half-space's normal has a zero component; every fifth closer, between 0.3 and
+    /// 1, as DLA's noise reduction stores them), with the earlier one.
     fn aggregate<const D: usize>(n: usize, seed: u64) -> Vec<([f64; D], Option<[f64; D]>)> {
         let mut next = uniform(seed);
         let mut pts: Vec<([f64; D], Option<[f64; D]>)> = vec![([0.3; D], None)];
@@ -338,7 +339,12 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
                 let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
                 u.map(|x| x / len)
             };
-            pts.push((std::array::from_fn(|i| p[i] + u[i]), Some(p)));
+            let f = if pts.len() % 5 == 0 {
+                0.3 + 0.7 * next()
+            } else {
+                1.0
+            };
+            pts.push((std::array::from_fn(|i| p[i] + f * u[i]), Some(p)));
         }
         pts
     }
