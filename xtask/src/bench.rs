@@ -209,13 +209,13 @@ pub const INSTRUCTION_WORKLOADS: &[Workload] = &[
         unit: "particles",
     },
     Workload {
-        name: "dla-3d-1e5-instructions",
+        name: "dla-3d-1e6-instructions",
         bin: "dla",
         args: &[
             "--dim",
             "3",
             "--particles",
-            "1e5",
+            "1e6",
             "--seed",
             "1",
             "--no-checkpoint",
@@ -241,16 +241,18 @@ pub struct InstructionCount {
     pub state_hash: Option<String>,
 }
 
-/// Cachegrind's `I refs` count from its report on stderr (`==123== I refs:  2,685,370,135`).
+/// Cachegrind's `I refs` count from its report on stderr (`==123== I   refs:  2,685,370,135`).
 pub fn parse_i_refs(stderr: &str) -> Option<u64> {
-    let line = stderr.lines().find(|l| l.contains("I refs:"))?;
-    let digits: String = line
-        .split("I refs:")
-        .nth(1)?
-        .chars()
-        .filter(char::is_ascii_digit)
-        .collect();
-    digits.parse().ok()
+    stderr.lines().find_map(|l| {
+        let words: Vec<&str> = l.split_whitespace().collect();
+        let at = words.windows(2).position(|w| w == ["I", "refs:"])?;
+        let digits: String = words
+            .get(at + 2)?
+            .chars()
+            .filter(char::is_ascii_digit)
+            .collect();
+        digits.parse().ok()
+    })
 }
 
 /// Runs workload `w` under cachegrind (no cache simulation) and counts its instructions.
@@ -730,7 +732,7 @@ mod tests {
     #[test]
     fn cachegrind_instruction_counts_are_read() {
         let stderr = "==4242== Cachegrind, a high-precision tracing profiler\n\
-                      ==4242== \n==4242== I refs:        2,685,370,135\n";
+                      ==4242== \n==4242== I   refs:      2,685,370,135\n";
         assert_eq!(parse_i_refs(stderr), Some(2_685_370_135));
         assert_eq!(parse_i_refs("no report"), None);
     }

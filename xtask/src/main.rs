@@ -103,7 +103,7 @@ enum Cmd {
         /// (for shared or noisy machines; every repeat's time is in the JSON).
         #[arg(long, default_value_t = 1, value_parser = sim_run::count::count_at_least_1::<usize>)]
         repeat: usize,
-        /// Count instructions instead of timing: 2D DLA 1e6 and 3D 1e5, one thread, under
+        /// Count instructions instead of timing: 2D and 3D DLA at 1e6, one thread, under
         /// `valgrind --tool=cachegrind --cache-sim=no` (a few minutes; the same count on a busy
         /// or quiet host), as instructions per particle.
         #[arg(long)]
