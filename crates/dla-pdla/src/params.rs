@@ -35,18 +35,6 @@ impl FarField {
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
     }
-
-    /// One line of plain text for the command line's help.
-    pub fn help(self) -> &'static str {
-        match self {
-            FarField::Return => {
-                "exact return to the birth sphere at the harmonic-measure hit point; no walker is ever killed"
-            }
-            FarField::Jump => {
-                "the paper's jump of |p| - R_ext - 1 in a random direction, relaunch beyond the death radius"
-            }
-        }
-    }
 }
 
 impl std::str::FromStr for FarField {
@@ -75,18 +63,6 @@ fn parse_choice<T: Copy>(
                 names.join(", ")
             )
         })
-}
-
-/// The command line parses `--far-field` through [`FarField::ALL`] and [`FarField::name`].
-#[cfg(feature = "cli")]
-impl clap::ValueEnum for FarField {
-    fn value_variants<'a>() -> &'a [Self] {
-        &Self::ALL
-    }
-
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()).help(self.help()))
-    }
 }
 
 core_lattice::declare_params! {

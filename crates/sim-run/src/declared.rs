@@ -8,12 +8,17 @@ use core_lattice::spec::{Declared, DeclaredParams, Kind, Range, help_text, show_
 use serde::Serialize;
 use serde_json::{Map, Value};
 
-/// The library's default of every parameter of `P`, by name, as JSON.
+/// The library's default of every parameter of `P` a front end sets (not the
+/// [`DeclaredParams::INTERNAL`] fields), by name, as JSON.
 pub fn defaults_of<P: DeclaredParams + Serialize>() -> Map<String, Value> {
-    match serde_json::to_value(P::default()) {
+    let mut m = match serde_json::to_value(P::default()) {
         Ok(Value::Object(m)) => m,
         _ => panic!("a declared Params serialises to a JSON object"),
+    };
+    for k in P::INTERNAL {
+        m.remove(*k);
     }
+    m
 }
 
 /// A default as the command line and the docs spell it: `5`, `1e-6`, `on`, `return`.

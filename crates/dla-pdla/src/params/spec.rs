@@ -9,20 +9,9 @@ use core_lattice::spec::{DeclaredParams, ParamSpec, spec_table};
 /// declaration ([`Params::DECLARED`] without what only the front ends need).
 pub const PARAMS: &[ParamSpec] = &spec_table::<{ Params::DECLARED.len() }>(Params::DECLARED);
 
-/// `Params` fields that are not parameters of a front end: set by the front end itself
-/// (`keep_positions`: the binary streams positions to a file, Python keeps them).
-pub const INTERNAL: &[&str] = Params::INTERNAL;
-
 /// The default of every parameter of [`PARAMS`], keyed by name, from [`Params::default`].
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
-    let mut m = match serde_json::to_value(Params::default()) {
-        Ok(serde_json::Value::Object(m)) => m,
-        _ => unreachable!("Params serialises to a JSON object"),
-    };
-    for k in INTERNAL {
-        m.remove(*k);
-    }
-    m
+    sim_run::declared::defaults_of::<Params>()
 }
 
 #[cfg(test)]
