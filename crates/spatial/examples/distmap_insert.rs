@@ -8,7 +8,8 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let path = args.next().expect("positions.bin");
     let bytes = std::fs::read(&path).expect("read");
-    assert_eq!(&bytes[..8], b"DLAPOS01");
+    // DLAPOS02 has the parents after the coordinates, which this reads past.
+    assert!(matches!(&bytes[..8], b"DLAPOS01" | b"DLAPOS02"));
     let dim = u32::from_le_bytes(bytes[8..12].try_into().unwrap());
     assert_eq!(dim, 2, "2D positions only");
     let n = u64::from_le_bytes(bytes[12..20].try_into().unwrap()) as usize;

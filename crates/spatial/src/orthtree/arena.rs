@@ -67,6 +67,12 @@ impl Element for AtomicU64 {
     }
 }
 
+impl Element for u32 {
+    fn duplicate(&self) -> Self {
+        *self
+    }
+}
+
 impl<const D: usize> Element for [u32; D] {
     fn duplicate(&self) -> Self {
         *self

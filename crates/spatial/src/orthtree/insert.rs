@@ -144,7 +144,10 @@ impl<const D: usize> Orthtree<D> {
                 self.leaves
                     .try_set_capacity(w.leaves, slow_growth(self.leaves.capacity(), w.leaves + 1))
             })
-            .and_then(|()| w.pool.reserve(&mut self.slots, leaf_len))
+            .and_then(|()| {
+                w.pool
+                    .reserve(&mut self.slots, self.tags.as_mut(), leaf_len)
+            })
             .map_err(|e| OrthtreeError::OutOfMemory { bytes: e.bytes })
     }
 
@@ -220,7 +223,15 @@ impl<const D: usize> Orthtree<D> {
     ///
     /// `w` is this tree's writer state, held by the caller (its lock, or exclusive access),
     /// and `retire` is `Some(current epoch)` whenever other threads may be reading the tree.
-    unsafe fn place(&self, w: &mut Writer, k: &[i64; D], code: [u32; D], retire: Option<u64>) {
+    unsafe fn place(
+        &self,
+        w: &mut Writer,
+        k: &[i64; D],
+        code: [u32; D],
+        tag: u32,
+        retire: Option<u64>,
+    ) {
+        let tags = self.tags.as_ref().map(|t| (t, tag));
         let mut node = self.root;
         let mut level = self.root_level;
         loop {
@@ -235,7 +246,7 @@ impl<const D: usize> Orthtree<D> {
                 // caller's contract); the empty record has no block.
                 let rec = unsafe {
                     w.pool
-                        .push(&self.slots, Leaf { start: 0, len: 0 }, code, retire)
+                        .push(&self.slots, tags, Leaf { start: 0, len: 0 }, code, retire)
                 };
                 let l = w.leaves;
                 // SAFETY: leaf record l is beyond every published leaf: no reader reaches it
@@ -267,7 +278,7 @@ impl<const D: usize> Orthtree<D> {
                 // SAFETY: `leaf` is this pool's current record of the leaf (only the writer
                 // changes it), `w` is this tree's writer and `retire` follows the readers (the
                 // caller's contract).
-                let rec = unsafe { w.pool.push(&self.slots, leaf, code, retire) };
+                let rec = unsafe { w.pool.push(&self.slots, tags, leaf, code, retire) };
                 record.store(rec.pack(), Ordering::Release);
                 return;
             }
@@ -292,6 +303,12 @@ impl<const D: usize> Orthtree<D> {
     ///
     /// Duplicate points are allowed. On error the tree is unchanged.
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], OrthtreeError> {
+        self.insert_tagged(p, 0)
+    }
+
+    /// [`insert`](Self::insert) of a point with tag `tag`, kept when the tree keeps tags
+    /// ([`keep_tags`](Self::keep_tags)) and ignored otherwise.
+    pub fn insert_tagged(&mut self, p: [f64; D], tag: u32) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(&p)?;
         // Capacity checks before any change, so that an error leaves the tree as it was.
         let leaf_len = self.existing_leaf_len(&k);
@@ -302,7 +319,7 @@ impl<const D: usize> Orthtree<D> {
             let mut w = self.writer();
             // SAFETY: `w` is this tree's writer; `&mut self` excludes readers, so the old
             // block may be freed at once (`None`).
-            unsafe { self.place(&mut w, &k, code, None) };
+            unsafe { self.place(&mut w, &k, code, tag, None) };
         }
         increment_mut(&mut self.shared.len);
         let w = Self::writer_mut(&mut self.shared);
@@ -312,7 +329,7 @@ impl<const D: usize> Orthtree<D> {
             // records describe.
             unsafe {
                 let leaves = self.leaves.prefix_mut(w.leaves);
-                w.pool.compact(&mut self.slots, leaves);
+                w.pool.compact(&mut self.slots, self.tags.as_mut(), leaves);
             }
         }
         Ok(self.decoded(&k, &code))
@@ -358,6 +375,22 @@ impl<const D: usize> Orthtree<D> {
         p: [f64; D],
         readers_epoch: impl FnOnce() -> u64,
     ) -> Result<([f64; D], bool), OrthtreeError> {
+        // SAFETY: the caller's contract is the same.
+        unsafe { self.insert_shared_tagged(p, 0, readers_epoch) }
+    }
+
+    /// [`insert_shared`](Self::insert_shared) of a point with tag `tag` (see
+    /// [`insert_tagged`](Self::insert_tagged)).
+    ///
+    /// # Safety
+    ///
+    /// As for [`insert_shared`](Self::insert_shared).
+    pub unsafe fn insert_shared_tagged(
+        &self,
+        p: [f64; D],
+        tag: u32,
+        readers_epoch: impl FnOnce() -> u64,
+    ) -> Result<([f64; D], bool), OrthtreeError> {
         let (k, code) = self.locate(&p)?;
         if self.root == EMPTY || !self.root_contains(&k) {
             return Err(OrthtreeError::NeedsExclusive);
@@ -381,7 +414,7 @@ impl<const D: usize> Orthtree<D> {
         unsafe { w.pool.reclaim(&self.slots, known) };
         // SAFETY: `w` is this tree's writer, locked, and old blocks are retired at the current
         // epoch, as readers may be scanning them.
-        unsafe { self.place(&mut w, &k, code, Some(epoch)) };
+        unsafe { self.place(&mut w, &k, code, tag, Some(epoch)) };
         self.shared.len.fetch_add(1, Ordering::Relaxed);
         w.since_epoch += 1;
         if w.since_epoch >= EPOCH_INSERTS {
@@ -440,6 +473,10 @@ impl<const D: usize> Orthtree<D> {
                 self.slots
                     .try_set_capacity(w.pool.len, self.slots.capacity().max(slots))
             })
+            .and_then(|()| match &mut self.tags {
+                Some(t) => t.try_set_capacity(w.pool.len, self.slots.capacity()),
+                None => Ok(()),
+            })
             .map_err(|e| OrthtreeError::OutOfMemory { bytes: e.bytes })?;
         // SAFETY: `&mut self`: no reader holds anything from the tree, so every retired block
         // can be reused; `self.slots` is the arena of `w.pool`.
@@ -467,6 +504,15 @@ impl<const D: usize> Orthtree<D> {
         let _ = self
             .slots
             .try_set_capacity(w.pool.len, keep(w.pool.len).min(self.slots.capacity()));
+        if let Some(t) = &mut self.tags {
+            // The tags follow the slots' capacity; if they cannot shrink with it, the
+            // slots grow back to theirs, which they had a moment ago.
+            if t.try_set_capacity(w.pool.len, self.slots.capacity())
+                .is_err()
+            {
+                self.slots.set_capacity(w.pool.len, t.capacity());
+            }
+        }
     }
 
     /// The position [`insert`](Self::insert) would store for `p` (its fixed-point rounding),
@@ -475,5 +521,46 @@ impl<const D: usize> Orthtree<D> {
     pub fn stored_position(&self, p: &[f64; D]) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(p)?;
         Ok(self.decoded(&k, &code))
+    }
+
+    /// The tag of the point stored at `q` (a stored position, as an insert or a query
+    /// returned it), or `None` when no point is stored there or the tree keeps no tags. Of
+    /// several points stored at `q`, the first inserted. Takes the writer's lock, so it may
+    /// run while other threads insert; O(depth + points in the leaf).
+    pub fn tag_of(&self, q: &[f64; D]) -> Option<u32> {
+        let tags = self.tags.as_ref()?;
+        let (k, code) = self.locate(q).ok()?;
+        // The lock: no insert changes a node, record, slot or tag meanwhile.
+        let _w = self.writer();
+        if self.root == EMPTY || !self.root_contains(&k) {
+            return None;
+        }
+        let mut node = self.root;
+        let mut level = self.root_level;
+        #[allow(unsafe_code)]
+        loop {
+            let slot = node as usize * Self::FANOUT + self.child_index(&k, level);
+            // SAFETY: `node` is the root or a non-empty value read below from a reached
+            // node's slot, so it was initialised before it was linked; the writer's lock is
+            // held, so nothing is written meanwhile.
+            let child = unsafe { self.children.get(slot) }.load(Ordering::Acquire);
+            if child == EMPTY {
+                return None;
+            }
+            if level == 1 {
+                // SAFETY: a non-empty slot of a level-1 node holds a published leaf record;
+                // its block's first `len` slots and tags were written before it was
+                // published, and the lock keeps them unchanged.
+                let leaf = Leaf::unpack(
+                    unsafe { self.leaves.get(child as usize) }.load(Ordering::Acquire),
+                );
+                let points = unsafe { LeafPool::points(&self.slots, leaf) };
+                let i = points.iter().position(|c| *c == code)?;
+                // SAFETY: as for the slots: the tag of a published slot is written first.
+                return Some(unsafe { *tags.get(leaf.start as usize + i) });
+            }
+            node = child;
+            level -= 1;
+        }
     }
 }

@@ -273,6 +273,9 @@ pub enum OrthtreeError {
         "the point needs the orthtree's root or capacity grown, which a shared insert cannot do; insert it with exclusive access"
     )]
     NeedsExclusive,
+    /// [`Orthtree::keep_tags`] on a tree that already holds points, whose tags are unknown.
+    #[error("the orthtree can keep tags only from its first point")]
+    TagsOnNonEmpty,
 }
 
 /// A leaf's block in the point pool.
@@ -376,6 +379,9 @@ pub struct Orthtree<const D: usize> {
     leaves: Arena<AtomicU64>,
     /// Point records of all leaves (blocks carved by the writer's [`LeafPool`]).
     slots: Arena<[u32; D]>,
+    /// A tag per point slot, beside `slots` and of its capacity, when the tree keeps tags
+    /// ([`Orthtree::keep_tags`]); read and written by the writer only.
+    tags: Option<Arena<u32>>,
     /// Counts, allocator and epoch.
     shared: Box<Shared>,
     /// Largest number of nodes, leaves or point slots ([`MAX_INDEX`] unless lowered by
@@ -433,12 +439,15 @@ impl<const D: usize> Clone for Orthtree<D> {
         // SAFETY: the writer's counts, read under its lock, are the initialised prefixes of
         // the arenas (nodes, leaf records, pool slots), and the lock held keeps a shared writer
         // from writing any of them meanwhile (readers only read).
-        let (children, leaves, slots) = unsafe {
+        let (children, leaves, slots, tags) = unsafe {
             (
                 self.children
                     .duplicate(w.nodes * Self::FANOUT, self.children.capacity()),
                 self.leaves.duplicate(w.leaves, self.leaves.capacity()),
                 self.slots.duplicate(w.pool.len, self.slots.capacity()),
+                self.tags
+                    .as_ref()
+                    .map(|t| t.duplicate(w.pool.len, t.capacity())),
             )
         };
         let shared = Box::new(Shared {
@@ -458,6 +467,7 @@ impl<const D: usize> Clone for Orthtree<D> {
             children,
             leaves,
             slots,
+            tags,
             shared,
             index_limit: self.index_limit,
         }
@@ -499,6 +509,7 @@ impl<const D: usize> Orthtree<D> {
             children: Arena::new(),
             leaves: Arena::new(),
             slots: Arena::new(),
+            tags: None,
             shared: Box::new(Shared {
                 writer: Mutex::new(Writer {
                     nodes: 0,
@@ -643,6 +654,38 @@ impl<const D: usize> Orthtree<D> {
             + self.children.capacity() * size_of::<u32>()
             + self.leaves.capacity() * size_of::<u64>()
             + self.slots.capacity() * size_of::<[u32; D]>()
+            + self
+                .tags
+                .as_ref()
+                .map_or(0, |t| t.capacity() * size_of::<u32>())
+    }
+
+    /// Makes the tree keep a 32-bit tag with every point from now on (4 bytes per point
+    /// slot), given at insertion ([`insert_tagged`](Self::insert_tagged),
+    /// [`insert_shared_tagged`](Self::insert_shared_tagged)) and looked up by stored position
+    /// ([`tag_of`](Self::tag_of)): DLA tags each particle with its arrival index, so that the
+    /// particle a walker touched names its parent. Queries never read the tags, so they cost
+    /// nothing there. Only an empty tree can start keeping tags (else
+    /// [`OrthtreeError::TagsOnNonEmpty`]); points inserted untagged get tag 0.
+    pub fn keep_tags(&mut self) -> Result<(), OrthtreeError> {
+        if !self.is_empty() {
+            return Err(OrthtreeError::TagsOnNonEmpty);
+        }
+        if self.tags.is_none() {
+            // An empty tree's pool holds no slot (points are never removed), so there is no
+            // tag to write.
+            debug_assert_eq!(Self::writer_mut(&mut self.shared).pool.len, 0);
+            let mut tags = Arena::new();
+            tags.try_set_capacity(0, self.slots.capacity())
+                .map_err(|e| OrthtreeError::OutOfMemory { bytes: e.bytes })?;
+            self.tags = Some(tags);
+        }
+        Ok(())
+    }
+
+    /// Whether the tree keeps tags ([`keep_tags`](Self::keep_tags)).
+    pub fn keeps_tags(&self) -> bool {
+        self.tags.is_some()
     }
 
     /// Shape and memory counts.

@@ -99,13 +99,19 @@ impl LeafPool {
     }
 
     /// Grows `slots` (exclusive access) so that a push into a leaf of length `leaf_len` fits.
+    /// Grows the tags too when the tree has them, to the slots' capacity.
     pub(super) fn reserve<const D: usize>(
         &self,
         slots: &mut Arena<[u32; D]>,
+        tags: Option<&mut Arena<u32>>,
         leaf_len: u32,
     ) -> Result<(), AllocFailed> {
         let need = self.len + Self::push_needs(leaf_len) as usize;
-        slots.try_set_capacity(self.len, slow_growth(slots.capacity(), need))
+        slots.try_set_capacity(self.len, slow_growth(slots.capacity(), need))?;
+        match tags {
+            Some(t) => t.try_set_capacity(self.len, slots.capacity()),
+            None => Ok(()),
+        }
     }
 
     /// A block of `cap` slots of class `class`, from the free list or the end of the pool
@@ -119,6 +125,7 @@ impl LeafPool {
     unsafe fn alloc<const D: usize>(
         &mut self,
         slots: &Arena<[u32; D]>,
+        tags: Option<&Arena<u32>>,
         class: usize,
         cap: u64,
     ) -> u32 {
@@ -134,6 +141,10 @@ impl LeafPool {
             for i in start..start + cap as usize {
                 // SAFETY: slots from `self.len` on are in no block, so no reader can reach them.
                 unsafe { slots.init(i, [0; D]) };
+                if let Some(t) = tags {
+                    // SAFETY: as for the slot (the tags have the slots' capacity).
+                    unsafe { t.init(i, 0) };
+                }
             }
             self.len += cap as usize;
             start as u32
@@ -166,7 +177,9 @@ impl LeafPool {
     /// points to a larger block if the block is full. The old block goes to its free list, or,
     /// with `retire = Some(epoch)` (readers may be scanning it), to the retired blocks. The
     /// caller has checked the slot capacity ([`push_needs`](Self::push_needs)). The new point
-    /// is written before the record that makes it visible is returned.
+    /// is written before the record that makes it visible is returned. `tags`: the tree's tags
+    /// (of the slots' capacity) and the new point's tag, when the tree keeps tags; they move
+    /// with their points.
     ///
     /// # Safety
     ///
@@ -177,28 +190,34 @@ impl LeafPool {
     pub(super) unsafe fn push<const D: usize>(
         &mut self,
         slots: &Arena<[u32; D]>,
+        tags: Option<(&Arena<u32>, u32)>,
         leaf: Leaf,
         code: [u32; D],
         retire: Option<u64>,
     ) -> Leaf {
+        let tag_arena = tags.map(|(t, _)| t);
         let n = leaf.len;
         let mut start = leaf.start;
         if n == 0 {
             let (class, cap) = class_of(1);
             // SAFETY: the caller's contract is `alloc`'s.
-            start = unsafe { self.alloc(slots, class, cap) };
+            start = unsafe { self.alloc(slots, tag_arena, class, cap) };
         } else {
             let (old_class, old_cap) = class_of(n);
             if u64::from(n) == old_cap {
                 let (new_class, new_cap) = class_of(n + 1);
                 // SAFETY: the caller's contract is `alloc`'s.
-                start = unsafe { self.alloc(slots, new_class, new_cap) };
+                start = unsafe { self.alloc(slots, tag_arena, new_class, new_cap) };
                 for i in 0..n {
                     // SAFETY: the old block's first n slots are written (the caller's
                     // contract); the new block is fresh or was free, so no reader reaches it
                     // until the returned record is published.
                     unsafe {
                         slots.init((start + i) as usize, *slots.get((leaf.start + i) as usize));
+                    }
+                    if let Some(t) = tag_arena {
+                        // SAFETY: as for the slot; tags are read only by the writer.
+                        unsafe { t.init((start + i) as usize, *t.get((leaf.start + i) as usize)) };
                     }
                 }
                 match retire {
@@ -220,6 +239,10 @@ impl LeafPool {
         // SAFETY: slot n of the block lies beyond the published length n (or the block is
         // new), so no reader reaches it until the returned record is published.
         unsafe { slots.init((start + n) as usize, code) };
+        if let Some((t, tag)) = tags {
+            // SAFETY: as for the slot.
+            unsafe { t.init((start + n) as usize, tag) };
+        }
         Leaf { start, len: n + 1 }
     }
 
@@ -265,6 +288,7 @@ impl LeafPool {
     pub(super) unsafe fn compact<const D: usize>(
         &mut self,
         slots: &mut Arena<[u32; D]>,
+        mut tags: Option<&mut Arena<u32>>,
         leaves: &mut [AtomicU64],
     ) {
         debug_assert!(self.retired.is_empty());
@@ -275,6 +299,8 @@ impl LeafPool {
         // SAFETY: the pool's first `self.len` slots are initialised (`alloc` writes every slot
         // it appends), and `slots` is its arena (the caller's contract).
         let pool = unsafe { slots.prefix_mut(self.len) };
+        // SAFETY: as for the slots: `alloc` writes the tag of every slot it appends.
+        let mut tags = tags.as_mut().map(|t| unsafe { t.prefix_mut(self.len) });
         let mut cursor = 0usize;
         for l in order {
             let rec = &mut leaves[l as usize];
@@ -282,6 +308,9 @@ impl LeafPool {
             let start = leaf.start as usize;
             debug_assert!(cursor <= start);
             pool.copy_within(start..start + leaf.len as usize, cursor);
+            if let Some(t) = &mut tags {
+                t.copy_within(start..start + leaf.len as usize, cursor);
+            }
             leaf.start = cursor as u32;
             store_mut(rec, leaf.pack());
             cursor += class_of(leaf.len).1 as usize;
@@ -348,11 +377,11 @@ mod tests {
         // and every record passed is the empty one or one the pool returned.
         unsafe {
             for i in 0..40u32 {
-                pool.reserve(&mut slots, a.len).unwrap();
-                a = pool.push(&slots, a, [i, 1000 + i], None);
+                pool.reserve(&mut slots, None, a.len).unwrap();
+                a = pool.push(&slots, None, a, [i, 1000 + i], None);
                 if i % 3 == 0 {
-                    pool.reserve(&mut slots, b.len).unwrap();
-                    b = pool.push(&slots, b, [i, 7], None);
+                    pool.reserve(&mut slots, None, b.len).unwrap();
+                    b = pool.push(&slots, None, b, [i, 7], None);
                 }
             }
             let pa: Vec<_> = LeafPool::points(&slots, a).to_vec();
@@ -369,15 +398,15 @@ mod tests {
             let used = (class_of(40).1 + class_of(14).1) as usize;
             assert_eq!(pool.len, used + pool.free_slots());
             let mut leaves = [AtomicU64::new(a.pack()), AtomicU64::new(b.pack())];
-            pool.compact(&mut slots, &mut leaves);
+            pool.compact(&mut slots, None, &mut leaves);
             let [a, b] = leaves.map(|l| Leaf::unpack(l.into_inner()));
             assert_eq!(pool.len, used);
             assert_eq!(pool.free_slots(), 0);
             assert_eq!(LeafPool::points(&slots, a), &pa[..]);
             assert_eq!(LeafPool::points(&slots, b), &pb[..]);
             // Growing after compaction works.
-            pool.reserve(&mut slots, b.len).unwrap();
-            let b = pool.push(&slots, b, [99, 99], None);
+            pool.reserve(&mut slots, None, b.len).unwrap();
+            let b = pool.push(&slots, None, b, [99, 99], None);
             assert_eq!(LeafPool::points(&slots, b).len(), 15);
             assert_eq!(LeafPool::points(&slots, b)[14], [99, 99]);
             assert_eq!(LeafPool::points(&slots, a), &pa[..]);
@@ -394,8 +423,8 @@ mod tests {
         // pool returned.
         unsafe {
             for i in 0..3u32 {
-                pool.reserve(&mut slots, a.len).unwrap();
-                a = pool.push(&slots, a, [i, i], Some(u64::from(i) + 1));
+                pool.reserve(&mut slots, None, a.len).unwrap();
+                a = pool.push(&slots, None, a, [i, i], Some(u64::from(i) + 1));
             }
             // Blocks of 1 (epoch 2) and 2 (epoch 3) slots are retired, not free.
             assert_eq!(pool.free_slots(), 3);

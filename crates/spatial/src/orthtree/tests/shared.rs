@@ -211,3 +211,60 @@ fn shared_inserts_ask_the_readers_once_per_epoch() {
         "{slots} slots, {stuck_slots} with a stuck reader"
     );
 }
+
+/// Tags follow their points through block moves, compaction, shared inserts with retired
+/// blocks, and clones: after each, every stored point's tag is its insertion index.
+#[test]
+fn tags_follow_their_points() {
+    let pts = crate::testdata::branching_cluster(20_000, 7);
+    let radius = pts.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs())) + 8.0;
+    let mut t = Orthtree::<2>::new();
+    t.keep_tags().unwrap();
+    assert!(t.keeps_tags());
+    let head = 12_000;
+    let mut stored = Vec::new();
+    for (i, &p) in pts[..head].iter().enumerate() {
+        stored.push(t.insert_tagged(p, i as u32).unwrap());
+    }
+    t.prepare_shared(pts.len() - head, radius).unwrap();
+    for (i, &p) in pts.iter().enumerate().skip(head) {
+        // SAFETY: no other thread reads the tree.
+        #[allow(unsafe_code)]
+        let (q, _) = unsafe { t.insert_shared_tagged(p, i as u32, || u64::MAX) }.unwrap();
+        stored.push(q);
+    }
+    t.finish_shared();
+    let copy = t.clone();
+    for (i, q) in stored.iter().enumerate() {
+        assert_eq!(t.tag_of(q), Some(i as u32), "point {i}");
+        assert_eq!(copy.tag_of(q), Some(i as u32), "point {i} of the clone");
+    }
+    assert_eq!(t.tag_of(&[1e6, 1e6]), None);
+    assert_eq!(t.tag_of(&[stored[5][0] + 0.25, stored[5][1]]), None);
+    // A tree without tags answers none, and keeping tags starts only on an empty tree.
+    let mut plain = Orthtree::<2>::new();
+    let q = plain.insert([0.5, 0.5]).unwrap();
+    assert_eq!(plain.tag_of(&q), None);
+    assert!(matches!(
+        plain.keep_tags(),
+        Err(OrthtreeError::TagsOnNonEmpty)
+    ));
+}
+
+/// Compaction (many leaves outgrowing their blocks with exclusive inserts) keeps the tags
+/// beside their points.
+#[test]
+fn tags_survive_compaction() {
+    let mut t = Orthtree::<2>::with_leaf_side(64.0).unwrap();
+    t.keep_tags().unwrap();
+    let mut rng = Rng::new(3);
+    let mut stored = Vec::new();
+    for i in 0..200_000u32 {
+        let p = [rng.uniform() * 4000.0, rng.uniform() * 4000.0];
+        stored.push(t.insert_tagged(p, i).unwrap());
+    }
+    for (i, q) in stored.iter().enumerate().step_by(7) {
+        assert_eq!(t.tag_of(q), Some(i as u32));
+    }
+    assert!(t.memory_bytes() >= 200_000 * 12);
+}
