@@ -159,6 +159,7 @@ pub fn write_positions(dir: &Path, world: &World, format: PointFormat) -> Result
         attributes: &attributes,
         index: None,
         title: &title,
+        parent: None,
     };
     write_points(dir, "positions", format, &set, &mut |f| {
         for a in world.animats() {

@@ -159,6 +159,7 @@ pub fn write_outputs(
             }],
             index: None,
             title: &title,
+            parent: None,
         };
         write_points(dir, "particles", format, &set, &mut |f| {
             let mut p = vec![0i64; dim];

@@ -53,9 +53,37 @@ fn format_error(path: &Path, why: impl Into<String>) -> NpyError {
     }
 }
 
-/// The [`HEADER_BYTES`] bytes of a `(rows, cols)` array of `<f8`.
-fn header(rows: u64, cols: usize) -> Vec<u8> {
-    header_bytes("<f8", rows, Some(cols))
+/// What an `.npy` file of this module holds: rows of `cols` `f64` (a `(rows, cols)` array
+/// of `<f8`), or one `i64` per row (a `(rows,)` array of `<i8`: indices such as DLA's parents).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Elements {
+    Reals(usize),
+    Ints,
+}
+
+impl Elements {
+    /// Eight-byte values per row.
+    fn cols(self) -> usize {
+        match self {
+            Elements::Reals(c) => c,
+            Elements::Ints => 1,
+        }
+    }
+
+    fn describe(self) -> String {
+        match self {
+            Elements::Reals(c) => format!("{c} columns of f64"),
+            Elements::Ints => "one column of i64".into(),
+        }
+    }
+}
+
+/// The [`HEADER_BYTES`] bytes of an array of `rows` rows of `what`.
+fn header(rows: u64, what: Elements) -> Vec<u8> {
+    match what {
+        Elements::Reals(cols) => header_bytes("<f8", rows, Some(cols)),
+        Elements::Ints => header_bytes("<i8", rows, None),
+    }
 }
 
 /// The [`HEADER_BYTES`] bytes of a C-order array of NumPy type `descr` (`<f8`, `<i8`) with
@@ -77,8 +105,8 @@ pub(crate) fn header_bytes(descr: &str, rows: u64, cols: Option<usize>) -> Vec<u
     h
 }
 
-/// Reads the header of `file`: `(rows, cols)`.
-fn read_header(file: &mut File, path: &Path) -> Result<(u64, usize), NpyError> {
+/// Reads the header of `file`: the rows and what each holds.
+fn read_header(file: &mut File, path: &Path) -> Result<(u64, Elements), NpyError> {
     let mut h = [0u8; HEADER_BYTES as usize];
     file.seek(SeekFrom::Start(0)).map_err(io_error(path))?;
     file.read_exact(&mut h)
@@ -91,10 +119,11 @@ fn read_header(file: &mut File, path: &Path) -> Result<(u64, usize), NpyError> {
     }
     let text =
         std::str::from_utf8(&h[10..]).map_err(|_| format_error(path, "header is not text"))?;
-    if !text.contains("'descr': '<f8'") || !text.contains("'fortran_order': False") {
+    let ints = text.contains("'descr': '<i8'");
+    if !(ints || text.contains("'descr': '<f8'")) || !text.contains("'fortran_order': False") {
         return Err(format_error(
             path,
-            "not a C-ordered array of little-endian f64",
+            "not a C-ordered array of little-endian f64 or i64",
         ));
     }
     let shape = text
@@ -107,15 +136,25 @@ fn read_header(file: &mut File, path: &Path) -> Result<(u64, usize), NpyError> {
         .map(str::trim)
         .filter(|s| !s.is_empty())
         .collect();
-    let (rows, cols) = match dims.as_slice() {
-        [r, c] => match (r.parse::<u64>(), c.parse::<usize>()) {
+    let (rows, cols) = match (dims.as_slice(), ints) {
+        ([r, c], false) => match (r.parse::<u64>(), c.parse::<usize>()) {
             (Ok(r), Ok(c)) if c > 0 => (r, c),
             _ => return Err(format_error(path, format!("bad shape ({shape})"))),
         },
-        _ => {
+        ([r], true) => match r.parse::<u64>() {
+            Ok(r) => (r, 1),
+            _ => return Err(format_error(path, format!("bad shape ({shape})"))),
+        },
+        (_, false) => {
             return Err(format_error(
                 path,
                 format!("shape ({shape}) is not two-dimensional"),
+            ));
+        }
+        (_, true) => {
+            return Err(format_error(
+                path,
+                format!("shape ({shape}) of i64 is not one-dimensional"),
             ));
         }
     };
@@ -128,7 +167,14 @@ fn read_header(file: &mut File, path: &Path) -> Result<(u64, usize), NpyError> {
             format!("shape ({shape}) has more than {MAX_COLS} columns"),
         ));
     }
-    Ok((rows, cols))
+    Ok((
+        rows,
+        if ints {
+            Elements::Ints
+        } else {
+            Elements::Reals(cols)
+        },
+    ))
 }
 
 /// Most columns an `.npy` file this reader opens may have (aggsim writes at most a few).
@@ -139,7 +185,7 @@ pub const MAX_COLS: usize = 1 << 16;
 pub struct NpyWriter {
     path: PathBuf,
     out: BufWriter<File>,
-    cols: usize,
+    what: Elements,
     rows: u64,
 }
 
@@ -149,13 +195,26 @@ impl NpyWriter {
     /// # Errors
     /// The file cannot be created or written.
     pub fn create(path: impl AsRef<Path>, cols: usize) -> Result<Self, NpyError> {
-        let path = path.as_ref().to_path_buf();
+        Self::create_of(path.as_ref(), Elements::Reals(cols))
+    }
+
+    /// A new file at `path` (replacing any) of `i64` values, one per row (a 1-D array),
+    /// holding none yet: append with [`push_int`](Self::push_int).
+    ///
+    /// # Errors
+    /// The file cannot be created or written.
+    pub fn create_ints(path: impl AsRef<Path>) -> Result<Self, NpyError> {
+        Self::create_of(path.as_ref(), Elements::Ints)
+    }
+
+    fn create_of(path: &Path, what: Elements) -> Result<Self, NpyError> {
+        let path = path.to_path_buf();
         let mut file = File::create(&path).map_err(io_error(&path))?;
-        file.write_all(&header(0, cols)).map_err(io_error(&path))?;
+        file.write_all(&header(0, what)).map_err(io_error(&path))?;
         Ok(NpyWriter {
             out: BufWriter::with_capacity(1 << 20, file),
             path,
-            cols,
+            what,
             rows: 0,
         })
     }
@@ -167,15 +226,31 @@ impl NpyWriter {
     /// [`NpyError::Format`] if the file is not an array of `cols` columns holding at least
     /// `rows` rows (counted or not); I/O errors.
     pub fn resume(path: impl AsRef<Path>, cols: usize, rows: u64) -> Result<Self, NpyError> {
-        let path = path.as_ref().to_path_buf();
+        Self::resume_of(path.as_ref(), Elements::Reals(cols), rows)
+    }
+
+    /// [`resume`](Self::resume) of a file of `i64` values ([`create_ints`](Self::create_ints)).
+    ///
+    /// # Errors
+    /// As for [`resume`](Self::resume).
+    pub fn resume_ints(path: impl AsRef<Path>, rows: u64) -> Result<Self, NpyError> {
+        Self::resume_of(path.as_ref(), Elements::Ints, rows)
+    }
+
+    fn resume_of(path: &Path, what: Elements, rows: u64) -> Result<Self, NpyError> {
+        let path = path.to_path_buf();
+        let cols = what.cols();
         let mut file = OpenOptions::new()
             .read(true)
             .write(true)
             .open(&path)
             .map_err(io_error(&path))?;
-        let (_, c) = read_header(&mut file, &path)?;
-        if c != cols {
-            return Err(format_error(&path, format!("{c} columns, not {cols}")));
+        let (_, found) = read_header(&mut file, &path)?;
+        if found != what {
+            return Err(format_error(
+                &path,
+                format!("{}, not {}", found.describe(), what.describe()),
+            ));
         }
         let end = HEADER_BYTES + rows * 8 * cols as u64;
         let len = file.metadata().map_err(io_error(&path))?.len();
@@ -190,15 +265,28 @@ impl NpyWriter {
         }
         file.set_len(end).map_err(io_error(&path))?;
         file.seek(SeekFrom::Start(0)).map_err(io_error(&path))?;
-        file.write_all(&header(rows, cols))
+        file.write_all(&header(rows, what))
             .map_err(io_error(&path))?;
         file.seek(SeekFrom::Start(end)).map_err(io_error(&path))?;
         Ok(NpyWriter {
             out: BufWriter::with_capacity(1 << 20, file),
             path,
-            cols,
+            what,
             rows,
         })
+    }
+
+    /// Appends one value to a file of `i64` ([`create_ints`](Self::create_ints)).
+    ///
+    /// # Errors
+    /// Writing failed.
+    pub fn push_int(&mut self, value: i64) -> Result<(), NpyError> {
+        debug_assert_eq!(self.what, Elements::Ints);
+        self.out
+            .write_all(&value.to_le_bytes())
+            .map_err(io_error(&self.path))?;
+        self.rows += 1;
+        Ok(())
     }
 
     /// Appends one row (`row.len()` must be the column count).
@@ -206,7 +294,7 @@ impl NpyWriter {
     /// # Errors
     /// Writing failed.
     pub fn push(&mut self, row: &[f64]) -> Result<(), NpyError> {
-        debug_assert_eq!(row.len(), self.cols);
+        debug_assert_eq!(self.what, Elements::Reals(row.len()));
         for x in row {
             self.out
                 .write_all(&x.to_le_bytes())
@@ -233,13 +321,13 @@ impl NpyWriter {
     /// Writing failed.
     pub fn sync(&mut self) -> Result<(), NpyError> {
         let rows = self.rows;
-        let cols = self.cols;
+        let what = self.what;
         let path = self.path.clone();
         self.out.flush().map_err(io_error(&path))?;
         let file = self.out.get_mut();
         let end = file.stream_position().map_err(io_error(&path))?;
         file.seek(SeekFrom::Start(0)).map_err(io_error(&path))?;
-        file.write_all(&header(rows, cols))
+        file.write_all(&header(rows, what))
             .map_err(io_error(&path))?;
         file.seek(SeekFrom::Start(end)).map_err(io_error(&path))?;
         file.sync_data().map_err(io_error(&path))?;
@@ -252,7 +340,7 @@ impl NpyWriter {
 pub struct NpyReader {
     path: PathBuf,
     input: BufReader<File>,
-    cols: usize,
+    what: Elements,
     rows: u64,
     read: u64,
 }
@@ -263,21 +351,53 @@ impl NpyReader {
     /// # Errors
     /// [`NpyError::Format`] if it is not an array of `f64` written by [`NpyWriter`].
     pub fn open(path: impl AsRef<Path>) -> Result<Self, NpyError> {
-        let path = path.as_ref().to_path_buf();
+        let r = Self::open_any(path.as_ref())?;
+        match r.what {
+            Elements::Reals(_) => Ok(r),
+            Elements::Ints => Err(format_error(&r.path, "an array of i64, not of f64")),
+        }
+    }
+
+    /// Opens a file of `i64` values, one per row ([`NpyWriter::create_ints`]); read them with
+    /// [`next_int`](Self::next_int).
+    ///
+    /// # Errors
+    /// [`NpyError::Format`] if it is not a 1-D array of `i64` written by [`NpyWriter`].
+    pub fn open_ints(path: impl AsRef<Path>) -> Result<Self, NpyError> {
+        let r = Self::open_any(path.as_ref())?;
+        match r.what {
+            Elements::Ints => Ok(r),
+            Elements::Reals(_) => Err(format_error(&r.path, "an array of f64, not of i64")),
+        }
+    }
+
+    fn open_any(path: &Path) -> Result<Self, NpyError> {
+        let path = path.to_path_buf();
         let mut file = File::open(&path).map_err(io_error(&path))?;
-        let (rows, cols) = read_header(&mut file, &path)?;
+        let (rows, what) = read_header(&mut file, &path)?;
         Ok(NpyReader {
             input: BufReader::with_capacity(1 << 20, file),
             path,
-            cols,
+            what,
             rows,
             read: 0,
         })
     }
 
-    /// Columns per row.
+    /// Columns per row (1 for a file of `i64`).
     pub fn cols(&self) -> usize {
-        self.cols
+        self.what.cols()
+    }
+
+    /// The next of the counted values of a file of `i64` ([`open_ints`](Self::open_ints)),
+    /// `None` after the last.
+    ///
+    /// # Errors
+    /// [`NpyError::Format`] if the file ends before its counted rows.
+    pub fn next_int(&mut self) -> Result<Option<i64>, NpyError> {
+        debug_assert_eq!(self.what, Elements::Ints);
+        let mut x = [0.0];
+        Ok(self.next_row(&mut x)?.then(|| x[0].to_bits() as i64))
     }
 
     /// Rows the header counts.
@@ -303,7 +423,7 @@ impl NpyReader {
     /// # Errors
     /// [`NpyError::Format`] if the file ends inside a row or inside the counted rows.
     pub fn read_beyond(&mut self, row: &mut [f64]) -> Result<bool, NpyError> {
-        debug_assert_eq!(row.len(), self.cols);
+        debug_assert_eq!(row.len(), self.what.cols());
         let mut b = [0u8; 8];
         for (k, x) in row.iter_mut().enumerate() {
             match self.input.read_exact(&mut b) {
@@ -396,6 +516,54 @@ mod tests {
         ));
         assert!(matches!(
             NpyWriter::resume(&path, 3, 1),
+            Err(NpyError::Format { .. })
+        ));
+    }
+
+    #[test]
+    fn ints_round_trip_resume_and_are_told_from_reals() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("positions_parent.npy");
+        let mut w = NpyWriter::create_ints(&path).unwrap();
+        for i in -1..9 {
+            w.push_int(i * 1_000_000_007).unwrap();
+        }
+        w.sync().unwrap();
+        drop(w);
+        let bytes = std::fs::read(&path).unwrap();
+        let text = String::from_utf8_lossy(&bytes[10..HEADER_BYTES as usize]);
+        assert!(
+            text.contains("'descr': '<i8'") && text.contains("'shape': (10,)"),
+            "{text}"
+        );
+        let mut w = NpyWriter::resume_ints(&path, 4).unwrap();
+        w.push_int(i64::MIN).unwrap();
+        w.sync().unwrap();
+        let mut r = NpyReader::open_ints(&path).unwrap();
+        let mut all = Vec::new();
+        while let Some(x) = r.next_int().unwrap() {
+            all.push(x);
+        }
+        assert_eq!(
+            all,
+            vec![-1_000_000_007, 0, 1_000_000_007, 2_000_000_014, i64::MIN]
+        );
+        assert!(matches!(
+            NpyReader::open(&path),
+            Err(NpyError::Format { .. })
+        ));
+        assert!(matches!(
+            NpyWriter::resume(&path, 1, 1),
+            Err(NpyError::Format { .. })
+        ));
+        let reals = dir.path().join("p.npy");
+        NpyWriter::create(&reals, 1).unwrap().sync().unwrap();
+        assert!(matches!(
+            NpyReader::open_ints(&reals),
+            Err(NpyError::Format { .. })
+        ));
+        assert!(matches!(
+            NpyWriter::resume_ints(&reals, 0),
             Err(NpyError::Format { .. })
         ));
     }

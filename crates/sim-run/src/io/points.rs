@@ -113,6 +113,11 @@ pub struct PointSet<'a> {
     pub index: Option<&'a str>,
     /// One line describing the set (VTK title, XYZ comment).
     pub title: &'a str,
+    /// The attribute (an index into `attributes`) holding each point's parent, the index of
+    /// another point or `-1`: VTK then draws each point with a parent as a line cell from
+    /// the parent to it (roots stay vertices), so that ParaView shows the branches; the other
+    /// formats keep it as the attribute it is.
+    pub parent: Option<usize>,
 }
 
 /// One point's coordinates: off-lattice centres or lattice sites.
@@ -126,14 +131,14 @@ pub enum Coords<'a> {
 
 impl Coords<'_> {
     /// Coordinate `i` as a float (0 past the last axis): VTK's points.
-    fn float(&self, i: usize) -> f64 {
+    pub(super) fn float(&self, i: usize) -> f64 {
         match self {
             Coords::Float(p) => p.get(i).copied().unwrap_or(0.0),
             Coords::Int(p) => p.get(i).map_or(0.0, |&x| x as f64),
         }
     }
 
-    fn is_int(&self) -> bool {
+    pub(super) fn is_int(&self) -> bool {
         matches!(self, Coords::Int(_))
     }
 }
@@ -143,7 +148,7 @@ pub type Visitor<'v> =
     dyn FnMut(&mut dyn FnMut(Coords<'_>, &[i64]) -> io::Result<()>) -> Result<(), OutputError> + 'v;
 
 /// The error of a point whose coordinates are not of the kind `set` declares.
-fn kind_error(set: &PointSet<'_>) -> io::Error {
+pub(super) fn kind_error(set: &PointSet<'_>) -> io::Error {
     io::Error::new(
         io::ErrorKind::InvalidData,
         format!(
@@ -262,7 +267,7 @@ pub fn write_points(
                 f.commit()?;
             }
         }
-        PointFormat::Vtk => write_vtk(&path, set, visit)?,
+        PointFormat::Vtk => super::vtk::write_vtk(&path, set, visit)?,
         PointFormat::Xyz => {
             let mut f = AtomicFile::create(&path)?;
             let mut count = 0u64;
@@ -351,93 +356,11 @@ impl NpyFile {
     }
 }
 
-/// Legacy VTK 3.0, binary (big-endian): an `UNSTRUCTURED_GRID` of `POINTS` (float64, z = 0 in
-/// the plane; only the first three axes of a higher-dimensional set) with one vertex cell
-/// (`CELL_TYPES` 1) per point, so that every viewer draws them, and the index and the
-/// attributes as `POINT_DATA` scalars. An unstructured grid rather than `POLYDATA`: the light
-/// readers (meshio) read only unstructured grids.
-fn write_vtk(path: &Path, set: &PointSet<'_>, visit: &mut Visitor<'_>) -> Result<(), OutputError> {
-    let n = set.n;
-    // VTK's legacy cells and scalars are 32-bit.
-    let n32 = i32::try_from(n)
-        .ok()
-        .filter(|_| n <= VTK_MAX_POINTS)
-        .ok_or_else(|| {
-            io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!("{n} points are too many for legacy VTK's 32-bit cells; use npy"),
-            )
-        })?;
-    let mut f = AtomicFile::create(path)?;
-    {
-        let mut b = BufWriter::new(&mut f);
-        let title: String = set.title.chars().filter(|c| *c != '\n').take(255).collect();
-        write!(
-            b,
-            "# vtk DataFile Version 3.0\n{title}\nBINARY\nDATASET UNSTRUCTURED_GRID\n\
-             POINTS {n} double\n"
-        )?;
-        let mut count = 0u64;
-        visit(&mut |p, _| {
-            count += 1;
-            if p.is_int() != set.integer_coordinates {
-                return Err(kind_error(set));
-            }
-            for i in 0..3 {
-                b.write_all(&p.float(i).to_be_bytes())?;
-            }
-            Ok(())
-        })?;
-        if count != n {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidData,
-                format!("{}: {count} points visited, {n} announced", path.display()),
-            )
-            .into());
-        }
-        // Each cell: its point count (1) and its point; then each cell's type, VTK_VERTEX (1).
-        write!(b, "\nCELLS {n} {}\n", 2 * n)?;
-        for i in 0..n32 {
-            b.write_all(&1i32.to_be_bytes())?;
-            b.write_all(&i.to_be_bytes())?;
-        }
-        write!(b, "\nCELL_TYPES {n}\n")?;
-        for _ in 0..n32 {
-            b.write_all(&1i32.to_be_bytes())?;
-        }
-        write!(b, "\nPOINT_DATA {n}\n")?;
-        if let Some(name) = set.index {
-            write!(b, "SCALARS {name} int 1\nLOOKUP_TABLE default\n")?;
-            for i in 0..n32 {
-                b.write_all(&i.to_be_bytes())?;
-            }
-            writeln!(b)?;
-        }
-        for (k, a) in set.attributes.iter().enumerate() {
-            write!(b, "SCALARS {} int 1\nLOOKUP_TABLE default\n", a.name)?;
-            visit(&mut |_, values| {
-                let v = values.get(k).copied().unwrap_or(0);
-                let v = i32::try_from(v).map_err(|_| {
-                    io::Error::new(
-                        io::ErrorKind::InvalidData,
-                        format!("{} = {v} does not fit VTK's 32-bit scalars", a.name),
-                    )
-                })?;
-                b.write_all(&v.to_be_bytes())
-            })?;
-            writeln!(b)?;
-        }
-        b.flush()?;
-    }
-    f.commit()?;
-    Ok(())
-}
-
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    const POINTS: [([f64; 2], [i64; 2]); 3] = [
+    pub(in crate::io) const POINTS: [([f64; 2], [i64; 2]); 3] = [
         ([0.0, 1.5], [0, 7]),
         ([2.0, -1.0], [1, 7]),
         ([3.25, 4.0], [0, 9]),
@@ -454,7 +377,7 @@ mod tests {
         },
     ];
 
-    fn set() -> PointSet<'static> {
+    pub(in crate::io) fn set() -> PointSet<'static> {
         PointSet {
             n: 3,
             axes: &["x", "y"],
@@ -462,10 +385,11 @@ mod tests {
             attributes: &ATTRS,
             index: Some("arrival"),
             title: "three points",
+            parent: None,
         }
     }
 
-    fn write(format: PointFormat, dir: &Path) -> Vec<std::path::PathBuf> {
+    pub(in crate::io) fn write(format: PointFormat, dir: &Path) -> Vec<std::path::PathBuf> {
         write_points(dir, "positions", format, &set(), &mut |f| {
             for (p, a) in &POINTS {
                 f(Coords::Float(p), a)?;
@@ -534,6 +458,7 @@ mod tests {
             attributes: &attributes,
             index: None,
             title: "two sites",
+            parent: None,
         };
         for format in [PointFormat::Npy, PointFormat::Csv, PointFormat::Xyz] {
             write_points(dir.path(), "sites", format, &set, &mut |f| {
@@ -566,42 +491,6 @@ mod tests {
         });
         assert!(r.is_err());
         assert!(!dir.path().join("mixed.npy").exists());
-    }
-
-    #[test]
-    fn vtk_has_points_vertex_cells_and_scalars() {
-        let dir = tempfile::tempdir().unwrap();
-        write(PointFormat::Vtk, dir.path());
-        let bytes = std::fs::read(dir.path().join("positions.vtk")).unwrap();
-        let head = "# vtk DataFile Version 3.0\nthree points\nBINARY\nDATASET UNSTRUCTURED_GRID\n\
-             POINTS 3 double\n";
-        assert!(bytes.starts_with(head.as_bytes()));
-        let at = head.len();
-        let xyz: Vec<f64> = bytes[at..at + 72]
-            .chunks(8)
-            .map(|c| f64::from_be_bytes(c.try_into().unwrap()))
-            .collect();
-        assert_eq!(xyz, [0.0, 1.5, 0.0, 2.0, -1.0, 0.0, 3.25, 4.0, 0.0]);
-        let rest = &bytes[at + 72..];
-        let find = |s: &str| {
-            rest.windows(s.len())
-                .position(|w| w == s.as_bytes())
-                .unwrap_or_else(|| panic!("{s:?} missing"))
-        };
-        let v = find("CELLS 3 6\n") + "CELLS 3 6\n".len();
-        assert_eq!(&rest[v..v + 8], &[0, 0, 0, 1, 0, 0, 0, 0]);
-        let t = find("CELL_TYPES 3\n") + "CELL_TYPES 3\n".len();
-        assert_eq!(&rest[t..t + 12], &[0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1]);
-        find("POINT_DATA 3\n");
-        let c = find("SCALARS cluster int 1\nLOOKUP_TABLE default\n")
-            + "SCALARS cluster int 1\nLOOKUP_TABLE default\n".len();
-        let ids: Vec<i32> = rest[c..c + 12]
-            .chunks(4)
-            .map(|b| i32::from_be_bytes(b.try_into().unwrap()))
-            .collect();
-        assert_eq!(ids, [7, 7, 9]);
-        find("SCALARS arrival int 1\n");
-        find("SCALARS species int 1\n");
     }
 
     #[test]
