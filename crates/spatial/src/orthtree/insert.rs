@@ -6,7 +6,7 @@
 //! grows, so a point's stored position does not depend on insertion order; every node lies on
 //! the path to at least one stored point.
 
-use super::arena::slow_growth;
+use super::arena::{Arena, slow_growth};
 use super::pool::LeafPool;
 use super::sync::{AtomicU32, AtomicU64, Ordering, increment_mut};
 use super::{
@@ -521,6 +521,34 @@ impl<const D: usize> Orthtree<D> {
     pub fn stored_position(&self, p: &[f64; D]) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(p)?;
         Ok(self.decoded(&k, &code))
+    }
+
+    /// Makes the tree keep a 32-bit tag with every point from now on (4 bytes per point
+    /// slot), given at insertion ([`insert_tagged`](Self::insert_tagged),
+    /// [`insert_shared_tagged`](Self::insert_shared_tagged)) and looked up by stored position
+    /// ([`tag_of`](Self::tag_of)): DLA tags each particle with its arrival index, so that the
+    /// particle a walker touched names its parent. Queries never read the tags, so they cost
+    /// nothing there. Only an empty tree can start keeping tags (else
+    /// [`OrthtreeError::TagsOnNonEmpty`]); points inserted untagged get tag 0.
+    pub fn keep_tags(&mut self) -> Result<(), OrthtreeError> {
+        if !self.is_empty() {
+            return Err(OrthtreeError::TagsOnNonEmpty);
+        }
+        if self.tags.is_none() {
+            // An empty tree's pool holds no slot (points are never removed), so there is no
+            // tag to write.
+            debug_assert_eq!(Self::writer_mut(&mut self.shared).pool.len, 0);
+            let mut tags = Arena::new();
+            tags.try_set_capacity(0, self.slots.capacity())
+                .map_err(|e| OrthtreeError::OutOfMemory { bytes: e.bytes })?;
+            self.tags = Some(tags);
+        }
+        Ok(())
+    }
+
+    /// Whether the tree keeps tags ([`keep_tags`](Self::keep_tags)).
+    pub fn keeps_tags(&self) -> bool {
+        self.tags.is_some()
     }
 
     /// The tag of the point stored at `q` (a stored position, as an insert or a query
