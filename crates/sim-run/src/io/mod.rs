@@ -26,7 +26,6 @@ pub mod npy;
 pub mod points;
 pub mod provenance;
 pub mod table;
-mod vtk;
 
 pub use atomic::{AtomicFile, remove_stale_temporaries, write_atomic};
 pub use bytes::{parse_bytes, show_bytes};

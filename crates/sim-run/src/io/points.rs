@@ -21,6 +21,8 @@ use super::{CsvField, CsvWriter, OutputError};
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
+mod vtk;
+
 /// A positions file format (`--positions`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
@@ -131,14 +133,14 @@ pub enum Coords<'a> {
 
 impl Coords<'_> {
     /// Coordinate `i` as a float (0 past the last axis): VTK's points.
-    pub(super) fn float(&self, i: usize) -> f64 {
+    fn float(&self, i: usize) -> f64 {
         match self {
             Coords::Float(p) => p.get(i).copied().unwrap_or(0.0),
             Coords::Int(p) => p.get(i).map_or(0.0, |&x| x as f64),
         }
     }
 
-    pub(super) fn is_int(&self) -> bool {
+    fn is_int(&self) -> bool {
         matches!(self, Coords::Int(_))
     }
 }
@@ -148,7 +150,7 @@ pub type Visitor<'v> =
     dyn FnMut(&mut dyn FnMut(Coords<'_>, &[i64]) -> io::Result<()>) -> Result<(), OutputError> + 'v;
 
 /// The error of a point whose coordinates are not of the kind `set` declares.
-pub(super) fn kind_error(set: &PointSet<'_>) -> io::Error {
+fn kind_error(set: &PointSet<'_>) -> io::Error {
     io::Error::new(
         io::ErrorKind::InvalidData,
         format!(
@@ -267,7 +269,7 @@ pub fn write_points(
                 f.commit()?;
             }
         }
-        PointFormat::Vtk => super::vtk::write_vtk(&path, set, visit)?,
+        PointFormat::Vtk => vtk::write_vtk(&path, set, visit)?,
         PointFormat::Xyz => {
             let mut f = AtomicFile::create(&path)?;
             let mut count = 0u64;
@@ -360,7 +362,7 @@ impl NpyFile {
 pub(super) mod tests {
     use super::*;
 
-    pub(in crate::io) const POINTS: [([f64; 2], [i64; 2]); 3] = [
+    pub(super) const POINTS: [([f64; 2], [i64; 2]); 3] = [
         ([0.0, 1.5], [0, 7]),
         ([2.0, -1.0], [1, 7]),
         ([3.25, 4.0], [0, 9]),
@@ -377,7 +379,7 @@ pub(super) mod tests {
         },
     ];
 
-    pub(in crate::io) fn set() -> PointSet<'static> {
+    pub(super) fn set() -> PointSet<'static> {
         PointSet {
             n: 3,
             axes: &["x", "y"],
@@ -389,7 +391,7 @@ pub(super) mod tests {
         }
     }
 
-    pub(in crate::io) fn write(format: PointFormat, dir: &Path) -> Vec<std::path::PathBuf> {
+    pub(super) fn write(format: PointFormat, dir: &Path) -> Vec<std::path::PathBuf> {
         write_points(dir, "positions", format, &set(), &mut |f| {
             for (p, a) in &POINTS {
                 f(Coords::Float(p), a)?;

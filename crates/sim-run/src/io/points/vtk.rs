@@ -1,10 +1,10 @@
-//! Legacy VTK 3.0 point sets ([`super::points`]'s `vtk` format): binary (big-endian), an
+//! Legacy VTK 3.0 point sets (the `vtk` format of [`super`]): binary (big-endian), an
 //! `UNSTRUCTURED_GRID` of the points with one cell per point (a vertex, or with parents a line
 //! to the parent) and the index and attributes as point scalars.
 
-use super::OutputError;
-use super::atomic::AtomicFile;
-use super::points::{PointSet, VTK_MAX_POINTS, Visitor, kind_error};
+use super::{PointSet, VTK_MAX_POINTS, Visitor, kind_error};
+use crate::io::OutputError;
+use crate::io::atomic::AtomicFile;
 use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
@@ -160,8 +160,8 @@ fn write_vtk_links(
 
 #[cfg(test)]
 mod tests {
-    use super::super::points::tests::{POINTS, set, write};
-    use super::super::points::{PointFormat, write_points};
+    use super::super::tests::{POINTS, set, write};
+    use super::super::{Coords, PointFormat, write_points};
 
     #[test]
     fn vtk_has_points_vertex_cells_and_scalars() {
@@ -208,7 +208,7 @@ mod tests {
         let parents = [-1i64, 0, 1];
         write_points(dir.path(), "positions", PointFormat::Vtk, &s, &mut |f| {
             for ((p, a), parent) in POINTS.iter().zip(parents) {
-                f(super::super::points::Coords::Float(p), &[a[0], parent])?;
+                f(Coords::Float(p), &[a[0], parent])?;
             }
             Ok(())
         })
@@ -232,7 +232,7 @@ mod tests {
         // A parent that names no point is refused.
         let e = write_points(dir.path(), "positions", PointFormat::Vtk, &s, &mut |f| {
             for (p, a) in &POINTS {
-                f(super::super::points::Coords::Float(p), &[a[0], 5])?;
+                f(Coords::Float(p), &[a[0], 5])?;
             }
             Ok(())
         });
