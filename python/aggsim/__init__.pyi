@@ -44,6 +44,18 @@ class DlaResult:
 
     positions: npt.NDArray[np.float64]
     """float64 (N, D): centres in arrival order, seed particle first."""
+    parent: Optional[npt.NDArray[np.int64]]
+    """int64 (N,): the arrival index of the particle each one stuck to, -1 for the seed."""
+    branches: Optional[Dict[str, npt.NDArray[Any]]]
+    """``branches.csv``'s columns per Horton-Strahler order: ``order``, ``branches``,
+    ``particles`` (uint64), ``mean_length``, ``bifurcation_ratio``, ``length_ratio`` (float64,
+    NaN at the highest order)."""
+    strahler_order: int
+    trees: int
+    bifurcation_ratio: Optional[float]
+    """R_B fitted over the middle orders (None when the cluster has too few)."""
+    length_ratio: Optional[float]
+    ratio_fit_orders: Optional[List[int]]
     growth: Dict[str, npt.NDArray[Any]]
     """``growth.csv``'s columns: ``n`` (uint64), ``radius_of_gyration``, ``r_ext``,
     ``seconds`` (float64) per growth sample."""

@@ -7,7 +7,8 @@ use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error
 use crate::declared::set_keywords;
 use crate::run::{Progress, interruptible, interruptible_guarded};
 use dla_pdla::params::PARAMS;
-use dla_pdla::sim::{GROWTH, POSITIONS_FILE};
+use dla_pdla::branches::Branches;
+use dla_pdla::sim::{GROWTH, PARENTS_FILE, POSITIONS_FILE};
 use dla_pdla::{Dim, Params, SimError, Simulation, Space};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
@@ -34,6 +35,17 @@ const PARTICLES: u64 = 100_000;
 /// positions : numpy.ndarray
 ///     float64, shape (N, D): every particle's centre in arrival order (the seed particle
 ///     first, at the origin); diameters are 1.
+/// parent : numpy.ndarray or None
+///     int64, shape (N,): the arrival index of the particle each one stuck to, -1 for the
+///     seed, as the binary's ``positions_parent.npy`` (None for a run resumed from a
+///     checkpoint that recorded no parents).
+/// branches : dict[str, numpy.ndarray] or None
+///     The Horton-Strahler analysis of ``parent``, as the binary's ``branches.csv``: per
+///     order ``order``, ``branches`` (N_k), ``particles`` (uint64), ``mean_length``
+///     (float64, particles per branch), ``bifurcation_ratio`` and ``length_ratio`` (float64,
+///     NaN at the highest order); the fitted ``bifurcation_ratio``,
+///     ``length_ratio``, ``strahler_order``, ``trees`` and ``ratio_fit_orders`` are results
+///     of ``run.json`` (below).
 /// growth : dict[str, numpy.ndarray]
 ///     The growth samples (200 log-spaced sizes per decade and the final size), as the
 ///     binary's ``growth.csv``, same names and dtypes: ``n`` (uint64, particles),
@@ -241,8 +253,9 @@ pub fn dla(
         dim,
         particles: count(PARAMS, "particles", particles)?,
         threads: count::<u64>(PARAMS, "threads", threads)? as usize,
-        // The positions are returned.
+        // The positions are returned, each particle's parent with them.
         keep_positions: true,
+        connectivity: true,
         ..defaults()
     };
     let given = set_keywords(&mut p, PARAMS, "dla", POSITIONAL, params)?;
@@ -345,29 +358,59 @@ where
         .add(py, "r_ext", samples.iter().map(|s| s.r_ext).collect())
         .add(py, "seconds", samples.iter().map(|s| s.seconds).collect())
         .into_dict(py)?;
-    let positions = match (sim.positions().is_some(), checkpoint) {
+    let mut m = m;
+    let links = sim.params().connectivity;
+    let (positions, parents) = match (sim.positions().is_some(), checkpoint) {
         (false, Some(ck)) => {
-            let mut v = Vec::with_capacity(usize::try_from(sim.particles()).unwrap_or(0));
-            dla_pdla::sim::each_position(&sim, &ck.dir, |_, p| {
+            let n = usize::try_from(sim.particles()).unwrap_or(0);
+            let mut v = Vec::with_capacity(n);
+            let mut up = Vec::with_capacity(if links { n } else { 0 });
+            dla_pdla::sim::each_particle(&sim, &ck.dir, |_, p, parent| {
                 v.push(*p);
+                up.extend(parent);
                 Ok(())
             })
             .map_err(run_error)?;
-            v
+            // Read from the files: the manifest could not analyse them.
+            if links {
+                let b = Branches::from_parents(&up).map_err(run_error)?;
+                dla_pdla::output::set_branch_results(&mut m, &b);
+            }
+            (v, links.then_some(up))
         }
-        _ => sim
-            .into_positions()
-            .ok_or_else(|| run_error("the positions were not kept"))?,
+        _ => {
+            let (v, up) = sim.into_positions_and_parents();
+            (v.ok_or_else(|| run_error("the positions were not kept"))?, up)
+        }
     };
     // The run is over (its streams closed): what only the checkpoint needed goes.
     if let Some(ck) = checkpoint {
-        ck.remove(&[POSITIONS_FILE, GROWTH.file])?;
+        ck.remove(&[POSITIONS_FILE, PARENTS_FILE, GROWTH.file])?;
     }
+    let branches = match &parents {
+        Some(up) => {
+            let b = Branches::from_parents(up).map_err(run_error)?;
+            let col = |f: &dyn Fn(&dla_pdla::branches::Order) -> u64| b.orders.iter().map(f).collect();
+            Some(
+                Columns::default()
+                    .add(py, "order", col(&|o| u64::from(o.order)))
+                    .add(py, "branches", col(&|o| o.branches))
+                    .add(py, "particles", col(&|o| o.particles))
+                    .add(py, "mean_length", b.orders.iter().map(|o| o.mean_length()).collect())
+                    .add(py, "bifurcation_ratio", b.ratios().iter().map(|r| r.0.unwrap_or(f64::NAN)).collect())
+                    .add(py, "length_ratio", b.ratios().iter().map(|r| r.1.unwrap_or(f64::NAN)).collect())
+                    .into_dict(py)?,
+            )
+        }
+        None => None,
+    };
     // `Vec<[f64; D]>` becomes an (N, D) array and NumPy takes it over: no copy.
     let positions = Array2::from(positions).into_pyarray(py);
     let out = Bound::new(py, DlaResult {})?;
     set_manifest(out.as_any(), &m)?;
     out.setattr("positions", positions)?;
+    out.setattr("parent", parents.map(|up| up.into_pyarray(py)))?;
+    out.setattr("branches", branches)?;
     out.setattr("growth", growth)?;
     Ok(out.unbind())
 }
@@ -384,7 +427,7 @@ where
     let differ = differences(
         serde_json::to_value(sim.params()),
         serde_json::to_value(params),
-        &[("keep_positions", None)],
+        &[("keep_positions", None), ("connectivity", None)],
     );
     ck.check_same(differ, (sim.seed(), seed))?;
     Ok(sim)

@@ -29,6 +29,34 @@ def test_dla_arrays(dim):
     assert isinstance(r.run_json, dict) and r.run_json["model"] == "dla"
 
 
+def test_dla_parents_form_a_tree_of_touching_particles():
+    r = aggsim.dla(particles=20_000, seed=4)
+    p = r.parent
+    assert p.dtype == np.int64 and p.shape == (20_000,)
+    assert p[0] == -1 and np.all(p[1:] >= 0) and np.all(p[1:] < np.arange(1, 20_000))
+    d = np.linalg.norm(r.positions[1:] - r.positions[p[1:]], axis=1)
+    np.testing.assert_allclose(d, 1.0, atol=1e-8)
+    b = r.branches
+    assert list(b) == [
+        "order", "branches", "particles", "mean_length", "bifurcation_ratio", "length_ratio",
+    ]
+    assert b["order"][-1] == r.strahler_order and b["particles"].sum() == 20_000
+    assert np.isnan(b["bifurcation_ratio"][-1])
+    np.testing.assert_allclose(b["bifurcation_ratio"][:-1], b["branches"][:-1] / b["branches"][1:])
+    assert r.trees == 1 and 4.0 < r.bifurcation_ratio < 6.5
+
+
+def test_a_resumed_dla_keeps_its_parents(tmp_path, monkeypatch):
+    from test_checkpoint import SMALL, stopped_at_start
+
+    stopped_at_start("dla", SMALL["dla"], tmp_path, monkeypatch)
+    resumed = aggsim.dla(checkpoint=tmp_path, **SMALL["dla"])
+    whole = aggsim.dla(**SMALL["dla"])
+    np.testing.assert_array_equal(resumed.parent, whole.parent)
+    assert resumed.bifurcation_ratio == whole.bifurcation_ratio
+    assert not (tmp_path / "positions_parent.npy").exists()
+
+
 def test_dlca_arrays():
     r = aggsim.dlca(size=[40, 30], particles=100, seed=2, target_clusters=10, gyration=True)
     assert r.positions.shape == (100, 2) and r.positions.dtype == np.int64

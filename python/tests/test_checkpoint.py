@@ -29,7 +29,7 @@ SMALL = {
 }
 # What a run leaves in DIR while it can be continued.
 FILES = {
-    "dla": {"checkpoint.bin", "positions.npy", "growth.csv"},
+    "dla": {"checkpoint.bin", "positions.npy", "positions_parent.npy", "growth.csv"},
     "dlca": {"checkpoint.bin"},
     "animat": {"checkpoint.bin"},
 }

@@ -37,7 +37,8 @@ def parse(text, column):
         bad = [t for t in text if not INTEGER.fullmatch(t)]
         assert not bad, f"{column['name']}: {bad[:3]} are not integers"
         return np.array([int(t) for t in text], dtype=dtype)
-    return np.array([float(t) for t in text], dtype=dtype)
+    # An empty field is a value that does not exist (NaN in Python).
+    return np.array([float(t) if t else np.nan for t in text], dtype=dtype)
 
 
 def axes(form, dim):

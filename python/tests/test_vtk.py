@@ -14,9 +14,18 @@ def test_dla_vtk_reads_with_meshio_and_matches_the_npy(cli):
     assert mesh.points.shape == (300, 3)
     np.testing.assert_array_equal(mesh.points[:, :2], xy)
     assert np.all(mesh.points[:, 2] == 0.0)
-    assert [c.type for c in mesh.cells] == ["vertex"]
-    assert len(mesh.cells[0].data) == 300
+    # The seed is a vertex; every other particle a line from its parent to it.
+    parent = np.load(out / "positions_parent.npy")
+    assert [c.type for c in mesh.cells] == ["vertex", "line"]
+    np.testing.assert_array_equal(mesh.cells[0].data.ravel(), [0])
+    lines = mesh.cells[1].data
+    np.testing.assert_array_equal(lines[:, 1], np.arange(1, 300))
+    np.testing.assert_array_equal(lines[:, 0], parent[1:])
     np.testing.assert_array_equal(mesh.point_data["arrival"].ravel(), np.arange(300))
+    np.testing.assert_array_equal(mesh.point_data["parent"].ravel(), parent)
+    # Each line joins touching particles.
+    d = np.linalg.norm(xy[lines[:, 1]] - xy[lines[:, 0]], axis=1)
+    np.testing.assert_allclose(d, 1.0, atol=1e-8)
 
 
 @pytest.mark.parametrize(

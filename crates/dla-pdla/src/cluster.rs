@@ -94,8 +94,12 @@ impl<const D: usize> Cluster<D> {
     where
         Dim<D>: Space<D>,
     {
+        let mut tree = Orthtree::with_leaf_side(params.leaf_side)?;
+        if params.connectivity {
+            tree.keep_tags()?;
+        }
         Ok(Cluster {
-            tree: Orthtree::with_leaf_side(params.leaf_side)?,
+            tree,
             maps: Arc::new(if params.distance_map {
                 Maps::new(
                     Dim::<D>::SPARSE_LEVEL
@@ -117,7 +121,23 @@ impl<const D: usize> Cluster<D> {
     /// orthtree's fixed-point rounding of `p`, which is what the maps and every observable
     /// see). With shared maps they are updated through [`update_maps`](Self::update_maps).
     pub fn insert(&mut self, p: [f64; D]) -> Result<[f64; D], SimError> {
-        self.insert_beside(p, None)
+        self.insert_beside(p, None, 0)
+    }
+
+    /// The parent of a particle that stuck to the stored particle `touched`: its arrival
+    /// index (the tree's tag), or `-1` for a particle that touched none (the seed, or one
+    /// rebuilt from a log). `None` without `connectivity` (the tree keeps no tags).
+    pub fn parent_of(&self, touched: Option<&[f64; D]>) -> Result<Option<i64>, SimError> {
+        if !self.tree.keeps_tags() {
+            return Ok(None);
+        }
+        match touched {
+            None => Ok(Some(-1)),
+            Some(t) => match self.tree.tag_of(t) {
+                Some(tag) => Ok(Some(i64::from(tag))),
+                None => Err(SimError::ParentUnknown(format!("{t:?}"))),
+            },
+        }
     }
 
     /// [`insert`](Self::insert) of a particle that stuck to the stored particle `touched`: the
@@ -125,14 +145,15 @@ impl<const D: usize> Cluster<D> {
     /// ones it can lower (the maps end up byte for byte as with [`insert`](Self::insert);
     /// [`spatial::distmap::DistanceMap::insert_beside`]). That holds at any distance between
     /// the two (at distance 1, or `noise_reduction` with it below 1; below 1/2 the maps
-    /// visit every cell).
+    /// visit every cell). `index`: its arrival index, kept with `connectivity`.
     pub fn insert_beside(
         &mut self,
         p: [f64; D],
         touched: Option<&[f64; D]>,
+        index: u32,
     ) -> Result<[f64; D], SimError> {
         let leaves = self.tree.leaf_count();
-        let q = self.tree.insert(p)?;
+        let q = self.tree.insert_tagged(p, index)?;
         let new_leaf = self.tree.leaf_count() > leaves;
         let (lo, hi) = self.leaf_box(&q);
         match Arc::get_mut(&mut self.maps) {

@@ -32,6 +32,11 @@ pub enum SimError {
     /// file).
     #[error("{0}")]
     Stream(String),
+    /// With `connectivity`, the particle a walker touched is not in the tree: a broken
+    /// invariant (the contact query returns stored positions), reported rather than
+    /// recorded as a wrong parent.
+    #[error("the particle touched at {0} is not stored; its parent cannot be named")]
+    ParentUnknown(String),
     /// PDLA discarded [`MAX_CONSECUTIVE_DISCARDS`](crate::sim::MAX_CONSECUTIVE_DISCARDS)
     /// walkers in a row without storing one.
     #[error(

@@ -34,6 +34,7 @@
 //! # Ok::<(), dla_pdla::SimError>(())
 //! ```
 
+pub mod branches;
 pub mod cluster;
 pub mod error;
 pub mod farfield;

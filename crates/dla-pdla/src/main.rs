@@ -129,6 +129,12 @@ fn params(cli: &Cli) -> Result<Params, String> {
     // Flags that would be silently ignored are refused too.
     p.validate_given(cli.params.given("death_ratio"))
         .map_err(|e| e.to_string())?;
+    // Wherever the positions stream, each particle's parent goes with them: into the
+    // positions files, and to resume with.
+    let p = Params {
+        connectivity: streams_positions(cli),
+        ..p
+    };
     if p.dim > 3 && matches!(cli.positions, PositionsFormat::Xyz | PositionsFormat::Vtk) {
         return Err(format!(
             "--positions {} holds three coordinates, not the {} of --dim {}; use npy, csv or bin",
@@ -157,6 +163,21 @@ fn params(cli: &Cli) -> Result<Params, String> {
     check_memory(cli, &p)?;
     sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
+}
+
+/// Whether the run's outputs need the positions (files, pictures, or checkpoints every N
+/// particles, which are kept).
+fn asked_positions(cli: &Cli) -> bool {
+    cli.png
+        || cli.animate
+        || cli.positions != PositionsFormat::None
+        || cli.checkpoint_every.is_some()
+}
+
+/// Whether the positions stream to positions.npy: when asked for, and for the checkpoints,
+/// which refer to them; a run that ends normally removes what was not asked for.
+fn streams_positions(cli: &Cli) -> bool {
+    asked_positions(cli) || cli.checkpoints.enabled()
 }
 
 /// Refuses a run whose estimated peak memory (the cluster, and the picture's buffers with
@@ -201,7 +222,18 @@ where
     let sim = Simulation::<D>::resume(dir, Some(params.particles))
         .map_err(|e| usage(format!("--resume {}: {e}", dir.display())))?;
     // --particles may grow (checked by `resume`).
-    let mut differ = flag_differences(sim.params(), params, &[("keep_positions", None)]);
+    // `connectivity` follows the positions' streaming; a resumed run records parents as the
+    // checkpointed one did (it cannot name the parents of the particles already stored).
+    let mut differ = flag_differences(
+        sim.params(),
+        params,
+        &[("keep_positions", None), ("connectivity", None)],
+    );
+    if params.connectivity && !sim.params().connectivity {
+        tracing::warn!(
+            "the checkpointed run recorded no parents (an earlier version, or --no-checkpoint): the outputs have none"
+        );
+    }
     if sim.seed() != seed {
         differ.push(format!(
             "--seed {} in the checkpoint, {seed} given",
@@ -221,7 +253,15 @@ where
 
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
 /// earlier run's and what --overwrite deletes.
-const RUN_FILES: &[&str] = &["growth.csv", "positions.*", "dla.png", "dla.gif"];
+const RUN_FILES: &[&str] = &[
+    "growth.csv",
+    "positions.*",
+    "positions_parent.npy",
+    "branches.csv",
+    "branches.png",
+    "dla.png",
+    "dla.gif",
+];
 
 /// What an ensemble (`--seeds`) averages over its members.
 const CURVES: &[Curve] = &[Curve {
@@ -289,12 +329,7 @@ where
     // The effective flags, so that `--config OUT/config.toml` repeats the run.
     sim_run::cli::config::save(&cli.out)
         .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
-    // The positions stream to positions.npy when asked for, and for the checkpoints, which
-    // refer to them; a run that ends normally removes what was not asked for.
-    let asked_positions = cli.png
-        || cli.animate
-        || cli.positions != PositionsFormat::None
-        || cli.checkpoint_every.is_some();
+    let asked_positions = asked_positions(cli);
     let checkpoints = cli.checkpoints.enabled();
     if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {
         tracing::warn!(
@@ -304,7 +339,7 @@ where
             total * 8 * D as u64 / 1_000_000_000
         );
     }
-    sim.stream_into(&cli.out, asked_positions || checkpoints)?;
+    sim.stream_into(&cli.out, streams_positions(cli))?;
     let progress = cli
         .log
         .progress("dla", total, "particles", PROGRESS_TEMPLATE);

@@ -20,20 +20,21 @@ use crate::sim::{GROWTH, GROWTH_COLUMNS, Simulation};
 use crate::space::{Dim, Space};
 use serde_json::json;
 use sim_run::io::{
-    AtomicFile, Coords, CsvWriter, PointFormat, PointSet, ProcessUsage, RunClock, RunManifest,
-    write_points,
+    AtomicFile, Attribute, Coords, CsvWriter, PointFormat, PointSet, ProcessUsage, RunClock,
+    RunManifest, write_points,
 };
 use std::io::Write;
 use std::path::Path;
 
-pub use crate::sim::each_position;
+pub use crate::sim::{each_particle, each_position};
 pub use sim_run::io::OutputError;
-use sim_run::schema::{Axes, Dtype, Form, Output};
+use sim_run::schema::{Axes, Column, Dtype, Form, Output};
 
 /// Every output of `dla` with its columns, names, dtypes and units (`docs/outputs.md`; see
 /// [`sim_run::schema`]).
 pub const SCHEMA: &[Output] = &[
     GROWTH,
+    crate::branches::BRANCHES,
     Output {
         file: "positions",
         form: Form::Points {
@@ -43,7 +44,11 @@ pub const SCHEMA: &[Output] = &[
         },
         python: "positions",
         when: Some("--positions"),
-        columns: &[],
+        columns: &[Column::new(
+            "parent",
+            Dtype::Int64,
+            "arrival index of the particle it stuck to (-1: the seed)",
+        )],
     },
 ];
 
@@ -139,16 +144,25 @@ where
                 sim.particles(),
                 sim.seed()
             );
+            let links = sim.params().connectivity;
+            let parent = [Attribute {
+                name: "parent",
+                labels: None,
+            }];
             let set = PointSet {
                 n: sim.particles(),
                 axes: &Dim::<D>::AXES,
                 integer_coordinates: false,
-                attributes: &[],
+                attributes: if links { &parent } else { &[] },
                 index: Some("arrival"),
                 title: &title,
+                parent: links.then_some(0),
             };
             write_points(dir, "positions", format, &set, &mut |f| {
-                each_position(sim, dir, |_, p: &[f64; D]| Ok(f(Coords::Float(p), &[])?))
+                each_particle(sim, dir, |_, p: &[f64; D], parent| match parent {
+                    Some(k) => Ok(f(Coords::Float(p), &[k])?),
+                    None => Ok(f(Coords::Float(p), &[])?),
+                })
             })?;
         }
     }
@@ -156,8 +170,19 @@ where
     if let Some(side) = png {
         crate::picture::write_png(sim, dir, &dir.join("dla.png"), side)?;
     }
+    let branches = branches_of(sim, dir)?;
+    if let Some(b) = &branches {
+        crate::branches::write_csv(b, dir)?;
+        #[cfg(feature = "figures")]
+        if png.is_some() {
+            crate::branches::write_png(b, sim.particles(), sim.seed(), &dir.join("branches.png"))?;
+        }
+    }
 
     let mut m = manifest_with_peak(sim, clock, simulation_peak)?;
+    if let Some(b) = &branches {
+        set_branch_results(&mut m, b);
+    }
     // The high-water mark now covers the output stage too.
     m.set_result("output_peak_rss_bytes", m.peak_rss_bytes);
     m.write(dir)?;
@@ -182,7 +207,46 @@ where
     let mut m = manifest_with_peak(sim, clock, peak)?;
     // No output stage ran.
     m.set_result("output_peak_rss_bytes", serde_json::Value::Null);
+    if let Some(parents) = sim.parents() {
+        let b = crate::branches::Branches::from_parents(parents)
+            .map_err(|e| std::io::Error::other(e.to_string()))?;
+        set_branch_results(&mut m, &b);
+    }
     Ok(m)
+}
+
+/// The Horton-Strahler analysis of a run with `connectivity`, from the parents kept in memory
+/// or in `positions_parent.npy` in `dir` (read from its end in blocks: 1 byte a particle);
+/// `None` without connectivity.
+pub fn branches_of<const D: usize>(
+    sim: &Simulation<D>,
+    dir: &Path,
+) -> Result<Option<crate::branches::Branches>, OutputError> {
+    if !sim.params().connectivity {
+        return Ok(None);
+    }
+    let b = match sim.parents() {
+        Some(parents) => {
+            crate::branches::Branches::from_parents(parents).map_err(|e| e.to_string())
+        }
+        None => crate::branches::Branches::from_npy(
+            &dir.join(crate::sim::PARENTS_FILE),
+            sim.particles(),
+        ),
+    };
+    b.map(Some)
+        .map_err(|e| OutputError::from(std::io::Error::other(e)))
+}
+
+/// The branch analysis's results in `run.json`: the highest Horton-Strahler order, the trees,
+/// and the fitted bifurcation and length ratios (null when the cluster has too few orders).
+pub fn set_branch_results(m: &mut RunManifest, b: &crate::branches::Branches) {
+    let range = b.fit_orders().map(|r| json!([r.start(), r.end()]));
+    m.set_result("strahler_order", b.max_order())
+        .set_result("trees", b.trees)
+        .set_result("bifurcation_ratio", b.bifurcation_ratio())
+        .set_result("length_ratio", b.length_ratio())
+        .set_result("ratio_fit_orders", range);
 }
 
 /// [`manifest`] with the simulation's peak resident memory measured before the output stage
@@ -243,7 +307,8 @@ where
 }
 
 /// `positions.bin`: little-endian; the 8 bytes `DLAPOS01`, `u32` dimension `D`, `u64` count
-/// `N`, then `N * D` `f64` coordinates, particle by particle in arrival order.
+/// `N`, then `N * D` `f64` coordinates, particle by particle in arrival order. With
+/// `connectivity` the magic is `DLAPOS02` and `N` `i64` parents follow the coordinates.
 pub fn write_positions_bin<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
@@ -251,7 +316,8 @@ pub fn write_positions_bin<const D: usize>(
     let mut f = AtomicFile::create(dir.join("positions.bin"))?;
     {
         let mut b = std::io::BufWriter::new(&mut f);
-        b.write_all(b"DLAPOS01")?;
+        let links = sim.params().connectivity;
+        b.write_all(if links { b"DLAPOS02" } else { b"DLAPOS01" })?;
         b.write_all(&(D as u32).to_le_bytes())?;
         b.write_all(&sim.particles().to_le_bytes())?;
         each_position(sim, dir, |_, p: &[f64; D]| {
@@ -260,6 +326,12 @@ pub fn write_positions_bin<const D: usize>(
             }
             Ok(())
         })?;
+        if links {
+            each_particle(sim, dir, |_, _, parent| {
+                b.write_all(&parent.unwrap_or(-1).to_le_bytes())?;
+                Ok(())
+            })?;
+        }
         b.flush()?;
     }
     f.commit()?;

@@ -176,6 +176,12 @@ core_lattice::declare_params! {
         /// Costs `8 D` bytes per particle; off by default. Set by the front ends: the binary
         /// streams the positions to a file instead, Python keeps them.
         keep_positions: bool = false,
+        /// Record each stored particle's parent, the particle it stuck to (`-1` for the
+        /// seed): the orthtree keeps every particle's arrival index (4 bytes per particle) to
+        /// name the particle a walker touched. Set by the front ends wherever the positions
+        /// are written or kept, so that the parents go with them; the walk is the same
+        /// either way.
+        connectivity: bool = false,
     }
 }
 
@@ -348,6 +354,11 @@ pub const CHECKPOINT_RESERVE_BYTES: u64 = 16 << 20;
 /// calibration table), tree, distance maps and walkers included; the positions stream to disk.
 pub const PEAK_BYTES_PER_PARTICLE: [u64; 4] = [13, 26, 40, 450];
 
+/// What `connectivity` adds per particle at the peak: the orthtree's 4-byte tag (the arrival
+/// index) while the cluster grows, and at the end the branch analysis's 1-byte order beside
+/// the cluster (it reads the parents from `positions_parent.npy` in blocks).
+pub const CONNECTIVITY_BYTES_PER_PARTICLE: u64 = 5;
+
 /// Peak memory of a run that does not grow with it: the binary, its libraries, the distance
 /// maps' smallest size, and the 1 MiB buffer of `positions.npy`, which streams for the
 /// checkpoints by default.
@@ -359,9 +370,16 @@ impl Params {
     /// measured peak RSS, within about 1.5 times of it for 1e5 particles and more
     /// (docs/dla.md, "Memory"). The binaries refuse a run whose estimate does not fit the
     /// memory available or `--max-memory`.
+    /// With `connectivity`, [`CONNECTIVITY_BYTES_PER_PARTICLE`] more, and the 1 MiB buffer of
+    /// `positions_parent.npy`.
     pub fn peak_memory_bytes(&self) -> u64 {
-        let per = PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2];
-        PEAK_FIXED_BYTES.saturating_add(self.particles.saturating_mul(per))
+        let (per, fixed) = if self.connectivity {
+            (CONNECTIVITY_BYTES_PER_PARTICLE, 1 << 20)
+        } else {
+            (0, 0)
+        };
+        let per = PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2] + per;
+        (PEAK_FIXED_BYTES + fixed).saturating_add(self.particles.saturating_mul(per))
     }
 
     /// The variable-precision paper's walk (Sosa-Herrera & Rodriguez-Romo, section 3.2), for

@@ -11,7 +11,7 @@ fn run_writes_every_output() {
     for (dim, fmt, file, header) in [
         ("2", "csv", "positions.csv", "x,y"),
         ("3", "csv", "positions.csv", "x,y,z"),
-        ("2", "bin", "positions.bin", "DLAPOS01"),
+        ("2", "bin", "positions.bin", "DLAPOS02"),
         ("3", "xyz", "positions.xyz", "500"),
         ("3", "vtk", "positions.vtk", "# vtk DataFile Version 3.0"),
     ] {
@@ -56,7 +56,8 @@ fn run_writes_every_output() {
         let bytes = std::fs::read(out.join(file)).unwrap();
         assert!(bytes.starts_with(header.as_bytes()), "{file}");
         if fmt == "bin" {
-            assert_eq!(bytes.len(), 8 + 4 + 8 + 500 * 2 * 8);
+            // The coordinates, then the parents (recorded with the positions).
+            assert_eq!(bytes.len(), 8 + 4 + 8 + 500 * 2 * 8 + 500 * 8);
         }
         assert!(out.join("dla.png").exists());
     }
@@ -250,8 +251,9 @@ fn outputs_are_created_with_the_umask_0644_and_0755_under_022() {
         files += 1;
     }
     assert_eq!(
-        files, 7,
-        "run.json, config.toml, growth.csv, positions.npy, positions.csv, dla.png, checkpoint.bin"
+        files, 10,
+        "run.json, config.toml, growth.csv, positions.npy, positions_parent.npy, positions.csv, dla.png, \
+         branches.csv, branches.png, checkpoint.bin"
     );
 }
 

@@ -11,8 +11,11 @@ const DLA: &str = env!("CARGO_BIN_EXE_dla");
 #[test]
 fn a_run_that_cannot_fit_is_refused_and_the_estimate_bounds_the_peak() {
     let tmp = tempfile::tempdir().unwrap();
+    // The binary's default streams the positions for its checkpoints, and the parents with
+    // them.
     let p = Params {
         particles: 300_000,
+        connectivity: true,
         ..Params::default()
     };
     let failures = memory_contract(

@@ -39,6 +39,9 @@ pub const CHECKPOINT_MODEL: &str = "dla";
 pub const CHECKPOINT_FILE: &str = "checkpoint.bin";
 /// File name of the streamed positions (the arrival log) in a run's directory.
 pub const POSITIONS_FILE: &str = "positions.npy";
+/// File name of the streamed parents (with `connectivity`), beside the positions: row `i`
+/// is the arrival index of the particle particle `i` stuck to, `-1` for the seed.
+pub const PARENTS_FILE: &str = "positions_parent.npy";
 
 /// The layout of the payload this version writes: the number that opens it, before the
 /// [`Snapshot`]. Never 2 to 5 (the `dim` that opens the checkpoints written before it).
@@ -121,6 +124,7 @@ impl From<Snapshot<ParamsBeforeVariants>> for Snapshot {
                 near_cache: p.near_cache,
                 sticking_probability: 1.0,
                 noise_reduction: 1.0,
+                connectivity: false,
             }),
             seed: s.seed,
             rng: s.rng,
@@ -301,6 +305,14 @@ where
     if growth.hasher.finish_hex() != snap.state_hash {
         return Err(bad_log("changed while it was read".into()));
     }
+    if params.connectivity {
+        // The rebuild stored each particle with its arrival index as its tag, which is all
+        // the tree needs; the parents themselves are in their own log.
+        let parents = read_parents(&dir.join(PARENTS_FILE), snap.n)?;
+        if let Some(kept) = &mut growth.parents {
+            *kept = parents;
+        }
+    }
     growth.samples = snap.samples;
     growth.next_sample = snap.next_sample;
     growth.last_off_schedule = snap.last_off_schedule;
@@ -324,6 +336,26 @@ where
         growth,
         log,
     })
+}
+
+/// The first `n` parents of the log at `path`, checked to form a tree in arrival order
+/// (row 0 is `-1`, every other row an earlier particle's index or `-1`).
+pub(crate) fn read_parents(path: &Path, n: u64) -> Result<Vec<i64>, SimError> {
+    let bad = |why: String| SimError::CheckpointUsage(format!("{}: {why}", path.display()));
+    let mut r = NpyReader::open_ints(path).map_err(|e| bad(e.to_string()))?;
+    let mut out = Vec::with_capacity(usize::try_from(n).unwrap_or(0));
+    for i in 0..n {
+        match r.next_int().map_err(|e| bad(e.to_string()))? {
+            Some(p) if p >= -1 && p < i as i64 => out.push(p),
+            Some(p) => {
+                return Err(bad(format!(
+                    "row {i} names parent {p}, not an earlier particle"
+                )));
+            }
+            None => return Err(bad(format!("holds {i} parents, the checkpoint needs {n}"))),
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

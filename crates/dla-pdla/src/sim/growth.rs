@@ -75,6 +75,9 @@ pub(crate) fn next_on_schedule(n: u64) -> u64 {
 pub(crate) struct Streams {
     /// `positions.npy`: every stored position, in arrival order.
     pub(crate) positions: Option<NpyWriter>,
+    /// `positions_parent.npy`: every stored particle's parent, beside the positions (with
+    /// `connectivity`).
+    pub(crate) parents: Option<NpyWriter>,
     /// `growth.csv`, a line per sample, flushed as it is taken.
     pub(crate) growth: BufWriter<File>,
     /// The first write error (the run goes on; it is reported at the next checkpoint or at the
@@ -88,12 +91,14 @@ impl Streams {
         dir: &Path,
         samples: &[Sample],
         positions: Option<NpyWriter>,
+        parents: Option<NpyWriter>,
     ) -> std::io::Result<Self> {
         let path = dir.join("growth.csv");
         let file = File::create(&path)
             .map_err(|e| std::io::Error::new(e.kind(), format!("{}: {e}", path.display())))?;
         let mut s = Streams {
             positions,
+            parents,
             growth: BufWriter::new(file),
             error: None,
         };
@@ -125,8 +130,11 @@ impl Streams {
         self.growth
             .flush()
             .map_err(|e| SimError::Stream(e.to_string()))?;
-        if let Some(p) = &mut self.positions {
-            p.sync().map_err(|e| SimError::Stream(e.to_string()))?;
+        for log in [&mut self.positions, &mut self.parents]
+            .into_iter()
+            .flatten()
+        {
+            log.sync().map_err(|e| SimError::Stream(e.to_string()))?;
         }
         Ok(())
     }
@@ -161,6 +169,8 @@ pub(crate) struct Growth<const D: usize> {
     pub(crate) hasher: StateHasher,
     /// Positions in arrival order, if kept.
     pub(crate) positions: Option<Vec<[f64; D]>>,
+    /// Parents in arrival order, if kept (with the positions, and `connectivity`).
+    pub(crate) parents: Option<Vec<i64>>,
     pub(crate) samples: Vec<Sample>,
     /// The particle count of the next scheduled sample.
     pub(crate) next_sample: u64,
@@ -181,6 +191,7 @@ impl<const D: usize> Growth<D> {
             gyration: Gyration::new(),
             hasher: StateHasher::new(),
             positions: params.keep_positions.then(Vec::new),
+            parents: (params.keep_positions && params.connectivity).then(Vec::new),
             samples: Vec::new(),
             next_sample: 1,
             last_off_schedule: false,
@@ -197,13 +208,14 @@ impl<const D: usize> Growth<D> {
         touched: Option<&[f64; D]>,
         target: u64,
     ) -> Result<[f64; D], SimError> {
-        let q = cluster.insert_beside(p, touched)?;
-        self.account(q, target);
+        let parent = cluster.parent_of(touched)?;
+        let q = cluster.insert_beside(p, touched, self.n as u32)?;
+        self.account(q, parent, target);
         Ok(q)
     }
 
-    /// Accounts for a particle already stored at `q`.
-    pub(crate) fn account(&mut self, q: [f64; D], target: u64) {
+    /// Accounts for a particle already stored at `q`, with its parent if recorded.
+    pub(crate) fn account(&mut self, q: [f64; D], parent: Option<i64>, target: u64) {
         self.n += 1;
         self.r_ext = self.r_ext.max(norm(&q));
         self.gyration.push(&q);
@@ -219,6 +231,18 @@ impl<const D: usize> Growth<D> {
             && let Err(e) = log.push(&q)
         {
             s.error = Some(std::io::Error::other(e.to_string()));
+        }
+        if let Some(parent) = parent {
+            if let Some(v) = &mut self.parents {
+                v.push(parent);
+            }
+            if let Some(s) = &mut self.streams
+                && let Some(log) = &mut s.parents
+                && s.error.is_none()
+                && let Err(e) = log.push_int(parent)
+            {
+                s.error = Some(std::io::Error::other(e.to_string()));
+            }
         }
         let scheduled = self.n >= self.next_sample;
         if scheduled || self.n == target {

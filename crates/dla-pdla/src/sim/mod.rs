@@ -15,14 +15,16 @@
 
 mod checkpoint;
 mod growth;
+mod particles;
 mod pdla;
 mod ring;
 mod serial;
 #[cfg(test)]
 mod tests;
 
-pub use self::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_MODEL, POSITIONS_FILE};
+pub use self::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_MODEL, PARENTS_FILE, POSITIONS_FILE};
 pub use self::growth::{GROWTH, GROWTH_COLUMNS, SAMPLES_PER_DECADE, Sample};
+pub use self::particles::{each_particle, each_position};
 pub use self::pdla::{DiscardGuard, MAX_CONSECUTIVE_DISCARDS, OVERLAP_DISTANCE, PURPOSE_PDLA};
 pub use self::serial::PURPOSE_WALK;
 pub use crate::error::SimError;
@@ -293,7 +295,9 @@ where
     /// rows of the last checkpoint, which a resume reads up to): for a run that streamed them
     /// only for its checkpoints and has ended (the binary's default), which then removes the
     /// file, after its outputs and `checkpoint.bin`, with
-    /// [`remove_positions_file`](Self::remove_positions_file). `growth.csv` streams on.
+    /// [`remove_positions_file`](Self::remove_positions_file). `growth.csv` and
+    /// `positions_parent.npy` (a few bytes a particle, which the branch analysis reads) stream on, and
+    /// `positions_parent.npy` goes with `positions.npy`.
     /// Returns whether positions were streamed.
     pub fn discard_positions(&mut self) -> bool {
         self.growth
@@ -310,14 +314,19 @@ where
         let Some(dir) = &self.stream_dir else {
             return Ok(());
         };
-        let path = dir.join(POSITIONS_FILE);
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(SimError::Stream(format!(
-                "removing {}: {e}",
-                path.display()
-            ))),
-            _ => Ok(()),
+        for file in [POSITIONS_FILE, PARENTS_FILE] {
+            let path = dir.join(file);
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(SimError::Stream(format!(
+                        "removing {}: {e}",
+                        path.display()
+                    )));
+                }
+                _ => {}
+            }
         }
+        Ok(())
     }
 
     /// Whether `positions.npy` is being written ([`stream_into`](Self::stream_into) with
@@ -402,6 +411,11 @@ where
     /// none of those sources holds.
     pub fn stream_into(&mut self, dir: &Path, positions: bool) -> Result<(), SimError> {
         let stream_error = |e: &dyn std::fmt::Display| SimError::Stream(e.to_string());
+        let parents = if positions && self.params.connectivity {
+            Some(self.parents_log(dir)?)
+        } else {
+            None
+        };
         let log = if positions {
             let path = dir.join(POSITIONS_FILE);
             let log = match &self.resumed_from {
@@ -445,11 +459,51 @@ where
         } else {
             None
         };
-        self.growth.streams =
-            Some(Streams::open(dir, &self.growth.samples, log).map_err(|e| stream_error(&e))?);
+        self.growth.streams = Some(
+            Streams::open(dir, &self.growth.samples, log, parents).map_err(|e| stream_error(&e))?,
+        );
         self.stream_dir = Some(dir.to_path_buf());
         self.resumed_from = None;
         Ok(())
+    }
+
+    /// `positions_parent.npy` in `dir`, holding the parents of the particles stored so far: the
+    /// resumed run's (copied unless it is this file), those kept in memory, or the seed's.
+    fn parents_log(&self, dir: &Path) -> Result<NpyWriter, SimError> {
+        let stream_error = |e: &dyn std::fmt::Display| SimError::Stream(e.to_string());
+        let path = dir.join(PARENTS_FILE);
+        if let Some(positions) = &self.resumed_from {
+            let src = positions.with_file_name(PARENTS_FILE);
+            let same = std::fs::canonicalize(&src)
+                .ok()
+                .is_some_and(|a| std::fs::canonicalize(&path).ok().is_some_and(|b| a == b));
+            if !same {
+                std::fs::copy(&src, &path).map_err(|e| {
+                    SimError::Stream(format!(
+                        "copying {} to {}: {e}",
+                        src.display(),
+                        path.display()
+                    ))
+                })?;
+            }
+            return NpyWriter::resume_ints(&path, self.growth.n).map_err(|e| stream_error(&e));
+        }
+        let mut w = NpyWriter::create_ints(&path).map_err(|e| stream_error(&e))?;
+        match &self.growth.parents {
+            Some(v) => {
+                for &p in v {
+                    w.push_int(p).map_err(|e| stream_error(&e))?;
+                }
+            }
+            None if self.growth.n == 1 => w.push_int(-1).map_err(|e| stream_error(&e))?,
+            None => {
+                return Err(SimError::CheckpointUsage(format!(
+                    "{} parents are recorded but not kept: stream positions before growing",
+                    self.growth.n
+                )));
+            }
+        }
+        Ok(w)
     }
 }
 
@@ -535,6 +589,17 @@ impl<const D: usize> Simulation<D> {
         self.growth.positions
     }
 
+    /// Each particle's parent in arrival order (the arrival index of the particle it stuck
+    /// to, `-1` for the seed), if `params.keep_positions` and `params.connectivity`.
+    pub fn parents(&self) -> Option<&[i64]> {
+        self.growth.parents.as_deref()
+    }
+
+    /// [`into_positions`](Self::into_positions) with [`parents`](Self::parents).
+    pub fn into_positions_and_parents(self) -> (Option<Vec<[f64; D]>>, Option<Vec<i64>>) {
+        (self.growth.positions, self.growth.parents)
+    }
+
     /// The spatial structure holding the cluster.
     pub fn tree(&self) -> &Orthtree<D> {
         self.cluster.tree()
@@ -564,42 +629,4 @@ impl<const D: usize> Simulation<D> {
             .unzip();
         Fit::log_log(&rg, &n)
     }
-}
-
-/// Calls `f(i, p)` with every stored position `p` in arrival order (`i` from 0): from memory
-/// (`keep_positions`) or from `positions.npy` in `dir`, read row by row.
-///
-/// # Errors
-/// Neither source holds the positions, the file does not read, or `f` fails.
-pub fn each_position<const D: usize>(
-    sim: &Simulation<D>,
-    dir: &Path,
-    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), sim_run::io::OutputError>,
-) -> Result<(), sim_run::io::OutputError> {
-    if let Some(pos) = sim.positions() {
-        for (i, p) in pos.iter().enumerate() {
-            f(i as u64, p)?;
-        }
-        return Ok(());
-    }
-    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
-    let path = dir.join(POSITIONS_FILE);
-    let mut r = sim_run::io::NpyReader::open(&path).map_err(npy)?;
-    if r.cols() != D || r.rows() != sim.particles() {
-        return Err(std::io::Error::other(format!(
-            "{}: shape ({}, {}), not ({}, {D})",
-            path.display(),
-            r.rows(),
-            r.cols(),
-            sim.particles()
-        ))
-        .into());
-    }
-    let mut p = [0.0; D];
-    let mut i = 0;
-    while r.next_row(&mut p).map_err(npy)? {
-        f(i, &p)?;
-        i += 1;
-    }
-    Ok(())
 }

@@ -485,11 +485,19 @@ where
                 continue;
             }
             let stored = noise_reduced(stick, me.walk.touched(), params.noise_reduction);
+            // Inserts happen under the lock held here, so the particle touched keeps its
+            // tag and the arrival index is `growth.n`.
+            let parent = match self.cluster.parent_of(me.walk.touched()) {
+                Ok(parent) => parent,
+                Err(e) => return self.fail(&mut guard, e),
+            };
+            let index = guard.growth.n as u32;
             // SAFETY: every thread announces its epoch at a walker's birth only, where it holds
             // nothing from the tree (`walk`, Release store), or u64::MAX once it stops reading;
             // `readers_epoch` is the minimum over all threads' slots (Acquire loads).
             #[allow(unsafe_code)]
-            let inserted = unsafe { tree.insert_shared(stored, || self.readers_epoch()) };
+            let inserted =
+                unsafe { tree.insert_shared_tagged(stored, index, || self.readers_epoch()) };
             let (q, new_leaf) = match inserted {
                 Ok(stored) => stored,
                 Err(OrthtreeError::NeedsExclusive) => {
@@ -501,7 +509,7 @@ where
                 Err(e) => return self.fail(&mut guard, e.into()),
             };
             let log = &mut *guard;
-            log.growth.account(q, self.final_target);
+            log.growth.account(q, parent, self.final_target);
             let n = log.growth.n as usize;
             self.ring.write(n - 1, &q);
             self.published
