@@ -69,7 +69,14 @@ fn tiny_run_produces_every_table_csv_and_plot() {
     assert_eq!(times.len(), Experiment::ALL.len());
     let d = dir.path();
 
-    for md in ["index.md", "dlca.md", "animat.md", "dla.md", "accuracy.md"] {
+    for md in [
+        "index.md",
+        "dlca.md",
+        "animat.md",
+        "dla.md",
+        "accuracy.md",
+        "family.md",
+    ] {
         let text = read(d, md);
         assert!(
             text.contains("cargo xtask scaling --scale tiny"),
@@ -100,6 +107,8 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "accuracy_vpdist.csv",
         "accuracy_vpdist_hist.csv",
         "accuracy_vpdist_ccdf.csv",
+        "family_branches.csv",
+        "family_branches_orders.csv",
     ] {
         check_csv(d, csv);
     }
@@ -114,6 +123,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "accuracy_pareto.png",
         "accuracy_pareto_prefactor.png",
         "accuracy_vpdist.png",
+        "family_branches.png",
     ] {
         check_png(d, png);
     }

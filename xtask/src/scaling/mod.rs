@@ -13,6 +13,7 @@ pub mod dla;
 pub mod dlca;
 pub mod dlca_dimension;
 pub mod ensemble;
+pub mod family;
 pub mod replot;
 
 use crate::report::{Doc, Table, build_id, machine, sig, utc_now};
@@ -62,15 +63,18 @@ pub enum Experiment {
     Dla,
     /// Accuracy against speed for DLA: precision, step length, far field.
     Accuracy,
+    /// The DLA family beyond the plain model: branch orders of the cluster as a tree.
+    Family,
 }
 
 impl Experiment {
     /// Every experiment.
-    pub const ALL: [Experiment; 4] = [
+    pub const ALL: [Experiment; 5] = [
         Experiment::Dlca,
         Experiment::Animat,
         Experiment::Dla,
         Experiment::Accuracy,
+        Experiment::Family,
     ];
 
     /// File stem and flag value.
@@ -80,6 +84,7 @@ impl Experiment {
             Experiment::Animat => "animat",
             Experiment::Dla => "dla",
             Experiment::Accuracy => "accuracy",
+            Experiment::Family => "family",
         }
     }
 }
@@ -192,6 +197,7 @@ pub fn run(opts: &Options) -> Result<Vec<(Experiment, f64)>> {
             Experiment::Animat => animat::run(&ctx),
             Experiment::Dla => dla::run(&ctx),
             Experiment::Accuracy => accuracy::run(&ctx),
+            Experiment::Family => family::run(&ctx),
         }
         .with_context(|| format!("experiment {}", e.name()))?;
         let secs = start.elapsed().as_secs_f64();

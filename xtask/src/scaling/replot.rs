@@ -48,6 +48,10 @@ pub const CHARTS: &[CsvChart] = &[
         csv: "accuracy_vpdist_ccdf.csv",
         draw: super::accuracy::vpdist_chart,
     },
+    CsvChart {
+        csv: super::family::ORDERS_CSV,
+        draw: super::family::branches_chart,
+    },
 ];
 
 /// What [`replot`] did: the charts written, and the charts' CSVs that were not in the
