@@ -57,7 +57,9 @@ def _declared_keywords(model):
 
 def _annotation(row):
     """The type of a declared parameter as the stubs write it."""
-    if row["choices"]:
+    if row.get("annotation"):
+        kind = row["annotation"]
+    elif row["choices"]:
         names = ", ".join(repr(c) for c in row["choices"])
         kind = f"Literal[{names}]"
     else:
@@ -68,9 +70,11 @@ def _annotation(row):
 def _signature(obj, model):
     """``obj``'s signature with the defaults the compiled module shows as ``...`` filled in
     from the library (``defaults(model)``, and the binaries' checkpoint interval), and with
-    the model's declared parameters as keyword arguments in place of ``**params``, so that
-    ``help()`` shows every keyword and its value."""
+    the model's declared parameters as keyword arguments in place of ``**params`` (before the
+    parameter ``_declared(model)["before"]``, else at the end), so that ``help()`` shows every
+    keyword and its value."""
     values = {**defaults(model), "checkpoint_interval": _aggsim._CHECKPOINT_INTERVAL}
+    before = _declared(model)["before"]
     sig = _inspect.signature(obj)
     params = []
     declared = [
@@ -85,7 +89,7 @@ def _signature(obj, model):
     for p in sig.parameters.values():
         if p.kind is p.VAR_KEYWORD:
             continue
-        if p.kind is p.KEYWORD_ONLY and declared:
+        if p.name == before and declared:
             params += declared
             declared = []
         if p.default is Ellipsis and p.name in values:
@@ -103,7 +107,10 @@ def _doc_entry(row, default):
         facts.append("one of " + ", ".join(f'``"{c}"``' for c in row["choices"]))
     elif row["range"] != "any":
         facts.append(f"accepted {row['range']}")
-    facts.append(f"default {default!r}" + (", None: not given" if row["optional"] else ""))
+    shown = f"default {default!r}"
+    if row.get("text") and not isinstance(default, list) and row["text"] != str(default):
+        shown += f" ({row['text']})"
+    facts.append(shown + (", None: not given" if row["optional"] else ""))
     text = f"{row['help']} ({'; '.join(facts)})."
     return f"{row['name']} : {_annotation(row)}\n" + "\n".join(
         "    " + line for line in _textwrap.wrap(text, 88)

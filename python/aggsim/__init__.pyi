@@ -203,6 +203,7 @@ class DlcaLattice:
         *,
         dim: Optional[int] = None,
         seed: int = 1,
+        # BEGIN GENERATED dlca-lattice-keywords: written by `cargo xtask generate` from the declaration; do not edit
         boundary: Optional[Boundary] = None,
         temperature: float = ...,
         gravity: float = ...,
@@ -211,12 +212,13 @@ class DlcaLattice:
         max_sweeps: Optional[Count] = None,
         search: Literal["auto", "all-pairs", "grid", "grid-doubling", "lattice"] = ...,
         grid_box: Optional[Count] = None,
-        max_memory: Union[None, Count, str] = None,
-        timing: bool = False,
-        histogram: bool = False,
+        max_memory: Optional[Union[Count, str]] = None,
+        timing: bool = ...,
+        histogram: bool = ...,
         histogram_sweeps: Optional[Sequence[Count]] = None,
-        gyration: bool = False,
+        gyration: bool = ...,
         fit_min_size: Count = ...,
+        # END GENERATED dlca-lattice-keywords
     ) -> None: ...
     def step(self, n: Count = 1, progress: Progress = None) -> int:
         """Run up to ``n`` sweeps (fewer once done); return how many ran."""
@@ -258,6 +260,7 @@ def dlca(
     *,
     dim: Optional[int] = None,
     seed: int = 1,
+    # BEGIN GENERATED dlca-keywords: written by `cargo xtask generate` from the declaration; do not edit
     boundary: Optional[Boundary] = None,
     temperature: float = ...,
     gravity: float = ...,
@@ -266,12 +269,13 @@ def dlca(
     max_sweeps: Optional[Count] = None,
     search: Literal["auto", "all-pairs", "grid", "grid-doubling", "lattice"] = ...,
     grid_box: Optional[Count] = None,
-    max_memory: Union[None, Count, str] = None,
-    timing: bool = False,
-    histogram: bool = False,
+    max_memory: Optional[Union[Count, str]] = None,
+    timing: bool = ...,
+    histogram: bool = ...,
     histogram_sweeps: Optional[Sequence[Count]] = None,
-    gyration: bool = False,
+    gyration: bool = ...,
     fit_min_size: Count = ...,
+    # END GENERATED dlca-keywords
     progress: Progress = None,
     animate: Union[None, str, PathLike[str]] = None,
     animate_every: Optional[Count] = None,

@@ -8,11 +8,11 @@ use crate::convert::{Count, count};
 use core_lattice::spec::{DeclaredParams, Input, Kind, ParamSpec};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 /// Sets the declared parameters given as keyword arguments `kwargs` of `function` on `p`,
-/// and returns the names given (a keyword given as None, allowed for optional parameters
-/// only, counts as not given). `positional` are declared parameters the function takes as
+/// and returns the names given (a keyword given as None, allowed for the parameters that are
+/// None by default only, counts as not given). `positional` are declared parameters the function takes as
 /// its own arguments, so not as keywords here.
 ///
 /// # Errors
@@ -40,7 +40,7 @@ pub fn set_keywords<P: DeclaredParams>(
             )));
         };
         if value.is_none() {
-            if d.optional {
+            if d.python_none() {
                 continue;
             }
             return Err(PyTypeError::new_err(format!(
@@ -68,6 +68,10 @@ pub fn set_keywords<P: DeclaredParams>(
             Kind::Count => Input::Count(count::<u64>(table, &name, value.extract::<Count>()?)?),
             Kind::Switch if value.is_instance_of::<PyBool>() => Input::Switch(value.extract()?),
             Kind::Choice if value.is_instance_of::<PyString>() => Input::Choice(value.extract()?),
+            Kind::Text | Kind::List => match text(table, &name, &value)? {
+                Some(input) => input,
+                None => return Err(wrong()),
+            },
             _ => return Err(wrong()),
         };
         p.set(&name, &input)
@@ -77,19 +81,63 @@ pub fn set_keywords<P: DeclaredParams>(
     Ok(given)
 }
 
+/// The value of a text or list parameter ([`Kind::Text`], [`Kind::List`]): a str as the
+/// command line writes it (`"1024x512"`, `"periodic,wall"`, `"4G"`), a count, or a sequence of
+/// strs and counts, which the command line writes separated by commas; `None` for another type.
+fn text(table: &[ParamSpec], name: &str, value: &Bound<'_, PyAny>) -> PyResult<Option<Input>> {
+    let item = |v: &Bound<'_, PyAny>| -> PyResult<Option<String>> {
+        if v.is_instance_of::<PyString>() {
+            Ok(Some(v.extract()?))
+        } else if v.is_instance_of::<PyBool>() {
+            Ok(None)
+        } else if v.is_instance_of::<PyInt>() || v.is_instance_of::<PyFloat>() {
+            Ok(Some(count::<u64>(table, name, v.extract()?)?.to_string()))
+        } else {
+            Ok(None)
+        }
+    };
+    if let Some(one) = item(value)? {
+        return Ok(Some(Input::Text(one)));
+    }
+    if !(value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>()) {
+        return Ok(None);
+    }
+    let mut parts = Vec::new();
+    for v in value.try_iter()? {
+        match item(&v?)? {
+            Some(t) => parts.push(t),
+            None => return Ok(None),
+        }
+    }
+    Ok(Some(Input::Text(parts.join(","))))
+}
+
 /// The declaration of a model as Python sees it: for each parameter, the kind's Python type,
-/// the whole help text, and whether it is optional (None by default) — beside the table of
+/// its stubs' type where the kind does not say it (`annotation`, empty otherwise), the default
+/// of a text or list value as the command line writes it (`text`, empty otherwise), the whole
+/// help text, and whether it is None by default (`optional`) — beside the table of
 /// `aggsim._params`, for the signatures and docstrings `aggsim` builds.
 pub fn declared_rows<P: DeclaredParams>() -> Vec<serde_json::Value> {
+    let texts = P::default().to_text();
     P::DECLARED
         .iter()
         .map(|d| {
+            // A text or list default as the command line writes it (`4G`).
+            let text = match d.kind {
+                Kind::Text | Kind::List => texts
+                    .iter()
+                    .find(|(n, _)| *n == d.spec.name)
+                    .map_or("", |(_, t)| t.as_str()),
+                _ => "",
+            };
             serde_json::json!({
                 "name": d.spec.name,
                 "type": d.kind.python_type(),
+                "annotation": d.python,
+                "text": text,
                 "help": core_lattice::spec::help_text(d.help),
                 "why": d.why,
-                "optional": d.optional,
+                "optional": d.python_none(),
             })
         })
         .collect()

@@ -281,6 +281,9 @@ pub fn dla(
 /// keywords of the declaration.
 pub const POSITIONAL: &[&str] = &["dim", "particles", "threads"];
 
+/// The parameter of `aggsim.dla` the declared keywords come before in its signature.
+pub const KEYWORDS_BEFORE: &str = "paper_settings";
+
 fn grow<const D: usize>(
     py: Python<'_>,
     params: Params,

@@ -72,26 +72,34 @@ fn params_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>
 }
 
 /// The declared parameters of ``model`` that ``aggsim`` builds keyword arguments from
-/// (``"dla"``): a list of dicts with ``name``, ``type`` (``float``, ``int``, ``bool``, ``str``),
-/// ``help`` (the whole description), ``why`` (the reason for the range) and ``optional`` (None
-/// by default), in declaration order, and the names taken as positional arguments
-/// (``positional``). Empty for a model whose keywords are not generated yet.
+/// (``"dla"``, ``"dlca"``): a list of dicts with ``name``, ``type`` (``float``, ``int``,
+/// ``bool``, ``str``, ``list``), ``annotation`` (the stubs' type where the type does not say
+/// it, else empty), ``help`` (the whole description), ``why`` (the reason for the range) and
+/// ``optional`` (None by default), in declaration order, the names the function takes as its
+/// own arguments (``positional``), and the parameter of its signature the keywords come before
+/// (``before``; empty: at the end). Empty for a model whose keywords are not generated yet.
 #[pyfunction]
 #[pyo3(name = "_declared")]
 fn declared_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
-    let (rows, positional): (Vec<serde_json::Value>, &[&str]) = match model {
+    let (rows, positional, before): (Vec<serde_json::Value>, &[&str], &str) = match model {
         "dla" => (
             declared::declared_rows::<dla_pdla::Params>(),
             dla::POSITIONAL,
+            dla::KEYWORDS_BEFORE,
         ),
-        "dlca" | "animat" => (Vec::new(), &[]),
+        "dlca" => (
+            declared::declared_rows::<::dlca::params::Settings>(),
+            dlca::POSITIONAL,
+            dlca::KEYWORDS_BEFORE,
+        ),
+        "animat" => (Vec::new(), &[], ""),
         other => {
             return Err(convert::value_error(format!(
                 "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
             )));
         }
     };
-    let v = serde_json::json!({ "params": rows, "positional": positional });
+    let v = serde_json::json!({ "params": rows, "positional": positional, "before": before });
     convert::json(py, &v)
 }
 

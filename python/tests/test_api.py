@@ -86,7 +86,8 @@ def test_docstrings_explain_every_argument_and_its_default(model):
         if isinstance(value, bool) or isinstance(value, str):
             text = str(value)
         elif name == "max_memory":
-            text = f"{value // 2**30} GiB"
+            # As the command line writes it: "default 4294967296 (4G)".
+            text = f"{value // 2**30}G"
         else:
             text = f"{value:g}"
         t = re.escape(text)

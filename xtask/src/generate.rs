@@ -1,16 +1,21 @@
 //! `cargo xtask generate`: the files written from the models' parameter declarations
 //! (`core_lattice::declare_params!`): each model's flag table in its docs and its keyword
-//! arguments in the Python stub, between their marker lines. `xtask/tests/generated.rs` (in
+//! arguments in the Python stub (for DLCA twice: `aggsim.dlca` and `aggsim.DlcaLattice`),
+//! between their marker lines. `xtask/tests/generated.rs` (in
 //! the test suite, so in CI) fails when a file is not what this would write.
 
 use anyhow::{Context, Result};
-use sim_run::declared::{docs_table, pyi_keywords, replace_generated};
+use sim_run::declared::{Plain, docs_table, docs_table_in, pyi_keywords, replace_generated};
 use std::path::Path;
 
 /// Parameters `aggsim.dla` takes as its own arguments (by position too), not among the
 /// keywords generated from the declaration (`python/src/dla.rs`, `POSITIONAL`; the Python tests
 /// compare the stub with the real signature).
 pub const DLA_PYTHON_POSITIONAL: &[&str] = &["dim", "particles", "threads"];
+
+/// Parameters `aggsim.dlca` and `aggsim.DlcaLattice` take as their own arguments
+/// (`python/src/dlca/mod.rs`, `POSITIONAL`).
+pub const DLCA_PYTHON_POSITIONAL: &[&str] = &["dim", "size", "fill", "particles"];
 
 /// One generated block: the file (from the workspace root), the block's name, the file's
 /// comment leader (`<!--` for Markdown) and the text.
@@ -39,6 +44,28 @@ pub fn blocks() -> Vec<Block> {
             name: "dla-keywords",
             comment: "#",
             text: pyi_keywords::<dla_pdla::Params>(DLA_PYTHON_POSITIONAL),
+        },
+        Block {
+            file: "docs/dlca.md",
+            name: "dlca-params",
+            comment: "<!--",
+            text: docs_table_in::<dlca::params::Settings, Plain>(),
+        },
+        Block {
+            file: "python/aggsim/__init__.pyi",
+            name: "dlca-keywords",
+            comment: "#",
+            text: pyi_keywords::<dlca::params::Settings>(DLCA_PYTHON_POSITIONAL),
+        },
+        Block {
+            file: "python/aggsim/__init__.pyi",
+            name: "dlca-lattice-keywords",
+            comment: "#",
+            // The arguments of a method, one level further in.
+            text: pyi_keywords::<dlca::params::Settings>(DLCA_PYTHON_POSITIONAL)
+                .lines()
+                .map(|l| format!("    {l}\n"))
+                .collect(),
         },
     ]
 }

@@ -11,6 +11,7 @@
 use std::fmt;
 
 mod declare;
+mod value;
 #[cfg(feature = "serde")]
 pub use declare::as_text;
 pub use declare::{

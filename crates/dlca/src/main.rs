@@ -5,9 +5,11 @@
 
 use anyhow::Context;
 use clap::{ArgGroup, Parser};
-use dlca::params::flags;
-use dlca::{Params, Search, Simulation, Snapshot};
-use sim_run::cli::{CheckpointArgs, ConfigArgs, LogArgs, flag_differences, usage};
+use dlca::params::{LATTICE_FLAGS, Settings};
+use dlca::{Params, Simulation, Snapshot};
+use sim_run::cli::{
+    CheckpointArgs, ConfigArgs, LogArgs, ParamFlags, Plain, flag_differences, usage,
+};
 use sim_run::ensemble::{Combine, Curve, EnsembleArgs, MemberRun, Pooled, PooledResult};
 use sim_run::io::{Positions, RunClock};
 use sim_run::io::{read_checkpoint, write_checkpoint};
@@ -23,29 +25,14 @@ use std::process::ExitCode;
 /// sweep visits every cluster in a fresh random order; a cluster moves one site in a random
 /// direction and merges with every cluster it then touches. Stops at --target-clusters or
 /// --max-sweeps. Outputs go into --out DIR (see docs/dlca.md).
-// Defaults come from the library (`Params::default()`) where clap takes a value; the others
-// (`--boundary`, `--max-memory`) and the flags, choices and ranges in the help are checked
-// against `dlca::params::PARAMS` by `cli_spec_tests`.
+// The model's flags are made from its one declaration (`dlca::params::Settings`), in two groups
+// around the run flags; `cli_spec_tests` checks them and the docs' table against
+// `dlca::params::PARAMS`.
 #[derive(Parser, Debug)]
 #[command(name = "dlca", version = sim_run::cli::version(), allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
 struct Cli {
-    /// Lattice dimension, 1..=5. With a single --size value, every axis gets that length.
-    #[arg(long, default_value_t = Params::default().dim())]
-    dim: usize,
-
-    /// Side lengths in sites: one number for every axis (`1024`) or one per axis (`1024x512`).
-    #[arg(long, value_parser = parse_size)]
-    size: Option<Sizes>,
-
-    // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
-    // clap would read `-inf` as an unknown short flag.
-    /// Fraction of sites holding a particle at the start, in (0, 1).
-    #[arg(long, allow_hyphen_values = true)]
-    fill: Option<f64>,
-
-    /// Number of particles at the start, 1 to the number of sites.
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
-    particles: Option<u64>,
+    #[command(flatten)]
+    lattice: ParamFlags<Settings, Plain, 0, LATTICE_FLAGS>,
 
     /// Seed of every random stream of the run: same seed and flags, same run.
     #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
@@ -72,77 +59,8 @@ struct Cli {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
 
-    /// Boundaries: `periodic` or `wall` for every axis, or one per axis separated by commas
-    /// (`periodic,wall`).
-    #[arg(long, default_value = "periodic")]
-    boundary: String,
-
-    /// Overall move probability of a cluster per sweep, in (0, 1].
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().temperature)]
-    temperature: f64,
-
-    /// Gravity g in [0, 1): the move down the last axis has weight 1+g, up 1-g, others 1.
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().gravity)]
-    gravity: f64,
-
-    /// Mobility exponent gamma in [0, inf): a cluster of s particles moves with probability
-    /// temperature * s^-gamma (0: all clusters equally mobile, as in the paper).
-    #[arg(long, allow_hyphen_values = true, default_value_t = Params::default().mobility_exponent)]
-    mobility_exponent: f64,
-
-    /// Stop when at most this many clusters remain, 1.. (the paper stops at 100 to 1000).
-    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().target_clusters)]
-    target_clusters: u64,
-
-    /// Stop after this many sweeps at the latest (default: no limit).
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
-    max_sweeps: Option<u64>,
-
-    /// Contact search. All give the same trajectory; `auto` picks by regime and logs why.
-    #[arg(long, value_enum, default_value_t = Params::default().search)]
-    search: Search,
-
-    /// Initial grid-box side in sites for `--search grid` or `grid-doubling`, a power of two (default:
-    /// `grid` takes the side of least predicted cost and re-tunes it as clusters grow;
-    /// `grid-doubling` starts from the cluster spacing and doubles with the largest cluster).
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
-    grid_box: Option<u64>,
-
-    /// Memory in bytes; suffixes K, M, G, T (powers of 1024). The occupancy lattice
-    /// (`--search lattice`, or `auto`) must fit in it; given explicitly, it is also the limit
-    /// of the whole run: a run whose estimated peak (docs/dlca.md, "Memory") is larger is
-    /// refused before it starts. Not given, that limit is the memory available (MemAvailable,
-    /// or a lower cgroup limit).
-    #[arg(long, default_value = "4G", value_parser = flags::parse_bytes)]
-    max_memory: u64,
-
-    /// Record the wall time of every sweep (a `seconds` column in sweeps.csv).
-    #[arg(long)]
-    timing: bool,
-
-    /// Record histograms of candidate clusters examined per move (histogram.csv) at the sweeps
-    /// of --histogram-sweeps (as in Figs. 4, 7, 8 of Hawick, James & Scogings 2006).
-    #[arg(long)]
-    histogram: bool,
-
-    /// Sweeps at which --histogram records, comma separated.
-    #[arg(
-        long,
-        requires = "histogram",
-        value_delimiter = ',',
-        value_parser = sim_run::cli::count::<u64>,
-        default_value = dlca::params::DEFAULT_HISTOGRAM_SWEEPS
-    )]
-    histogram_sweeps: Vec<u64>,
-
-    /// Measure every final cluster's radius of gyration (clusters.csv) and fit the fractal
-    /// dimension from log s = D log R_g + c.
-    #[arg(long)]
-    gyration: bool,
-
-    /// Smallest cluster size (particles) used in the fractal-dimension fit, 2..
-    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = Params::default().fit_min_size)]
-    fit_min_size: u64,
+    #[command(flatten)]
+    model: ParamFlags<Settings, Plain, LATTICE_FLAGS>,
 
     /// Write dlca.png: a figure of the final state on the first two axes (axes in lattice
     /// cells, scale bar, sweep, clusters and seed), touching clusters in different colours.
@@ -184,44 +102,11 @@ struct Cli {
     overwrite: sim_run::cli::OverwriteArgs,
 }
 
-/// Side lengths as given to `--size`.
-#[derive(Debug, Clone)]
-struct Sizes(Vec<u64>);
-
-fn parse_size(s: &str) -> Result<Sizes, String> {
-    flags::parse_size(s).map(Sizes)
-}
-
 /// Turn the flags into validated parameters.
 fn params(cli: &Cli) -> Result<Params, String> {
-    let given = cli
-        .size
-        .as_ref()
-        .map(|s| s.0.as_slice())
-        .unwrap_or_default();
-    let (size, boundary) = flags::axes(cli.dim, given, &cli.boundary)?;
-    let p = Params {
-        size,
-        boundary,
-        init: flags::init(cli.fill, cli.particles)?,
-        temperature: cli.temperature,
-        gravity: cli.gravity,
-        mobility_exponent: cli.mobility_exponent,
-        target_clusters: cli.target_clusters,
-        max_sweeps: cli.max_sweeps,
-        search: cli.search,
-        grid_box: cli.grid_box,
-        max_memory: cli.max_memory,
-        timing: cli.timing,
-        histogram_sweeps: if cli.histogram {
-            cli.histogram_sweeps.clone()
-        } else {
-            Vec::new()
-        },
-        gyration: cli.gyration,
-        fit_min_size: cli.fit_min_size,
-    };
-    p.validate().map_err(|e| e.to_string())?;
+    let mut settings = cli.model.params();
+    cli.lattice.apply(&mut settings);
+    let p = settings.to_params(|name| cli.lattice.given(name) || cli.model.given(name))?;
     sim_run::figure::animation::check_picture_flags(
         cli.png_size,
         cli.animate,
@@ -231,7 +116,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     )?;
     // The default 4G is the occupancy lattice's budget only; the run's limit is then the memory
     // available.
-    let given = sim_run::cli::config::given("max_memory").then_some(cli.max_memory);
+    let given = cli.model.given("max_memory").then_some(p.max_memory);
     let n = p.particles().unwrap_or(0);
     let picture = if cli.png || cli.animate {
         let side = u64::from(cli.png_size.unwrap_or(PICTURE_MAX_DEFAULT_SIDE));
@@ -262,14 +147,7 @@ fn resume(dir: &Path, params: Params, seed: u64) -> anyhow::Result<Simulation> {
     let mut snapshot: Snapshot =
         read_checkpoint(&path, "dlca").map_err(|e| usage(format!("{}: {e}", at())))?;
     snapshot.set_stop(params.target_clusters, params.max_sweeps);
-    let mut differ = flag_differences(
-        snapshot.params(),
-        &params,
-        &[
-            ("init", Some("--fill/--particles")),
-            ("histogram_sweeps", Some("--histogram/--histogram-sweeps")),
-        ],
-    );
+    let mut differ = flag_differences(snapshot.params(), &params, dlca::params::COMBINED_FLAGS);
     if snapshot.seed() != seed {
         differ.push(format!(
             "--seed {} in the checkpoint, {seed} given",

@@ -6,7 +6,9 @@
 use core_lattice::{Boundary, Lattice, LatticeError};
 use serde::{Deserialize, Serialize};
 
+mod settings;
 mod spec;
+pub use settings::{Boundaries, Bytes, LATTICE_FLAGS, Settings, Sizes, Sweeps};
 pub use spec::{PARAMS, defaults};
 
 /// Largest dimension the model accepts (Hawick, James & Scogings 2006 run 2 to 5; 1 is
@@ -39,7 +41,21 @@ pub const PEAK_BYTES_PER_SITE: f64 = 0.25;
 
 /// Default sweeps at which `--histogram` records (`--histogram-sweeps`): about three per
 /// decade up to 10^4, as in Figs. 4, 7, 8 of Hawick, James & Scogings 2006.
-pub const DEFAULT_HISTOGRAM_SWEEPS: &str = "1,2,5,10,20,50,100,200,500,1000,2000,5000,10000";
+pub const DEFAULT_HISTOGRAM_SWEEPS: &[u64] =
+    &[1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 2000, 5000, 10000];
+
+/// The fields of [`Params`] that several parameters make, named as a resumed run's differences
+/// name them on the command line.
+pub const COMBINED_FLAGS: &[(&str, Option<&str>)] = &[
+    ("init", Some("--fill/--particles")),
+    ("histogram_sweeps", Some("--histogram/--histogram-sweeps")),
+];
+
+/// [`COMBINED_FLAGS`] as Python names them (keyword arguments).
+pub const COMBINED_KEYWORDS: &[(&str, Option<&str>)] = &[
+    ("init", Some("fill/particles")),
+    ("histogram_sweeps", Some("histogram/histogram_sweeps")),
+];
 
 /// How many particles to place.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -82,27 +98,13 @@ impl Search {
     ];
 
     /// The names of [`ALL`](Self::ALL), in the same order: the one spelling the command line,
-    /// config files, Python and the outputs use.
+    /// config files, Python and the outputs use (each with its help in
+    /// [`Settings`]'s declaration).
     pub const NAMES: [&'static str; 5] = ["auto", "all-pairs", "grid", "grid-doubling", "lattice"];
 
     /// The name used on the command line and in outputs.
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
-    }
-
-    /// One line of plain text for the command line's help.
-    pub fn help(self) -> &'static str {
-        match self {
-            Search::Auto => "Pick by regime (memory, dimension, density) and log why",
-            Search::AllPairs => "The all-pairs baseline of Hawick, James & Scogings 2006",
-            Search::Grid => {
-                "Grid boxes (Hawick, James & Scogings 2006) with a halo per cluster: small boxes, each cluster listed in every box its bounding region grown by one site overlaps, the box side re-tuned at run time by a cost model"
-            }
-            Search::GridDoubling => {
-                "The paper's grid boxes (Hawick, James & Scogings 2006), doubling with the largest cluster, falling back to all-pairs once 3A >= L on some axis (the Fig. 6 rule)"
-            }
-            Search::Lattice => "Occupancy lattice: a cluster id per site",
-        }
     }
 }
 
@@ -121,18 +123,6 @@ impl std::str::FromStr for Search {
                     Self::NAMES.join(", ")
                 )
             })
-    }
-}
-
-/// The command line parses `--search` through [`Search::ALL`] and [`Search::name`].
-#[cfg(feature = "cli")]
-impl clap::ValueEnum for Search {
-    fn value_variants<'a>() -> &'a [Self] {
-        &Self::ALL
-    }
-
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()).help(self.help()))
     }
 }
 
@@ -314,6 +304,11 @@ impl Params {
     /// The dimension.
     pub fn dim(&self) -> usize {
         self.size.len()
+    }
+
+    /// Whether the run records histograms of candidates examined per move (`--histogram`).
+    pub fn records_histograms(&self) -> bool {
+        !self.histogram_sweeps.is_empty()
     }
 
     /// Number of particles these parameters place (after validation).

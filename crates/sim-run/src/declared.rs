@@ -8,6 +8,32 @@ use core_lattice::spec::{Declared, DeclaredParams, Kind, Range, help_text, show_
 use serde::Serialize;
 use serde_json::{Map, Value};
 
+/// How a binary shows its declared parameters as flags: [`Annotated`] or [`Plain`].
+pub trait FlagStyle: 'static {
+    /// Whether the help is the declaration's doc as written ([`Plain`]).
+    const PLAIN: bool;
+}
+
+/// The help of each flag is its doc's first sentence (the whole doc with `--help`) followed by
+/// the unit and accepted range from the declaration; values are named `X`, `N`, `NAME`, and
+/// switches take `on` or `off` (`--near-cache off`). The `dla` binary's flags.
+#[derive(Debug, Clone, Copy)]
+pub struct Annotated;
+
+impl FlagStyle for Annotated {
+    const PLAIN: bool = false;
+}
+
+/// The help of each flag is its doc as written (which states the unit and range in its own
+/// words), values are named after the parameter (`--fill <FILL>`) and switches are bare flags
+/// (`--gyration`), as clap's derive writes flags. The `dlca` binary's flags.
+#[derive(Debug, Clone, Copy)]
+pub struct Plain;
+
+impl FlagStyle for Plain {
+    const PLAIN: bool = true;
+}
+
 /// The library's default of every parameter of `P` a front end sets (not the
 /// [`DeclaredParams::INTERNAL`] fields), by name, as JSON.
 pub fn defaults_of<P: DeclaredParams + Serialize>() -> Map<String, Value> {
@@ -32,15 +58,40 @@ pub fn cli_default(d: &Declared, v: &Value) -> String {
     }
 }
 
+/// The default of a declared parameter as the command line writes it: the text of the typed
+/// default for a [`Kind::Text`] or [`Kind::List`] (`4G`, `1,2,5`), else from its JSON.
+pub fn shown_default<P: DeclaredParams>(d: &Declared, default: &Value) -> String {
+    if matches!(d.kind, Kind::Text | Kind::List) {
+        if let Some((_, text)) = P::default()
+            .to_text()
+            .into_iter()
+            .find(|(n, _)| *n == d.spec.name)
+        {
+            return text;
+        }
+    }
+    cli_default(d, default)
+}
+
 /// The unit and accepted values of a parameter as one phrase: `in diameters, accepted [1,
 /// 1e4]`, `one of return, jump`, `on or off`; empty when there is nothing to say.
 pub fn accepted(d: &Declared) -> String {
+    accepted_in::<Annotated>(d)
+}
+
+/// [`accepted`] for flags shown in style `S`: a [`Plain`] switch is a bare flag, with nothing
+/// to say.
+fn accepted_in<S: FlagStyle>(d: &Declared) -> String {
     let mut parts = Vec::new();
     if !d.spec.unit.is_empty() {
         parts.push(format!("in {}", d.spec.unit));
     }
     match (d.kind, d.spec.range) {
+        (Kind::Switch, _) if S::PLAIN => {}
         (Kind::Switch, _) => parts.push("on or off".into()),
+        (Kind::Text | Kind::List, Range::Choices(c)) => {
+            parts.push(format!("each one of {}", c.join(", ")))
+        }
         (_, Range::Choices(c)) => parts.push(format!("one of {}", c.join(", "))),
         (_, Range::Any) => {}
         (_, r) => parts.push(format!("accepted {r}")),
@@ -49,8 +100,14 @@ pub fn accepted(d: &Declared) -> String {
 }
 
 /// The markdown flag table of `P`'s declared parameters: flag, default and meaning (the whole
-/// help, its unit and range, and the reason for the range).
+/// help, its unit and range, and the reason for the range), for flags in the [`Annotated`]
+/// style.
 pub fn docs_table<P: DeclaredParams + Serialize>() -> String {
+    docs_table_in::<P, Annotated>()
+}
+
+/// [`docs_table`] for flags shown in style `S`.
+pub fn docs_table_in<P: DeclaredParams + Serialize, S: FlagStyle>() -> String {
     let defaults = defaults_of::<P>();
     let mut out = String::from("| flag | default | meaning |\n|---|---|---|\n");
     for d in P::DECLARED {
@@ -58,10 +115,10 @@ pub fn docs_table<P: DeclaredParams + Serialize>() -> String {
         let default = if d.required {
             "(required)".to_string()
         } else {
-            cli_default(d, &defaults[d.spec.name])
+            shown_default::<P>(d, &defaults[d.spec.name])
         };
         let mut meaning = help_text(d.help);
-        let acc = accepted(d);
+        let acc = accepted_in::<S>(d);
         if !acc.is_empty() {
             meaning.push_str(&format!(" ({acc}"));
             if !d.why.is_empty() {
@@ -75,10 +132,12 @@ pub fn docs_table<P: DeclaredParams + Serialize>() -> String {
     out
 }
 
-/// The Python type of a declared parameter as the stubs write it: `float`, `Count` for counts,
-/// `bool`, `Literal["return", "jump"]` for choices, in `Optional[...]` when optional.
+/// The Python type of a declared parameter as the stubs write it: its type's own
+/// ([`Declared::python`]), else `float`, `Count` for counts, `bool`, `Literal["return",
+/// "jump"]` for choices; in `Optional[...]` when None by default ([`Declared::python_none`]).
 pub fn python_annotation(d: &Declared) -> String {
     let kind = match (d.kind, d.spec.range) {
+        _ if !d.python.is_empty() => d.python.into(),
         (_, Range::Choices(c)) => {
             let names: Vec<String> = c.iter().map(|n| format!("\"{n}\"")).collect();
             format!("Literal[{}]", names.join(", "))
@@ -86,7 +145,7 @@ pub fn python_annotation(d: &Declared) -> String {
         (Kind::Count, _) => "Count".into(),
         (k, _) => k.python_type().into(),
     };
-    if d.optional {
+    if d.python_none() {
         format!("Optional[{kind}]")
     } else {
         kind
@@ -100,7 +159,7 @@ pub fn pyi_keywords<P: DeclaredParams>(positional: &[&str]) -> String {
         .iter()
         .filter(|d| !positional.contains(&d.spec.name))
         .map(|d| {
-            let default = if d.optional { "None" } else { "..." };
+            let default = if d.python_none() { "None" } else { "..." };
             format!(
                 "    {}: {} = {default},\n",
                 d.spec.name,

@@ -33,29 +33,7 @@ impl DlcaLattice {
 #[pymethods]
 impl DlcaLattice {
     #[new]
-    #[pyo3(signature = (
-        size,
-        fill = None,
-        particles = None,
-        *,
-        dim = None,
-        seed = 1,
-        boundary = None,
-        temperature = defaults().temperature,
-        gravity = defaults().gravity,
-        mobility_exponent = defaults().mobility_exponent,
-        target_clusters = Count::Int(i128::from(defaults().target_clusters)),
-        max_sweeps = None,
-        search = defaults().search.name(),
-        grid_box = None,
-        max_memory = None,
-        timing = false,
-        histogram = false,
-        histogram_sweeps = None,
-        gyration = false,
-        fit_min_size = Count::Int(i128::from(defaults().fit_min_size)),
-    ))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (size, fill = None, particles = None, *, dim = None, seed = 1, **params))]
     pub(super) fn new(
         py: Python<'_>,
         size: &Bound<'_, PyAny>,
@@ -63,41 +41,9 @@ impl DlcaLattice {
         particles: Option<Count>,
         dim: Option<usize>,
         seed: u64,
-        boundary: Option<&Bound<'_, PyAny>>,
-        temperature: f64,
-        gravity: f64,
-        mobility_exponent: f64,
-        target_clusters: Count,
-        max_sweeps: Option<Count>,
-        search: &str,
-        grid_box: Option<Count>,
-        max_memory: Option<&Bound<'_, PyAny>>,
-        timing: bool,
-        histogram: bool,
-        histogram_sweeps: Option<Vec<Count>>,
-        gyration: bool,
-        fit_min_size: Count,
+        params: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let p = params(
-            size,
-            fill,
-            particles,
-            dim,
-            boundary,
-            temperature,
-            gravity,
-            mobility_exponent,
-            target_clusters,
-            max_sweeps,
-            search,
-            grid_box,
-            max_memory,
-            timing,
-            histogram,
-            histogram_sweeps,
-            gyration,
-            fit_min_size,
-        )?;
+        let p = self::params("DlcaLattice", size, (fill, particles, dim), params)?;
         Ok(DlcaLattice {
             run: Mutex::new(Run::new(py, p, seed)?),
         })

@@ -4,12 +4,13 @@
 
 use crate::checkpoint::{Checkpoint, Session, differences, honour, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
+use crate::declared::set_keywords;
 use crate::figure::Animate;
 use crate::run::{Progress, interruptible, interruptible_guarded};
 use ::dlca::analysis::{gyration, size_distribution};
-use ::dlca::params::{DEFAULT_HISTOGRAM_SWEEPS, PARAMS, flags};
+use ::dlca::params::{PARAMS, Settings, Sizes, flags};
 use ::dlca::picture::{ANIMATION_DEFAULT_EVERY, ANIMATION_DEFAULT_SIDE, Animation};
-use ::dlca::{Params, Search, Simulation, Snapshot};
+use ::dlca::{Params, Simulation, Snapshot};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
 use pyo3::exceptions::PyRuntimeError;
@@ -26,11 +27,6 @@ pub use lattice::DlcaLattice;
 
 /// Model name in the checkpoint envelope: the `dlca` binary's.
 const CHECKPOINT_MODEL: &str = "dlca";
-
-/// The library's defaults, which are the `dlca` binary's.
-fn defaults() -> Params {
-    Params::default()
-}
 
 /// `--size`: an int (every axis), a sequence of ints (one per axis) or a string as the binary
 /// takes it (`"1024x512"`).
@@ -52,95 +48,41 @@ fn sizes(arg: &Bound<'_, PyAny>) -> PyResult<Vec<u64>> {
         .collect()
 }
 
-/// `--boundary`: `"periodic"`, `"wall"`, one per axis separated by commas, or a sequence of
-/// them.
-fn boundary(arg: &Bound<'_, PyAny>) -> PyResult<String> {
-    if let Ok(s) = arg.cast::<PyString>() {
-        return Ok(s.to_str()?.to_string());
-    }
-    let names: Vec<String> = arg.extract()?;
-    Ok(names.join(","))
-}
+/// Declared parameters `aggsim.dlca` and `aggsim.DlcaLattice` take as their own arguments (by
+/// position too, and `dim`, whose default depends on `size`), not as keywords of the
+/// declaration.
+pub const POSITIONAL: &[&str] = &["dim", "size", "fill", "particles"];
 
-/// `--max-memory`: bytes, or a string as the binary takes it (`"4G"`).
-fn bytes(arg: &Bound<'_, PyAny>) -> PyResult<u64> {
-    if let Ok(s) = arg.cast::<PyString>() {
-        return flags::parse_bytes(s.to_str()?).map_err(value_error);
-    }
-    count(PARAMS, "max_memory", arg.extract()?)
-}
+/// The parameter of `aggsim.dlca` the declared keywords come before in its signature.
+pub const KEYWORDS_BEFORE: &str = "progress";
 
-/// The parameters of the keyword arguments, checked as the binary checks its flags (`None`
-/// for `boundary` and `max_memory`: the defaults).
-#[allow(clippy::too_many_arguments)]
+/// The parameters of the arguments, checked as the binary checks its flags: `size`, `fill`,
+/// `particles` and `dim` as the functions take them, the declared keyword arguments
+/// (`kwargs`, those of [`Settings`]) on the library's defaults.
 fn params(
+    function: &str,
     size: &Bound<'_, PyAny>,
-    fill: Option<f64>,
-    particles: Option<Count>,
-    dim: Option<usize>,
-    boundary: Option<&Bound<'_, PyAny>>,
-    temperature: f64,
-    gravity: f64,
-    mobility_exponent: f64,
-    target_clusters: Count,
-    max_sweeps: Option<Count>,
-    search: &str,
-    grid_box: Option<Count>,
-    max_memory: Option<&Bound<'_, PyAny>>,
-    timing: bool,
-    histogram: bool,
-    histogram_sweeps: Option<Vec<Count>>,
-    gyration: bool,
-    fit_min_size: Count,
+    (fill, particles, dim): (Option<f64>, Option<Count>, Option<usize>),
+    kwargs: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Params> {
-    let given = sizes(size)?;
-    // A sequence of lengths gives the dimension; one length takes the binary's default, 2.
-    let dim = dim.unwrap_or(if given.len() > 1 { given.len() } else { 2 });
-    let boundary = match boundary {
-        Some(b) => self::boundary(b)?,
-        None => defaults().boundary[0].to_string(),
-    };
-    let (size, boundary) = flags::axes(dim, &given, &boundary).map_err(value_error)?;
-    let particles = particles
-        .map(|n| count(PARAMS, "particles", n))
-        .transpose()?;
-    let histogram_sweeps = match (histogram, histogram_sweeps) {
-        (false, Some(_)) => {
-            return Err(value_error(
-                "--histogram-sweeps is used with --histogram only",
-            ));
-        }
-        (false, None) => Vec::new(),
-        (true, Some(v)) => v
-            .into_iter()
-            .map(|s| count(PARAMS, "histogram_sweeps", s))
-            .collect::<PyResult<_>>()?,
-        (true, None) => DEFAULT_HISTOGRAM_SWEEPS
-            .split(',')
-            .map(|s| s.parse().map_err(run_error))
-            .collect::<PyResult<_>>()?,
-    };
-    let p = Params {
-        size,
-        boundary,
-        init: flags::init(fill, particles).map_err(value_error)?,
-        temperature,
-        gravity,
-        mobility_exponent,
-        target_clusters: count(PARAMS, "target_clusters", target_clusters)?,
-        max_sweeps: max_sweeps
-            .map(|n| count(PARAMS, "max_sweeps", n))
+    let lengths = sizes(size)?;
+    let mut s = Settings {
+        // A sequence of lengths gives the dimension; one length takes the binary's default.
+        dim: dim.unwrap_or(if lengths.len() > 1 {
+            lengths.len()
+        } else {
+            Settings::default().dim
+        }),
+        size: Some(Sizes(lengths)),
+        fill,
+        particles: particles
+            .map(|n| count(PARAMS, "particles", n))
             .transpose()?,
-        search: search.parse::<Search>().map_err(value_error)?,
-        grid_box: grid_box.map(|n| count(PARAMS, "grid_box", n)).transpose()?,
-        max_memory: max_memory.map_or(Ok(defaults().max_memory), bytes)?,
-        timing,
-        histogram_sweeps,
-        gyration,
-        fit_min_size: count(PARAMS, "fit_min_size", fit_min_size)?,
+        ..Settings::default()
     };
-    p.validate().map_err(value_error)?;
-    Ok(p)
+    let given = set_keywords(&mut s, PARAMS, function, POSITIONAL, kwargs)?;
+    s.to_params(|name| given.iter().any(|g| g == name))
+        .map_err(value_error)
 }
 
 /// A run and its clock (`run.json`'s times count from the lattice's creation).
@@ -169,10 +111,7 @@ impl Run {
         let differ = differences(
             serde_json::to_value(snapshot.params()),
             serde_json::to_value(&params),
-            &[
-                ("init", Some("fill/particles")),
-                ("histogram_sweeps", Some("histogram/histogram_sweeps")),
-            ],
+            ::dlca::params::COMBINED_KEYWORDS,
         );
         ck.check_same(differ, (snapshot.seed(), seed))?;
         // Rebuilding a large lattice takes a while: without the GIL.
@@ -358,7 +297,7 @@ impl Run {
             None => py.None().into_bound(py),
         };
         out.setattr("gyration", g)?;
-        let hist = if sim.params().histogram_sweeps.is_empty() {
+        let hist = if !sim.params().records_histograms() {
             py.None().into_bound(py)
         } else {
             let (mut s, mut c, mut k) = (Vec::new(), Vec::new(), Vec::new());
@@ -477,6 +416,10 @@ impl DlcaResult {
 /// Optimisation"). The run is a pure function of (parameters, seed): its ``state_hash`` is the
 /// binary's.
 ///
+/// The model's parameters (``boundary``, ``temperature``, ``search``, ...) are keyword arguments
+/// made from the library's declaration of them, listed last below; ``size``, ``fill`` and
+/// ``particles`` may also be given by position.
+///
 /// Parameters
 /// ----------
 /// size : int, sequence of int or str
@@ -491,39 +434,6 @@ impl DlcaResult {
 ///     length, as the binary).
 /// seed : int
 ///     Seed of every random stream (default 1).
-/// boundary : str or sequence of str
-///     ``"periodic"`` (default) or ``"wall"`` for every axis, or one per axis
-///     (``"periodic,wall"`` or ``["periodic", "wall"]``).
-/// temperature : float
-///     Move probability of a cluster per sweep, in (0, 1] (default 1).
-/// gravity : float
-///     g in [0, 1): moves down the last axis have weight 1+g, up 1-g (default 0).
-/// mobility_exponent : float
-///     gamma in [0, inf): a cluster of s particles moves with probability temperature * s^-gamma
-///     (default 0).
-/// target_clusters : int
-///     Stop when at most this many clusters remain, 1.. (default 100).
-/// max_sweeps : int or None
-///     Stop after this many sweeps at the latest (default None: no limit).
-/// search : str
-///     Contact search, ``"auto"`` (default), ``"all-pairs"``, ``"grid"``,
-///     ``"grid-doubling"`` or ``"lattice"``: all give the same trajectory.
-/// grid_box : int or None
-///     Initial grid-box side for ``search="grid"`` or ``"grid-doubling"``, a power of two
-///     (default: chosen).
-/// max_memory : int or str
-///     Memory the occupancy lattice may take, bytes or ``"4G"`` (default 4 GiB).
-/// timing : bool
-///     Record each sweep's wall time (``per_sweep["seconds"]``; default False).
-/// histogram : bool
-///     Record histograms of candidates examined per move (default False).
-/// histogram_sweeps : list of int or None
-///     The sweeps ``histogram`` records (default 1, 2, 5, ... 10000).
-/// gyration : bool
-///     Measure every final cluster's radius of gyration and fit the fractal dimension
-///     (default False).
-/// fit_min_size : int
-///     Smallest cluster size in that fit, 2.. (default 10).
 /// progress : bool or callable
 ///     True prints progress (merges) to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).
@@ -580,26 +490,13 @@ impl DlcaResult {
     *,
     dim = None,
     seed = 1,
-    boundary = None,
-    temperature = defaults().temperature,
-    gravity = defaults().gravity,
-    mobility_exponent = defaults().mobility_exponent,
-    target_clusters = Count::Int(i128::from(defaults().target_clusters)),
-    max_sweeps = None,
-    search = defaults().search.name(),
-    grid_box = None,
-    max_memory = None,
-    timing = false,
-    histogram = false,
-    histogram_sweeps = None,
-    gyration = false,
-    fit_min_size = Count::Int(i128::from(defaults().fit_min_size)),
     progress = None,
     animate = None,
     animate_every = None,
     animate_size = None,
     checkpoint = None,
     checkpoint_interval = Some(crate::checkpoint::DEFAULT_INTERVAL),
+    **params,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn dlca(
@@ -609,50 +506,18 @@ pub fn dlca(
     particles: Option<Count>,
     dim: Option<usize>,
     seed: u64,
-    boundary: Option<&Bound<'_, PyAny>>,
-    temperature: f64,
-    gravity: f64,
-    mobility_exponent: f64,
-    target_clusters: Count,
-    max_sweeps: Option<Count>,
-    search: &str,
-    grid_box: Option<Count>,
-    max_memory: Option<&Bound<'_, PyAny>>,
-    timing: bool,
-    histogram: bool,
-    histogram_sweeps: Option<Vec<Count>>,
-    gyration: bool,
-    fit_min_size: Count,
     progress: Option<&Bound<'_, PyAny>>,
     animate: Option<PathBuf>,
     animate_every: Option<Count>,
     animate_size: Option<Count>,
     checkpoint: Option<PathBuf>,
     checkpoint_interval: Option<f64>,
+    params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<DlcaResult>> {
     let progress = Progress::from_arg(progress, "dlca", "merges")?;
     let animate = Animate::from_args(animate, animate_every, animate_size, "dlca")?;
     let checkpoint = Checkpoint::from_args(checkpoint, checkpoint_interval)?;
-    let p = params(
-        size,
-        fill,
-        particles,
-        dim,
-        boundary,
-        temperature,
-        gravity,
-        mobility_exponent,
-        target_clusters,
-        max_sweeps,
-        search,
-        grid_box,
-        max_memory,
-        timing,
-        histogram,
-        histogram_sweeps,
-        gyration,
-        fit_min_size,
-    )?;
+    let p = self::params("dlca", size, (fill, particles, dim), params)?;
     let Some(ck) = checkpoint else {
         let mut run = Run::new(py, p, seed)?;
         run.until_done(py, &progress, animate.as_ref(), None)?;

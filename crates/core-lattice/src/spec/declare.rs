@@ -5,7 +5,7 @@
 //! files, the Python keyword arguments, their stubs and the docs' flag tables) are generated
 //! from the table at run time or checked against it.
 
-use super::{ParamSpec, Range, show_number};
+use super::{ParamSpec, Range};
 use std::fmt;
 
 /// How a front end reads a parameter's value.
@@ -19,6 +19,11 @@ pub enum Kind {
     Switch,
     /// One of the names of its [`Range::Choices`].
     Choice,
+    /// Text the type reads itself (`1024x512`, `periodic,wall`, `4G`).
+    Text,
+    /// A list of values separated by commas (`1,2,5`): on the command line one flag, its
+    /// values split at the commas; in files and Python a list.
+    List,
 }
 
 impl Kind {
@@ -28,7 +33,8 @@ impl Kind {
             Kind::Real => "float",
             Kind::Count => "int",
             Kind::Switch => "bool",
-            Kind::Choice => "str",
+            Kind::Choice | Kind::Text => "str",
+            Kind::List => "list",
         }
     }
 }
@@ -44,6 +50,8 @@ pub enum Input {
     Switch(bool),
     /// A name.
     Choice(String),
+    /// Text the parameter's type reads ([`Kind::Text`], [`Kind::List`]).
+    Text(String),
 }
 
 /// A parameter's type as the declarations see it: its [`Kind`], whether a value lies in a
@@ -52,6 +60,12 @@ pub enum Input {
 pub trait ParamValue: Sized {
     /// How the front ends read it.
     const KIND: Kind;
+    /// The type as the Python stubs write it, where the [`Kind`] does not say it (`Size`,
+    /// `Sequence[Count]`); empty for the kind's.
+    const PYTHON: &'static str = "";
+    /// A line of help for each name of a [`Kind::Choice`], in the order of its
+    /// [`Range::Choices`]; empty for none.
+    const CHOICE_HELP: &'static [&'static str] = &[];
     /// The value of a front end's input; the error says what was expected.
     fn from_input(v: &Input) -> Result<Self, String>;
     /// The value from its [`show`](Self::show) text, exactly (the self-describing form
@@ -62,109 +76,6 @@ pub trait ParamValue: Sized {
     /// The value as a user would type it; [`parse_text`](Self::parse_text) reads it back
     /// exactly.
     fn show(&self) -> String;
-}
-
-impl ParamValue for f64 {
-    const KIND: Kind = Kind::Real;
-    fn from_input(v: &Input) -> Result<Self, String> {
-        match v {
-            Input::Real(x) => Ok(*x),
-            Input::Count(n) => Ok(*n as f64),
-            other => Err(format!("expected a number, not {other:?}")),
-        }
-    }
-    fn parse_text(s: &str) -> Result<Self, String> {
-        s.parse().map_err(|_| format!("'{s}' is not a number"))
-    }
-    fn in_range(&self, range: &Range) -> bool {
-        let v = *self;
-        match range {
-            Range::Real(lo, hi) => {
-                let above = match lo {
-                    super::End::Closed(a) => v >= *a,
-                    super::End::Open(a) => v > *a,
-                    super::End::Unbounded => !v.is_nan(),
-                };
-                let below = match hi {
-                    super::End::Closed(b) => v <= *b,
-                    super::End::Open(b) => v < *b,
-                    super::End::Unbounded => !v.is_nan(),
-                };
-                above && below
-            }
-            Range::Int { min, max } => {
-                v.fract() == 0.0 && v >= *min as f64 && max.is_none_or(|m| v <= m as f64)
-            }
-            Range::Values(vals) => vals.iter().any(|&x| x as f64 == v),
-            Range::Any | Range::Choices(_) | Range::Text(_) => !v.is_nan(),
-        }
-    }
-    /// As a user would type it: `0.25`, `1001`, `1000000000`; the exponent form for the very
-    /// small and large (`1e-300`, `1e300`).
-    fn show(&self) -> String {
-        let (v, a) = (*self, self.abs());
-        if a != 0.0 && a.is_finite() && !(1e-4..1e15).contains(&a) {
-            format!("{v:e}")
-        } else if v.is_infinite() {
-            show_number(v)
-        } else {
-            v.to_string()
-        }
-    }
-}
-
-macro_rules! whole_number {
-    ($($t:ty),*) => {$(
-        impl ParamValue for $t {
-            const KIND: Kind = Kind::Count;
-            fn from_input(v: &Input) -> Result<Self, String> {
-                match v {
-                    Input::Count(n) => <$t>::try_from(*n)
-                        .map_err(|_| format!("{n} is too large (at most {})", <$t>::MAX)),
-                    other => Err(format!("expected a whole number, not {other:?}")),
-                }
-            }
-            fn parse_text(s: &str) -> Result<Self, String> {
-                s.parse().map_err(|_| format!("'{s}' is not a whole number"))
-            }
-            fn in_range(&self, range: &Range) -> bool {
-                let v = *self as i128;
-                match range {
-                    Range::Int { min, max } => v >= *min && max.is_none_or(|m| v <= m),
-                    Range::Values(vals) => vals.iter().any(|&x| x as i128 == v),
-                    Range::Real(..) => (*self as f64).in_range(range),
-                    Range::Any | Range::Choices(_) | Range::Text(_) => true,
-                }
-            }
-            fn show(&self) -> String {
-                self.to_string()
-            }
-        }
-    )*};
-}
-whole_number!(u32, u64, usize);
-
-impl ParamValue for bool {
-    const KIND: Kind = Kind::Switch;
-    fn from_input(v: &Input) -> Result<Self, String> {
-        match v {
-            Input::Switch(b) => Ok(*b),
-            other => Err(format!("expected on or off, not {other:?}")),
-        }
-    }
-    fn parse_text(s: &str) -> Result<Self, String> {
-        match s {
-            "on" => Ok(true),
-            "off" => Ok(false),
-            other => Err(format!("'{other}' is not on or off")),
-        }
-    }
-    fn in_range(&self, _: &Range) -> bool {
-        true
-    }
-    fn show(&self) -> String {
-        if *self { "on".into() } else { "off".into() }
-    }
 }
 
 /// One declared parameter: its [`ParamSpec`] (name, flag, unit, one-line meaning, range) and
@@ -188,6 +99,19 @@ pub struct Declared {
     /// line and in `--dump-config`, `None` in Python) so that giving it can be told from not
     /// giving it: for a parameter only some settings use, refused where it would be ignored.
     pub optional: bool,
+    /// The Python stubs' type ([`ParamValue::PYTHON`]); empty for the kind's.
+    pub python: &'static str,
+    /// Help for each choice ([`ParamValue::CHOICE_HELP`]).
+    pub choice_help: &'static [&'static str],
+}
+
+impl Declared {
+    /// Whether a Python keyword of this parameter is None by default: an optional parameter,
+    /// or one whose values Python takes in several forms (text, a number or a sequence: a
+    /// [`Kind::Text`] or [`Kind::List`]), where None stands for its default.
+    pub fn python_none(&self) -> bool {
+        self.optional || matches!(self.kind, Kind::Text | Kind::List)
+    }
 }
 
 /// The [`ParamSpec`]s of a declaration, as an array (`N` = `declared.len()`):
@@ -448,6 +372,8 @@ macro_rules! declare_params {
                         why: $crate::__declare_opt!($($why)?),
                         required: $crate::__declare_flag!($($required)?),
                         optional: $crate::__declare_flag!($($optional)?),
+                        python: <$ty as $crate::spec::ParamValue>::PYTHON,
+                        choice_help: <$ty as $crate::spec::ParamValue>::CHOICE_HELP,
                     },
                 )+
             ];

@@ -1,189 +1,30 @@
 //! The table of DLCA parameters ([`PARAMS`]): name, flag, unit, meaning and accepted range of
-//! every parameter a front end sets, beside their defaults from [`Params::default`]
-//! ([`defaults`]). The names are the flags' (and the Python keywords'); the front ends turn them
-//! into [`Params`] with [`flags`](super::flags) (`--dim` and `--size` into
-//! [`Params::size`], `--fill` or `--particles` into [`Params::init`]). The `dlca` binary, the
-//! Python bindings, xtask and `docs/dlca.md` are checked against it (`docs/architecture.md`,
-//! "Parameters: one declaration").
+//! every parameter a front end sets, from [`Settings`]'s one declaration, beside their defaults
+//! from [`Settings::default`] ([`defaults`]). The front ends turn them into [`Params`] with
+//! [`Settings::to_params`].
 
-use super::{DEFAULT_HISTOGRAM_SWEEPS, MAX_MODEL_DIM, Params, Search};
-use core_lattice::spec::{End, ParamSpec, Range};
+use super::Settings;
+#[cfg(test)]
+use super::{Params, Search};
+use core_lattice::spec::{DeclaredParams, ParamSpec, spec_table};
 
-const fn int(min: i128, max: Option<i128>) -> Range {
-    Range::Int { min, max }
-}
+/// Every parameter a front end sets, in declaration order (that of `dlca --help`): the table
+/// of [`Settings`]'s declaration. The ranges are those [`Params::validate`] accepts (written as
+/// its error messages write them; a unit test probes each bound).
+pub const PARAMS: &[ParamSpec] = &spec_table::<{ Settings::DECLARED.len() }>(Settings::DECLARED);
 
-/// Every parameter a front end sets, in the order of `docs/dlca.md`'s flag table. The ranges
-/// are those [`Params::validate`] accepts (written as its error messages write them; a unit
-/// test probes each bound).
-pub const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "dim",
-        flag: Some("dim"),
-        unit: "",
-        doc: "Lattice dimension.",
-        range: int(1, Some(MAX_MODEL_DIM as i128)),
-    },
-    ParamSpec {
-        name: "size",
-        flag: Some("size"),
-        unit: "sites",
-        doc: "Side lengths: one for every axis or one per axis.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "boundary",
-        flag: Some("boundary"),
-        unit: "",
-        doc: "Boundary of every axis, or of each axis.",
-        range: Range::Choices(&["periodic", "wall"]),
-    },
-    ParamSpec {
-        name: "fill",
-        flag: Some("fill"),
-        unit: "",
-        doc: "Fraction of sites holding a particle at the start.",
-        range: Range::Real(End::Open(0.0), End::Open(1.0)),
-    },
-    ParamSpec {
-        name: "particles",
-        flag: Some("particles"),
-        unit: "particles",
-        doc: "Number of particles at the start.",
-        range: Range::Text("1 to the number of sites"),
-    },
-    ParamSpec {
-        name: "temperature",
-        flag: Some("temperature"),
-        unit: "",
-        doc: "Move probability of a cluster per sweep.",
-        range: Range::Real(End::Open(0.0), End::Closed(1.0)),
-    },
-    ParamSpec {
-        name: "mobility_exponent",
-        flag: Some("mobility-exponent"),
-        unit: "",
-        doc: "gamma: a cluster of s particles moves with probability temperature * s^-gamma.",
-        range: Range::Real(End::Closed(0.0), End::Open(f64::INFINITY)),
-    },
-    ParamSpec {
-        name: "gravity",
-        flag: Some("gravity"),
-        unit: "",
-        doc: "g: moves down the last axis have weight 1+g, up 1-g.",
-        range: Range::Real(End::Closed(0.0), End::Open(1.0)),
-    },
-    ParamSpec {
-        name: "target_clusters",
-        flag: Some("target-clusters"),
-        unit: "clusters",
-        doc: "Stop when at most this many clusters remain.",
-        range: int(1, None),
-    },
-    ParamSpec {
-        name: "max_sweeps",
-        flag: Some("max-sweeps"),
-        unit: "sweeps",
-        doc: "Stop after this many sweeps at the latest (none: no limit).",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "search",
-        flag: Some("search"),
-        unit: "",
-        doc: "Contact search; every strategy gives the same trajectory.",
-        range: Range::Choices(&Search::NAMES),
-    },
-    ParamSpec {
-        name: "grid_box",
-        flag: Some("grid-box"),
-        unit: "sites",
-        doc: "Initial grid-box side for the grid strategies (none: chosen).",
-        range: Range::Text("a power of two"),
-    },
-    ParamSpec {
-        name: "max_memory",
-        flag: Some("max-memory"),
-        unit: "bytes",
-        doc: "Memory the occupancy lattice may take.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "gyration",
-        flag: Some("gyration"),
-        unit: "",
-        doc: "Measure each final cluster's radius of gyration and fit the fractal dimension.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "fit_min_size",
-        flag: Some("fit-min-size"),
-        unit: "particles",
-        doc: "Smallest cluster size in the fractal-dimension fit.",
-        range: int(2, None),
-    },
-    ParamSpec {
-        name: "timing",
-        flag: Some("timing"),
-        unit: "",
-        doc: "Record the wall time of each sweep.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "histogram",
-        flag: Some("histogram"),
-        unit: "",
-        doc: "Record histograms of candidate clusters examined per move.",
-        range: Range::Any,
-    },
-    ParamSpec {
-        name: "histogram_sweeps",
-        flag: Some("histogram-sweeps"),
-        unit: "sweeps",
-        doc: "The sweeps at which histograms are recorded.",
-        range: Range::Any,
-    },
-];
-
-/// The default of every parameter of [`PARAMS`], keyed by name, from [`Params::default`]:
+/// The default of every parameter of [`PARAMS`], keyed by name, from [`Settings::default`]:
 /// `null` where the front end must be given a value (`size`, and one of `fill` and
 /// `particles`) or where none means a choice (`max_sweeps`: no limit, `grid_box`: chosen).
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
-    let p = Params::default();
-    let sweeps: Vec<u64> = DEFAULT_HISTOGRAM_SWEEPS
-        .split(',')
-        .filter_map(|s| s.parse().ok())
-        .collect();
-    let v = serde_json::json!({
-        "dim": p.dim(),
-        "size": null,
-        "boundary": p.boundary[0].to_string(),
-        "fill": null,
-        "particles": null,
-        "temperature": p.temperature,
-        "mobility_exponent": p.mobility_exponent,
-        "gravity": p.gravity,
-        "target_clusters": p.target_clusters,
-        "max_sweeps": p.max_sweeps,
-        "search": p.search.name(),
-        "grid_box": p.grid_box,
-        "max_memory": p.max_memory,
-        "gyration": p.gyration,
-        "fit_min_size": p.fit_min_size,
-        "timing": p.timing,
-        "histogram": !p.histogram_sweeps.is_empty(),
-        "histogram_sweeps": sweeps,
-    });
-    match v {
-        serde_json::Value::Object(m) => m,
-        _ => unreachable!("a JSON object"),
-    }
+    sim_run::declared::defaults_of::<Settings>()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::Init;
+    use crate::params::{Init, LATTICE_FLAGS};
+    use core_lattice::spec::Input;
     use serde_json::Value;
 
     #[test]
@@ -195,6 +36,8 @@ mod tests {
             assert!(d.contains_key(s.name), "{}", s.name);
             assert_eq!(s.flag, Some(s.name.replace('_', "-")).as_deref());
         }
+        let lattice: Vec<&str> = PARAMS[..LATTICE_FLAGS].iter().map(|s| s.name).collect();
+        assert_eq!(lattice, ["dim", "size", "fill", "particles"]);
         assert_eq!(Search::ALL.map(Search::name), Search::NAMES);
         for x in Search::ALL {
             assert_eq!(x.name().parse::<Search>(), Ok(x));
@@ -206,35 +49,68 @@ mod tests {
                 .ends_with("possible values are auto, all-pairs, grid, grid-doubling, lattice")
         );
         // Every boundary of the table parses, and nothing else.
-        for b in PARAMS[2].range.choices() {
+        let boundary = PARAMS.iter().find(|s| s.name == "boundary").unwrap();
+        for b in boundary.range.choices() {
             assert_eq!(b.parse::<core_lattice::Boundary>().unwrap().to_string(), *b);
         }
+        // The defaults are the engine's.
+        let p = Settings {
+            size: Some(crate::params::Sizes(vec![1024])),
+            fill: Some(0.01),
+            ..Settings::default()
+        }
+        .to_params(|_| false)
+        .unwrap();
+        assert_eq!(p, Params::default());
+    }
+
+    #[test]
+    fn the_text_values_read_back_what_they_show() {
+        let mut s = Settings::default();
+        for (name, text) in [
+            ("size", "64x32"),
+            ("boundary", "periodic,wall"),
+            ("max_memory", "1536M"),
+            ("histogram_sweeps", "1,3"),
+        ] {
+            assert_eq!(s.set(name, &Input::Text(text.into())), Ok(true), "{name}");
+            let shown = s.to_text().into_iter().find(|(n, _)| *n == name).unwrap();
+            assert_eq!(shown.1, text);
+        }
+        assert_eq!(s.max_memory.0, 1536 << 20);
+        assert!(s.set("size", &Input::Text("64xx".into())).is_err());
+        assert!(
+            s.set("histogram_sweeps", &Input::Text("1,x".into()))
+                .is_err()
+        );
+        assert_eq!(Settings::default().to_text()[12].1, "4G");
+        // The sweeps of --histogram-sweeps need --histogram.
+        s.size = Some(crate::params::Sizes(vec![64]));
+        s.fill = Some(0.1);
+        let given = |n: &str| n == "histogram_sweeps";
+        assert_eq!(
+            s.to_params(given).unwrap_err(),
+            "--histogram-sweeps is used with --histogram only"
+        );
+        s.histogram = true;
+        assert_eq!(s.to_params(given).unwrap().histogram_sweeps, [1, 3]);
     }
 
     /// `Params` with the parameter `name` set to `v`, as the front ends set it.
     fn with(name: &str, v: &Value) -> Result<Params, String> {
-        let mut p = Params::default();
-        let f = v.as_f64().unwrap();
-        let n = || u64::try_from(v.as_i64().unwrap()).map_err(|e| e.to_string());
-        match name {
-            "dim" => {
-                let (size, boundary) = super::super::flags::axes(
-                    v.as_i64().unwrap().max(0) as usize,
-                    &[64],
-                    "periodic",
-                )?;
-                p.size = size;
-                p.boundary = boundary;
-            }
-            "fill" => p.init = Init::Fill(f),
-            "temperature" => p.temperature = f,
-            "mobility_exponent" => p.mobility_exponent = f,
-            "gravity" => p.gravity = f,
-            "target_clusters" => p.target_clusters = n()?,
-            "fit_min_size" => p.fit_min_size = n()?,
-            other => panic!("no probe for {other}"),
+        let mut s = Settings {
+            size: Some(crate::params::Sizes(vec![64])),
+            ..Settings::default()
+        };
+        let input = match v.as_u64() {
+            Some(n) if name != "fill" => Input::Count(n),
+            _ => Input::Real(v.as_f64().unwrap()),
+        };
+        if name != "fill" {
+            s.fill = Some(0.01);
         }
-        Ok(p)
+        assert_eq!(s.set(name, &input), Ok(true), "{name}");
+        s.to_params(|_| false)
     }
 
     /// Validation accepts each range's bounds and refuses the nearest values outside, naming
@@ -243,7 +119,8 @@ mod tests {
     fn validation_refuses_just_outside_each_stated_range() {
         core_lattice::spec::check_range_probes(PARAMS, |name, value| {
             let v: Value = serde_json::from_str(value).unwrap();
-            with(name, &v).and_then(|p| p.validate().map_err(|e| e.to_string()))
+            with(name, &v).map(drop)
         });
+        assert!(matches!(with("fill", &Value::from(0.5)), Ok(p) if p.init == Init::Fill(0.5)));
     }
 }

@@ -31,7 +31,7 @@ pub use out_dir::{
     Claim, ClaimError, ENSEMBLE_FILES, EarlierRun, LOCK_FILE, LockHolder, OutDirLock,
     check_out_dir, claim_out_dir, prepare_out_dir,
 };
-pub use params::ParamFlags;
+pub use params::{Annotated, FlagStyle, ParamFlags, Plain};
 pub use progress::Progress;
 pub use resume::{flag_differences, labelled_differences};
 
