@@ -194,7 +194,7 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
         "{} particles in {}D at {} bytes each{}",
         p.particles,
         p.dim,
-        dla_pdla::params::PEAK_BYTES_PER_PARTICLE[p.dim.clamp(2, 5) - 2],
+        p.peak_bytes_per_particle(),
         if cli.png || cli.animate {
             " and the picture"
         } else {

@@ -373,13 +373,21 @@ impl Params {
     /// With `connectivity`, [`CONNECTIVITY_BYTES_PER_PARTICLE`] more, and the 1 MiB buffer of
     /// `positions_parent.npy`.
     pub fn peak_memory_bytes(&self) -> u64 {
-        let (per, fixed) = if self.connectivity {
-            (CONNECTIVITY_BYTES_PER_PARTICLE, 1 << 20)
-        } else {
-            (0, 0)
-        };
-        let per = PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2] + per;
-        (PEAK_FIXED_BYTES + fixed).saturating_add(self.particles.saturating_mul(per))
+        let fixed = if self.connectivity { 1 << 20 } else { 0 };
+        (PEAK_FIXED_BYTES + fixed).saturating_add(
+            self.particles
+                .saturating_mul(self.peak_bytes_per_particle()),
+        )
+    }
+
+    /// The bytes per particle of [`peak_memory_bytes`](Self::peak_memory_bytes).
+    pub fn peak_bytes_per_particle(&self) -> u64 {
+        PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2]
+            + if self.connectivity {
+                CONNECTIVITY_BYTES_PER_PARTICLE
+            } else {
+                0
+            }
     }
 
     /// The variable-precision paper's walk (Sosa-Herrera & Rodriguez-Romo, section 3.2), for
