@@ -6,8 +6,8 @@ use crate::checkpoint::{Checkpoint, differences, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::declared::set_keywords;
 use crate::run::{Progress, interruptible, interruptible_guarded};
-use dla_pdla::params::PARAMS;
 use dla_pdla::branches::Branches;
+use dla_pdla::params::PARAMS;
 use dla_pdla::sim::{GROWTH, PARENTS_FILE, POSITIONS_FILE};
 use dla_pdla::{Dim, Params, SimError, Simulation, Space};
 use numpy::IntoPyArray;
@@ -383,7 +383,10 @@ where
         }
         _ => {
             let (v, up) = sim.into_positions_and_parents();
-            (v.ok_or_else(|| run_error("the positions were not kept"))?, up)
+            (
+                v.ok_or_else(|| run_error("the positions were not kept"))?,
+                up,
+            )
         }
     };
     // The run is over (its streams closed): what only the checkpoint needed goes.
@@ -393,15 +396,28 @@ where
     let branches = match &parents {
         Some(up) => {
             let b = Branches::from_parents(up).map_err(run_error)?;
-            let col = |f: &dyn Fn(&dla_pdla::branches::Order) -> u64| b.orders.iter().map(f).collect();
+            let col =
+                |f: &dyn Fn(&dla_pdla::branches::Order) -> u64| b.orders.iter().map(f).collect();
             Some(
                 Columns::default()
                     .add(py, "order", col(&|o| u64::from(o.order)))
                     .add(py, "branches", col(&|o| o.branches))
                     .add(py, "particles", col(&|o| o.particles))
-                    .add(py, "mean_length", b.orders.iter().map(|o| o.mean_length()).collect())
-                    .add(py, "bifurcation_ratio", b.ratios().iter().map(|r| r.0.unwrap_or(f64::NAN)).collect())
-                    .add(py, "length_ratio", b.ratios().iter().map(|r| r.1.unwrap_or(f64::NAN)).collect())
+                    .add(
+                        py,
+                        "mean_length",
+                        b.orders.iter().map(|o| o.mean_length()).collect(),
+                    )
+                    .add(
+                        py,
+                        "bifurcation_ratio",
+                        b.ratios().iter().map(|r| r.0.unwrap_or(f64::NAN)).collect(),
+                    )
+                    .add(
+                        py,
+                        "length_ratio",
+                        b.ratios().iter().map(|r| r.1.unwrap_or(f64::NAN)).collect(),
+                    )
                     .into_dict(py)?,
             )
         }

@@ -1,6 +1,6 @@
 //! The table of DLCA parameters ([`PARAMS`]): name, flag, unit, meaning and accepted range of
 //! every parameter a front end sets, from [`Settings`]'s one declaration, beside their defaults
-//! from [`Settings::default`] ([`defaults`]). The front ends turn them into [`Params`] with
+//! from [`Settings::default`] ([`defaults`]). The front ends turn them into [`Params`](super::Params) with
 //! [`Settings::to_params`].
 
 use super::Settings;
@@ -9,7 +9,7 @@ use super::{Params, Search};
 use core_lattice::spec::{DeclaredParams, ParamSpec, spec_table};
 
 /// Every parameter a front end sets, in declaration order (that of `dlca --help`): the table
-/// of [`Settings`]'s declaration. The ranges are those [`Params::validate`] accepts (written as
+/// of [`Settings`]'s declaration. The ranges are those [`Params::validate`](super::Params::validate) accepts (written as
 /// its error messages write them; a unit test probes each bound).
 pub const PARAMS: &[ParamSpec] = &spec_table::<{ Settings::DECLARED.len() }>(Settings::DECLARED);
 
