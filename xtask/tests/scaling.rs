@@ -109,6 +109,8 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "accuracy_vpdist_ccdf.csv",
         "family_branches.csv",
         "family_branches_orders.csv",
+        "family_sticking.csv",
+        "family_sticking_summary.csv",
     ] {
         check_csv(d, csv);
     }
@@ -124,6 +126,7 @@ fn tiny_run_produces_every_table_csv_and_plot() {
         "accuracy_pareto_prefactor.png",
         "accuracy_vpdist.png",
         "family_branches.png",
+        "family_sticking.png",
     ] {
         check_png(d, png);
     }

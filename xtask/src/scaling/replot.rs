@@ -52,6 +52,10 @@ pub const CHARTS: &[CsvChart] = &[
         csv: super::family::ORDERS_CSV,
         draw: super::family::branches_chart,
     },
+    CsvChart {
+        csv: super::family::STICKING_CSV,
+        draw: super::family::sticking_chart,
+    },
 ];
 
 /// What [`replot`] did: the charts written, and the charts' CSVs that were not in the
