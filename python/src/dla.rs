@@ -266,9 +266,7 @@ pub fn dla(
     } else {
         p
     };
-    params
-        .validate_given(given("death_ratio"))
-        .map_err(value_error)?;
+    params.validate_given(given).map_err(value_error)?;
     let progress = Progress::from_arg(progress, "dla", "particles")?;
     // The library's one run-time dimension dispatch, as in the binary.
     let ck = checkpoint.as_ref();

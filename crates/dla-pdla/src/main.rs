@@ -127,7 +127,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         p
     };
     // Flags that would be silently ignored are refused too.
-    p.validate_given(cli.params.given("death_ratio"))
+    p.validate_given(|name| cli.params.given(name))
         .map_err(|e| e.to_string())?;
     // Wherever the positions stream, each particle's parent goes with them: into the
     // positions files, and to resume with.

@@ -436,12 +436,13 @@ impl Params {
     }
 
     /// [`validate`](Self::validate), then refuse what a front end was given but the run would
-    /// silently ignore: a death ratio (`death_ratio_given`) without `--far-field jump`, and
-    /// `serial_until` with one thread. The `dla` binary and the Python bindings check their
-    /// parameters with this.
-    pub fn validate_given(&self, death_ratio_given: bool) -> Result<(), ParamsError> {
+    /// silently ignore: a death ratio without `--far-field jump`, and `serial_until` with one
+    /// thread. `given(name)`: whether the front end was given the parameter `name` (the
+    /// library knows which matter, so the front ends name none). The `dla` binary and the
+    /// Python bindings check their parameters with this.
+    pub fn validate_given(&self, given: impl Fn(&str) -> bool) -> Result<(), ParamsError> {
         self.validate()?;
-        if death_ratio_given && self.far_field != FarField::Jump {
+        if given("death_ratio") && self.far_field != FarField::Jump {
             return Err(ParamsError::DeathRatioUnused);
         }
         if self.serial_until > 0 && self.threads == 1 {
@@ -618,18 +619,21 @@ mod tests {
     #[test]
     fn flags_the_run_would_ignore_are_refused() {
         let d = Params::default;
-        assert_eq!(d().validate_given(false), Ok(()));
-        assert_eq!(d().validate_given(true), Err(ParamsError::DeathRatioUnused));
+        assert_eq!(d().validate_given(|_| false), Ok(()));
+        assert_eq!(
+            d().validate_given(|n| n == "death_ratio"),
+            Err(ParamsError::DeathRatioUnused)
+        );
         let jump = Params {
             far_field: FarField::Jump,
             ..d()
         };
-        assert_eq!(jump.validate_given(true), Ok(()));
+        assert_eq!(jump.validate_given(|n| n == "death_ratio"), Ok(()));
         let serial = Params {
             serial_until: 100,
             ..d()
         };
-        let e = serial.validate_given(false).unwrap_err().to_string();
+        let e = serial.validate_given(|_| false).unwrap_err().to_string();
         assert!(
             e.starts_with("--serial-until 100 is used with --threads > 1"),
             "{e}"
@@ -639,12 +643,12 @@ mod tests {
                 threads: 2,
                 ..serial
             }
-            .validate_given(false),
+            .validate_given(|_| false),
             Ok(())
         );
         // Range errors come first, as from `validate`.
         let e = Params { threads: 0, ..d() }
-            .validate_given(true)
+            .validate_given(|n| n == "death_ratio")
             .unwrap_err();
         assert_eq!(
             e.to_string(),
