@@ -86,8 +86,8 @@ impl Branches {
         })
     }
 
-    /// Analyses the parents of `positions_parent.npy` at `path` (as `dla` writes it, `n` rows), read
-    /// from the last to the first in blocks: 1 byte a particle beside the file.
+    /// Analyses the parents of `positions_parent.npy` at `path` (as `dla` writes it, `n`
+    /// rows), read from the last to the first in blocks: 1 byte a particle beside the file.
     ///
     /// # Errors
     /// The file does not read or is not `n` parents forming a forest.
