@@ -296,9 +296,9 @@ where
     /// only for its checkpoints and has ended (the binary's default), which then removes the
     /// file, after its outputs and `checkpoint.bin`, with
     /// [`remove_positions_file`](Self::remove_positions_file). `growth.csv` and
-    /// `positions_parent.npy` (a few bytes a particle, which the branch analysis reads) stream on, and
-    /// `positions_parent.npy` goes with `positions.npy`.
-    /// Returns whether positions were streamed.
+    /// `positions_parent.npy` (8 bytes a particle, which the branch analysis reads) stream on;
+    /// `positions_parent.npy` is removed with `positions.npy`. Returns whether positions were
+    /// streamed.
     pub fn discard_positions(&mut self) -> bool {
         self.growth
             .streams
