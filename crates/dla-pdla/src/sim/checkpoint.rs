@@ -308,9 +308,9 @@ where
     if params.connectivity {
         // The rebuild stored each particle with its arrival index as its tag, which is all
         // the tree needs; the parents themselves are in their own log.
-        let parents = read_parents(&dir.join(PARENTS_FILE), snap.n)?;
-        if let Some(kept) = &mut growth.parents {
-            *kept = parents;
+        let keep = growth.parents.is_some();
+        if let Some(parents) = read_parents(&dir.join(PARENTS_FILE), snap.n, keep)? {
+            growth.parents = Some(parents);
         }
     }
     growth.samples = snap.samples;
@@ -338,15 +338,16 @@ where
     })
 }
 
-/// The first `n` parents of the log at `path`, checked to form a tree in arrival order
-/// (row 0 is `-1`, every other row an earlier particle's index or `-1`).
-pub(crate) fn read_parents(path: &Path, n: u64) -> Result<Vec<i64>, SimError> {
+/// The first `n` parents of the log at `path`, checked to form a forest in arrival order
+/// (every row an earlier particle's index or `-1`), read row by row; returned only with
+/// `keep` (a run that keeps them in memory), so that checking costs no memory.
+pub(crate) fn read_parents(path: &Path, n: u64, keep: bool) -> Result<Option<Vec<i64>>, SimError> {
     let bad = |why: String| SimError::CheckpointUsage(format!("{}: {why}", path.display()));
     let mut r = NpyReader::open_ints(path).map_err(|e| bad(e.to_string()))?;
-    let mut out = Vec::with_capacity(usize::try_from(n).unwrap_or(0));
+    let mut out = keep.then(|| Vec::with_capacity(usize::try_from(n).unwrap_or(0)));
     for i in 0..n {
         match r.next_int().map_err(|e| bad(e.to_string()))? {
-            Some(p) if p >= -1 && p < i as i64 => out.push(p),
+            Some(p) if p >= -1 && p < i as i64 => out.iter_mut().for_each(|v| v.push(p)),
             Some(p) => {
                 return Err(bad(format!(
                     "row {i} names parent {p}, not an earlier particle"
