@@ -4,29 +4,26 @@
 //! unchanged; checkpoints keep them; the branch analysis of a real cluster matches a naive
 //! one; and the binary writes them in every positions format.
 
+mod common;
+
+use common::tolerance;
 use dla_pdla::branches::{Branches, Order};
 use dla_pdla::sim::PARENTS_FILE;
 use dla_pdla::{Dim, Params, Simulation, Space};
 use std::process::Command;
 
+/// A finished run of `params` with its parents recorded (positions kept).
 fn grow<const D: usize>(params: Params, seed: u64) -> Simulation<D>
 where
     Dim<D>: Space<D>,
 {
-    let params = Params {
-        dim: D,
-        keep_positions: true,
-        connectivity: true,
-        ..params
-    };
-    let mut sim = Simulation::<D>::new(params, seed).unwrap();
-    sim.run().unwrap();
-    sim
-}
-
-/// The stored positions' rounding, as in `tests/variants.rs`.
-fn tolerance<const D: usize>(params: &Params) -> f64 {
-    (D as f64).sqrt() * params.leaf_side / 2f64.powi(33) + 1e-12
+    common::grow(
+        Params {
+            connectivity: true,
+            ..params
+        },
+        seed,
+    )
 }
 
 /// Parents form one tree in arrival order and each particle lies at the contact distance

@@ -4,31 +4,10 @@
 //! checkpointed run resumes to the uninterrupted one.
 
 use dla_pdla::sim::OVERLAP_DISTANCE;
+mod common;
+
+use common::{grow, tolerance};
 use dla_pdla::{Dim, Params, Simulation, Space};
-
-/// A finished run of `params` (positions kept) with `seed`.
-fn grow<const D: usize>(params: Params, seed: u64) -> Simulation<D>
-where
-    Dim<D>: Space<D>,
-{
-    let params = Params {
-        dim: D,
-        keep_positions: true,
-        ..params
-    };
-    let mut sim = Simulation::<D>::new(params, seed).unwrap();
-    sim.run().unwrap();
-    sim
-}
-
-/// How far a stored distance may differ from the exact one: the orthtree stores each
-/// coordinate to within `leaf_side / 2^33` (9.3e-10 for the default leaf side 8), so a stored
-/// position is within `sqrt(D)` times that of the position computed, plus the rounding of the
-/// contact itself (far below 1e-12 at these coordinates): 1.32e-9 in 2D, of which a few
-/// thousand particles use up to 1.3e-9, so a tolerance of 1e-9 would fail.
-fn tolerance<const D: usize>(params: &Params) -> f64 {
-    (D as f64).sqrt() * params.leaf_side / 2f64.powi(33) + 1e-12
-}
 
 /// Brute force over the stored positions: for every particle after the seed, the distance to
 /// the nearest earlier one, as (smallest, largest) over the particles.
