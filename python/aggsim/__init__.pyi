@@ -56,6 +56,15 @@ class DlaResult:
     """R_B fitted over the middle orders (None when the cluster has too few)."""
     length_ratio: Optional[float]
     ratio_fit_orders: Optional[List[int]]
+    deposit: Optional[Dict[str, npt.NDArray[Any]]]
+    """A deposit's (``substrate_width`` > 0) ``deposit.csv`` columns per layer of one
+    diameter: ``height``, ``particles`` (uint64), ``density``, ``trees`` (uint64); None for
+    radial growth."""
+    deposit_growth: Optional[Dict[str, npt.NDArray[Any]]]
+    """A deposit's ``deposit_growth.csv`` columns per block of W^(d-1) particles: ``n``,
+    ``height``, ``mean_height``, ``active_zone_width``, ``growing_trees``."""
+    density_dimension: Optional[float]
+    """A deposit's trees' fractal dimension from its density profile (None without a fit)."""
     growth: Dict[str, npt.NDArray[Any]]
     """``growth.csv``'s columns: ``n`` (uint64), ``radius_of_gyration``, ``r_ext``,
     ``seconds`` (float64) per growth sample."""
@@ -133,6 +142,10 @@ def dla(
     fit_from: Count = ...,
     sticking_probability: float = ...,
     noise_reduction: float = ...,
+    substrate_width: float = ...,
+    drift: float = ...,
+    ballistic: bool = ...,
+    seed_set: Optional[str] = None,
     # END GENERATED dla-keywords
     paper_settings: bool = False,
     progress: Progress = None,

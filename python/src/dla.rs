@@ -7,6 +7,7 @@ use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error
 use crate::declared::set_keywords;
 use crate::run::{Progress, interruptible, interruptible_guarded};
 use dla_pdla::branches::Branches;
+use dla_pdla::deposit::Deposit;
 use dla_pdla::params::PARAMS;
 use dla_pdla::sim::{GROWTH, PARENTS_FILE, POSITIONS_FILE};
 use dla_pdla::{Dim, Params, SimError, Simulation, Space};
@@ -46,6 +47,13 @@ const PARTICLES: u64 = 100_000;
 ///     NaN at the highest order); the fitted ``bifurcation_ratio``,
 ///     ``length_ratio``, ``strahler_order``, ``trees`` and ``ratio_fit_orders`` are results
 ///     of ``run.json`` (below).
+/// deposit, deposit_growth : dict[str, numpy.ndarray] or None
+///     A deposit's profile and active zone (``substrate_width`` > 0), as the binary's
+///     ``deposit.csv`` (per layer of one diameter: ``height``, ``particles``, ``density``,
+///     ``trees``) and ``deposit_growth.csv`` (per block of W^(d-1) particles: ``n``,
+///     ``height``, ``mean_height``, ``active_zone_width``, ``growing_trees``); the fitted
+///     ``density_dimension`` and the other ``deposit_*`` results are in ``run.json``. None
+///     for radial growth.
 /// growth : dict[str, numpy.ndarray]
 ///     The growth samples (200 log-spaced sizes per decade and the final size), as the
 ///     binary's ``growth.csv``, same names and dtypes: ``n`` (uint64, particles),
@@ -361,6 +369,7 @@ where
         .into_dict(py)?;
     let mut m = m;
     let links = sim.params().connectivity;
+    let m_substrate = sim.params().substrate().map(|s| s.width);
     let (positions, parents) = match (sim.positions().is_some(), checkpoint) {
         (false, Some(ck)) => {
             let n = usize::try_from(sim.particles()).unwrap_or(0);
@@ -421,6 +430,42 @@ where
         }
         None => None,
     };
+    let (deposit, deposit_growth) = match (m_substrate, &parents) {
+        (Some(width), Some(up)) => {
+            let mut d = Deposit::new(D, width);
+            for (p, &parent) in positions.iter().zip(up) {
+                d.push(p, parent).map_err(run_error)?;
+            }
+            d.finish();
+            dla_pdla::deposit::set_results(&mut m, &d);
+            let trees = d.surviving_trees();
+            let layers = d.layers.len();
+            let profile = Columns::default()
+                .add(py, "height", (0..layers).map(|k| k as f64).collect())
+                .add(py, "particles", d.layers.clone())
+                .add(py, "density", (0..layers).map(|k| d.density(k)).collect())
+                .add(py, "trees", trees)
+                .into_dict(py)?;
+            let b = &d.blocks;
+            let blocks = Columns::default()
+                .add(py, "n", b.iter().map(|b| b.n).collect())
+                .add(py, "height", b.iter().map(|b| b.height).collect())
+                .add(py, "mean_height", b.iter().map(|b| b.mean_height).collect())
+                .add(
+                    py,
+                    "active_zone_width",
+                    b.iter().map(|b| b.active_zone_width).collect(),
+                )
+                .add(
+                    py,
+                    "growing_trees",
+                    b.iter().map(|b| b.growing_trees).collect(),
+                )
+                .into_dict(py)?;
+            (Some(profile), Some(blocks))
+        }
+        _ => (None, None),
+    };
     // `Vec<[f64; D]>` becomes an (N, D) array and NumPy takes it over: no copy.
     let positions = Array2::from(positions).into_pyarray(py);
     let out = Bound::new(py, DlaResult {})?;
@@ -428,6 +473,8 @@ where
     out.setattr("positions", positions)?;
     out.setattr("parent", parents.map(|up| up.into_pyarray(py)))?;
     out.setattr("branches", branches)?;
+    out.setattr("deposit", deposit)?;
+    out.setattr("deposit_growth", deposit_growth)?;
     out.setattr("growth", growth)?;
     Ok(out.unbind())
 }

@@ -46,6 +46,29 @@ def test_dla_parents_form_a_tree_of_touching_particles():
     assert r.trees == 1 and 4.0 < r.bifurcation_ratio < 6.5
 
 
+def test_dla_deposit_on_a_substrate():
+    w = 64.0
+    r = aggsim.dla(particles=4000, seed=2, substrate_width=w, drift=0.5)
+    pos, p = r.positions, r.parent
+    assert np.all(np.abs(pos[:, 0]) <= w / 2) and np.all(pos[:, 1] >= -1e-9)
+    roots = p == -1
+    np.testing.assert_allclose(pos[roots, 1], 0.0, atol=1e-8)
+    dx = np.abs(pos[~roots, 0] - pos[p[~roots], 0])
+    dx = np.minimum(dx, w - dx)
+    dz = pos[~roots, 1] - pos[p[~roots], 1]
+    np.testing.assert_allclose(np.hypot(dx, dz), 1.0, atol=1e-8)
+    d = r.deposit
+    assert list(d) == ["height", "particles", "density", "trees"]
+    assert d["particles"].sum() == 4000 and d["trees"][0] == roots.sum()
+    np.testing.assert_allclose(d["density"], d["particles"] / w)
+    g = r.deposit_growth
+    assert g["n"][-1] == 4000 and np.all(np.diff(g["height"]) >= 0)
+    assert r.run_json["results"]["deposit_trees"] == roots.sum()
+    assert aggsim.dla(particles=100, seed=2).deposit is None
+    with pytest.raises(ValueError, match="--drift needs --substrate-width"):
+        aggsim.dla(particles=100, drift=1.0)
+
+
 def test_a_resumed_dla_keeps_its_parents(tmp_path, monkeypatch):
     from test_checkpoint import SMALL, stopped_at_start
 

@@ -36,6 +36,7 @@
 
 pub mod branches;
 pub mod cluster;
+pub mod deposit;
 pub mod error;
 pub mod farfield;
 mod near;
@@ -43,8 +44,10 @@ pub mod output;
 pub mod params;
 #[cfg(feature = "figures")]
 pub mod picture;
+pub mod seeds;
 pub mod sim;
 pub mod space;
+pub mod substrate;
 pub mod walker;
 
 pub use cluster::Cluster;

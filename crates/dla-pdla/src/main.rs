@@ -5,7 +5,7 @@
 
 use anyhow::Context;
 use clap::Parser;
-use dla_pdla::output::{PositionsFormat, default_png_side, write_outputs};
+use dla_pdla::output::{PositionsFormat, default_png_side_of, write_outputs};
 use dla_pdla::{Dim, Params, ParamsError, SimError, Simulation, Space};
 use sim_run::cli::{
     CheckpointArgs, ConfigArgs, LogArgs, OverwriteArgs, ParamFlags, flag_differences, stopped,
@@ -359,12 +359,15 @@ where
     }
     progress.finish();
     // Positions streamed only for the checkpoints are not synced: they go at the end.
-    let discard = !asked_positions && sim.discard_positions();
+    // ... unless an output reads them back (a deposit's profile): then they are synced and
+    // removed after the outputs.
+    let read_back = dla_pdla::output::reads_positions(sim.params());
+    let discard = !asked_positions && !read_back && sim.discard_positions();
+    let remove = discard || (!asked_positions && read_back && sim.streams_positions());
     sim.sync_streams()?;
-    let png = cli.png.then(|| {
-        cli.png_size
-            .unwrap_or_else(|| default_png_side(sim.r_ext()))
-    });
+    let png = cli
+        .png
+        .then(|| cli.png_size.unwrap_or_else(|| default_png_side_of(&sim)));
     if cli.animate {
         let side = cli
             .png_size
@@ -386,29 +389,17 @@ where
     // positions); what was asked for stays.
     sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.out, cli.checkpoint_every.is_some())
         .context("removing checkpoint.bin")?;
-    if discard {
+    if remove {
         sim.remove_positions_file()?;
     }
-    if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str()) {
+    if let Some(e) = m.results.get("fit_error").and_then(|v| v.as_str())
+        && sim.params().substrate().is_none()
+    {
         tracing::warn!("no fractal dimension: {e}");
     }
     tracing::info!(discarded = sim.discarded_walkers(), "done");
     if !cli.log.is_quiet() {
-        let d = m
-            .results
-            .get("fractal_dimension")
-            .and_then(|v| v.as_f64())
-            .map_or_else(|| "n/a".to_string(), |d| format!("{d:.4}"));
-        eprintln!(
-            "dla: {} particles in {}D, R_g {:.2}, R_ext {:.2}, D_f {} in {:.2} s; outputs in {}",
-            sim.particles(),
-            D,
-            sim.radius_of_gyration(),
-            sim.r_ext(),
-            d,
-            m.wall_seconds,
-            cli.out.display()
-        );
+        eprintln!("{}", dla_pdla::output::summary(&sim, &m, &cli.out));
     }
     Ok(())
 }

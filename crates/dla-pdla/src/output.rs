@@ -15,6 +15,8 @@
 //! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView); 2D and 3D only |
 //! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (feature `figures`, see [`crate::picture`]) |
 //! | `dla.gif` | `--animate`: the growth of the cluster, one frame every `--animate-every` particles |
+//! | `branches.csv`, `branches.png` | the Horton-Strahler analysis (whenever the parents are recorded; the chart with `--png`) |
+//! | `deposit.csv`, `deposit_growth.csv`, `deposit.png` | a deposit's profile, surviving trees and active zone (`--substrate-width`; the chart with `--png`; see [`crate::deposit`]) |
 
 use crate::sim::{GROWTH, GROWTH_COLUMNS, Simulation};
 use crate::space::{Dim, Space};
@@ -35,6 +37,8 @@ use sim_run::schema::{Axes, Column, Dtype, Form, Output};
 pub const SCHEMA: &[Output] = &[
     GROWTH,
     crate::branches::BRANCHES,
+    crate::deposit::DEPOSIT,
+    crate::deposit::DEPOSIT_GROWTH,
     Output {
         file: "positions",
         form: Form::Points {
@@ -179,9 +183,21 @@ where
         }
     }
 
+    let deposit = deposit_of(sim, dir)?;
+    if let Some(d) = &deposit {
+        crate::deposit::write_csv(d, dir)?;
+        #[cfg(feature = "figures")]
+        if png.is_some() {
+            crate::deposit::write_png(d, sim.seed(), &dir.join("deposit.png"))?;
+        }
+    }
+
     let mut m = manifest_with_peak(sim, clock, simulation_peak)?;
     if let Some(b) = &branches {
         set_branch_results(&mut m, b);
+    }
+    if let Some(d) = &deposit {
+        crate::deposit::set_results(&mut m, d);
     }
     // The high-water mark now covers the output stage too.
     m.set_result("output_peak_rss_bytes", m.peak_rss_bytes);
@@ -212,7 +228,66 @@ where
             .map_err(|e| std::io::Error::other(e.to_string()))?;
         set_branch_results(&mut m, &b);
     }
+    if sim.positions().is_some()
+        && let Some(d) = deposit_of(sim, Path::new(""))?
+    {
+        crate::deposit::set_results(&mut m, &d);
+    }
     Ok(m)
+}
+
+/// The analysis of a deposit ([`crate::deposit`]) from the particles and parents kept in
+/// memory or streamed to `dir`; `None` for radial growth or a run without `connectivity`.
+pub fn deposit_of<const D: usize>(
+    sim: &Simulation<D>,
+    dir: &Path,
+) -> Result<Option<crate::deposit::Deposit>, OutputError> {
+    let Some(substrate) = sim.params().substrate() else {
+        return Ok(None);
+    };
+    if !sim.params().connectivity {
+        return Ok(None);
+    }
+    let mut d = crate::deposit::Deposit::new(D, substrate.width);
+    each_particle(sim, dir, |_, p: &[f64; D], parent| {
+        d.push(p, parent.unwrap_or(-1))
+            .map_err(|e| std::io::Error::other(e.to_string()).into())
+    })?;
+    d.finish();
+    Ok(Some(d))
+}
+
+/// The one-line summary the `dla` binary prints at the end of a run, from its manifest `m`.
+pub fn summary<const D: usize>(sim: &Simulation<D>, m: &RunManifest, dir: &Path) -> String {
+    let number = |key: &str, digits: usize| {
+        m.results
+            .get(key)
+            .and_then(|v| v.as_f64())
+            .map_or_else(|| "n/a".to_string(), |d| format!("{d:.digits$}"))
+    };
+    let head = match sim.params().substrate() {
+        Some(s) => format!(
+            "dla: {} particles in {D}D on a substrate of width {}, height {:.2}, trees {} ({} still growing), density dimension {}",
+            sim.particles(),
+            s.width,
+            sim.r_ext(),
+            number("deposit_trees", 0),
+            number("deposit_growing_trees", 0),
+            number("density_dimension", 4),
+        ),
+        None => format!(
+            "dla: {} particles in {D}D, R_g {:.2}, R_ext {:.2}, D_f {}",
+            sim.particles(),
+            sim.radius_of_gyration(),
+            sim.r_ext(),
+            number("fractal_dimension", 4),
+        ),
+    };
+    format!(
+        "{head} in {:.2} s; outputs in {}",
+        m.wall_seconds,
+        dir.display()
+    )
 }
 
 /// The Horton-Strahler analysis of a run with `connectivity`, from the parents kept in memory
@@ -292,6 +367,14 @@ where
         .set_result("simulation_peak_rss_bytes", simulation_peak)
         .set_result("bytes_per_particle", bpp);
     match fit {
+        _ if params.substrate().is_some() => {
+            m.set_result("fractal_dimension", serde_json::Value::Null)
+                .set_result("fractal_dimension_stderr", serde_json::Value::Null)
+                .set_result(
+                    "fit_error",
+                    "a deposit has no radius-of-gyration fit: see density_dimension",
+                );
+        }
         Ok(f) => {
             m.set_result("fractal_dimension", f.slope)
                 .set_result("fractal_dimension_stderr", f.slope_stderr)
@@ -336,6 +419,18 @@ pub fn write_positions_bin<const D: usize>(
     }
     f.commit()?;
     Ok(())
+}
+
+/// Whether the outputs of a run of `params` read its positions back (a deposit's analysis,
+/// [`deposit_of`]), so that a front end must sync them even where it was not asked to keep
+/// them.
+pub fn reads_positions(params: &crate::Params) -> bool {
+    params.substrate().is_some()
+}
+
+/// [`default_png_side`] of a run's frame ([`Simulation::picture_half`]).
+pub fn default_png_side_of<const D: usize>(sim: &Simulation<D>) -> u32 {
+    default_png_side(sim.picture_half())
 }
 
 /// Side of `dla.png` in pixels when none is asked for: one pixel per diameter across the

@@ -170,6 +170,38 @@ core_lattice::declare_params! {
             range: Range::Real(End::Open(0.0), End::Closed(1.0)),
             why: "the stored particle's distance to the one it touched, in diameters; at 0 the two would coincide",
         },
+        /// Growth on a substrate of this width (0: radial growth from one seed particle). The
+        /// substrate is a line (2D) or a plane (3D; a hyperplane in 4D and 5D) with periodic
+        /// lateral boundaries of period W; walkers start above the deposit and stick to it or
+        /// to the substrate (diffusion-limited deposition). Writes deposit.csv and
+        /// deposit_growth.csv. One thread only.
+        substrate_width: f64 = 0.0 => {
+            flag: "substrate-width", unit: "diameters",
+            range: Range::Real(End::Closed(0.0), End::Closed(MAX_SUBSTRATE_WIDTH)),
+            why: "0 = radial growth; a substrate needs at least 8",
+        },
+        /// Drift towards the substrate, as the Péclet number Pe = v d / D_w (v the drift
+        /// speed, d the diameter, D_w the walker's diffusion coefficient): a deposit is
+        /// diffusion-limited up to heights of about 2 / Pe and ballistic above. Exact: each
+        /// jump's direction is drawn from the drifting walker's exit law. Needs a substrate.
+        drift: f64 = 0.0 => {
+            flag: "drift", unit: "",
+            range: Range::Real(End::Closed(0.0), End::Closed(MAX_DRIFT)),
+            why: "Pe; beyond 1e6 a walker moves straight within 1e-6 radians, use --ballistic",
+        },
+        /// Straight-line walkers, the infinite-drift limit: ballistic deposition with a
+        /// substrate (walkers fall straight down), ballistic aggregation without (each walker
+        /// on a straight line from a random direction, Vold-Sutherland-Meakin). One thread
+        /// only.
+        ballistic: bool = false => { flag: "ballistic", unit: "", range: Range::Any },
+        /// Grow from the particles of this positions file (.npy, .csv, .bin, .xyz or .vtk, as
+        /// dla writes them) instead of one seed at the origin: each is stored first, in the
+        /// file's order, with parent -1. With a substrate they must lie in the strip, on or
+        /// above it. A resumed run keeps them (they are its first particles).
+        seed_set: Option<SeedSet> = None => {
+            flag: "seed-set", unit: "",
+            range: Range::Text("a positions file"), optional: true,
+        },
     }
     internal {
         /// Keep every position in arrival order (needed for position files and pictures).
@@ -182,6 +214,33 @@ core_lattice::declare_params! {
         /// are written or kept, so that the parents go with them; the walk is the same
         /// either way.
         connectivity: bool = false,
+    }
+}
+
+/// The path of a seed set (`--seed-set`), as given.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(transparent)]
+pub struct SeedSet(pub String);
+
+impl ParamValue for SeedSet {
+    const KIND: Kind = Kind::Text;
+    fn from_input(v: &Input) -> Result<Self, String> {
+        match v {
+            Input::Text(s) => Self::parse_text(s),
+            other => Err(format!("expected a path, not {other:?}")),
+        }
+    }
+    fn parse_text(s: &str) -> Result<Self, String> {
+        if s.is_empty() {
+            return Err("an empty path".into());
+        }
+        Ok(SeedSet(s.to_string()))
+    }
+    fn in_range(&self, _: &Range) -> bool {
+        true
+    }
+    fn show(&self) -> String {
+        self.0.clone()
     }
 }
 
@@ -247,6 +306,15 @@ pub const PAPER_PRECISION: f64 = 2.0;
 /// thousand times that at the radius of a 1e9-particle cluster, while `--step-min 1e-300` would
 /// leave a walker in place forever.
 pub const MIN_STEP_MIN: f64 = 1e-6;
+
+/// Largest accepted `--substrate-width`, in diameters: far beyond what a deposit of
+/// [`MAX_PARTICLES`] covers with more than one layer in 2D.
+pub const MAX_SUBSTRATE_WIDTH: f64 = 1e7;
+
+/// Largest accepted `--drift` (Péclet number): at Pe 1e6 a step of 0.1 diameters deviates
+/// from the drift's direction by about 1e-2.5 radians and a jump of 10 by 1e-3.5; larger values
+/// are the ballistic limit, `--ballistic`.
+pub const MAX_DRIFT: f64 = 1e6;
 
 /// Largest accepted `--birth-gap`. The birth sphere only has to enclose the cluster: where a
 /// walker first comes near the cluster does not depend on how far out it was born (uniformly
@@ -333,6 +401,51 @@ pub enum ParamsError {
     /// `serial_until` given with one thread, which is serial throughout.
     #[error("--serial-until {0} is used with --threads > 1 only (one thread is serial throughout)")]
     SerialUntilUnused(u64),
+    /// A substrate narrower than [`MIN_SUBSTRATE_WIDTH`](crate::substrate::MIN_SUBSTRATE_WIDTH).
+    #[error(
+        "--substrate-width {0} is outside the accepted values: 0 (radial growth) or [8, 1e7] diameters (a narrower strip would hold under a few particles per layer)"
+    )]
+    SubstrateTooNarrow(f64),
+    /// Drift without a substrate.
+    #[error(
+        "--drift needs --substrate-width: with a point seed a drifting walker that passes the cluster leaves for good, and where one would come back has no exact law (radial growth takes --ballistic, the infinite-drift limit)"
+    )]
+    DriftNeedsSubstrate,
+    /// Both drift and the ballistic limit.
+    #[error("--ballistic is the limit of infinite --drift: give one or the other")]
+    BallisticDrift,
+    /// A sticking probability below 1 with ballistic walkers.
+    #[error(
+        "--sticking-probability below 1 has no effect with --ballistic: a straight walker refused at a contact moves on into the same particle and touches it again"
+    )]
+    BallisticSticking,
+    /// The `jump` far field with a substrate or ballistic walkers.
+    #[error(
+        "--far-field jump is the radial diffusive walk's: a deposit returns its walkers to the launch plane exactly and ballistic walkers never come back"
+    )]
+    FarFieldJumpUnused,
+    /// A seed set that cannot be read or does not fit the run.
+    #[error("{0}")]
+    SeedSet(String),
+    /// PDLA with a substrate or ballistic walkers.
+    #[error(
+        "--threads {0}: deposits (--substrate-width) and ballistic walkers grow with one thread only"
+    )]
+    VariantThreads(usize),
+    /// A near-field step too long for the substrate's image margin.
+    #[error(
+        "--step-min {step} is too long for --substrate-width {width}: a step must stay below {max} diameters (the periodic images reach {margin} beyond each edge)"
+    )]
+    StepTooLongForSubstrate {
+        /// The step given.
+        step: f64,
+        /// The substrate's width.
+        width: f64,
+        /// The longest step accepted.
+        max: f64,
+        /// The image margin.
+        margin: f64,
+    },
 }
 
 impl ParamsError {
@@ -359,6 +472,12 @@ pub const PEAK_BYTES_PER_PARTICLE: [u64; 4] = [13, 26, 40, 450];
 /// the cluster (it reads the parents from `positions_parent.npy` in blocks).
 pub const CONNECTIVITY_BYTES_PER_PARTICLE: u64 = 5;
 
+/// What a deposit adds per particle beyond its images (see
+/// [`Params::peak_bytes_per_particle`]): the analysis after the run (each particle's tree, 4
+/// bytes) and the map window's rebuilds. Checked against peak RSS for 2D widths 64 and 1000
+/// and 3D widths 64 and 200 (`docs/dla.md`, "Memory").
+pub const DEPOSIT_BYTES_PER_PARTICLE: u64 = 8;
+
 /// Peak memory of a run that does not grow with it: the binary, its libraries, the distance
 /// maps' smallest size, and the 1 MiB buffer of `positions.npy`, which streams for the
 /// checkpoints by default.
@@ -380,9 +499,20 @@ impl Params {
         )
     }
 
-    /// The bytes per particle of [`peak_memory_bytes`](Self::peak_memory_bytes).
+    /// The bytes per particle of [`peak_memory_bytes`](Self::peak_memory_bytes). A deposit
+    /// stores every particle near a lateral edge again across it: the dimension's bytes
+    /// times the expected copies per particle, `(1 + 2 margin / W)^(d - 1)`, and
+    /// [`DEPOSIT_BYTES_PER_PARTICLE`] more.
     pub fn peak_bytes_per_particle(&self) -> u64 {
-        PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2]
+        let base = PEAK_BYTES_PER_PARTICLE[self.dim.clamp(2, 5) - 2];
+        let cluster = match self.substrate() {
+            Some(s) => {
+                let copies = (1.0 + 2.0 * s.margin / s.width).powi(self.dim as i32 - 1);
+                (base as f64 * copies).ceil() as u64 + DEPOSIT_BYTES_PER_PARTICLE
+            }
+            None => base,
+        };
+        cluster
             + if self.connectivity {
                 CONNECTIVITY_BYTES_PER_PARTICLE
             } else {
@@ -432,6 +562,51 @@ impl Params {
             });
         }
         self.check_ranges()?;
+        self.check_variants()?;
+        Ok(())
+    }
+
+    /// The substrate, if the run grows a deposit.
+    pub fn substrate(&self) -> Option<crate::substrate::Substrate> {
+        crate::substrate::Substrate::new(self.substrate_width)
+    }
+
+    /// Refuses the combinations of the variants that have no meaning (or that the engine
+    /// does not grow: PDLA deposits and ballistic walkers).
+    fn check_variants(&self) -> Result<(), ParamsError> {
+        let w = self.substrate_width;
+        if w > 0.0 && w < crate::substrate::MIN_SUBSTRATE_WIDTH {
+            return Err(ParamsError::SubstrateTooNarrow(w));
+        }
+        if self.drift > 0.0 && w == 0.0 {
+            return Err(ParamsError::DriftNeedsSubstrate);
+        }
+        if self.ballistic && self.drift > 0.0 {
+            return Err(ParamsError::BallisticDrift);
+        }
+        if self.ballistic && self.sticking_probability < 1.0 {
+            return Err(ParamsError::BallisticSticking);
+        }
+        let variant = w > 0.0 || self.ballistic;
+        if variant && self.far_field == FarField::Jump {
+            return Err(ParamsError::FarFieldJumpUnused);
+        }
+        if variant && self.threads > 1 {
+            return Err(ParamsError::VariantThreads(self.threads));
+        }
+        if let Some(s) = self.substrate() {
+            // A step's contact search covers step + 1 around the walker: all within the
+            // images' margin.
+            let max = s.margin - 1.0;
+            if self.step_min >= max {
+                return Err(ParamsError::StepTooLongForSubstrate {
+                    step: self.step_min,
+                    width: w,
+                    max,
+                    margin: s.margin,
+                });
+            }
+        }
         Ok(())
     }
 
@@ -614,6 +789,25 @@ mod tests {
             );
         }
         assert_eq!(max_particles(6), 0);
+    }
+
+    /// A deposit's estimate counts its images: twice the particles on a strip of twice the
+    /// margin (every particle near an edge), about 1.06 times on a wide one, and four times
+    /// in 3D on the narrow strip.
+    #[test]
+    fn a_deposit_estimate_counts_the_images() {
+        let at = |dim: usize, w: f64| {
+            Params {
+                dim,
+                substrate_width: w,
+                ..Params::default()
+            }
+            .peak_bytes_per_particle()
+        };
+        assert_eq!(at(2, 0.0), 13);
+        assert_eq!(at(2, 64.0), 26 + DEPOSIT_BYTES_PER_PARTICLE);
+        assert_eq!(at(2, 1000.0), 14 + DEPOSIT_BYTES_PER_PARTICLE);
+        assert_eq!(at(3, 64.0), 104 + DEPOSIT_BYTES_PER_PARTICLE);
     }
 
     #[test]

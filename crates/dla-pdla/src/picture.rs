@@ -34,6 +34,8 @@ enum Mode {
 struct Canvas {
     side: u32,
     extent: f64,
+    /// The frame's centre, `(x, y)` in the picture's plane.
+    centre: (f64, f64),
     scale: f64,
     total: u64,
     mode: Mode,
@@ -46,9 +48,10 @@ struct Canvas {
 impl Canvas {
     /// An empty picture of `side` pixels of a cluster of `total` particles whose centres lie
     /// within `r_ext` of the origin.
-    fn new(side: u32, r_ext: f64, total: u64, dim: usize) -> Self {
-        // Every centre lies within R_ext of the origin; one radius more holds every disc.
-        let extent = r_ext + 1.0;
+    fn new(side: u32, frame: Frame, total: u64, dim: usize) -> Self {
+        // Every centre lies within `half` of the frame's centre; one radius more holds every
+        // disc.
+        let extent = frame.half + 1.0;
         let scale = f64::from(side) / (2.0 * extent);
         let mode = match (scale >= 1.0, dim >= 3) {
             (true, false) => Mode::Discs,
@@ -60,6 +63,7 @@ impl Canvas {
         Canvas {
             side,
             extent,
+            centre: frame.centre,
             scale,
             total,
             mode,
@@ -83,8 +87,8 @@ impl Canvas {
     fn add(&mut self, i: u64, p: &[f64]) {
         let s = self.side as usize;
         let (cx, cy) = (
-            (p[0] + self.extent) * self.scale,
-            (self.extent - p[1]) * self.scale,
+            (p[0] - self.centre.0 + self.extent) * self.scale,
+            (self.extent - (p[1] - self.centre.1)) * self.scale,
         );
         let frac = (i as f64 / (self.total.max(2) - 1) as f64) as f32;
         match self.mode {
@@ -167,16 +171,19 @@ impl Canvas {
         &self,
         raster: &'a Raster,
         dim: usize,
+        deposit: bool,
         seed: u64,
         shown: u64,
         top: u32,
     ) -> Figure<'a> {
-        let view = match (self.mode, dim) {
-            (Mode::Density, 2) => ", particles per pixel",
-            (Mode::Density, _) => ", projected on x, y",
-            (_, 2) => "",
-            (_, 3) => ", seen from +z",
-            _ => ", x, y, z seen from +z",
+        let view = match (self.mode, dim, deposit) {
+            (Mode::Density, 2, _) => ", particles per pixel",
+            (Mode::Density, _, false) => ", projected on x, y",
+            (Mode::Density, _, true) => ", projected on x and the height",
+            (_, 2, _) => "",
+            (_, 3, false) => ", seen from +z",
+            (_, _, false) => ", x, y, z seen from +z",
+            (_, _, true) => ", x and the height seen from -y",
         };
         let count = if shown < self.total {
             format!("{} of {}", group_digits(shown), group_digits(self.total))
@@ -202,12 +209,15 @@ impl Canvas {
         Figure {
             raster,
             extent: Extent {
-                x: (-self.extent, self.extent),
-                y: (-self.extent, self.extent),
+                x: (self.centre.0 - self.extent, self.centre.0 + self.extent),
+                y: (self.centre.1 - self.extent, self.centre.1 + self.extent),
             },
             unit: "diameters".into(),
-            axes: ("x".into(), "y".into()),
-            header: format!("DLA {dim}D{view}: N = {count}, seed {seed}"),
+            axes: ("x".into(), if deposit { "height" } else { "y" }.into()),
+            header: format!(
+                "{} {dim}D{view}: N = {count}, seed {seed}",
+                if deposit { "Deposit" } else { "DLA" }
+            ),
             legend,
         }
     }
@@ -218,7 +228,10 @@ impl Canvas {
 /// particle (called twice for a density animation).
 struct Cluster<F> {
     dim: usize,
-    r_ext: f64,
+    frame: Frame,
+    /// A deposit: the positions `each` gives are already in the picture's axes (`x`, the
+    /// height, then `-y` as the depth).
+    deposit: bool,
     total: u64,
     seed: u64,
     each: F,
@@ -232,7 +245,7 @@ where
     F: Fn(&mut Visit<'_>) -> Result<(), OutputError>,
 {
     fn write_png(&self, path: &Path, side: u32) -> Result<(), OutputError> {
-        let mut canvas = Canvas::new(side, self.r_ext, self.total, self.dim);
+        let mut canvas = Canvas::new(side, self.frame, self.total, self.dim);
         (self.each)(&mut |i, p| {
             canvas.add(i, p);
             Ok(())
@@ -241,18 +254,18 @@ where
         let top = canvas.max_count();
         let raster = canvas.raster(&map, top);
         canvas
-            .figure(&raster, self.dim, self.seed, self.total, top)
+            .figure(&raster, self.dim, self.deposit, self.seed, self.total, top)
             .write_png(path)?;
         Ok(())
     }
 
     fn write_animation(&self, path: &Path, side: u32, every: u64) -> Result<u64, OutputError> {
         let total = self.total;
-        let mut canvas = Canvas::new(side, self.r_ext, total, self.dim);
+        let mut canvas = Canvas::new(side, self.frame, total, self.dim);
         // A density picture's colours run to the finished cluster's densest pixel, so that a
         // colour means the same count in every frame: one pass first to find it.
         let top = if canvas.mode == Mode::Density {
-            let mut full = Canvas::new(side, self.r_ext, total, self.dim);
+            let mut full = Canvas::new(side, self.frame, total, self.dim);
             (self.each)(&mut |i, p| {
                 full.add(i, p);
                 Ok(())
@@ -267,7 +280,7 @@ where
         let mut frame = |canvas: &Canvas, shown: u64| -> Result<(), OutputError> {
             let raster = canvas.raster(&map, top);
             let image = canvas
-                .figure(&raster, self.dim, self.seed, shown, top)
+                .figure(&raster, self.dim, self.deposit, self.seed, shown, top)
                 .render()?;
             let g = match &mut gif {
                 Some(g) => g,
@@ -298,12 +311,49 @@ fn of_sim<'s, const D: usize>(
 where
     Dim<D>: Space<D>,
 {
+    let substrate = sim.params().substrate();
     Cluster {
         dim: D,
-        r_ext: sim.r_ext(),
+        frame: match substrate {
+            // The strip and the deposit's height, in a square.
+            Some(_) => Frame {
+                centre: (0.0, 0.5 * sim.r_ext()),
+                half: sim.picture_half(),
+            },
+            None => Frame::around_origin(sim.r_ext()),
+        },
+        deposit: substrate.is_some(),
         total: sim.particles(),
         seed: sim.seed(),
-        each: move |f: &mut Visit<'_>| each_position(sim, dir, |i, p: &[f64; D]| f(i, p)),
+        each: move |f: &mut Visit<'_>| {
+            each_position(sim, dir, |i, p: &[f64; D]| {
+                if substrate.is_none() || D == 2 {
+                    return f(i, p);
+                }
+                // Seen from -y: x across, the height up, -y the depth.
+                let mut q = *p;
+                q[1] = p[D - 1];
+                q[2] = -p[1];
+                f(i, &q)
+            })
+        },
+    }
+}
+
+/// The square a picture shows: every centre lies within `half` of `centre` along both axes.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    centre: (f64, f64),
+    half: f64,
+}
+
+impl Frame {
+    /// A radial cluster's frame: centred on the seed, `R_ext` wide.
+    fn around_origin(r_ext: f64) -> Self {
+        Frame {
+            centre: (0.0, 0.0),
+            half: r_ext,
+        }
     }
 }
 
@@ -324,7 +374,8 @@ fn of_positions(
     }
     Ok(Cluster {
         dim,
-        r_ext,
+        frame: Frame::around_origin(r_ext),
+        deposit: false,
         total: (positions.len() / dim) as u64,
         seed,
         each: move |f: &mut Visit<'_>| {
@@ -469,14 +520,23 @@ mod tests {
 
     #[test]
     fn the_mode_follows_the_scale_and_dimension() {
-        assert_eq!(Canvas::new(512, 100.0, 10, 2).mode, Mode::Discs);
-        assert_eq!(Canvas::new(512, 100.0, 10, 3).mode, Mode::Spheres);
-        assert_eq!(Canvas::new(64, 100.0, 10, 2).mode, Mode::Density);
+        assert_eq!(
+            Canvas::new(512, Frame::around_origin(100.0), 10, 2).mode,
+            Mode::Discs
+        );
+        assert_eq!(
+            Canvas::new(512, Frame::around_origin(100.0), 10, 3).mode,
+            Mode::Spheres
+        );
+        assert_eq!(
+            Canvas::new(64, Frame::around_origin(100.0), 10, 2).mode,
+            Mode::Density
+        );
     }
 
     #[test]
     fn later_particles_are_drawn_over_earlier_ones_in_their_colour() {
-        let mut c = Canvas::new(40, 9.0, 3, 2);
+        let mut c = Canvas::new(40, Frame::around_origin(9.0), 3, 2);
         c.add(0, &[0.0, 0.0]);
         c.add(2, &[0.0, 0.0]);
         c.add(1, &[0.0, 0.0]);
@@ -489,7 +549,7 @@ mod tests {
 
     #[test]
     fn density_is_log_scaled_to_the_top_count() {
-        let mut c = Canvas::new(16, 100.0, 100, 2);
+        let mut c = Canvas::new(16, Frame::around_origin(100.0), 100, 2);
         for i in 0..100 {
             c.add(i, &[0.0, 0.0]);
         }

@@ -139,7 +139,7 @@ impl Space<2> for Dim<2> {
     const AXES: [&'static str; 2] = ["x", "y"];
 
     /// The disk direction.
-    #[inline]
+    #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 2] {
         let (c, s) = disk_direction(rng);
         [c, s]
@@ -182,7 +182,7 @@ impl Space<3> for Dim<3> {
     const AXES: [&'static str; 3] = ["x", "y", "z"];
 
     /// `z` uniform in `[-1, 1]` (Archimedes), then the azimuth from a disk direction.
-    #[inline]
+    #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 3] {
         let z = 2.0 * uniform01(rng) - 1.0;
         let rho = (1.0 - z * z).max(0.0).sqrt();
@@ -218,7 +218,7 @@ impl Space<4> for Dim<4> {
     /// Marsaglia's method ("Choosing a point from the surface of a sphere", 1972): two points
     /// `(x1, x2)` and `(x3, x4)` uniform in the unit disk, then `(x1, x2, k x3, k x4)` with
     /// `k = sqrt((1 - s1) / s2)`, `s` their squared norms.
-    #[inline]
+    #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
         marsaglia_4d(rng)
     }
@@ -256,7 +256,7 @@ impl Space<5> for Dim<5> {
     /// `(3/4) (1 - v^2)`), then the other four a 4D direction (Marsaglia's) scaled by
     /// `sqrt(1 - v^2)`: a uniform point on the 4-sphere is `(sqrt(1 - v^2) w, v)` with `w`
     /// uniform on the 3-sphere and independent of `v`.
-    #[inline]
+    #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 5] {
         let a = 2.0 * uniform01(rng) - 1.0;
         let b = 2.0 * uniform01(rng) - 1.0;

@@ -20,6 +20,7 @@ use crate::farfield::norm;
 use crate::near::{NEAR_RADIUS, NearCache, REBUILD_UPPER};
 use crate::params::{FarField, Params};
 use crate::space::{Dim, Space};
+use crate::substrate::{Substrate, ballistic_start, drift_direction};
 use core_lattice::rng::{Rng, uniform01};
 use spatial::orthtree::{Orthtree, VpEstimate, dist_sq};
 
@@ -45,6 +46,24 @@ where
         Walker { p }
     }
 
+    /// A new walker of the run whose memory is `state` (reset for it): born on the birth
+    /// sphere of radius `r_b` ([`born`](Self::born)), or on a substrate's launch plane at
+    /// height `r_b`, or, ballistic in radial growth, entering the birth sphere along its own
+    /// straight line ([`ballistic_start`]).
+    pub(crate) fn launch<R: Rng + ?Sized>(r_b: f64, state: &mut WalkState<D>, rng: &mut R) -> Self {
+        if let Some(s) = state.substrate {
+            return Walker {
+                p: s.launch(r_b, rng),
+            };
+        }
+        if let Motion::Ballistic = state.motion {
+            let (p, aim) = ballistic_start(r_b, rng, Dim::<D>::direction::<R>);
+            state.aim = aim;
+            return Walker { p };
+        }
+        Walker::born(r_b, rng)
+    }
+
     /// One move on a non-empty cluster whose particles all lie within `r_ext` of the origin.
     /// Returns the sticking position (centre distance 1 to the particle first touched) when
     /// the move ends in contact and the walker sticks (with `params.sticking_probability`;
@@ -57,7 +76,10 @@ where
         rng: &mut R,
     ) -> Option<[f64; D]> {
         let state = &mut WalkState::new(params);
-        let q = self.advance(state, cluster, r_ext, params, rng)?;
+        if let Some(s) = state.substrate {
+            s.wrap(&mut self.p);
+        }
+        let q = self.advance::<true, R>(state, cluster, r_ext, params, rng)?;
         if state.refuse {
             return self.settle(q, state, cluster, params, rng);
         }
@@ -70,7 +92,11 @@ where
     ///
     /// Every contact is returned, whatever `params.sticking_probability`: with it below 1 the
     /// caller then asks [`settle`](Self::settle) whether the walker sticks.
-    pub(crate) fn advance<R: Rng + ?Sized>(
+    ///
+    /// `VARIANT`: the walk may have a substrate, a drift or ballistic walkers
+    /// ([`WalkState::variant`]); a plain walk is compiled without them (the callers choose
+    /// once per walker).
+    pub(crate) fn advance<const VARIANT: bool, R: Rng + ?Sized>(
         &mut self,
         state: &mut WalkState<D>,
         cluster: &Cluster<D>,
@@ -79,14 +105,30 @@ where
         rng: &mut R,
     ) -> Option<[f64; D]> {
         let r_b = r_ext + params.birth_gap;
+        state.counts.moves += 1;
+        if VARIANT && let Some(s) = state.substrate {
+            // A deposit's far field: above the launch plane, returned to it exactly.
+            if self.p[D - 1] > r_b * FAR_FIELD_MARGIN {
+                state.counts.far_field += 1;
+                state.forget();
+                self.p = s.return_to_plane(&self.p, r_b, state.half_pe(), rng);
+                return None;
+            }
+            return self.near_move::<true, true, R>(state, cluster, r_ext, params, rng);
+        }
         let r = norm(&self.p);
         // Far field. The margin keeps a walker just returned to the birth sphere (whose norm
         // may round to slightly above r_b) in the near field, which is valid everywhere;
         // without it a walker at r_b (1 + 1e-16) would be "returned" to itself forever.
-        state.counts.moves += 1;
         if r > r_b * FAR_FIELD_MARGIN {
             state.counts.far_field += 1;
             state.forget();
+            if VARIANT && let Motion::Ballistic = state.motion {
+                // A straight walker that left the birth sphere never comes back: the next one.
+                state.counts.walkers += 1;
+                *self = Walker::launch(r_b, state, rng);
+                return None;
+            }
             match params.far_field {
                 FarField::Return => self.p = Dim::<D>::return_to_sphere(&self.p, r_b, rng),
                 FarField::Jump => {
@@ -95,12 +137,27 @@ where
                     } else {
                         // Every particle is within r_ext of the origin, so within distance
                         // r - r_ext - 1 the walker cannot touch one.
-                        self.jump(r - r_ext - 1.0, rng);
+                        self.jump::<VARIANT, R>(r - r_ext - 1.0, state, rng);
                     }
                 }
             }
             return None;
         }
+        self.near_move::<false, VARIANT, R>(state, cluster, r_ext, params, rng)
+    }
+
+    /// One move in the near field (see [`advance`](Self::advance)); `DEPOSIT`: on a
+    /// substrate, whose wall bounds the jumps and may be touched, whose images bound what
+    /// the index's distances say, and whose lateral edges wrap the walker.
+    #[inline(always)]
+    fn near_move<const DEPOSIT: bool, const VARIANT: bool, R: Rng + ?Sized>(
+        &mut self,
+        state: &mut WalkState<D>,
+        cluster: &Cluster<D>,
+        r_ext: f64,
+        params: &Params,
+        rng: &mut R,
+    ) -> Option<[f64; D]> {
         // Near field. First the distance map: one byte read bounds the distance to the
         // cluster from below; a walker at least a few diameters out jumps by it. A bound capped
         // by the coarsest map only says "at least its cap": in the large empty regions of a big
@@ -109,18 +166,44 @@ where
         // tree's distance, a few hundred nanoseconds, gives the long jump instead.
         let mut floor = 0.0;
         state.counts.map_reads += 1;
-        if let Some((lb, ub, capped)) = cluster.map_bounds_within(&self.p, state.upper) {
+        let bounds = if DEPOSIT {
+            cluster.deposit_map_bounds(&self.p, state.upper)
+        } else {
+            cluster.map_bounds_within(&self.p, state.upper)
+        };
+        if let Some((lb, ub, capped)) = bounds {
             // The map bounds the distance from above too: a walker with no answer yet (just
             // born or returned) or a looser one starts its tree query from the few nodes
             // around that ball rather than from the root.
             state.upper = state.upper.min(ub);
-            if capped {
+            if capped && DEPOSIT {
+                // A deposit's jumps stop at the images' margin: a floor beyond it needs no
+                // tree query.
+                let lb = state.deposit_bound(lb, &self.p, r_ext);
+                if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
+                    state.counts.map_jumps += 1;
+                    self.jump::<VARIANT, R>(lb - 1.0, state, rng);
+                    state.upper += (lb - 1.0) * (1.0 + 1e-9);
+                    self.wrap(state);
+                    return None;
+                }
                 floor = lb;
-            } else if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
+            } else if capped {
+                floor = lb;
+            } else if !DEPOSIT && lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
                 state.counts.map_jumps += 1;
-                self.jump(lb - 1.0, rng);
+                self.jump::<VARIANT, R>(lb - 1.0, state, rng);
                 state.upper += (lb - 1.0) * (1.0 + 1e-9);
                 return None;
+            } else if DEPOSIT {
+                let lb = state.deposit_bound(lb, &self.p, r_ext);
+                if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
+                    state.counts.map_jumps += 1;
+                    self.jump::<VARIANT, R>(lb - 1.0, state, rng);
+                    state.upper += (lb - 1.0) * (1.0 + 1e-9);
+                    self.wrap(state);
+                    return None;
+                }
             }
         }
         // Then the tree: a lower bound on the distance to the nearest centre.
@@ -140,11 +223,21 @@ where
             }
             None => {
                 state.counts.tree_queries += 1;
-                let answer = tree
-                    .vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p))
-                    .expect("the cluster is never empty");
-                state.counts.tree_nodes += u64::from(answer.0.nodes);
-                answer
+                match tree.vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p)) {
+                    Some(answer) => {
+                        state.counts.tree_nodes += u64::from(answer.0.nodes);
+                        answer
+                    }
+                    // Only a deposit starts empty.
+                    None => (
+                        VpEstimate {
+                            distance: f64::INFINITY,
+                            half_diagonal: None,
+                            nodes: 0,
+                        },
+                        None,
+                    ),
+                }
             }
         };
         state.anchor = nearest;
@@ -152,14 +245,24 @@ where
         // a relative margin for the rounding of that bound.
         state.upper = (est.distance + 2.0 * est.half_diagonal.unwrap_or(0.0)) * (1.0 + 1e-9) + 1e-9;
         // Both the tree's estimate and a capped map bound are lower bounds: jump by the larger.
-        let delta = est.distance.max(floor);
+        let mut delta = est.distance.max(floor);
+        if DEPOSIT {
+            delta = state.deposit_bound(delta, &self.p, r_ext);
+        }
         if delta - 1.0 > params.step_min {
-            self.jump(delta - 1.0, rng);
+            self.jump::<VARIANT, R>(delta - 1.0, state, rng);
             state.upper += (delta - 1.0) * (1.0 + 1e-9);
+            if DEPOSIT {
+                self.wrap(state);
+            }
             return None;
         }
         state.upper += params.step_min * (1.0 + 1e-9);
-        let u = Dim::<D>::direction(rng);
+        let u = if VARIANT {
+            state.heading(params.step_min, rng)
+        } else {
+            Dim::<D>::direction(rng)
+        };
         let r = params.step_min + 1.0;
         // `covers` is false unless the cache was built, which only `near_query` does, and only
         // when the cache is on.
@@ -175,19 +278,48 @@ where
             state.counts.contact_tree += 1;
             first_contact_with::<D, false>(tree, &self.p, &u, params.step_min)
         };
+        if DEPOSIT
+            && let Some(tw) = wall_contact::<false>(self.p[D - 1], u[D - 1], params.step_min)
+            && t.is_none_or(|(tp, _)| tw < tp)
+        {
+            let mut q = self.p;
+            for i in 0..D - 1 {
+                q[i] += tw * u[i];
+            }
+            q[D - 1] = 0.0;
+            state.touched = None;
+            state.on_wall = true;
+            state.step = u;
+            return Some(q);
+        }
         if let Some((t, touched)) = t {
             let mut q = self.p;
             for i in 0..D {
                 q[i] += t * u[i];
             }
             state.touched = Some(touched);
+            state.on_wall = false;
             state.step = u;
             return Some(q);
         }
         for i in 0..D {
             self.p[i] += params.step_min * u[i];
         }
+        if DEPOSIT {
+            self.wrap(state);
+        }
         None
+    }
+
+    /// Wraps a deposit's walker into the strip; one that crossed an edge forgets its bounds
+    /// and near cache, which were about the other side's images.
+    #[inline]
+    fn wrap(&mut self, state: &mut WalkState<D>) {
+        if let Some(s) = state.substrate
+            && s.wrap(&mut self.p)
+        {
+            state.forget();
+        }
     }
 
     /// What becomes of a walker whose last move ([`advance`](Self::advance)) ended in contact
@@ -226,36 +358,82 @@ where
             } else {
                 first_contact_with::<D, true>(cluster.tree(), &self.p, &u, len)
             };
-            let Some((t, touched)) = found else {
-                state.touched = None;
-                for i in 0..D {
-                    self.p[i] += len * u[i];
+            let wall = state
+                .substrate
+                .and_then(|_| wall_contact::<true>(self.p[D - 1], u[D - 1], len))
+                .filter(|&tw| found.is_none_or(|(tp, _)| tw < tp));
+            match (found, wall) {
+                (_, Some(tw)) => {
+                    let mut q: [f64; D] = std::array::from_fn(|i| self.p[i] + tw * u[i]);
+                    q[D - 1] = 0.0;
+                    (q, None)
                 }
-                return None;
-            };
-            (std::array::from_fn(|i| self.p[i] + t * u[i]), touched)
+                (Some((t, touched)), None) => {
+                    (std::array::from_fn(|i| self.p[i] + t * u[i]), Some(touched))
+                }
+                (None, None) => {
+                    state.touched = None;
+                    for i in 0..D {
+                        self.p[i] += len * u[i];
+                    }
+                    self.wrap(state);
+                    return None;
+                }
+            }
+        } else if state.on_wall {
+            (q, None)
         } else {
             (
                 q,
-                state.touched.expect("a contact sets the particle touched"),
+                Some(state.touched.expect("a contact sets the particle touched")),
             )
         };
         if uniform01(rng) >= params.sticking_probability {
             state.counts.refused += 1;
             state.touched = None;
             self.p = q;
+            self.wrap(state);
             return None;
         }
-        state.touched = Some(touched);
+        state.on_wall = touched.is_none();
+        state.touched = touched;
         Some(q)
     }
 
-    fn jump<R: Rng + ?Sized>(&mut self, len: f64, rng: &mut R) {
-        let u = Dim::<D>::direction(rng);
+    /// A jump of `len` in the walker's direction for it ([`WalkState::heading`]; uniform in
+    /// a plain walk).
+    #[inline(always)]
+    fn jump<const VARIANT: bool, R: Rng + ?Sized>(
+        &mut self,
+        len: f64,
+        state: &WalkState<D>,
+        rng: &mut R,
+    ) {
+        let u = if VARIANT {
+            state.heading(len, rng)
+        } else {
+            Dim::<D>::direction(rng)
+        };
         for i in 0..D {
             self.p[i] += len * u[i];
         }
     }
+}
+
+/// The time `t` in `[0, len]` at which a deposit's walker at height `z`, stepping with vertical
+/// component `uz`, touches the substrate (its centre at `z = 0`), if it does. At `z <= 0` the
+/// walker already touches it: `t = 0`, with `REFUSE` only if the step points into it (as for
+/// a particle, see [`contact`]).
+#[inline(always)]
+fn wall_contact<const REFUSE: bool>(z: f64, uz: f64, len: f64) -> Option<f64> {
+    if z <= 0.0 {
+        return (!REFUSE || uz < 0.0).then_some(0.0);
+    }
+    if uz >= 0.0 {
+        return None;
+    }
+    let t = z / -uz;
+    (t <= len).then_some(t)
 }
 
 /// A uniformly random unit vector: [`Space::direction`] of [`Dim<D>`].
@@ -330,6 +508,34 @@ fn contact<const D: usize, const REFUSE: bool>(
     }
 }
 
+impl<const D: usize> WalkState<D>
+where
+    Dim<D>: Space<D>,
+{
+    /// A unit vector for a move of length `len`: uniform for a diffusive walker, the von
+    /// Mises-Fisher exit law of a drifting one ([`drift_direction`], concentration
+    /// `Pe len / 2`), the walker's own direction for a ballistic one.
+    #[inline(always)]
+    fn heading<R: Rng + ?Sized>(&self, len: f64, rng: &mut R) -> [f64; D] {
+        match self.motion {
+            Motion::Diffusive => Dim::<D>::direction(rng),
+            Motion::Ballistic => self.aim,
+            Motion::Drift { half_pe } => drift_direction::<D, R>(half_pe * len, rng),
+        }
+    }
+}
+
+/// How walkers move between contacts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Motion {
+    /// Brownian: every jump and step in a uniform direction.
+    Diffusive,
+    /// Brownian with a drift towards the substrate, `half_pe = Pe / 2` in the walk's units.
+    Drift { half_pe: f64 },
+    /// Straight lines: every move along the walker's `aim`.
+    Ballistic,
+}
+
 /// What a walker remembers between moves: an upper bound of its exact distance to the
 /// nearest centre (`+inf` when unknown), and the stored particle found nearest at the last
 /// exact tree query (`anchor`). Both stay valid while particles are only added, so PDLA
@@ -347,6 +553,14 @@ pub(crate) struct WalkState<const D: usize> {
     pub(crate) refuse: bool,
     /// The direction of the step that ended in the last contact.
     step: [f64; D],
+    /// Whether the last contact was with a deposit's substrate (`touched` is then `None`).
+    on_wall: bool,
+    /// How the walker moves: `params.ballistic`, `params.drift`.
+    motion: Motion,
+    /// A ballistic walker's direction (on a substrate, straight down).
+    aim: [f64; D],
+    /// `params.substrate()`.
+    substrate: Option<Substrate>,
     near: NearCache<D>,
     /// What the walkers of this state did, summed over them.
     pub(crate) counts: WalkCounts,
@@ -421,9 +635,47 @@ impl<const D: usize> WalkState<D> {
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
             refuse: params.sticking_probability < 1.0,
             step: [0.0; D],
+            on_wall: false,
+            motion: if params.ballistic {
+                Motion::Ballistic
+            } else if params.drift > 0.0 {
+                Motion::Drift {
+                    half_pe: 0.5 * params.drift,
+                }
+            } else {
+                Motion::Diffusive
+            },
+            aim: std::array::from_fn(|i| if i + 1 == D { -1.0 } else { 0.0 }),
+            substrate: params.substrate(),
             near: NearCache::new(),
             counts: WalkCounts::default(),
         }
+    }
+
+    /// Whether the walk has a substrate, a drift or ballistic walkers: the walkers then move
+    /// through [`Walker::advance`]'s `VARIANT` code.
+    pub(crate) fn variant(&self) -> bool {
+        self.substrate.is_some() || self.motion != Motion::Diffusive
+    }
+
+    /// `Pe / 2`, the drift velocity in the walk's units (0 without drift).
+    fn half_pe(&self) -> f64 {
+        match self.motion {
+            Motion::Drift { half_pe } => half_pe,
+            _ => 0.0,
+        }
+    }
+
+    /// A deposit's lower bound of the centre distance to what the walker at `p` may touch,
+    /// from a lower bound `b` of the distance to the stored points (particles and images):
+    /// `b` is a bound of the periodic distance only up to the images' margin; the height
+    /// above the deposit's top `h` bounds it too; the substrate is touched at `z = 0`, at a
+    /// centre distance of 1 in the walk's terms at `z`.
+    #[inline(always)]
+    fn deposit_bound(&self, b: f64, p: &[f64; D], h: f64) -> f64 {
+        let margin = self.substrate.map_or(f64::INFINITY, |s| s.margin);
+        let z = p[D - 1];
+        b.min(margin).max(z - h).min(z + 1.0)
     }
 
     /// A new walker: nothing known.
@@ -437,6 +689,7 @@ impl<const D: usize> WalkState<D> {
         self.upper = f64::INFINITY;
         self.anchor = None;
         self.touched = None;
+        self.on_wall = false;
         self.near.reset();
     }
 

@@ -129,6 +129,51 @@ fn bad_inputs_are_refused_before_any_work() {
             "--threads",
         ),
         (with(&["--dim", "6"]), "--dim 6"),
+        // The variants' ranges and the combinations without a meaning.
+        (with(&["--drift", "1"]), "--drift needs --substrate-width"),
+        (
+            with(&["--substrate-width", "100", "--drift", "2e6"]),
+            "accepted range [0, 1e6]",
+        ),
+        (
+            with(&["--substrate-width", "5"]),
+            "--substrate-width 5 is outside the accepted values",
+        ),
+        (
+            with(&["--ballistic", "on", "--sticking-probability", "0.5"]),
+            "--sticking-probability below 1 has no effect with --ballistic",
+        ),
+        (
+            with(&[
+                "--substrate-width",
+                "100",
+                "--ballistic",
+                "on",
+                "--drift",
+                "2",
+            ]),
+            "--ballistic is the limit of infinite --drift",
+        ),
+        (
+            with(&["--substrate-width", "100", "--far-field", "jump"]),
+            "--far-field jump is the radial diffusive walk's",
+        ),
+        (
+            with(&["--substrate-width", "100", "--threads", "2"]),
+            "--threads 2: deposits",
+        ),
+        (
+            with(&["--substrate-width", "20", "--step-min", "9.5"]),
+            "--step-min 9.5 is too long for --substrate-width 20",
+        ),
+        (
+            with(&["--seed-set", "missing.npy"]),
+            "--seed-set missing.npy: ",
+        ),
+        (
+            with(&["--seed-set", "unknown.toml"]),
+            "not a positions file",
+        ),
         (
             with(&["--dim", "4", "--positions", "vtk"]),
             "--positions vtk holds three coordinates, not the 4 of --dim 4",

@@ -51,6 +51,10 @@ mod tests {
             let mut m = d.clone();
             m.insert(name.into(), serde_json::from_str(value).unwrap());
             m.insert("keep_positions".into(), false.into());
+            // Drift has a meaning on a substrate only.
+            if name == "drift" {
+                m.insert("substrate_width".into(), 100.0.into());
+            }
             serde_json::from_value::<Params>(m.into())
                 .map_err(|e| e.to_string())
                 .and_then(|p| p.validate().map_err(|e| e.to_string()))

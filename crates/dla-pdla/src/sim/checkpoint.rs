@@ -123,6 +123,10 @@ impl From<Snapshot<ParamsBeforeVariants>> for Snapshot {
                 distance_map: p.distance_map,
                 near_cache: p.near_cache,
                 sticking_probability: 1.0,
+                substrate_width: 0.0,
+                drift: 0.0,
+                ballistic: false,
+                seed_set: None,
                 noise_reduction: 1.0,
                 connectivity: false,
             }),
@@ -242,9 +246,11 @@ where
         params.particles = m;
         params.validate()?;
     }
-    if snap.n == 0 || snap.n > params.particles {
+    // A radial run holds its seed from the start; a deposit may be checkpointed empty.
+    let first = u64::from(params.substrate().is_none());
+    if snap.n < first || snap.n > params.particles {
         return Err(SimError::CheckpointUsage(format!(
-            "the checkpoint holds {} particles, outside 1..={}",
+            "the checkpoint holds {} particles, outside {first}..={}",
             snap.n, params.particles
         )));
     }

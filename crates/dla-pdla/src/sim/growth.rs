@@ -163,8 +163,11 @@ pub(crate) fn noise_reduced<const D: usize>(
 pub(crate) struct Growth<const D: usize> {
     /// Particles stored.
     pub(crate) n: u64,
-    /// Largest centre distance from the origin.
+    /// Largest centre distance from the origin; on a substrate, the deposit's height (the
+    /// largest centre height above the substrate's contact plane).
     pub(crate) r_ext: f64,
+    /// Whether the run grows a deposit on a substrate.
+    pub(crate) deposit: bool,
     pub(crate) gyration: Gyration<D>,
     pub(crate) hasher: StateHasher,
     /// Positions in arrival order, if kept.
@@ -188,6 +191,7 @@ impl<const D: usize> Growth<D> {
         Growth {
             n: 0,
             r_ext: 0.0,
+            deposit: params.substrate().is_some(),
             gyration: Gyration::new(),
             hasher: StateHasher::new(),
             positions: params.keep_positions.then(Vec::new),
@@ -217,7 +221,9 @@ impl<const D: usize> Growth<D> {
     /// Accounts for a particle already stored at `q`, with its parent if recorded.
     pub(crate) fn account(&mut self, q: [f64; D], parent: Option<i64>, target: u64) {
         self.n += 1;
-        self.r_ext = self.r_ext.max(norm(&q));
+        self.r_ext = self
+            .r_ext
+            .max(if self.deposit { q[D - 1] } else { norm(&q) });
         self.gyration.push(&q);
         for x in q {
             self.hasher.f64(x);

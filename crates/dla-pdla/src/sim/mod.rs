@@ -35,7 +35,7 @@ use self::growth::{Growth, Streams};
 use self::pdla::PdlaStats;
 use self::serial::Serial;
 use crate::cluster::Cluster;
-use crate::params::Params;
+use crate::params::{Params, ParamsError};
 use crate::space::{Dim, Space};
 use core_lattice::Fit;
 use sim_run::guard::{Guard, Request, StopReason};
@@ -60,13 +60,17 @@ pub struct Simulation<const D: usize> {
     stream_dir: Option<PathBuf>,
     /// The `positions.npy` a resumed run was rebuilt from, until it streams again.
     resumed_from: Option<PathBuf>,
+    /// The seeds of a seed set, until the run streams them ([`stream_into`](Self::stream_into)),
+    /// for a run that keeps no positions in memory.
+    seeds: Vec<[f64; D]>,
 }
 
 impl<const D: usize> Simulation<D>
 where
     Dim<D>: Space<D>,
 {
-    /// A cluster holding the seed particle at the origin.
+    /// A cluster holding the seed particle at the origin, or, on a substrate, an empty
+    /// deposit.
     pub fn new(params: Params, seed: u64) -> Result<Self, SimError> {
         params.validate()?;
         if params.dim != D {
@@ -74,7 +78,40 @@ where
         }
         let mut cluster = Cluster::new(&params)?;
         let mut growth = Growth::new(&params);
-        growth.add(&mut cluster, [0.0; D], None, params.particles)?;
+        let mut initial = Vec::new();
+        match &params.seed_set {
+            Some(set) => {
+                let seeds = crate::seeds::read::<D>(Path::new(&set.0))
+                    .map_err(|e| SimError::Params(ParamsError::SeedSet(e)))?;
+                if seeds.len() as u64 > params.particles {
+                    return Err(SimError::Params(ParamsError::SeedSet(format!(
+                        "--seed-set {}: {} seeds, more than --particles {}",
+                        set.0,
+                        seeds.len(),
+                        params.particles
+                    ))));
+                }
+                if let Some(s) = params.substrate() {
+                    let half = 0.5 * s.width;
+                    if let Some(p) = seeds.iter().find(|p| {
+                        p[D - 1] < 0.0 || p[..D - 1].iter().any(|&x| x < -half || x >= half)
+                    }) {
+                        return Err(SimError::Params(ParamsError::SeedSet(format!(
+                            "--seed-set {}: the seed at {p:?} is not in the strip [-{half}, {half}) on or above the substrate (height >= 0)",
+                            set.0
+                        ))));
+                    }
+                }
+                for p in &seeds {
+                    growth.add(&mut cluster, *p, None, params.particles)?;
+                }
+                initial = seeds;
+            }
+            None if params.substrate().is_none() => {
+                growth.add(&mut cluster, [0.0; D], None, params.particles)?;
+            }
+            None => {}
+        }
         Ok(Simulation {
             serial: Serial::new(&params, seed),
             params,
@@ -85,6 +122,7 @@ where
             pdla_rounds: 0,
             stream_dir: None,
             resumed_from: None,
+            seeds: initial,
         })
     }
 
@@ -396,6 +434,7 @@ where
             pdla_rounds: r.pdla_rounds,
             stream_dir: None,
             resumed_from: Some(r.log),
+            seeds: Vec::new(),
         })
     }
 
@@ -439,6 +478,15 @@ where
                     match &self.growth.positions {
                         Some(v) => {
                             for p in v {
+                                w.push(p).map_err(|e| stream_error(&e))?;
+                            }
+                        }
+                        // A deposit starts empty.
+                        None if self.growth.n == 0 => {}
+                        None if !self.seeds.is_empty()
+                            && self.growth.n == self.seeds.len() as u64 =>
+                        {
+                            for p in &self.seeds {
                                 w.push(p).map_err(|e| stream_error(&e))?;
                             }
                         }
@@ -495,6 +543,12 @@ where
                     w.push_int(p).map_err(|e| stream_error(&e))?;
                 }
             }
+            None if self.growth.n == 0 => {}
+            None if !self.seeds.is_empty() && self.growth.n == self.seeds.len() as u64 => {
+                for _ in &self.seeds {
+                    w.push_int(-1).map_err(|e| stream_error(&e))?;
+                }
+            }
             None if self.growth.n == 1 => w.push_int(-1).map_err(|e| stream_error(&e))?,
             None => {
                 return Err(SimError::CheckpointUsage(format!(
@@ -526,6 +580,16 @@ impl<const D: usize> Simulation<D> {
     /// Largest centre distance from the origin.
     pub fn r_ext(&self) -> f64 {
         self.growth.r_ext
+    }
+
+    /// The half side of the square a picture of the run frames: `R_ext` for a radial cluster,
+    /// half the larger of the strip's width and the height for a deposit (framed from the
+    /// substrate up, centred at half the height).
+    pub fn picture_half(&self) -> f64 {
+        match self.params.substrate() {
+            Some(s) => (0.5 * s.width).max(0.5 * self.growth.r_ext),
+            None => self.growth.r_ext,
+        }
     }
 
     /// Radius of gyration of the cluster.

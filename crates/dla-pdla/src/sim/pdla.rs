@@ -424,7 +424,10 @@ where
                 .store(tree.epoch(), Ordering::Release);
             let mut w = Walker::born(me.r_ext + params.birth_gap, rng);
             let stick = loop {
-                if let Some(p) = w.advance(&mut me.walk, self.cluster, me.r_ext, params, rng) {
+                // Plain walks only: PDLA refuses substrates and ballistic walkers (`Params::validate`).
+                if let Some(p) =
+                    w.advance::<false, _>(&mut me.walk, self.cluster, me.r_ext, params, rng)
+                {
                     if !me.walk.refuse {
                         break p;
                     }

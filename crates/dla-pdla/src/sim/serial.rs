@@ -50,11 +50,38 @@ impl<const D: usize> Serial<D> {
     where
         Dim<D>: Space<D>,
     {
-        let mut w = Walker::born(growth.r_ext + params.birth_gap, &mut self.rng);
         self.walk.reset();
+        let w = Walker::launch(
+            growth.r_ext + params.birth_gap,
+            &mut self.walk,
+            &mut self.rng,
+        );
+        if self.walk.variant() {
+            self.walk_one::<true>(w, params, cluster, growth)
+        } else {
+            self.walk_one::<false>(w, params, cluster, growth)
+        }
+    }
+
+    /// Walks `w` until it sticks and grows `cluster` by it ([`Walker::advance`]'s `VARIANT`).
+    fn walk_one<const VARIANT: bool>(
+        &mut self,
+        mut w: Walker<D>,
+        params: &Params,
+        cluster: &mut Cluster<D>,
+        growth: &mut Growth<D>,
+    ) -> Result<[f64; D], SimError>
+    where
+        Dim<D>: Space<D>,
+    {
         loop {
-            if let Some(p) = w.advance(&mut self.walk, cluster, growth.r_ext, params, &mut self.rng)
-            {
+            if let Some(p) = w.advance::<VARIANT, _>(
+                &mut self.walk,
+                cluster,
+                growth.r_ext,
+                params,
+                &mut self.rng,
+            ) {
                 let p = if self.walk.refuse {
                     match w.settle(p, &mut self.walk, cluster, params, &mut self.rng) {
                         Some(p) => p,

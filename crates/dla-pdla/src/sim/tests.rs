@@ -25,7 +25,7 @@ where
         let mut w = Walker::born(sim.growth.r_ext + params.birth_gap, &mut rng);
         state.reset();
         while w
-            .advance(
+            .advance::<false, _>(
                 &mut state,
                 &sim.cluster,
                 sim.growth.r_ext,

@@ -141,7 +141,7 @@ pub trait PointMap<const D: usize>: Cells<D> {
     /// a relative `2^-40` for rounding); `+inf` for a capped cell. As `(lower, upper,
     /// capped)`. After [`DistanceMap::insert_box`] the upper bound is one to the nearest box:
     /// add the boxes' diagonal for one to the points in them.
-    #[inline]
+    #[inline(always)]
     fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
         let (m, e, v) = self.read(p)?;
         let capped = v == CAPPED;
