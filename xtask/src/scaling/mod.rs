@@ -9,6 +9,7 @@
 pub mod accuracy;
 pub mod animat;
 pub mod csvfile;
+pub mod deposit;
 pub mod dla;
 pub mod dlca;
 pub mod dlca_dimension;
@@ -65,16 +66,19 @@ pub enum Experiment {
     Accuracy,
     /// The DLA family beyond the plain model: branch orders of the cluster as a tree.
     Family,
+    /// Deposits on a substrate with drift, up to ballistic deposition and aggregation.
+    Deposit,
 }
 
 impl Experiment {
     /// Every experiment.
-    pub const ALL: [Experiment; 5] = [
+    pub const ALL: [Experiment; 6] = [
         Experiment::Dlca,
         Experiment::Animat,
         Experiment::Dla,
         Experiment::Accuracy,
         Experiment::Family,
+        Experiment::Deposit,
     ];
 
     /// File stem and flag value.
@@ -85,6 +89,7 @@ impl Experiment {
             Experiment::Dla => "dla",
             Experiment::Accuracy => "accuracy",
             Experiment::Family => "family",
+            Experiment::Deposit => "deposit",
         }
     }
 }
@@ -198,6 +203,7 @@ pub fn run(opts: &Options) -> Result<Vec<(Experiment, f64)>> {
             Experiment::Dla => dla::run(&ctx),
             Experiment::Accuracy => accuracy::run(&ctx),
             Experiment::Family => family::run(&ctx),
+            Experiment::Deposit => deposit::run(&ctx),
         }
         .with_context(|| format!("experiment {}", e.name()))?;
         let secs = start.elapsed().as_secs_f64();

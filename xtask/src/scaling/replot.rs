@@ -56,6 +56,10 @@ pub const CHARTS: &[CsvChart] = &[
         csv: super::family::STICKING_CSV,
         draw: super::family::sticking_chart,
     },
+    CsvChart {
+        csv: super::deposit::PROFILES_CSV,
+        draw: super::deposit::charts,
+    },
 ];
 
 /// What [`replot`] did: the charts written, and the charts' CSVs that were not in the
