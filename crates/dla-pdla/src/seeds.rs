@@ -58,13 +58,16 @@ pub fn read<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
 }
 
 fn read_npy<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
-    let mut r = sim_run::io::NpyReader::open(path).map_err(|e| e.to_string())?;
+    // The reader's messages name the file, which `read` names already.
+    let prefix = format!("{}: ", path.display());
+    let why = |e: sim_run::io::NpyError| e.to_string().replace(&prefix, "");
+    let mut r = sim_run::io::NpyReader::open(path).map_err(why)?;
     if r.cols() != D {
         return Err(format!("{} columns, not {D}", r.cols()));
     }
     let mut out = Vec::new();
     let mut p = [0.0; D];
-    while r.read_beyond(&mut p).map_err(|e| e.to_string())? {
+    while r.read_beyond(&mut p).map_err(why)? {
         out.push(p);
         if out.len() > MAX_SEEDS {
             break;

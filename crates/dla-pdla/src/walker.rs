@@ -747,7 +747,7 @@ impl<const D: usize> WalkState<D> {
     /// The exact nearest distance and a particle at it from the near cache, rebuilding the
     /// cache around `p` when it cannot answer and `p` is known to be close to the cluster;
     /// `None` when the tree must answer.
-    #[inline]
+    #[inline(always)]
     fn near_query(&mut self, p: &[f64; D], tree: &Orthtree<D>) -> Option<(f64, [f64; D])> {
         if !self.near_on {
             return None;

@@ -209,6 +209,10 @@ impl<const D: usize> Orthtree<D> {
     /// found). A walker keeps that point: its distance from wherever the walker moves next is
     /// an upper bound of the nearest distance there, usually much tighter than the last answer
     /// plus the distance moved. Same walk and same answer as `vpdist_bounded`.
+    ///
+    /// Always inlined: it is the walk's hot path, and a caller with several instantiations of
+    /// its walk (DLA's plain and variant walks) would otherwise get it as a call.
+    #[inline(always)]
     pub fn vpdist_bounded_nearest(
         &self,
         p: &[f64; D],
