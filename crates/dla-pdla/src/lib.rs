@@ -36,6 +36,7 @@
 
 pub mod branches;
 pub mod cluster;
+mod contact;
 pub mod deposit;
 pub mod error;
 pub mod farfield;
