@@ -193,11 +193,6 @@ impl<const D: usize> Cluster<D> {
         Ok(q)
     }
 
-    /// The substrate, if the cluster is a deposit.
-    pub fn substrate(&self) -> Option<&Substrate> {
-        self.substrate.as_ref()
-    }
-
     /// [`insert_beside`](Self::insert_beside) of one stored point.
     fn insert_one(
         &mut self,

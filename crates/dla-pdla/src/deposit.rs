@@ -327,6 +327,7 @@ pub fn write_csv(d: &Deposit, dir: &std::path::Path) -> Result<(), sim_run::io::
 /// The deposit's results in `run.json`.
 pub fn set_results(m: &mut sim_run::io::RunManifest, d: &Deposit) {
     let fit = d.density_dimension();
+    let trees = d.tree_mass_exponent();
     let range = d
         .fit_layers()
         .map(|r| serde_json::json!([r.start as f64, r.end as f64]));
@@ -339,11 +340,8 @@ pub fn set_results(m: &mut sim_run::io::RunManifest, d: &Deposit) {
         .set_result("density_dimension", fit.map(|f| f.0))
         .set_result("density_dimension_stderr", fit.map(|f| f.1))
         .set_result("density_fit_heights", range)
-        .set_result("tree_mass_exponent", d.tree_mass_exponent().map(|f| f.0))
-        .set_result(
-            "tree_mass_exponent_stderr",
-            d.tree_mass_exponent().map(|f| f.1),
-        )
+        .set_result("tree_mass_exponent", trees.map(|f| f.0))
+        .set_result("tree_mass_exponent_stderr", trees.map(|f| f.1))
         .set_result("active_zone_width", d.active_zone_width());
 }
 

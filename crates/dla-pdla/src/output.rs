@@ -211,7 +211,9 @@ where
 /// The one place these results are assembled, for the `dla` binary and the Python bindings.
 /// Called right after the simulation (as the Python bindings do), the process's peak memory is
 /// the simulation's: `simulation_peak_rss_bytes` and `bytes_per_particle` measure it, and
-/// `output_peak_rss_bytes` is null (no output stage ran; [`write_outputs`] sets it).
+/// `output_peak_rss_bytes` is null (no output stage ran; [`write_outputs`] sets it). A
+/// deposit's results are added by the caller, which analyses the particles once for both its
+/// arrays and [`crate::deposit::set_results`] (the Python bindings).
 pub fn manifest<const D: usize>(
     sim: &Simulation<D>,
     clock: &RunClock,
@@ -227,11 +229,6 @@ where
         let b = crate::branches::Branches::from_parents(parents)
             .map_err(|e| std::io::Error::other(e.to_string()))?;
         set_branch_results(&mut m, &b);
-    }
-    if sim.positions().is_some()
-        && let Some(d) = deposit_of(sim, Path::new(""))?
-    {
-        crate::deposit::set_results(&mut m, &d);
     }
     Ok(m)
 }

@@ -178,34 +178,25 @@ where
             // born or returned) or a looser one starts its tree query from the few nodes
             // around that ball rather than from the root.
             state.upper = state.upper.min(ub);
-            if capped && DEPOSIT {
-                // A deposit's jumps stop at the images' margin: a floor beyond it needs no
-                // tree query.
-                let lb = state.deposit_bound(lb, &self.p, r_ext);
-                if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
-                    state.counts.map_jumps += 1;
-                    self.jump::<VARIANT, R>(lb - 1.0, state, rng);
-                    state.upper += (lb - 1.0) * (1.0 + 1e-9);
-                    self.wrap(state);
-                    return None;
-                }
+            // A deposit's bound stops at the images' margin (or the height above its top), so
+            // there a capped floor beyond the margin needs no tree query either.
+            let lb = if DEPOSIT {
+                state.deposit_bound(lb, &self.p, r_ext)
+            } else {
+                lb
+            };
+            if capped && !DEPOSIT {
                 floor = lb;
-            } else if capped {
-                floor = lb;
-            } else if !DEPOSIT && lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
+            } else if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
                 state.counts.map_jumps += 1;
                 self.jump::<VARIANT, R>(lb - 1.0, state, rng);
                 state.upper += (lb - 1.0) * (1.0 + 1e-9);
-                return None;
-            } else if DEPOSIT {
-                let lb = state.deposit_bound(lb, &self.p, r_ext);
-                if lb - 1.0 > Dim::<D>::MAP_JUMP_MIN {
-                    state.counts.map_jumps += 1;
-                    self.jump::<VARIANT, R>(lb - 1.0, state, rng);
-                    state.upper += (lb - 1.0) * (1.0 + 1e-9);
+                if DEPOSIT {
                     self.wrap(state);
-                    return None;
                 }
+                return None;
+            } else if capped {
+                floor = lb;
             }
         }
         // Then the tree: a lower bound on the distance to the nearest centre.

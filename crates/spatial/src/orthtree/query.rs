@@ -208,10 +208,8 @@ impl<const D: usize> Orthtree<D> {
     /// is `None`) the stored position of a nearest point, at that distance (ties: the first
     /// found). A walker keeps that point: its distance from wherever the walker moves next is
     /// an upper bound of the nearest distance there, usually much tighter than the last answer
-    /// plus the distance moved. Same walk and same answer as `vpdist_bounded`.
-    ///
-    /// Always inlined: it is the walk's hot path, and a caller with several instantiations of
-    /// its walk (DLA's plain and variant walks) would otherwise get it as a call.
+    /// plus the distance moved. Same walk and same answer as `vpdist_bounded`. Always inlined:
+    /// the hot path of walks instantiated more than once (DLA's plain and variant walks).
     #[inline(always)]
     pub fn vpdist_bounded_nearest(
         &self,
