@@ -9,6 +9,7 @@ use core_lattice::spec::{DeclaredParams, Input, Kind, ParamSpec};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use std::path::Path;
 
 /// Sets the declared parameters given as keyword arguments `kwargs` of `function` on `p`,
 /// and returns the names given (a keyword given as None, allowed for the parameters that are
@@ -141,4 +142,101 @@ pub fn declared_rows<P: DeclaredParams>() -> Vec<serde_json::Value> {
             })
         })
         .collect()
+}
+
+/// The 1-based line where `key` is set in `text` (0 if not found).
+fn key_line(text: &str, key: &str) -> usize {
+    text.lines()
+        .position(|l| {
+            l.trim_start()
+                .strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+        })
+        .map_or(0, |i| i + 1)
+}
+
+/// Reads the TOML file `path` of a model's parameters onto `p`, as the binaries' `--config`
+/// reads one (keys are the declared names, with dashes or underscores; flags that are not
+/// declared parameters, such as `steps`, are the function's own arguments), and returns the
+/// names set, and the numbers of the keys in `extra` (parameters of the front end's own, such
+/// as `density`).
+///
+/// # Errors
+/// `ValueError` naming the file and the line: unreadable, malformed, an unknown key, a value of
+/// the wrong type.
+pub fn read_config<P: DeclaredParams>(
+    p: &mut P,
+    path: &Path,
+    extra: &[&str],
+) -> PyResult<(Vec<&'static str>, Vec<(String, f64)>)> {
+    let shown = path.display();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| PyValueError::new_err(format!("config {shown}: cannot read it: {e}")))?;
+    let table: toml::Table = toml::from_str(&text).map_err(|e| {
+        let line = e.span().map_or(0, |s| {
+            text[..s.start.min(text.len())].matches('\n').count() + 1
+        });
+        let msg = e.message().split_whitespace().collect::<Vec<_>>().join(" ");
+        PyValueError::new_err(format!("config {shown}, line {line}: {msg}"))
+    })?;
+    let mut entries: Vec<(&String, &toml::Value)> = table.iter().collect();
+    entries.sort_by_key(|(k, _)| key_line(&text, k));
+    let (mut given, mut extras) = (Vec::new(), Vec::new());
+    for (key, value) in entries {
+        let at = format!("config {shown}, line {}", key_line(&text, key));
+        let name = key.replace('-', "_");
+        let number = |v: &toml::Value| match v {
+            toml::Value::Float(x) => Some(*x),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        };
+        if extra.contains(&name.as_str()) {
+            let x = number(value)
+                .ok_or_else(|| PyValueError::new_err(format!("{at}: `{key}` is a number")))?;
+            extras.push((name, x));
+            continue;
+        }
+        let Some(d) = P::DECLARED.iter().find(|d| d.spec.name == name) else {
+            let keys: Vec<&str> = P::DECLARED.iter().map(|d| d.spec.name).collect();
+            return Err(PyValueError::new_err(format!(
+                "{at}: unknown key `{key}`; the keys are the model's parameters: {}{}",
+                keys.join(", "),
+                extra.iter().map(|e| format!(", {e}")).collect::<String>()
+            )));
+        };
+        let scalar = |v: &toml::Value| match v {
+            toml::Value::String(s) => Some(s.clone()),
+            toml::Value::Integer(i) => Some(i.to_string()),
+            _ => None,
+        };
+        let input = match (d.kind, value) {
+            (Kind::Real, v) => number(v).map(Input::Real),
+            (Kind::Count, toml::Value::Integer(i)) => u64::try_from(*i).ok().map(Input::Count),
+            // `1e6` in TOML is a float: a count if it is a whole number.
+            (Kind::Count, toml::Value::Float(x))
+                if x.fract() == 0.0 && *x >= 0.0 && *x < 2f64.powi(64) =>
+            {
+                Some(Input::Count(*x as u64))
+            }
+            (Kind::Switch, toml::Value::Boolean(b)) => Some(Input::Switch(*b)),
+            (Kind::Choice, toml::Value::String(s)) => Some(Input::Choice(s.clone())),
+            (Kind::Text | Kind::List, toml::Value::Array(items)) => items
+                .iter()
+                .map(scalar)
+                .collect::<Option<Vec<_>>>()
+                .map(|v| Input::Text(v.join(","))),
+            (Kind::Text | Kind::List, v) => scalar(v).map(Input::Text),
+            _ => None,
+        };
+        let Some(input) = input else {
+            return Err(PyValueError::new_err(format!(
+                "{at}: `{key}` = {value}: expected {}",
+                d.kind.python_type()
+            )));
+        };
+        p.set(d.spec.name, &input)
+            .map_err(|e| PyValueError::new_err(format!("{at}: `{key}` = {value}: {e}")))?;
+        given.push(d.spec.name);
+    }
+    Ok((given, extras))
 }

@@ -21,40 +21,95 @@ mod dlca;
 mod figure;
 mod run;
 
+use core_lattice::spec::ParamSpec;
 use pyo3::prelude::*;
+use serde_json::{Map, Value};
+
+/// A model as the package registers it: what the functions over every model (`defaults`,
+/// `_params`, `_declared`, `_schema`) read of it. A model module adds its own functions and
+/// classes to the module (`register`); this row is the rest.
+struct Registered {
+    /// The name the functions take (`"dla"`).
+    name: &'static str,
+    /// The library's parameter table.
+    params: &'static [ParamSpec],
+    /// The library's defaults, keyed by parameter.
+    defaults: fn() -> Map<String, Value>,
+    /// The defaults of the Python functions (the library's, with the functions' own).
+    python_defaults: for<'py> fn(Python<'py>) -> PyResult<Bound<'py, PyAny>>,
+    /// The declaration as Python sees it (`declared::declared_rows`).
+    declared: fn() -> Vec<Value>,
+    /// Declared parameters the functions take as their own arguments.
+    positional: &'static [&'static str],
+    /// The argument of the signatures the declared keywords come before (empty: at the end).
+    before: &'static str,
+    /// The output schema (`sim_run::schema`).
+    schema: &'static [sim_run::schema::Output],
+}
+
+/// Every model of the package.
+const MODELS: &[Registered] = &[
+    Registered {
+        name: "dla",
+        params: dla_pdla::params::PARAMS,
+        defaults: dla_pdla::params::defaults,
+        python_defaults: dla::defaults_dict,
+        declared: declared::declared_rows::<dla_pdla::Params>,
+        positional: dla::POSITIONAL,
+        before: dla::KEYWORDS_BEFORE,
+        schema: dla_pdla::output::SCHEMA,
+    },
+    Registered {
+        name: "dlca",
+        params: ::dlca::params::PARAMS,
+        defaults: ::dlca::params::defaults,
+        python_defaults: dlca::defaults_dict,
+        declared: declared::declared_rows::<::dlca::params::Settings>,
+        positional: dlca::POSITIONAL,
+        before: dlca::KEYWORDS_BEFORE,
+        schema: ::dlca::output::SCHEMA,
+    },
+    Registered {
+        name: "animat",
+        params: ::animat::params::PARAMS,
+        defaults: ::animat::params::defaults,
+        python_defaults: animat::defaults_dict,
+        declared: declared::declared_rows::<::animat::Params>,
+        positional: animat::POSITIONAL,
+        before: animat::KEYWORDS_BEFORE,
+        schema: ::animat::output::SCHEMA,
+    },
+];
+
+/// The registered model `name`; a `ValueError` naming the models for another.
+fn model(name: &str) -> PyResult<&'static Registered> {
+    MODELS.iter().find(|m| m.name == name).ok_or_else(|| {
+        let names: Vec<String> = MODELS.iter().map(|m| format!("\"{}\"", m.name)).collect();
+        convert::value_error(format!(
+            "unknown model {name:?}: expected {}",
+            names.join(", ")
+        ))
+    })
+}
 
 /// The defaults of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``) as a dict: the binaries'
 /// defaults, taken from the libraries, keyed by the keyword arguments' names.
 #[pyfunction]
 fn defaults<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
-    match model {
-        "dla" => dla::defaults_dict(py),
-        "dlca" => dlca::defaults_dict(py),
-        "animat" => animat::defaults_dict(py),
-        other => Err(convert::value_error(format!(
-            "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
-        ))),
-    }
+    (self::model(model)?.python_defaults)(py)
 }
 
 /// The parameter table of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``), from the library:
-/// a list of dicts with ``name``, ``flag`` (None: config files only), ``unit``, ``doc``,
-/// ``range`` (as the error messages write it), ``choices`` and ``default``. The consistency
-/// tests check the keyword arguments and stubs against it.
+/// a list of dicts with ``name``, ``flag``, ``unit``, ``doc``, ``range`` (as the error messages
+/// write it), ``choices`` and ``default``. The consistency tests check the keyword arguments and
+/// stubs against it.
 #[pyfunction]
 #[pyo3(name = "_params")]
 fn params_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
-    let (table, defaults) = match model {
-        "dla" => (dla_pdla::params::PARAMS, dla_pdla::params::defaults()),
-        "dlca" => (::dlca::params::PARAMS, ::dlca::params::defaults()),
-        "animat" => (::animat::params::PARAMS, ::animat::params::defaults()),
-        other => {
-            return Err(convert::value_error(format!(
-                "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
-            )));
-        }
-    };
-    let rows = table
+    let m = self::model(model)?;
+    let defaults = (m.defaults)();
+    let rows = m
+        .params
         .iter()
         .map(|s| {
             serde_json::json!({
@@ -68,38 +123,24 @@ fn params_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>
             })
         })
         .collect();
-    convert::json(py, &serde_json::Value::Array(rows))
+    convert::json(py, &Value::Array(rows))
 }
 
-/// The declared parameters of ``model`` that ``aggsim`` builds keyword arguments from
-/// (``"dla"``, ``"dlca"``): a list of dicts with ``name``, ``type`` (``float``, ``int``,
-/// ``bool``, ``str``, ``list``), ``annotation`` (the stubs' type where the type does not say
-/// it, else empty), ``help`` (the whole description), ``why`` (the reason for the range) and
-/// ``optional`` (None by default), in declaration order, the names the function takes as its
-/// own arguments (``positional``), and the parameter of its signature the keywords come before
-/// (``before``; empty: at the end). Empty for a model whose keywords are not generated yet.
+/// The declared parameters of ``model`` that ``aggsim`` builds keyword arguments from: a list
+/// of dicts with ``name``, ``type`` (``float``, ``int``, ``bool``, ``str``, ``list``),
+/// ``annotation`` (the stubs' type where the type does not say it, else empty), ``help`` (the
+/// whole description), ``why`` (the reason for the range) and ``optional`` (None by default),
+/// in declaration order, the names the function takes as its own arguments (``positional``),
+/// and the parameter of its signature the keywords come before (``before``; empty: at the end).
 #[pyfunction]
 #[pyo3(name = "_declared")]
 fn declared_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
-    let (rows, positional, before): (Vec<serde_json::Value>, &[&str], &str) = match model {
-        "dla" => (
-            declared::declared_rows::<dla_pdla::Params>(),
-            dla::POSITIONAL,
-            dla::KEYWORDS_BEFORE,
-        ),
-        "dlca" => (
-            declared::declared_rows::<::dlca::params::Settings>(),
-            dlca::POSITIONAL,
-            dlca::KEYWORDS_BEFORE,
-        ),
-        "animat" => (Vec::new(), &[], ""),
-        other => {
-            return Err(convert::value_error(format!(
-                "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
-            )));
-        }
-    };
-    let v = serde_json::json!({ "params": rows, "positional": positional, "before": before });
+    let m = self::model(model)?;
+    let v = serde_json::json!({
+        "params": (m.declared)(),
+        "positional": m.positional,
+        "before": m.before,
+    });
     convert::json(py, &v)
 }
 
@@ -112,17 +153,7 @@ fn declared_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAn
 #[pyfunction]
 #[pyo3(name = "_schema")]
 fn schema_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAny>> {
-    let schema = match model {
-        "dla" => dla_pdla::output::SCHEMA,
-        "dlca" => ::dlca::output::SCHEMA,
-        "animat" => ::animat::output::SCHEMA,
-        other => {
-            return Err(convert::value_error(format!(
-                "unknown model {other:?}: expected \"dla\", \"dlca\" or \"animat\""
-            )));
-        }
-    };
-    let v = serde_json::to_value(schema).map_err(convert::value_error)?;
+    let v = serde_json::to_value(self::model(model)?.schema).map_err(convert::value_error)?;
     convert::json(py, &v)
 }
 

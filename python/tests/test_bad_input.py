@@ -46,10 +46,8 @@ DLCA = [
 ANIMAT = [
     (["--vision", 0], dict(vision=0)),
     (["--foxes", 100000], dict(foxes=100000)),
-    (["--start-radius", -1], dict(start_radius=-1)),
     (["--density", 0.9], dict(density=0.9)),
     (["--grid-box", 0], dict(grid_box=0)),
-    (["--grid-box", "huge"], dict(grid_box="huge")),
 ]
 
 
@@ -83,14 +81,14 @@ def test_animat_messages(cli, flags, kwargs):
 
 
 def test_animat_config_messages(cli, tmp_path):
-    """A value from the config file is named with the file, by both."""
+    """A rule between two values of a config file is refused by both with the same message."""
     config = tmp_path / "bad.toml"
     config.write_text("hungry_at = 31\nstarve = 30\n")
     expected = cli.error("animat", "--config", config)
     with pytest.raises(ValueError) as e:
         aggsim.animat(config=config)
     assert str(e.value) == expected
-    assert expected.startswith(f"config {config}: hungry_at = 31 is above starve = 30")
+    assert expected.startswith("hungry_at = 31 is above starve = 30")
 
 
 def test_values_the_command_line_cannot_spell():
@@ -107,7 +105,9 @@ def test_values_the_command_line_cannot_spell():
         (lambda: aggsim.dlca(size=64, fill=0.1, histogram_sweeps=[1]), "--histogram"),
         (lambda: aggsim.animat(start_radius=50, density=0.1), "--density"),
         (lambda: aggsim.animat(fox_rules=["eat", "fly"]), "unknown fox rule \"fly\""),
-        (lambda: aggsim.animat(fox_breed_p=1.5), "fox_breed_p = 1.5 is outside"),
+        (lambda: aggsim.animat(fox_breed_p=1.5), "--fox-breed-p 1.5 is outside"),
+        (lambda: aggsim.animat(start_radius=-1), "start_radius = -1 is outside"),
+        (lambda: aggsim.animat(grid_box="huge"), "grid_box = huge: invalid grid box"),
         (lambda: aggsim.animat(hungry_at=-1), "hungry_at = -1 is outside"),
         (lambda: aggsim.DlcaLattice(64, 0.1).step(-1), "n = -1 is outside"),
     ]
@@ -115,3 +115,17 @@ def test_values_the_command_line_cannot_spell():
         with pytest.raises(ValueError) as e:
             call()
         assert text in str(e.value), str(e.value)
+
+
+def test_a_config_file_key_that_is_not_a_parameter_is_refused(tmp_path):
+    """The Python config reader names the file, the line and the key, and lists the keys."""
+    config = tmp_path / "wings.toml"
+    config.write_text("foxes = 10\nwings = 2\n")
+    with pytest.raises(ValueError) as e:
+        aggsim.animat(config=config)
+    assert str(e.value).startswith(f"config {config}, line 2: unknown key `wings`"), str(e.value)
+    assert "fox_breed_p" in str(e.value)
+    config.write_text("fox-breed-p = 0.05\nfoxes = \"many\"\n")
+    with pytest.raises(ValueError) as e:
+        aggsim.AnimatWorld(config=config)
+    assert str(e.value).startswith(f"config {config}, line 2: `foxes` = \"many\""), str(e.value)

@@ -29,6 +29,8 @@ PYTHON_ONLY |= {"animate", "animate_every", "animate_size", "frame_radius"}
 # Where a run keeps its checkpoint and how often (the binaries' --out, --resume and
 # --checkpoint-interval): how the run is kept, not a model parameter.
 PYTHON_ONLY |= {"checkpoint", "checkpoint_interval"}
+# animat's start density (the binary's --density): sets the declared start_radius.
+PYTHON_ONLY |= {"density"}
 
 # Documented differences from the library default: ``aggsim.dla`` grows 1e5 particles when
 # none are given (the binary requires ``--particles``); ``aggsim.dlca``'s ``dim`` defaults to

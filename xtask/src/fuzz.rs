@@ -87,13 +87,6 @@ pub const TARGETS: &[Target] = &[
         file: "crates/animat/tests/fuzz.rs",
         test: "fuzz_animat_checkpoint",
     },
-    Target {
-        reader: "animat --config (animat::config)",
-        package: "animat",
-        select: FUZZ,
-        file: "crates/animat/tests/fuzz.rs",
-        test: "fuzz_animat_config",
-    },
 ];
 
 fn command(cargo: &str, root: &Path, t: &Target) -> Command {

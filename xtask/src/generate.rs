@@ -1,6 +1,7 @@
 //! `cargo xtask generate`: the files written from the models' parameter declarations
 //! (`core_lattice::declare_params!`): each model's flag table in its docs and its keyword
-//! arguments in the Python stub (for DLCA twice: `aggsim.dlca` and `aggsim.DlcaLattice`),
+//! arguments in the Python stub (for DLCA and the animats twice: `aggsim.dlca` and
+//! `aggsim.DlcaLattice`, `aggsim.animat` and `aggsim.AnimatWorld`),
 //! between their marker lines. `xtask/tests/generated.rs` (in
 //! the test suite, so in CI) fails when a file is not what this would write.
 
@@ -28,6 +29,15 @@ pub struct Block {
     pub comment: &'static str,
     /// What belongs between the markers.
     pub text: String,
+}
+
+/// Parameters `aggsim.animat` and `aggsim.AnimatWorld` take as their own arguments: none (the
+/// model's are all keywords; `steps`, `seed` and `density` are not declared parameters).
+pub const ANIMAT_PYTHON_POSITIONAL: &[&str] = &[];
+
+/// Keyword arguments as a method's, one level further in.
+fn method(keywords: String) -> String {
+    keywords.lines().map(|l| format!("    {l}\n")).collect()
 }
 
 /// Every generated block of the workspace.
@@ -61,11 +71,27 @@ pub fn blocks() -> Vec<Block> {
             file: "python/aggsim/__init__.pyi",
             name: "dlca-lattice-keywords",
             comment: "#",
-            // The arguments of a method, one level further in.
-            text: pyi_keywords::<dlca::params::Settings>(DLCA_PYTHON_POSITIONAL)
-                .lines()
-                .map(|l| format!("    {l}\n"))
-                .collect(),
+            text: method(pyi_keywords::<dlca::params::Settings>(
+                DLCA_PYTHON_POSITIONAL,
+            )),
+        },
+        Block {
+            file: "docs/animat.md",
+            name: "animat-params",
+            comment: "<!--",
+            text: docs_table::<animat::Params>(),
+        },
+        Block {
+            file: "python/aggsim/__init__.pyi",
+            name: "animat-keywords",
+            comment: "#",
+            text: pyi_keywords::<animat::Params>(ANIMAT_PYTHON_POSITIONAL),
+        },
+        Block {
+            file: "python/aggsim/__init__.pyi",
+            name: "animat-world-keywords",
+            comment: "#",
+            text: method(pyi_keywords::<animat::Params>(ANIMAT_PYTHON_POSITIONAL)),
         },
     ]
 }

@@ -20,6 +20,8 @@ const RUN_FLAGS: &[&str] = &[
     "checkpoint-every",
     "resume",
     "config",
+    // animat's: sets the declared start_radius from the start population.
+    "density",
 ];
 
 fn params(bin: &str) -> &'static [ParamSpec] {

@@ -1,19 +1,28 @@
 //! The experiment behind the default parameters (docs/animat.md): run the default start (or
-//! the defaults overridden by TOML text given as the first argument) for `STEPS` steps
+//! the defaults overridden by `name=value` pairs, separated by spaces, given as the first
+//! argument) for `STEPS` steps
 //! (second argument, default 3000) on seeds 1..=10 and report, per seed, whether both species
 //! survived, the step at which one died out, and the population extremes. A third argument
 //! `FIRST-LAST` picks other seeds.
 //!
-//! `cargo run --release -p animat --example defaults_experiment -- 'rabbit_breed_p = 0.2' 3000`
+//! `cargo run --release -p animat --example defaults_experiment -- 'rabbit_breed_p=0.2 starve=40' 3000`
 
-use animat::{Params, config::parse_config};
+use animat::Params;
+use core_lattice::spec::DeclaredParams;
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let params: Params = match args.get(1) {
-        Some(t) => parse_config(t, "argument").unwrap_or_else(|e| panic!("{e}")),
-        None => Params::default(),
-    };
+    let mut params = Params::default();
+    for pair in args.get(1).map_or("", String::as_str).split_whitespace() {
+        let (name, value) = pair
+            .split_once('=')
+            .unwrap_or_else(|| panic!("{pair}: expected name=value"));
+        match params.set_text(name, value) {
+            Ok(true) => {}
+            Ok(false) => panic!("{name} is not a parameter"),
+            Err(e) => panic!("{name}: {e}"),
+        }
+    }
     params.validate().unwrap_or_else(|e| panic!("{e}"));
     let steps: u64 = args.get(2).map_or(3000, |s| s.parse().expect("steps"));
     // Optional third argument: the seeds, `FIRST-LAST` (default 1-10).

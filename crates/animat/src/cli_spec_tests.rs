@@ -1,17 +1,21 @@
-//! The `animat` command line, its config files and `docs/animat.md`'s parameter table against
-//! the library's parameter table ([`animat::params::PARAMS`]) and defaults: a parameter
-//! missing on either side, another default or range fails here.
+//! The `animat` command line, its config files and `docs/animat.md`'s flag tables against the
+//! library's parameter declaration ([`animat::params::PARAMS`]) and defaults: the model's flags
+//! are made from the declaration, so this checks that they all reach the command line with the
+//! library's defaults and ranges, that the docs' generated table is the declaration's, and that
+//! every other flag is a run flag listed in the docs.
 
 use super::Cli;
-use animat::params::{PARAMS, defaults};
+use animat::params::{PARAMS, Params, defaults};
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
+use sim_run::declared::{check_generated, docs_table};
 use sim_run::spec_check::{CliSpec, DocColumns};
 
 /// Flags of `animat` that are not model parameters, beyond the run flags every binary has
 /// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
 const NOT_PARAMS: &[&str] = &[
     "steps",
+    "density",
     "timing",
     "max-memory",
     "snapshot-every",
@@ -25,10 +29,10 @@ fn spec() -> CliSpec<'static> {
     CliSpec::new("animat", PARAMS, defaults(), NOT_PARAMS)
 }
 
-/// The flags have no clap defaults (the value comes from the config file or the library unless
-/// the flag is given), so each help text states the library's default as `[default: X]`.
+const DOC: &str = include_str!("../../../docs/animat.md");
+
 #[test]
-fn every_flagged_parameter_is_a_flag_stating_its_range() {
+fn every_parameter_is_a_flag_with_the_library_default_and_range() {
     spec().check_flags(&Cli::command());
 }
 
@@ -39,7 +43,7 @@ fn the_default_config_file_has_every_parameter() {
     for s in PARAMS {
         let key = format!("{} =", s.name);
         assert!(
-            s.flag == Some("density") || toml.lines().any(|l| l.starts_with(&key)),
+            toml.lines().any(|l| l.starts_with(&key)),
             "data/animat-default.toml has no {}",
             s.name
         );
@@ -47,40 +51,30 @@ fn the_default_config_file_has_every_parameter() {
 }
 
 #[test]
-fn the_docs_table_states_each_default_and_range() {
-    let md = include_str!("../../../docs/animat.md");
-    let rows = markdown_table(md, "## Parameters and defaults");
-    assert_eq!(rows[0], ["parameter", "flag", "default", "accepted"]);
-    let columns = DocColumns::new(1, 2, 3);
-    let row_of = |s: &core_lattice::spec::ParamSpec, r: &[String]| {
-        r[0] == format!("`{}`", s.name) || s.flag.is_some_and(|f| r[1] == format!("`--{f}`"))
-    };
-    // The option list is both tables: the model's parameters and, laid out as parameter rows
-    // without a parameter name, the run flags.
-    let run_flags = markdown_table(md, "## Run flags");
-    assert_eq!(run_flags[0], ["flag", "default", "meaning"]);
-    let options: Vec<Vec<String>> = rows
+fn the_docs_parameter_table_is_the_declarations() {
+    let table = docs_table::<Params>();
+    check_generated("docs/animat.md", DOC, "animat-params", "<!--", &table).unwrap();
+    let rows = markdown_table(&format!("#\n{table}"), "#");
+    spec().check_params_table("docs/animat.md", &rows, DocColumns::new(0, 1, 2), |s, r| {
+        r[0] == format!("`--{}`", s.flag.unwrap())
+    });
+}
+
+#[test]
+fn the_docs_list_every_run_flag() {
+    let rows = markdown_table(DOC, "## Run flags");
+    assert_eq!(rows[0], ["flag", "default", "meaning"]);
+    let mut listed: Vec<String> = rows[1..]
         .iter()
-        .cloned()
-        .chain(run_flags[1..].iter().map(|r| {
-            let mut row = vec![String::new()];
-            row.extend(r.iter().cloned());
-            row
-        }))
+        .flat_map(|r| sim_run::spec_check::flags_of(&r[0]))
         .collect();
-    spec().check_docs_table("docs/animat.md", &options, columns, &Cli::command(), row_of);
-    for s in PARAMS {
-        let row = rows.iter().find(|r| row_of(s, r)).unwrap();
-        let flag = s.flag.map(|f| format!("`--{f}`")).unwrap_or_default();
-        assert_eq!(row[1], flag, "{}: the flag", s.name);
-    }
-    // Every row is a parameter of the table.
-    for r in &rows[1..] {
-        assert!(
-            PARAMS.iter().any(|s| row_of(s, r)),
-            "docs/animat.md lists {} {}, not a parameter",
-            r[0],
-            r[1]
-        );
+    listed.extend(PARAMS.iter().map(|s| format!("--{}", s.flag.unwrap())));
+    for a in Cli::command().get_arguments() {
+        if let Some(long) = a.get_long().filter(|l| *l != "help") {
+            assert!(
+                listed.contains(&format!("--{long}")),
+                "--{long} is missing from docs/animat.md's flag tables"
+            );
+        }
     }
 }

@@ -21,7 +21,6 @@
 
 pub mod bench;
 pub mod checkpoint;
-pub mod config;
 mod hint;
 pub mod output;
 pub mod params;

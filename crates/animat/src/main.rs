@@ -5,11 +5,11 @@
 
 use animat::checkpoint::Saved;
 use animat::output::{self, PopulationRow};
-use animat::{GridBox, Params, ParamsError, World};
+use animat::{Params, World};
 use anyhow::Context;
 use clap::Parser;
-use sim_run::cli::{CheckpointArgs, LogArgs, flag_differences, usage};
-use sim_run::ensemble::{Curve, EnsembleArgs};
+use sim_run::cli::{Model, Own, ParamFlags, RunArgs, flag_differences, usage};
+use sim_run::ensemble::{Combine, Curve};
 use sim_run::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -17,8 +17,8 @@ use std::process::ExitCode;
 /// Foxes and rabbits on an unbounded plane, each running its rule list in priority order.
 ///
 /// Parameters come from the defaults, then --config FILE.toml, then the flags below (flags
-/// win). Outputs go into --out DIR: run.json, populations.csv, and on request PNG snapshots
-/// and positions.csv (see docs/animat.md).
+/// win); every model parameter is a flag and a config key. Outputs go into --out DIR: run.json,
+/// populations.csv, and on request PNG snapshots and positions.csv (see docs/animat.md).
 #[derive(Parser, Debug)]
 #[command(name = "animat", version = sim_run::cli::version(), allow_negative_numbers = true)]
 struct Cli {
@@ -26,54 +26,18 @@ struct Cli {
     #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = animat::params::DEFAULT_STEPS)]
     steps: u64,
 
-    /// Seed of every random stream of the run: same seed and parameters, same run.
-    #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
-    seed: u64,
+    #[command(flatten)]
+    run: RunArgs,
 
-    /// Output directory (created if missing; nothing is written on bad input). It is this run's
-    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
-    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
-    /// or replace it with --overwrite.
-    #[arg(long, required_unless_present = "dump_config")]
-    out: Option<PathBuf>,
-
-    /// TOML file with any model parameters (see data/animat-default.toml); unknown keys are
-    /// errors. A run saves its parameters as OUT/config.toml, so `--config OUT/config.toml`
-    /// with the same --steps and --seed repeats it.
-    #[arg(long)]
-    config: Option<PathBuf>,
-
-    /// Print the effective model parameters (defaults, then --config, then flags) as a config
-    /// file and exit without running.
-    #[arg(long)]
-    dump_config: bool,
-
-    /// Foxes at the start [default: 300].
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
-    foxes: Option<u64>,
-
-    /// Rabbits at the start [default: 2000].
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
-    rabbits: Option<u64>,
-
-    /// Radius of the start disc around the origin, in cells, 0..=1073741824 [default: 60].
-    #[arg(long, conflicts_with = "density")]
-    start_radius: Option<i64>,
+    #[command(flatten)]
+    params: ParamFlags<Params>,
 
     // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
     // clap would read `-inf` as an unknown short flag.
-    /// Start density in animats per cell, in (0, 0.5]: sets the start radius.
-    #[arg(long, allow_hyphen_values = true)]
+    /// Start density in animats per cell, in (0, 0.5]: sets the start radius to
+    /// ceil(sqrt(animats / (pi density))).
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "start_radius")]
     density: Option<f64>,
-
-    /// Vision radius in cells, 1..=1073741824 [default: 60].
-    #[arg(long)]
-    vision: Option<i64>,
-
-    /// Grid-box side in cells: a positive integer, `vision` or `none` (exhaustive search).
-    /// Changes only the speed, never the result [default: vision].
-    #[arg(long)]
-    grid_box: Option<String>,
 
     /// Record neighbour-search seconds and distance evaluations per step in populations.csv.
     #[arg(long)]
@@ -123,59 +87,18 @@ struct Cli {
     #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
-    #[command(flatten)]
-    checkpoints: CheckpointArgs,
-
     /// Continue the run saved in DIR/checkpoint.bin (a checkpoint, or a stopped run) to the same state
     /// as an uninterrupted run: the model parameters and --seed must be those of the saved run
     /// (--steps may grow; output flags may change).
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
-
-    #[command(flatten)]
-    log: LogArgs,
-
-    #[command(flatten)]
-    ensemble: EnsembleArgs,
-
-    #[command(flatten)]
-    overwrite: sim_run::cli::OverwriteArgs,
 }
 
-impl Cli {
-    /// The output directory (clap requires it unless `--dump-config`, which never gets here).
-    fn out(&self) -> &Path {
-        self.out
-            .as_deref()
-            .expect("clap requires --out unless --dump-config")
-    }
-}
-
-/// Builds validated parameters: defaults, then the config file, then the flags.
+/// Builds validated parameters: the defaults, then the flags (those of `--config` first).
 fn params(cli: &Cli) -> Result<Params, String> {
-    let mut p = match &cli.config {
-        Some(path) => animat::config::read_config(path).map_err(|e| e.to_string())?,
-        None => Params::default(),
-    };
-    if let Some(v) = cli.foxes {
-        p.foxes = v;
-    }
-    if let Some(v) = cli.rabbits {
-        p.rabbits = v;
-    }
-    if let Some(v) = cli.start_radius {
-        p.start_radius = v;
-    }
+    let mut p = cli.params.params();
     if let Some(d) = cli.density {
         p.set_density(d)?;
-    }
-    if let Some(v) = cli.vision {
-        p.vision = v;
-    }
-    if let Some(g) = &cli.grid_box {
-        p.grid_box = g
-            .parse::<GridBox>()
-            .map_err(|e| format!("--grid-box: {e}"))?;
     }
     if cli.snapshot_every == Some(0) {
         return Err("--snapshot-every 0 is outside the accepted range 1..".into());
@@ -196,7 +119,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             "--frame-radius frames the pictures of --snapshot-every and --animate; give one".into(),
         );
     }
-    p.validate().map_err(|e| culprit(cli, &e))?;
+    p.validate().map_err(|e| e.to_string())?;
     if cli.resume.is_none() {
         let what = format!(
             "{} animats in a disc of radius {}: a 36 KiB tile of the cell index for each 64 x 64 \
@@ -212,10 +135,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             "raise --density (or lower --start-radius)",
         )?;
     }
-    cli.checkpoints.check(cli.checkpoint_every)?;
-    if let Some(out) = &cli.out {
-        sim_run::cli::check_out_dir(out)?;
-    }
+    cli.run.checkpoints.check(cli.checkpoint_every)?;
     Ok(p)
 }
 
@@ -225,20 +145,6 @@ const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 /// The memory the run may take: `--max-memory`, else 4 GiB or the memory available if less.
 fn memory_limit(cli: &Cli) -> sim_run::memory::Limit {
     sim_run::memory::Limit::with_default_cap(cli.max_memory, DEFAULT_MAX_MEMORY)
-}
-
-/// The message of a parameter error, naming where the value came from: a flag
-/// (`--vision 0 is outside ...`) or the config file.
-fn culprit(cli: &Cli, e: &ParamsError) -> String {
-    let by_flag = |name: &str| match name {
-        "foxes" => cli.foxes.is_some(),
-        "rabbits" => cli.rabbits.is_some(),
-        "start_radius" => cli.start_radius.is_some() || cli.density.is_some(),
-        "vision" => cli.vision.is_some(),
-        "grid_box" => cli.grid_box.is_some(),
-        _ => false,
-    };
-    animat::params::error_message(e, by_flag, cli.config.as_deref())
 }
 
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
@@ -268,35 +174,46 @@ const CURVES: &[Curve] = &[Curve {
     ],
 }];
 
-fn main() -> ExitCode {
-    if let Some(code) = sim_run::ensemble::before_parsing("animat", CURVES) {
-        return code;
+/// The animat model as the run machinery sees it.
+struct Animat;
+
+impl Model for Animat {
+    const NAME: &'static str = "animat";
+    const RUN_FILES: &'static [&'static str] = RUN_FILES;
+    const COMBINE: Combine<'static> = Combine {
+        curves: CURVES,
+        pooled: &[],
+    };
+    type Cli = Cli;
+    type Params = Params;
+
+    fn run_args(cli: &Cli) -> &RunArgs {
+        &cli.run
     }
-    sim_run::cli::main_with(
-        "animat",
-        |c: &Cli| c.log,
-        params,
-        |cli, params| {
-            if cli.dump_config {
-                print!("{}", animat::config::to_toml(&params)?);
-                return Ok(());
-            }
-            let owner = sim_run::ensemble::Owner {
-                run_files: RUN_FILES,
-                params: serde_json::to_value(&params)?,
-                config: Some(animat::config::to_toml(&params)?),
-                run_flags: vec![(
-                    "--steps",
-                    cli.steps.to_string(),
-                    animat::params::DEFAULT_STEPS.to_string(),
-                )],
-                overwrite: cli.overwrite.overwrite,
-            };
-            cli.ensemble
-                .run("animat", 1, cli.out(), CURVES, &cli.log, &owner)
-                .unwrap_or_else(|| run(cli, params))
-        },
-    )
+
+    fn params(cli: &Cli) -> Result<Params, String> {
+        params(cli)
+    }
+
+    fn resume_dir(cli: &Cli) -> Option<&Path> {
+        cli.resume.as_deref()
+    }
+
+    fn run_flags(cli: &Cli) -> Vec<(&'static str, String, String)> {
+        vec![(
+            "--steps",
+            cli.steps.to_string(),
+            animat::params::DEFAULT_STEPS.to_string(),
+        )]
+    }
+
+    fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
+        run(cli, params, own)
+    }
+}
+
+fn main() -> ExitCode {
+    sim_run::cli::model::main::<Animat>()
 }
 
 /// File name of checkpoints in the output directory.
@@ -349,34 +266,22 @@ fn resume(
     Ok((world, saved.rows))
 }
 
-fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
+fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
     let clock = RunClock::start();
     let limit = memory_limit(cli);
     // Everything that can refuse the run happens before --out is created.
     let (mut world, mut rows) = match &cli.resume {
-        Some(dir) => resume(dir, &params, cli.seed, cli.steps)?,
+        Some(dir) => resume(dir, &params, cli.run.seed, cli.steps)?,
         None => {
             // Every error of the set-up is a parameter the run cannot take.
-            let world = World::new(params, cli.seed).map_err(|e| usage(e.to_string()))?;
+            let world = World::new(params, cli.run.seed).map_err(|e| usage(e.to_string()))?;
             let start = PopulationRow::of(&world, Default::default());
             (world, vec![start])
         }
     };
     world.set_timing(cli.timing);
     // Ours until the run ends: refused if another run holds it or it holds an earlier run.
-    let claim = sim_run::cli::Claim::single(
-        cli.out(),
-        RUN_FILES,
-        cli.resume.as_deref(),
-        cli.overwrite.overwrite,
-    );
-    let _lock = sim_run::cli::own_out_dir(&claim)?;
-    // The effective parameters, so that `--config OUT/config.toml` repeats the run.
-    sim_run::io::write_atomic(
-        cli.out().join("config.toml"),
-        animat::config::to_toml(world.params())?.as_bytes(),
-    )
-    .with_context(|| format!("writing {}/config.toml", cli.out().display()))?;
+    let _lock = own.take()?;
     tracing::info!(
         foxes = world.foxes(),
         rabbits = world.rabbits(),
@@ -388,13 +293,13 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             world: world.snapshot(),
             rows: rows.to_vec(),
         };
-        write_checkpoint(cli.out().join(CHECKPOINT), CHECKPOINT_MODEL, &saved)
+        write_checkpoint(cli.run.out.join(CHECKPOINT), CHECKPOINT_MODEL, &saved)
             .context("writing a checkpoint")?;
         Ok(())
     };
     let frame = output::SnapshotFrame::new(world.params(), cli.frame_radius, cli.png_size);
     let snapshot = |w: &World| -> anyhow::Result<()> {
-        let path = cli.out().join(format!("snapshot_{:06}.png", w.steps()));
+        let path = cli.run.out.join(format!("snapshot_{:06}.png", w.steps()));
         output::write_snapshot(&path, w, &frame)?;
         Ok(())
     };
@@ -404,14 +309,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             .unwrap_or_else(|| output::default_animate_every(cli.steps));
         Some(output::Animation::start(
             &world,
-            &cli.out().join("animat.gif"),
+            &cli.run.out.join("animat.gif"),
             frame,
             every,
         )?)
     } else {
         None
     };
-    let progress = cli.log.progress(
+    let progress = cli.run.log.progress(
         "animat",
         cli.steps,
         "steps",
@@ -422,8 +327,9 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     }
     progress.set_position(world.steps().min(cli.steps));
     // Timed checkpoints, signals and the memory watch, which keeps room for a checkpoint.
-    let enabled = cli.checkpoints.enabled();
+    let enabled = cli.run.checkpoints.enabled();
     let (guard, _watch, memory) = cli
+        .run
         .checkpoints
         .start(animat::checkpoint::reserve_bytes(&world, rows.len()))
         .context("installing signal handlers")?;
@@ -433,7 +339,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             sim_run::cli::checkpoints::honour(
                 &guard,
                 enabled,
-                cli.out(),
+                &cli.run.out,
                 || save(&world, &rows),
                 at,
             )
@@ -451,7 +357,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
                 save(&world, &rows)?;
                 format!(
                     "raise --max-memory and continue with --resume {} (checkpointed at this step)",
-                    cli.out().display()
+                    cli.run.out.display()
                 )
             } else {
                 "raise --max-memory".to_string()
@@ -498,7 +404,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     } else {
         // A checkpoint the run did not ask for (a timed one, or the one it was resumed from)
         // goes.
-        sim_run::cli::checkpoints::remove_unasked_checkpoint(cli.out(), false)
+        sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.run.out, false)
             .context("removing checkpoint.bin")?;
     }
     if let Some(k) = cli.snapshot_every {
@@ -510,12 +416,12 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         let frames = a.finish(&world)?;
         tracing::info!(frames, "animat.gif");
     }
-    output::write_populations(cli.out(), &rows, cli.timing)?;
+    output::write_populations(&cli.run.out, &rows, cli.timing)?;
     if let Some(format) = cli.positions.format() {
-        output::write_positions(cli.out(), &world, format)?;
+        output::write_positions(&cli.run.out, &world, format)?;
     }
-    let m = output::write_manifest(cli.out(), &world, cli.seed, &clock)?;
-    if !cli.log.is_quiet() {
+    let m = output::write_manifest(&cli.run.out, &world, cli.run.seed, &clock)?;
+    if !cli.run.log.is_quiet() {
         eprintln!(
             "animat: {} foxes, {} rabbits after {} steps in {:.2} s (state {}); outputs in {}",
             world.foxes(),
@@ -523,7 +429,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             world.steps(),
             m.wall_seconds,
             world.state_hash(),
-            cli.out().display()
+            cli.run.out.display()
         );
     }
     Ok(())

@@ -73,7 +73,7 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--start-radius", "5"]), "start disc of radius 5"),
         (
             with(&["--start-radius", "-3"]),
-            "--start-radius -3 is outside",
+            "'-3' for '--start-radius <N>': -3 is negative",
         ),
         (with(&["--density", "0"]), "--density 0 is outside"),
         (with(&["--density", "0.6"]), "--density 0.6 is outside"),
@@ -128,13 +128,19 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--config", "missing.toml"]), "missing.toml"),
         (with(&["--config", "unknown.toml"]), "wings"),
         (with(&["--config", "broken.toml"]), "broken.toml, line 1"),
-        (with(&["--config", "typed.toml"]), "typed.toml, line 1"),
+        (
+            with(&["--config", "typed.toml"]),
+            "'many' for '--foxes <N>'",
+        ),
         (with(&["--config", "norules.toml"]), "fox_rules is empty"),
         (
             with(&["--config", "hungry.toml"]),
             "hungry_at = 40 is above starve = 30",
         ),
-        (with(&["--config", "prob.toml"]), "fox_breed_p = 2"),
+        (
+            with(&["--config", "prob.toml"]),
+            "--fox-breed-p 2 is outside",
+        ),
         (
             with(&["--config", "rule.toml"]),
             "unknown rabbit rule \"fly\"",
@@ -142,7 +148,7 @@ fn bad_inputs_are_refused_before_any_work() {
         (with(&["--config", "twice.toml"]), "listed twice"),
         (
             with(&["--config", "crowd.toml"]),
-            "config crowd.toml: crowd_radius = 0",
+            "--crowd-radius 0 is outside",
         ),
         (vec!["--out", "file"], "--out file"),
         (vec!["--out", "file/sub"], "--out file/sub"),

@@ -367,8 +367,8 @@ fn positions_in_every_format_hold_the_same_animats() {
     }
 }
 
-/// A run saves its parameters as `config.toml`; `--dump-config` prints the same without `--out`;
-/// `--config OUT/config.toml` with the same steps and seed repeats the run.
+/// A run saves its flags as `config.toml`; `--dump-config` prints the same without `--out`;
+/// `--config OUT/config.toml` alone repeats the run (its steps and seed are in it).
 #[test]
 fn config_files_repeat_runs() {
     let tmp = tempfile::tempdir().unwrap();
@@ -379,7 +379,7 @@ fn config_files_repeat_runs() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let saved = std::fs::read_to_string(a.join("config.toml")).unwrap();
     assert!(saved.contains("vision = 25"), "{saved}");
-    let dump = animat(&["--vision", "25", "--dump-config"]);
+    let dump = animat(&[&flags[..], &["--dump-config"]].concat());
     assert!(
         dump.status.success(),
         "{}",
@@ -388,10 +388,6 @@ fn config_files_repeat_runs() {
     assert_eq!(String::from_utf8_lossy(&dump.stdout), saved);
     let config = a.join("config.toml");
     let o = animat(&[
-        "--steps",
-        "6",
-        "--seed",
-        "3",
         "-q",
         "--config",
         config.to_str().unwrap(),

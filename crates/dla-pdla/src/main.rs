@@ -7,11 +7,8 @@ use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side_of, write_outputs};
 use dla_pdla::{Dim, Params, ParamsError, SimError, Simulation, Space};
-use sim_run::cli::{
-    CheckpointArgs, ConfigArgs, LogArgs, OverwriteArgs, ParamFlags, flag_differences, stopped,
-    usage,
-};
-use sim_run::ensemble::{Curve, EnsembleArgs};
+use sim_run::cli::{Model, Own, ParamFlags, RunArgs, flag_differences, stopped, usage};
+use sim_run::ensemble::{Combine, Curve};
 use sim_run::io::RunClock;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -30,16 +27,8 @@ struct Cli {
     #[command(flatten)]
     params: ParamFlags<Params>,
 
-    /// Seed of every random stream of the run: same seed and flags, same run (one thread).
-    #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
-    seed: u64,
-
-    /// Output directory (created if missing; nothing is written on bad input). It is this run's
-    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
-    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
-    /// or replace it with --overwrite.
-    #[arg(long)]
-    out: PathBuf,
+    #[command(flatten)]
+    run: RunArgs,
 
     /// The variable-precision paper's walk, to reproduce its numbers: --far-field jump
     /// --death-ratio 100 --step-min 0.5 --precision 2 --distance-map off (the step of 0.5
@@ -63,9 +52,6 @@ struct Cli {
     /// is a valid PDLA cluster.
     #[arg(long, value_parser = sim_run::cli::count::<u64>, value_name = "N")]
     checkpoint_every: Option<u64>,
-
-    #[command(flatten)]
-    checkpoints: CheckpointArgs,
 
     /// Continue the run checkpointed in DIR (checkpoint.bin and positions.npy). The run flags
     /// (and --seed) must be those of the checkpointed run, except --particles, which may grow:
@@ -102,18 +88,6 @@ struct Cli {
     /// the memory available (MemAvailable, or a lower cgroup limit).
     #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
     max_memory: Option<u64>,
-
-    #[command(flatten)]
-    config: ConfigArgs,
-
-    #[command(flatten)]
-    log: LogArgs,
-
-    #[command(flatten)]
-    ensemble: EnsembleArgs,
-
-    #[command(flatten)]
-    overwrite: OverwriteArgs,
 }
 
 fn params(cli: &Cli) -> Result<Params, String> {
@@ -143,7 +117,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             p.dim
         ));
     }
-    cli.checkpoints.check(cli.checkpoint_every)?;
+    cli.run.checkpoints.check(cli.checkpoint_every)?;
     sim_run::figure::animation::check_picture_flags(
         cli.png_size,
         cli.animate,
@@ -159,9 +133,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
             p.particles
         ));
     }
-    // After every other check of the flags, so that a bad flag is named first.
     check_memory(cli, &p)?;
-    sim_run::cli::check_out_dir(&cli.out)?;
     Ok(p)
 }
 
@@ -177,7 +149,7 @@ fn asked_positions(cli: &Cli) -> bool {
 /// Whether the positions stream to positions.npy: when asked for, and for the checkpoints,
 /// which refer to them; a run that ends normally removes what was not asked for.
 fn streams_positions(cli: &Cli) -> bool {
-    asked_positions(cli) || cli.checkpoints.enabled()
+    asked_positions(cli) || cli.run.checkpoints.enabled()
 }
 
 /// Refuses a run whose estimated peak memory (the cluster, and the picture's buffers with
@@ -276,61 +248,64 @@ const CURVES: &[Curve] = &[Curve {
     colours: &[],
 }];
 
-fn main() -> ExitCode {
-    if let Some(code) = sim_run::ensemble::before_parsing("dla", CURVES) {
-        return code;
+/// DLA and PDLA as the run machinery sees them.
+struct Dla;
+
+impl Model for Dla {
+    const NAME: &'static str = "dla";
+    const RUN_FILES: &'static [&'static str] = RUN_FILES;
+    const COMBINE: Combine<'static> = Combine {
+        curves: CURVES,
+        pooled: &[],
+    };
+    type Cli = Cli;
+    type Params = Params;
+
+    fn run_args(cli: &Cli) -> &RunArgs {
+        &cli.run
     }
-    sim_run::cli::main_with_config(
-        "dla",
-        |c: &Cli| c.log,
-        params,
-        // The one run-time dimension dispatch (`with_dim!`, shared with Python and xtask).
-        |cli, params: Params| {
-            let owner = sim_run::ensemble::Owner {
-                run_files: RUN_FILES,
-                params: serde_json::to_value(&params)?,
-                config: sim_run::cli::config::effective_text().map(str::to_owned),
-                run_flags: Vec::new(),
-                overwrite: cli.overwrite.overwrite,
-            };
-            let ensemble =
-                cli.ensemble
-                    .run("dla", params.threads, &cli.out, CURVES, &cli.log, &owner);
-            ensemble.unwrap_or_else(|| {
-                dla_pdla::with_dim!(params.dim, D => run::<D>(cli, params), d => Err(ParamsError::dim(d).into()))
-            })
-        },
-    )
+
+    fn params(cli: &Cli) -> Result<Params, String> {
+        params(cli)
+    }
+
+    fn resume_dir(cli: &Cli) -> Option<&Path> {
+        cli.resume.as_deref()
+    }
+
+    fn threads(params: &Params) -> usize {
+        params.threads
+    }
+
+    // The one run-time dimension dispatch (`with_dim!`, shared with Python and xtask).
+    fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
+        dla_pdla::with_dim!(params.dim, D => run::<D>(cli, params, own), d => Err(ParamsError::dim(d).into()))
+    }
 }
 
-fn run<const D: usize>(cli: &Cli, params: Params) -> anyhow::Result<()>
+fn main() -> ExitCode {
+    sim_run::cli::model::main::<Dla>()
+}
+
+fn run<const D: usize>(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()>
 where
     Dim<D>: Space<D>,
 {
     let clock = RunClock::start();
     let total = params.particles;
-    tracing::info!(?params, seed = cli.seed, "starting growth");
+    tracing::info!(?params, seed = cli.run.seed, "starting growth");
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
-        None => Simulation::<D>::new(params, cli.seed).map_err(|e| match e {
+        None => Simulation::<D>::new(params, cli.run.seed).map_err(|e| match e {
             SimError::Params(e) => usage(e.to_string()),
             other => anyhow::Error::from(other).context("setting up the run"),
         })?,
-        Some(dir) => resume::<D>(dir, &params, cli.seed)?,
+        Some(dir) => resume::<D>(dir, &params, cli.run.seed)?,
     };
     // Ours until the run ends: refused if another run holds it or it holds an earlier run.
-    let claim = sim_run::cli::Claim::single(
-        &cli.out,
-        RUN_FILES,
-        cli.resume.as_deref(),
-        cli.overwrite.overwrite,
-    );
-    let _lock = sim_run::cli::own_out_dir(&claim)?;
-    // The effective flags, so that `--config OUT/config.toml` repeats the run.
-    sim_run::cli::config::save(&cli.out)
-        .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
+    let _lock = own.take()?;
     let asked_positions = asked_positions(cli);
-    let checkpoints = cli.checkpoints.enabled();
+    let checkpoints = cli.run.checkpoints.enabled();
     if matches!(cli.positions, PositionsFormat::Csv | PositionsFormat::Xyz) && total > 10_000_000 {
         tracing::warn!(
             "--positions {} for {total} particles writes about {} GB of text; positions.npy holds them in {} GB",
@@ -339,14 +314,16 @@ where
             total * 8 * D as u64 / 1_000_000_000
         );
     }
-    sim.stream_into(&cli.out, streams_positions(cli))?;
+    sim.stream_into(&cli.run.out, streams_positions(cli))?;
     let progress = cli
+        .run
         .log
         .progress("dla", total, "particles", PROGRESS_TEMPLATE);
     let report = |n| progress.set_position(n);
     // Timed checkpoints, signals and the memory watch; a checkpoint needs a few kilobytes
     // beyond the buffers already flushed.
     let (guard, watch, _) = cli
+        .run
         .checkpoints
         .start(dla_pdla::params::CHECKPOINT_RESERVE_BYTES)
         .context("installing signal handlers")?;
@@ -355,7 +332,7 @@ where
     if let Some(reason) = end {
         progress.finish();
         let at = format!("at {} of {total} particles", sim.particles());
-        return Err(stopped(&reason, &at, &cli.out, checkpoints));
+        return Err(stopped(&reason, &at, &cli.run.out, checkpoints));
     }
     progress.finish();
     // Positions streamed only for the checkpoints are not synced: they go at the end.
@@ -377,18 +354,21 @@ where
             .unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));
         let frames = dla_pdla::picture::write_animation(
             &sim,
-            &cli.out,
-            &cli.out.join("dla.gif"),
+            &cli.run.out,
+            &cli.run.out.join("dla.gif"),
             side,
             every,
         )?;
         tracing::info!(frames, "dla.gif");
     }
-    let m = write_outputs(&sim, &clock, &cli.out, cli.positions, png)?;
+    let m = write_outputs(&sim, &clock, &cli.run.out, cli.positions, png)?;
     // What only the checkpoints needed goes, the checkpoint first (it refers to the
     // positions); what was asked for stays.
-    sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.out, cli.checkpoint_every.is_some())
-        .context("removing checkpoint.bin")?;
+    sim_run::cli::checkpoints::remove_unasked_checkpoint(
+        &cli.run.out,
+        cli.checkpoint_every.is_some(),
+    )
+    .context("removing checkpoint.bin")?;
     if remove {
         sim.remove_positions_file()?;
     }
@@ -398,8 +378,8 @@ where
         tracing::warn!("no fractal dimension: {e}");
     }
     tracing::info!(discarded = sim.discarded_walkers(), "done");
-    if !cli.log.is_quiet() {
-        eprintln!("{}", dla_pdla::output::summary(&sim, &m, &cli.out));
+    if !cli.run.log.is_quiet() {
+        eprintln!("{}", dla_pdla::output::summary(&sim, &m, &cli.run.out));
     }
     Ok(())
 }

@@ -7,10 +7,8 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use dlca::params::{LATTICE_FLAGS, Settings};
 use dlca::{Params, Simulation, Snapshot};
-use sim_run::cli::{
-    CheckpointArgs, ConfigArgs, LogArgs, ParamFlags, Plain, flag_differences, usage,
-};
-use sim_run::ensemble::{Combine, Curve, EnsembleArgs, MemberRun, Pooled, PooledResult};
+use sim_run::cli::{Model, Own, ParamFlags, Plain, RunArgs, flag_differences, usage};
+use sim_run::ensemble::{Combine, Curve, MemberRun, Pooled, PooledResult};
 use sim_run::io::{Positions, RunClock};
 use sim_run::io::{read_checkpoint, write_checkpoint};
 
@@ -34,24 +32,13 @@ struct Cli {
     #[command(flatten)]
     lattice: ParamFlags<Settings, Plain, 0, LATTICE_FLAGS>,
 
-    /// Seed of every random stream of the run: same seed and flags, same run.
-    #[arg(long, default_value_t = 1, value_parser = sim_run::cli::seed)]
-    seed: u64,
-
-    /// Output directory (created if missing; nothing is written on bad input). It is this run's
-    /// while it runs (locked in DIR/run.lock); one in use by another run, or holding an earlier
-    /// run (run.json, a checkpoint or partial outputs), is refused: continue it with --resume,
-    /// or replace it with --overwrite.
-    #[arg(long)]
-    out: PathBuf,
+    #[command(flatten)]
+    run: RunArgs,
 
     /// Also save the run's state to OUT/checkpoint.bin every N sweeps (atomically), and keep
     /// it at the end.
     #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
-
-    #[command(flatten)]
-    checkpoints: CheckpointArgs,
 
     /// Continue the run saved in DIR/checkpoint.bin (a checkpoint, or a stopped run) to the same final
     /// state as an uninterrupted run. The other flags must be those of the saved run, except
@@ -88,18 +75,6 @@ struct Cli {
     /// particles.xyz (extended XYZ: OVITO, VMD), or none.
     #[arg(long, value_enum, value_name = "FORMAT", default_value_t = Positions::Csv)]
     positions: Positions,
-
-    #[command(flatten)]
-    config: ConfigArgs,
-
-    #[command(flatten)]
-    log: LogArgs,
-
-    #[command(flatten)]
-    ensemble: EnsembleArgs,
-
-    #[command(flatten)]
-    overwrite: sim_run::cli::OverwriteArgs,
 }
 
 /// Turn the flags into validated parameters.
@@ -133,8 +108,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         ),
         "lower --size or --fill/--particles",
     )?;
-    cli.checkpoints.check(cli.checkpoint_every)?;
-    sim_run::cli::check_out_dir(&cli.out)?;
+    cli.run.checkpoints.check(cli.checkpoint_every)?;
     Ok(p)
 }
 
@@ -257,57 +231,56 @@ const RUN_FILES: &[&str] = &[
 /// The largest default side of a picture, for the memory estimate before the run.
 const PICTURE_MAX_DEFAULT_SIDE: u32 = dlca::picture::PNG_MAX_SIDE as u32;
 
-fn main() -> ExitCode {
-    if let Some(code) = sim_run::ensemble::before_parsing("dlca", COMBINE) {
-        return code;
+/// DLCA as the run machinery sees it.
+struct Dlca;
+
+impl Model for Dlca {
+    const NAME: &'static str = "dlca";
+    const RUN_FILES: &'static [&'static str] = RUN_FILES;
+    const COMBINE: Combine<'static> = COMBINE;
+    type Cli = Cli;
+    type Params = Params;
+
+    fn run_args(cli: &Cli) -> &RunArgs {
+        &cli.run
     }
-    sim_run::cli::main_with_config(
-        "dlca",
-        |c: &Cli| c.log,
-        params,
-        |cli, params| {
-            let owner = sim_run::ensemble::Owner {
-                run_files: RUN_FILES,
-                params: serde_json::to_value(&params)?,
-                config: sim_run::cli::config::effective_text().map(str::to_owned),
-                run_flags: Vec::new(),
-                overwrite: cli.overwrite.overwrite,
-            };
-            cli.ensemble
-                .run("dlca", 1, &cli.out, COMBINE, &cli.log, &owner)
-                .unwrap_or_else(|| run(cli, params))
-        },
-    )
+
+    fn params(cli: &Cli) -> Result<Params, String> {
+        params(cli)
+    }
+
+    fn resume_dir(cli: &Cli) -> Option<&Path> {
+        cli.resume.as_deref()
+    }
+
+    fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
+        run(cli, params, own)
+    }
 }
 
-fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
+fn main() -> ExitCode {
+    sim_run::cli::model::main::<Dlca>()
+}
+
+fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
     let clock = RunClock::start();
     let target = params.target_clusters;
     // Everything that can refuse the run happens before --out is created.
     let mut sim = match &cli.resume {
-        Some(dir) => resume(dir, params, cli.seed)?,
+        Some(dir) => resume(dir, params, cli.run.seed)?,
         // Every error of the set-up is a parameter the run cannot take, except an allocation
         // the system refused: a failed run.
-        None => Simulation::new(params, cli.seed).map_err(|e| match e {
+        None => Simulation::new(params, cli.run.seed).map_err(|e| match e {
             dlca::params::ParamError::Alloc(a) => anyhow::Error::from(a),
             other => usage(other.to_string()),
         })?,
     };
     // Created before the run so a long run cannot end with nowhere to write.
     // Ours until the run ends: refused if another run holds it or it holds an earlier run.
-    let claim = sim_run::cli::Claim::single(
-        &cli.out,
-        RUN_FILES,
-        cli.resume.as_deref(),
-        cli.overwrite.overwrite,
-    );
-    let _lock = sim_run::cli::own_out_dir(&claim)?;
-    // The effective flags, so that `--config OUT/config.toml` repeats the run.
-    sim_run::cli::config::save(&cli.out)
-        .with_context(|| format!("writing {}/config.toml", cli.out.display()))?;
+    let _lock = own.take()?;
     tracing::info!("{}", sim.strategy_reason());
     let initial = sim.clusters();
-    let progress = cli.log.progress(
+    let progress = cli.run.log.progress(
         "dlca",
         initial.saturating_sub(target),
         "merges",
@@ -315,13 +288,14 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
     );
     // Timed checkpoints, signals and the memory watch, which keeps room for a checkpoint.
     let reserve = dlca::sim::checkpoint_reserve_bytes(sim.particles());
-    let enabled = cli.checkpoints.enabled();
+    let enabled = cli.run.checkpoints.enabled();
     let (guard, _watch, _) = cli
+        .run
         .checkpoints
         .start(reserve)
         .context("installing signal handlers")?;
     let save = |s: &Simulation| {
-        write_checkpoint(cli.out.join(CHECKPOINT), "dlca", &s.snapshot())
+        write_checkpoint(cli.run.out.join(CHECKPOINT), "dlca", &s.snapshot())
             .context("writing a checkpoint")
     };
     let mut animation = if cli.animate {
@@ -330,8 +304,8 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             .unwrap_or(dlca::picture::ANIMATION_DEFAULT_SIDE);
         Some(dlca::picture::Animation::start(
             &sim,
-            cli.seed,
-            &cli.out.join("dlca.gif"),
+            cli.run.seed,
+            &cli.run.out.join("dlca.gif"),
             side,
         )?)
     } else {
@@ -360,7 +334,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         }
         if !s.is_done() && guard.is_set() {
             let at = || format!("after sweep {} ({} clusters)", s.sweeps(), s.clusters());
-            sim_run::cli::checkpoints::honour(&guard, enabled, &cli.out, || save(s), at)
+            sim_run::cli::checkpoints::honour(&guard, enabled, &cli.run.out, || save(s), at)
                 .inspect_err(|_| progress.finish())?;
         }
     }
@@ -384,17 +358,20 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
         tracing::info!(frames, "dlca.gif");
     }
     // A checkpoint the run did not ask for (a timed one, or the one it was resumed from) goes.
-    sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.out, cli.checkpoint_every.is_some())
-        .context("removing checkpoint.bin")?;
+    sim_run::cli::checkpoints::remove_unasked_checkpoint(
+        &cli.run.out,
+        cli.checkpoint_every.is_some(),
+    )
+    .context("removing checkpoint.bin")?;
     let m = dlca::output::write_outputs(
         &sim,
-        cli.seed,
+        cli.run.seed,
         &clock,
-        &cli.out,
+        &cli.run.out,
         cli.png.then_some(cli.png_size),
         cli.positions.format(),
     )?;
-    if !cli.log.is_quiet() {
+    if !cli.run.log.is_quiet() {
         eprintln!(
             "dlca: {} clusters (largest {}) after {} sweeps in {:.2} s with {}; outputs in {}",
             sim.clusters(),
@@ -402,7 +379,7 @@ fn run(cli: &Cli, params: Params) -> anyhow::Result<()> {
             sim.sweeps(),
             m.wall_seconds,
             sim.strategy().name(),
-            cli.out.display()
+            cli.run.out.display()
         );
     }
     Ok(())

@@ -4,12 +4,13 @@
 
 use crate::checkpoint::{Checkpoint, Session, differences, honour, raise_after_saving};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
+use crate::declared::{read_config, set_keywords};
 use crate::figure::Animate;
 use crate::run::{Progress, interruptible_guarded};
 use ::animat::checkpoint::{CHECKPOINT_MODEL, Saved};
 use ::animat::output::{Animation, PopulationRow, SnapshotFrame, default_animate_every};
-use ::animat::params::{DEFAULT_STEPS, FLAGS, PARAMS, error_message};
-use ::animat::{GridBox, Params, World, WorldError};
+use ::animat::params::{DEFAULT_STEPS, PARAMS};
+use ::animat::{Params, World, WorldError};
 use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::exceptions::PyRuntimeError;
@@ -24,121 +25,46 @@ use std::sync::{Mutex, MutexGuard, TryLockError};
 mod world;
 pub use world::AnimatWorld;
 
-/// `--grid-box`: an int side, `"vision"` or `"none"`.
-fn grid_box(arg: &Bound<'_, PyAny>) -> PyResult<GridBox> {
-    if let Ok(s) = arg.cast::<PyString>() {
-        return s
-            .to_str()?
-            .parse::<GridBox>()
-            .map_err(|e| value_error(format!("--grid-box: {e}")));
-    }
-    Ok(GridBox::Side(arg.extract()?))
-}
+/// Declared parameters `aggsim.animat` and `aggsim.AnimatWorld` take as their own arguments:
+/// none, every model parameter is a keyword made from the declaration.
+pub const POSITIONAL: &[&str] = &[];
 
-/// The model's keyword arguments; `None` keeps the config file's value or the default.
-#[derive(Default)]
+/// The parameter of their signatures the declared keywords come before.
+pub const KEYWORDS_BEFORE: &str = "timing";
+
+/// The model's arguments: a config file, `density` and the declared keywords.
 struct Args<'a, 'py> {
+    /// The function's name, for errors about its keywords.
+    function: &'static str,
     config: Option<PathBuf>,
-    foxes: Option<Count>,
-    rabbits: Option<Count>,
-    start_radius: Option<i64>,
     density: Option<f64>,
-    vision: Option<i64>,
-    grid_box: Option<&'a Bound<'py, PyAny>>,
-    hungry_at: Option<Count>,
-    starve: Option<Count>,
-    fox_max_age: Option<Count>,
-    rabbit_max_age: Option<Count>,
-    fox_breed_p: Option<f64>,
-    rabbit_breed_p: Option<f64>,
-    prey_needed: Option<Count>,
-    crowd_max: Option<Count>,
-    crowd_radius: Option<i64>,
-    fox_rules: Option<Vec<String>>,
-    rabbit_rules: Option<Vec<String>>,
+    keywords: Option<&'a Bound<'py, PyDict>>,
 }
 
 impl Args<'_, '_> {
-    /// Defaults, then the config file, then the arguments (as the binary: defaults, config,
-    /// flags), validated; errors name the flag or the config file as the binary's do.
+    /// Defaults, then the config file, then the keywords (as the binary: defaults, config,
+    /// flags), then `density`, validated with the binary's messages.
     fn params(&self) -> PyResult<Params> {
-        let mut p = match &self.config {
-            Some(path) => ::animat::config::read_config(path).map_err(value_error)?,
-            None => Params::default(),
-        };
-        if let Some(v) = self.foxes.clone() {
-            p.foxes = count(PARAMS, "foxes", v)?;
+        let mut p = Params::default();
+        let mut density = None;
+        if let Some(path) = &self.config {
+            let (_, extras) = read_config(&mut p, path, &["density"])?;
+            density = extras.into_iter().map(|(_, d)| d).next_back();
         }
-        if let Some(v) = self.rabbits.clone() {
-            p.rabbits = count(PARAMS, "rabbits", v)?;
-        }
-        if self.start_radius.is_some() && self.density.is_some() {
+        let given = set_keywords(&mut p, PARAMS, self.function, POSITIONAL, self.keywords)?;
+        let radius_given = given.iter().any(|g| g == "start_radius");
+        if self.density.is_some() && radius_given {
             return Err(value_error(
                 "--start-radius cannot be used with --density (it sets the start radius)",
             ));
         }
-        if let Some(v) = self.start_radius {
-            p.start_radius = v;
-        }
-        if let Some(d) = self.density {
+        // A start radius given as an argument overrides the config file's density, as the
+        // flag does on the command line.
+        if let Some(d) = self.density.or(density.filter(|_| !radius_given)) {
             p.set_density(d).map_err(value_error)?;
         }
-        if let Some(v) = self.vision {
-            p.vision = v;
-        }
-        if let Some(g) = self.grid_box {
-            p.grid_box = grid_box(g)?;
-        }
-        let u32s = [
-            ("hungry_at", self.hungry_at.clone(), &mut p.hungry_at),
-            ("starve", self.starve.clone(), &mut p.starve),
-            ("fox_max_age", self.fox_max_age.clone(), &mut p.fox_max_age),
-            (
-                "rabbit_max_age",
-                self.rabbit_max_age.clone(),
-                &mut p.rabbit_max_age,
-            ),
-            ("prey_needed", self.prey_needed.clone(), &mut p.prey_needed),
-            ("crowd_max", self.crowd_max.clone(), &mut p.crowd_max),
-        ];
-        for (name, given, field) in u32s {
-            if let Some(v) = given {
-                *field = count(PARAMS, name, v)?;
-            }
-        }
-        if let Some(v) = self.fox_breed_p {
-            p.fox_breed_p = v;
-        }
-        if let Some(v) = self.rabbit_breed_p {
-            p.rabbit_breed_p = v;
-        }
-        if let Some(v) = self.crowd_radius {
-            p.crowd_radius = v;
-        }
-        if let Some(v) = &self.fox_rules {
-            p.fox_rules = v.clone();
-        }
-        if let Some(v) = &self.rabbit_rules {
-            p.rabbit_rules = v.clone();
-        }
-        p.validate().map_err(|e| self.message(&e))?;
+        p.validate().map_err(value_error)?;
         Ok(p)
-    }
-
-    /// The binary's wording of a parameter error: the flag if the value was given as one.
-    fn message(&self, e: &::animat::ParamsError) -> PyErr {
-        let by_flag = |name: &str| {
-            FLAGS.contains(&name)
-                && match name {
-                    "foxes" => self.foxes.is_some(),
-                    "rabbits" => self.rabbits.is_some(),
-                    "start_radius" => self.start_radius.is_some() || self.density.is_some(),
-                    "vision" => self.vision.is_some(),
-                    "grid_box" => self.grid_box.is_some(),
-                    _ => false,
-                }
-        };
-        value_error(error_message(e, by_flag, self.config.as_deref()))
     }
 }
 
@@ -159,7 +85,7 @@ impl Run {
         // Placing a large population takes a while: without the GIL.
         let world = py.detach(|| World::new(params, seed));
         let mut world = world.map_err(|e| match e {
-            WorldError::Params(e) => args.message(&e),
+            WorldError::Params(e) => value_error(e),
             other => value_error(other),
         })?;
         world.set_timing(timing);
@@ -459,13 +385,17 @@ impl AnimatResult {
 /// Run the predator-prey animat model and return an :class:`AnimatResult`.
 ///
 /// The model and every parameter are those of the ``animat`` binary (``animat --help`` and
-/// its config file, data/animat-default.toml), keyword names being its flags and config keys;
-/// a parameter left None takes the config file's value (``config``) or the default, from the
-/// library (see :func:`aggsim.defaults`). Foxes and rabbits live one per cell on the unbounded
+/// its config file, data/animat-default.toml), keyword names being its flags with dashes as
+/// underscores; a parameter not given takes the config file's value (``config``) or the
+/// default, from the library (see :func:`aggsim.defaults`). Foxes and rabbits live one per cell on the unbounded
 /// integer plane; every step each runs the first rule of its species' priority list whose
 /// condition holds (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 /// Performance Optimisation", section II.B). The run is a pure function of (parameters, seed):
 /// its ``state_hash`` is the binary's.
+///
+/// The model's parameters (``foxes``, ``vision``, ``fox_breed_p``, ...) are keyword arguments
+/// made from the library's declaration of them, listed last below;
+/// ``aggsim.defaults("animat")`` lists every default.
 ///
 /// Parameters
 /// ----------
@@ -474,31 +404,11 @@ impl AnimatResult {
 /// seed : int
 ///     Seed of every random stream (default 1).
 /// config : str or path or None
-///     A TOML file of model parameters, read as the binary's ``--config``; the arguments
-///     below override it.
-/// foxes, rabbits : int
-///     Start populations (default 300 and 2000).
-/// start_radius : int
-///     Radius of the start disc around the origin, in cells, 0..=1073741824 (default 60).
-/// density : float
-///     Start density in animats per cell, in (0, 0.5]: sets ``start_radius`` instead.
-/// vision : int
-///     Vision radius in cells, 1..=1073741824 (default 60, the paper's).
-/// grid_box : int or str
-///     Grid-box side, ``"vision"`` (default) or ``"none"`` (exhaustive search): speed only.
-/// hungry_at, starve, fox_max_age, rabbit_max_age : int
-///     A fox is hungry at this hunger (0..=``starve``) and starves above ``starve``
-///     (1..=4294967295); each species dies older than its maximum age (1..=4294967295).
-/// fox_breed_p, rabbit_breed_p : float
-///     Probabilities that a breed rule whose condition holds produces an animat, in [0, 1].
-/// prey_needed : int
-///     Rabbits within vision a fox needs to breed, 0..=4294967295.
-/// crowd_max, crowd_radius : int
-///     More than ``crowd_max`` (0..=4294967294) animats within ``crowd_radius``
-///     (1..=1073741824) forbid breeding.
-/// fox_rules, rabbit_rules : list of str
-///     Rule lists in priority order (fox: eat, breed, hunt, seek_mate, wander; rabbit: flee,
-///     breed, herd, wander).
+///     A TOML file of model parameters (keys as in data/animat-default.toml, dashes or
+///     underscores), read as the binary's ``--config``; the arguments override it.
+/// density : float or None
+///     Start density in animats per cell, in (0, 0.5]: sets ``start_radius`` to
+///     ceil(sqrt(animats / (pi density))) (default None: the start radius is given).
 /// timing : bool
 ///     Record the perception queries' seconds and distance evaluations per step (default
 ///     False).
@@ -534,8 +444,6 @@ impl AnimatResult {
 ///     Seconds of wall time between checkpoints, > 0 (default 300, the binaries'
 ///     ``--checkpoint-interval``); None: checkpoints only when the run is stopped.
 ///
-/// ``aggsim.defaults("animat")`` lists every default.
-///
 /// Returns
 /// -------
 /// AnimatResult
@@ -559,23 +467,7 @@ impl AnimatResult {
     seed = 1,
     *,
     config = None,
-    foxes = None,
-    rabbits = None,
-    start_radius = None,
     density = None,
-    vision = None,
-    grid_box = None,
-    hungry_at = None,
-    starve = None,
-    fox_max_age = None,
-    rabbit_max_age = None,
-    fox_breed_p = None,
-    rabbit_breed_p = None,
-    prey_needed = None,
-    crowd_max = None,
-    crowd_radius = None,
-    fox_rules = None,
-    rabbit_rules = None,
     timing = false,
     progress = None,
     animate = None,
@@ -584,6 +476,7 @@ impl AnimatResult {
     frame_radius = None,
     checkpoint = None,
     checkpoint_interval = Some(crate::checkpoint::DEFAULT_INTERVAL),
+    **params,
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn animat(
@@ -591,23 +484,7 @@ pub fn animat(
     steps: Count,
     seed: u64,
     config: Option<PathBuf>,
-    foxes: Option<Count>,
-    rabbits: Option<Count>,
-    start_radius: Option<i64>,
     density: Option<f64>,
-    vision: Option<i64>,
-    grid_box: Option<&Bound<'_, PyAny>>,
-    hungry_at: Option<Count>,
-    starve: Option<Count>,
-    fox_max_age: Option<Count>,
-    rabbit_max_age: Option<Count>,
-    fox_breed_p: Option<f64>,
-    rabbit_breed_p: Option<f64>,
-    prey_needed: Option<Count>,
-    crowd_max: Option<Count>,
-    crowd_radius: Option<i64>,
-    fox_rules: Option<Vec<String>>,
-    rabbit_rules: Option<Vec<String>>,
     timing: bool,
     progress: Option<&Bound<'_, PyAny>>,
     animate: Option<PathBuf>,
@@ -616,6 +493,7 @@ pub fn animat(
     frame_radius: Option<Count>,
     checkpoint: Option<PathBuf>,
     checkpoint_interval: Option<f64>,
+    params: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Py<AnimatResult>> {
     let steps = count(&[], "steps", steps)?;
     let checkpoint = Checkpoint::from_args(checkpoint, checkpoint_interval)?;
@@ -629,24 +507,10 @@ pub fn animat(
         ));
     }
     let args = Args {
+        function: "animat",
         config,
-        foxes,
-        rabbits,
-        start_radius,
         density,
-        vision,
-        grid_box,
-        hungry_at,
-        starve,
-        fox_max_age,
-        rabbit_max_age,
-        fox_breed_p,
-        rabbit_breed_p,
-        prey_needed,
-        crowd_max,
-        crowd_radius,
-        fox_rules,
-        rabbit_rules,
+        keywords: params,
     };
     let animate = animate.as_ref().map(|a| (a, frame_radius));
     let Some(ck) = checkpoint else {
@@ -672,11 +536,9 @@ pub fn animat(
     Ok(out)
 }
 
-/// The `animat` binary's defaults, from the library's parameter table (`density`: none, the
-/// start radius is the default's).
+/// The `animat` binary's defaults, from the library's parameter declaration.
 pub fn defaults_dict(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
     let mut o = ::animat::params::defaults();
-    o.remove("density");
     o.insert("steps".into(), DEFAULT_STEPS.into());
     o.insert("seed".into(), 1.into());
     o.insert("timing".into(), false.into());

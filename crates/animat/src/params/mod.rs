@@ -5,6 +5,7 @@
 //! `docs/animat.md`; `data/animat-default.toml` spells the same values out. A config file may
 //! set any subset of the fields; unknown keys are rejected.
 
+use core_lattice::spec::{DeclaredParams, End, Input, Kind, ParamValue, Range, RangeError};
 use serde::{Deserialize, Serialize};
 use spatial::plane::BoxSize;
 use std::fmt;
@@ -218,29 +219,42 @@ impl<'de> Deserialize<'de> for GridBox {
     }
 }
 
+/// `--grid-box` as the declarations read it: the text `none`, `vision` or a side.
+impl ParamValue for GridBox {
+    const KIND: Kind = Kind::Text;
+    const PYTHON: &'static str = "GridBox";
+    fn from_input(v: &Input) -> Result<Self, String> {
+        match v {
+            Input::Text(s) | Input::Choice(s) => s.parse(),
+            Input::Count(n) => i64::try_from(*n)
+                .map(GridBox::Side)
+                .map_err(|_| format!("grid box {n} is too large")),
+            other => Err(format!(
+                "expected `none`, `vision` or a positive integer, not {other:?}"
+            )),
+        }
+    }
+    fn parse_text(s: &str) -> Result<Self, String> {
+        s.parse()
+    }
+    /// A side from 1 to [`MAX_RADIUS`]; the names always.
+    fn in_range(&self, _: &Range) -> bool {
+        match *self {
+            GridBox::Side(a) => (1..=MAX_RADIUS).contains(&a),
+            GridBox::Vision | GridBox::None => true,
+        }
+    }
+    fn show(&self) -> String {
+        self.to_string()
+    }
+}
+
 /// Bad parameters: each names the offending value and the accepted range.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParamsError {
-    /// A probability outside `[0, 1]` (or NaN).
-    #[error("{name} = {value} is outside the accepted range [0, 1]")]
-    Probability {
-        /// Field name.
-        name: &'static str,
-        /// Value given.
-        value: f64,
-    },
-    /// An integer outside its accepted range.
-    #[error("{name} = {value} is outside the accepted range {min}..={max}")]
-    Range {
-        /// Field name.
-        name: &'static str,
-        /// Value given.
-        value: i128,
-        /// Smallest accepted value.
-        min: i128,
-        /// Largest accepted value.
-        max: i128,
-    },
+    /// A value outside its declared range, named by its flag.
+    #[error(transparent)]
+    Range(#[from] RangeError),
     /// A rule name that is not a rule of that species.
     #[error("unknown {species} rule {name:?}; accepted: {accepted}")]
     UnknownRule {
@@ -324,95 +338,83 @@ pub const ANIMAT_BYTES: u64 = 256;
 /// the step's scratch); see [`Params::peak_memory_bytes`].
 pub const PEAK_FIXED_BYTES: u64 = 8 << 20;
 
-/// Every parameter of the model (`docs/animat.md`, "Parameters and defaults"). Build one (or
-/// start from
-/// [`Params::default`]), call [`Params::validate`] (the [`World`](crate::World) does), run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Params {
-    /// Foxes at the start (`--foxes`).
-    pub foxes: u64,
-    /// Rabbits at the start (`--rabbits`).
-    pub rabbits: u64,
-    /// Radius of the disc around the origin in which the start population is placed, on
-    /// distinct cells drawn uniformly (`--start-radius`, or `--density`).
-    pub start_radius: i64,
-    /// Vision radius V, Euclidean, in cells (`--vision`; the paper's 60).
-    pub vision: i64,
-    /// Grid-box side (`--grid-box`): a positive integer, `"vision"` (the default: V) or
-    /// `"none"` (exhaustive search). Every setting gives the same trajectory.
-    pub grid_box: GridBox,
-    /// A fox is hungry when its hunger (steps since it last ate) is at least this.
-    pub hungry_at: u32,
-    /// A fox whose hunger exceeds this dies of starvation.
-    pub starve: u32,
-    /// A fox older than this dies.
-    pub fox_max_age: u32,
-    /// A rabbit older than this dies.
-    pub rabbit_max_age: u32,
-    /// Probability that the fox `breed` rule, once its condition holds, produces a fox.
-    pub fox_breed_p: f64,
-    /// Probability that the rabbit `breed` rule, once its condition holds, produces a rabbit.
-    pub rabbit_breed_p: f64,
-    /// Rabbits needed within vision for a fox to breed.
-    pub prey_needed: u32,
-    /// Overcrowding: more than this many animats (either species, the breeder excluded)
-    /// within `crowd_radius` forbid breeding.
-    pub crowd_max: u32,
-    /// Radius of the overcrowding count, Euclidean, in cells.
-    pub crowd_radius: i64,
-    /// Fox rules in priority order (names: eat, breed, hunt, seek_mate, wander).
-    pub fox_rules: Vec<String>,
-    /// Rabbit rules in priority order (names: flee, breed, herd, wander).
-    pub rabbit_rules: Vec<String>,
-}
+/// Largest accepted radius, as a range bound.
+const R: i128 = MAX_RADIUS as i128;
 
-impl Default for Params {
-    /// The documented defaults (docs/animat.md, "Defaults and the experiment behind them").
-    fn default() -> Self {
-        Params {
-            foxes: 300,
-            rabbits: 2000,
-            start_radius: 60,
-            vision: 60,
-            grid_box: GridBox::Vision,
-            hungry_at: 10,
-            starve: 30,
-            fox_max_age: 400,
-            rabbit_max_age: 200,
-            fox_breed_p: 0.02,
-            rabbit_breed_p: 0.1,
-            prey_needed: 10,
-            crowd_max: 4,
-            crowd_radius: 2,
-            fox_rules: FoxRule::ALL.iter().map(|r| r.name().to_string()).collect(),
-            rabbit_rules: RabbitRule::ALL
-                .iter()
-                .map(|r| r.name().to_string())
-                .collect(),
-        }
+/// Largest `u32`, as a range bound.
+const U32: i128 = u32::MAX as i128;
+
+const fn int(min: i128, max: i128) -> Range {
+    Range::Int {
+        min,
+        max: Some(max),
     }
 }
 
-fn check_prob(name: &'static str, value: f64) -> Result<(), ParamsError> {
-    if (0.0..=1.0).contains(&value) {
-        Ok(())
-    } else {
-        Err(ParamsError::Probability { name, value })
+core_lattice::declare_params! {
+    /// Every parameter of the model (`docs/animat.md`, "Parameters and defaults"), declared
+    /// once: the `animat` binary's flags and config keys, the Python keyword arguments, the
+    /// stubs and the docs' table are made from this list. Build one (or start from
+    /// [`Params::default`]), call [`Params::validate`] (the [`World`](crate::World) does), run.
+    #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+    #[serde(deny_unknown_fields, default)]
+    pub struct Params {
+        /// Foxes at the start.
+        foxes: u64 = 300 => { flag: "foxes", unit: "foxes", range: Range::Any },
+        /// Rabbits at the start.
+        rabbits: u64 = 2000 => { flag: "rabbits", unit: "rabbits", range: Range::Any },
+        /// Radius of the start disc around the origin (its cells at least twice the animats).
+        /// The start population is placed on distinct cells drawn uniformly in it; --density
+        /// sets it from a density instead.
+        start_radius: i64 = 60 => {
+            flag: "start-radius", unit: "cells", range: int(0, R),
+            why: "coordinates stay far inside 64-bit integers",
+        },
+        /// Vision radius, Euclidean. The paper's is 60.
+        vision: i64 = 60 => {
+            flag: "vision", unit: "cells", range: int(1, R),
+            why: "squared radii stay far inside 64-bit integers",
+        },
+        /// Grid-box side: speed only, every setting gives the same trajectory. A positive
+        /// integer, `vision` (boxes of the vision radius, the paper's choice) or `none` (the
+        /// exhaustive search without boxes).
+        grid_box: GridBox = GridBox::Vision => {
+            flag: "grid-box", unit: "cells",
+            range: Range::Text("a positive integer up to 1073741824, `vision` or `none`"),
+        },
+        /// A fox is hungry when its hunger (steps since it last ate) is at least this.
+        hungry_at: u32 = 10 => { flag: "hungry-at", unit: "steps", range: Range::Text("0..=`starve`") },
+        /// A fox whose hunger exceeds this dies of starvation.
+        starve: u32 = 30 => { flag: "starve", unit: "steps", range: int(1, U32) },
+        /// A fox older than this dies.
+        fox_max_age: u32 = 400 => { flag: "fox-max-age", unit: "steps", range: int(1, U32) },
+        /// A rabbit older than this dies.
+        rabbit_max_age: u32 = 200 => { flag: "rabbit-max-age", unit: "steps", range: int(1, U32) },
+        /// Probability that the fox breed rule, once its condition holds, produces a fox.
+        fox_breed_p: f64 = 0.02 => {
+            flag: "fox-breed-p", unit: "", range: Range::Real(End::Closed(0.0), End::Closed(1.0)),
+        },
+        /// Probability that the rabbit breed rule, once its condition holds, produces a rabbit.
+        rabbit_breed_p: f64 = 0.1 => {
+            flag: "rabbit-breed-p", unit: "", range: Range::Real(End::Closed(0.0), End::Closed(1.0)),
+        },
+        /// Rabbits needed within vision for a fox to breed.
+        prey_needed: u32 = 10 => { flag: "prey-needed", unit: "rabbits", range: int(0, U32) },
+        /// More than this many animats within crowd_radius forbid breeding. Either species
+        /// counts, the breeder excluded.
+        crowd_max: u32 = 4 => { flag: "crowd-max", unit: "animats", range: int(0, U32 - 1) },
+        /// Radius of the overcrowding count, Euclidean.
+        crowd_radius: i64 = 2 => { flag: "crowd-radius", unit: "cells", range: int(1, R) },
+        /// Fox rules in priority order, each at most once.
+        fox_rules: Vec<String> = FoxRule::ALL.iter().map(|r| r.name().to_string()).collect() => {
+            flag: "fox-rules", unit: "", range: Range::Choices(&FoxRule::NAMES),
+        },
+        /// Rabbit rules in priority order, each at most once.
+        rabbit_rules: Vec<String> = RabbitRule::ALL.iter().map(|r| r.name().to_string()).collect() => {
+            flag: "rabbit-rules", unit: "", range: Range::Choices(&RabbitRule::NAMES),
+        },
     }
-}
-
-fn check_range(name: &'static str, value: i128, min: i128, max: i128) -> Result<(), ParamsError> {
-    if (min..=max).contains(&value) {
-        Ok(())
-    } else {
-        Err(ParamsError::Range {
-            name,
-            value,
-            min,
-            max,
-        })
-    }
+    internal {}
 }
 
 /// The names of `all` rules, comma separated.
@@ -484,29 +486,7 @@ impl Params {
     /// # Errors
     /// The first offending value, as a [`ParamsError`] naming it and its accepted range.
     pub fn validate(&self) -> Result<(), ParamsError> {
-        let m = i128::from(MAX_RADIUS);
-        check_range("vision", self.vision.into(), 1, m)?;
-        if let GridBox::Side(a) = self.grid_box {
-            check_range("grid_box", a.into(), 1, m)?;
-        }
-        check_range("start_radius", self.start_radius.into(), 0, m)?;
-        check_range("crowd_radius", self.crowd_radius.into(), 1, m)?;
-        check_range("starve", self.starve.into(), 1, u32::MAX.into())?;
-        check_range("fox_max_age", self.fox_max_age.into(), 1, u32::MAX.into())?;
-        check_range(
-            "rabbit_max_age",
-            self.rabbit_max_age.into(),
-            1,
-            u32::MAX.into(),
-        )?;
-        check_range(
-            "crowd_max",
-            self.crowd_max.into(),
-            0,
-            i128::from(u32::MAX) - 1,
-        )?;
-        check_prob("fox_breed_p", self.fox_breed_p)?;
-        check_prob("rabbit_breed_p", self.rabbit_breed_p)?;
+        self.check_ranges()?;
         self.fox_rule_list()?;
         self.rabbit_rule_list()?;
         // An empty list is accepted for a species with no animats (a hand-built scene).
@@ -597,40 +577,6 @@ impl Params {
             ));
         }
         Ok(())
-    }
-}
-
-/// The parameters the `animat` command line sets with a flag of their own (`--foxes`,
-/// `--rabbits`, `--start-radius`, `--vision`, `--grid-box`); the others come from a config
-/// file.
-pub const FLAGS: [&str; 5] = ["foxes", "rabbits", "start_radius", "vision", "grid_box"];
-
-/// The message of a parameter error, naming where the value came from: a flag
-/// (`--vision 0 is outside ...`) when `by_flag(name)` says the value was given as one (see
-/// [`FLAGS`]; `start_radius` also by `--density`), else the config file `config` if any
-/// (`config FILE: vision = 0 is outside ...`). The `animat` binary and the Python bindings
-/// word their errors with this.
-pub fn error_message(
-    e: &ParamsError,
-    by_flag: impl Fn(&str) -> bool,
-    config: Option<&std::path::Path>,
-) -> String {
-    let text = e.to_string();
-    match e {
-        ParamsError::Range { name, .. } if by_flag(name) => text.replacen(
-            &format!("{name} = "),
-            &format!("--{} ", name.replace('_', "-")),
-            1,
-        ),
-        ParamsError::StartTooDense { .. } | ParamsError::TooManyAnimats { .. }
-            if config.is_none() =>
-        {
-            text
-        }
-        _ => match config {
-            Some(path) => format!("config {}: {text}", path.display()),
-            None => text,
-        },
     }
 }
 

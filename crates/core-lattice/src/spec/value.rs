@@ -1,5 +1,5 @@
-//! [`ParamValue`] for the types of declared parameters: reals, whole numbers, switches and
-//! `Option`s of them (a parameter that may be left unset, `none` as text).
+//! [`ParamValue`] for the types of declared parameters: reals, whole numbers, switches,
+//! lists of names and `Option`s of them (a parameter that may be left unset, `none` as text).
 
 use super::declare::{Input, Kind, ParamValue};
 use super::{End, Range, show_number};
@@ -82,7 +82,9 @@ macro_rules! whole_number {
         }
     )*};
 }
-whole_number!(u32, u64, usize);
+// `i64` for the parameters a model stores signed (radii it subtracts from coordinates); the
+// front ends still read them as non-negative counts.
+whole_number!(u32, u64, usize, i64);
 
 impl ParamValue for bool {
     const KIND: Kind = Kind::Switch;
@@ -128,5 +130,31 @@ impl<T: ParamValue> ParamValue for Option<T> {
     fn show(&self) -> String {
         self.as_ref()
             .map_or_else(|| "none".into(), ParamValue::show)
+    }
+}
+
+/// A list of names (`eat,breed,wander`): each item is one of the declaration's
+/// [`Range::Choices`], which the model's validation checks (with its own message for an unknown
+/// or repeated name); the empty text is the empty list.
+impl ParamValue for Vec<String> {
+    const KIND: Kind = Kind::List;
+    const PYTHON: &'static str = "Sequence[str]";
+    fn from_input(v: &Input) -> Result<Self, String> {
+        match v {
+            Input::Text(s) => Self::parse_text(s),
+            other => Err(format!("expected names separated by commas, not {other:?}")),
+        }
+    }
+    fn parse_text(s: &str) -> Result<Self, String> {
+        if s.trim().is_empty() {
+            return Ok(Vec::new());
+        }
+        Ok(s.split(',').map(|x| x.trim().to_string()).collect())
+    }
+    fn in_range(&self, _: &Range) -> bool {
+        true
+    }
+    fn show(&self) -> String {
+        self.join(",")
     }
 }
