@@ -380,8 +380,7 @@ pub fn write_png(
         log_y: true,
         series,
     };
-    sim_run::plot::write_png(&chart, path).map_err(|e| std::io::Error::other(e.to_string()))?;
-    Ok(())
+    crate::output::write_chart(&chart, path)
 }
 
 #[cfg(test)]

@@ -400,8 +400,7 @@ pub fn write_png(
         "density; surviving trees (fraction)",
         series,
     );
-    sim_run::plot::write_png(&chart, path).map_err(|e| std::io::Error::other(e.to_string()))?;
-    Ok(())
+    crate::output::write_chart(&chart, path)
 }
 
 #[cfg(test)]

@@ -103,25 +103,54 @@ struct ParamsBeforeVariants {
     near_cache: bool,
 }
 
+/// A `$To` struct literal holding the fields [`Params`] and [`ParamsBeforeVariants`] share,
+/// copied from `$p`, then the fields `$rest` (those only `$To` has): the one list of the
+/// shared fields, for the conversions both ways.
+macro_rules! shared_params {
+    ($To:ident from $p:expr, $($rest:tt)*) => {{
+        let p = $p;
+        $To {
+            dim: p.dim,
+            particles: p.particles,
+            birth_gap: p.birth_gap,
+            far_field: p.far_field,
+            death_ratio: p.death_ratio,
+            step_min: p.step_min,
+            precision: p.precision,
+            threads: p.threads,
+            serial_until: p.serial_until,
+            fit_from: p.fit_from,
+            keep_positions: p.keep_positions,
+            leaf_side: p.leaf_side,
+            distance_map: p.distance_map,
+            near_cache: p.near_cache,
+            $($rest)*
+        }
+    }};
+}
+
+impl<P> Snapshot<P> {
+    /// The same snapshot with its parameters converted by `f`.
+    fn map_params<Q>(self, f: impl FnOnce(P) -> Q) -> Snapshot<Q> {
+        Snapshot {
+            params: f(self.params),
+            seed: self.seed,
+            rng: self.rng,
+            pdla_rounds: self.pdla_rounds,
+            n: self.n,
+            state_hash: self.state_hash,
+            samples: self.samples,
+            next_sample: self.next_sample,
+            last_off_schedule: self.last_off_schedule,
+            seconds: self.seconds,
+        }
+    }
+}
+
 impl From<Snapshot<ParamsBeforeVariants>> for Snapshot {
     fn from(s: Snapshot<ParamsBeforeVariants>) -> Self {
-        let p = s.params;
-        Snapshot {
-            params: TextParams(Params {
-                dim: p.dim,
-                particles: p.particles,
-                birth_gap: p.birth_gap,
-                far_field: p.far_field,
-                death_ratio: p.death_ratio,
-                step_min: p.step_min,
-                precision: p.precision,
-                threads: p.threads,
-                serial_until: p.serial_until,
-                fit_from: p.fit_from,
-                keep_positions: p.keep_positions,
-                leaf_side: p.leaf_side,
-                distance_map: p.distance_map,
-                near_cache: p.near_cache,
+        s.map_params(|p| {
+            TextParams(shared_params!(Params from p,
                 sticking_probability: 1.0,
                 substrate_width: 0.0,
                 drift: 0.0,
@@ -129,17 +158,8 @@ impl From<Snapshot<ParamsBeforeVariants>> for Snapshot {
                 seed_set: None,
                 noise_reduction: 1.0,
                 connectivity: false,
-            }),
-            seed: s.seed,
-            rng: s.rng,
-            pdla_rounds: s.pdla_rounds,
-            n: s.n,
-            state_hash: s.state_hash,
-            samples: s.samples,
-            next_sample: s.next_sample,
-            last_off_schedule: s.last_off_schedule,
-            seconds: s.seconds,
-        }
+            ))
+        })
     }
 }
 
@@ -372,35 +392,10 @@ mod tests {
 
     impl From<Snapshot> for Snapshot<ParamsBeforeVariants> {
         fn from(s: Snapshot) -> Self {
-            let p = s.params.0;
-            assert_eq!((p.sticking_probability, p.noise_reduction), (1.0, 1.0));
-            Snapshot {
-                params: ParamsBeforeVariants {
-                    dim: p.dim,
-                    particles: p.particles,
-                    birth_gap: p.birth_gap,
-                    far_field: p.far_field,
-                    death_ratio: p.death_ratio,
-                    step_min: p.step_min,
-                    precision: p.precision,
-                    threads: p.threads,
-                    serial_until: p.serial_until,
-                    fit_from: p.fit_from,
-                    keep_positions: p.keep_positions,
-                    leaf_side: p.leaf_side,
-                    distance_map: p.distance_map,
-                    near_cache: p.near_cache,
-                },
-                seed: s.seed,
-                rng: s.rng,
-                pdla_rounds: s.pdla_rounds,
-                n: s.n,
-                state_hash: s.state_hash,
-                samples: s.samples,
-                next_sample: s.next_sample,
-                last_off_schedule: s.last_off_schedule,
-                seconds: s.seconds,
-            }
+            s.map_params(|TextParams(p)| {
+                assert_eq!((p.sticking_probability, p.noise_reduction), (1.0, 1.0));
+                shared_params!(ParamsBeforeVariants from p,)
+            })
         }
     }
 

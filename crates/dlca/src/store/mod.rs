@@ -12,26 +12,31 @@
 //! all-pairs during a merge ([`Merged::to_all_pairs`]); [`Engine`] makes the switch.
 
 /// Inside an `impl ClusterStore`: the methods that query and move the clusters (`live`,
-/// `contains`, `len_of`, `try_move`), forwarded to the structure that holds them, `$e` (an
-/// expression of `$s`, the store), which has methods of the same names and signatures.
+/// `contains`, `len_of`, `try_move`), forwarded either to the structure that holds them, `$e`
+/// (an expression of `$s`, the store), which has methods of the same names and signatures
+/// (`forward_clusters!(s => s.inner)`), or, for [`Engine`], to the installed store
+/// (`forward_clusters!(each)`).
 macro_rules! forward_clusters {
     ($s:ident => $e:expr) => {
+        forward_clusters!(@methods ($s => $e));
+    };
+    (each) => {
+        forward_clusters!(@methods each);
+    };
+    (@methods $to:tt) => {
         #[inline]
         fn live(&self) -> &[ItemId] {
-            let $s = self;
-            $e.live()
+            forward_clusters!(@call self, $to, live())
         }
 
         #[inline]
         fn contains(&self, id: ItemId) -> bool {
-            let $s = self;
-            $e.contains(id)
+            forward_clusters!(@call self, $to, contains(id))
         }
 
         #[inline]
         fn len_of(&self, id: ItemId) -> usize {
-            let $s = self;
-            $e.len_of(id)
+            forward_clusters!(@call self, $to, len_of(id))
         }
 
         #[inline]
@@ -41,9 +46,15 @@ macro_rules! forward_clusters {
             dir: Direction,
             contacts: &mut Vec<ItemId>,
         ) -> Result<usize, Blocked> {
-            let $s = self;
-            $e.try_move(id, dir, contacts)
+            forward_clusters!(@call self, $to, try_move(id, dir, contacts))
         }
+    };
+    (@call $store:expr, ($s:ident => $e:expr), $method:ident($($arg:expr),*)) => {{
+        let $s = $store;
+        $e.$method($($arg),*)
+    }};
+    (@call $store:expr, each, $method:ident($($arg:expr),*)) => {
+        each!($store, s => s.$method($($arg),*))
     };
 }
 
@@ -110,30 +121,7 @@ impl ClusterStore for Engine {
         each!(self, s => s.grid_side())
     }
 
-    #[inline]
-    fn live(&self) -> &[ItemId] {
-        each!(self, s => s.live())
-    }
-
-    #[inline]
-    fn contains(&self, id: ItemId) -> bool {
-        each!(self, s => s.contains(id))
-    }
-
-    #[inline]
-    fn len_of(&self, id: ItemId) -> usize {
-        each!(self, s => s.len_of(id))
-    }
-
-    #[inline]
-    fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        contacts: &mut Vec<ItemId>,
-    ) -> Result<usize, Blocked> {
-        each!(self, s => s.try_move(id, dir, contacts))
-    }
+    forward_clusters!(each);
 
     /// Merges, then installs all-pairs in place of a store that has stopped paying.
     fn merge(&mut self, survivor: ItemId, others: &[ItemId], notes: &mut Vec<String>) -> Merged {
