@@ -45,7 +45,7 @@ fn check(bin: &str, arg: &str, origin: &str) {
 #[test]
 fn benchmark_workloads_pass_parameters_the_binaries_have() {
     for w in WORKLOADS {
-        for a in w.args {
+        for a in w.arg_list() {
             check(w.bin, a, w.name);
         }
     }
