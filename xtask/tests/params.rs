@@ -65,6 +65,11 @@ fn experiments_pass_parameters_the_binaries_have() {
             "scaling/accuracy/sweep.rs",
             include_str!("../src/scaling/accuracy/sweep.rs"),
         ),
+        (
+            "dla",
+            "scaling/accuracy/setting.rs",
+            include_str!("../src/scaling/accuracy/setting.rs"),
+        ),
         ("dla", "scale.rs", include_str!("../src/scale.rs")),
         (
             "dlca",
