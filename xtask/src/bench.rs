@@ -20,10 +20,18 @@ pub struct Workload {
     pub name: &'static str,
     /// Binary under `target/release`.
     pub bin: &'static str,
-    /// Arguments.
-    pub args: &'static [&'static str],
+    /// Arguments, separated by spaces (none contains one): the command line as a reader
+    /// would type it.
+    pub args: &'static str,
     /// What the rate counts.
     pub unit: &'static str,
+}
+
+impl Workload {
+    /// The arguments one by one, as a process takes them.
+    pub fn arg_list(&self) -> impl Iterator<Item = &'static str> {
+        self.args.split_whitespace()
+    }
 }
 
 /// The headline workloads, in the order they run.
@@ -31,163 +39,74 @@ pub const WORKLOADS: &[Workload] = &[
     Workload {
         name: "dla-2d-1e6-1thread",
         bin: "dla",
-        args: &[
-            "--dim",
-            "2",
-            "--particles",
-            "1000000",
-            "--threads",
-            "1",
-            "--seed",
-            "1",
-        ],
+        args: "--dim 2 --particles 1000000 --threads 1 --seed 1",
         unit: "particles per second",
     },
     Workload {
         name: "dla-2d-1e6-2threads",
         bin: "dla",
-        args: &[
-            "--dim",
-            "2",
-            "--particles",
-            "1000000",
-            "--threads",
-            "2",
-            "--seed",
-            "1",
-        ],
+        args: "--dim 2 --particles 1000000 --threads 2 --seed 1",
         unit: "particles per second",
     },
     Workload {
         name: "dla-3d-1e5",
         bin: "dla",
-        args: &["--dim", "3", "--particles", "100000", "--seed", "1"],
+        args: "--dim 3 --particles 100000 --seed 1",
         unit: "particles per second",
     },
     Workload {
         name: "dla-3d-1e6",
         bin: "dla",
-        args: &["--dim", "3", "--particles", "1000000", "--seed", "1"],
+        args: "--dim 3 --particles 1000000 --seed 1",
         unit: "particles per second",
     },
     // The 3D PDLA pair: the speed-up is the ratio of their wall times.
     Workload {
         name: "dla-3d-3e5-1thread",
         bin: "dla",
-        args: &[
-            "--dim",
-            "3",
-            "--particles",
-            "300000",
-            "--threads",
-            "1",
-            "--seed",
-            "21",
-        ],
+        args: "--dim 3 --particles 300000 --threads 1 --seed 21",
         unit: "particles per second",
     },
     Workload {
         name: "dla-3d-3e5-2threads",
         bin: "dla",
-        args: &[
-            "--dim",
-            "3",
-            "--particles",
-            "300000",
-            "--threads",
-            "2",
-            "--seed",
-            "21",
-        ],
+        args: "--dim 3 --particles 300000 --threads 2 --seed 21",
         unit: "particles per second",
     },
     Workload {
         name: "dlca-1024-50k-to-1",
         bin: "dlca",
-        args: &[
-            "--size",
-            "1024",
-            "--particles",
-            "50000",
-            "--target-clusters",
-            "1",
-            "--seed",
-            "1",
-        ],
+        args: "--size 1024 --particles 50000 --target-clusters 1 --seed 1",
         unit: "sweeps per second",
     },
     Workload {
         name: "dlca-1024x512-5pct-to-100",
         bin: "dlca",
-        args: &["--size", "1024x512", "--fill", "0.05", "--seed", "1"],
+        args: "--size 1024x512 --fill 0.05 --seed 1",
         unit: "sweeps per second",
     },
     Workload {
         name: "dlca-grid-1024x512-5pct-to-1",
         bin: "dlca",
-        args: &[
-            "--size",
-            "1024x512",
-            "--fill",
-            "0.05",
-            "--search",
-            "grid",
-            "--target-clusters",
-            "1",
-            "--seed",
-            "1",
-        ],
+        args: "--size 1024x512 --fill 0.05 --search grid --target-clusters 1 --seed 1",
         unit: "sweeps per second",
     },
     Workload {
         name: "dlca-lattice-1024x512-5pct-to-1",
         bin: "dlca",
-        args: &[
-            "--size",
-            "1024x512",
-            "--fill",
-            "0.05",
-            "--search",
-            "lattice",
-            "--target-clusters",
-            "1",
-            "--seed",
-            "1",
-        ],
+        args: "--size 1024x512 --fill 0.05 --search lattice --target-clusters 1 --seed 1",
         unit: "sweeps per second",
     },
     Workload {
         name: "animat-1e5-100steps",
         bin: "animat",
-        args: &[
-            "--foxes",
-            "13043",
-            "--rabbits",
-            "86957",
-            "--density",
-            "0.2",
-            "--steps",
-            "100",
-            "--seed",
-            "1",
-        ],
+        args: "--foxes 13043 --rabbits 86957 --density 0.2 --steps 100 --seed 1",
         unit: "animat-steps per second",
     },
     Workload {
         name: "animat-1e6-10steps",
         bin: "animat",
-        args: &[
-            "--foxes",
-            "130430",
-            "--rabbits",
-            "869570",
-            "--density",
-            "0.2",
-            "--steps",
-            "10",
-            "--seed",
-            "1",
-        ],
+        args: "--foxes 130430 --rabbits 869570 --density 0.2 --steps 10 --seed 1",
         unit: "animat-steps per second",
     },
 ];
@@ -342,13 +261,12 @@ fn animat_steps(path: &Path) -> Result<(f64, f64)> {
 pub fn measure(w: &Workload, bin_dir: &Path) -> Result<Measurement> {
     let out = tempfile::tempdir().context("creating a temporary output directory")?;
     let bin = bin_dir.join(w.bin);
-    let command = format!("target/release/{} {} -q --out DIR", w.bin, w.args.join(" "));
+    let command = format!("target/release/{} {} -q --out DIR", w.bin, w.args);
     eprintln!("==> {}: {command}", w.name);
     let threads = w
-        .args
-        .iter()
-        .position(|a| *a == "--threads")
-        .and_then(|i| w.args.get(i + 1))
+        .arg_list()
+        .skip_while(|a| *a != "--threads")
+        .nth(1)
         .and_then(|t| t.parse::<usize>().ok())
         .unwrap_or(1);
     let core_round_trip_ns = if threads > 1 {
@@ -361,7 +279,7 @@ pub fn measure(w: &Workload, bin_dir: &Path) -> Result<Measurement> {
     }
     let start = Instant::now();
     let output = Command::new(&bin)
-        .args(w.args)
+        .args(w.arg_list())
         .arg("-q")
         .arg("--out")
         .arg(out.path())

@@ -47,7 +47,7 @@ fn check(bin: &str, arg: &str, origin: &str) {
 #[test]
 fn benchmark_workloads_pass_parameters_the_binaries_have() {
     for w in WORKLOADS {
-        for a in w.args {
+        for a in w.arg_list() {
             check(w.bin, a, w.name);
         }
     }
@@ -66,6 +66,11 @@ fn experiments_pass_parameters_the_binaries_have() {
             "dla",
             "scaling/accuracy/sweep.rs",
             include_str!("../src/scaling/accuracy/sweep.rs"),
+        ),
+        (
+            "dla",
+            "scaling/accuracy/setting.rs",
+            include_str!("../src/scaling/accuracy/setting.rs"),
         ),
         ("dla", "scale.rs", include_str!("../src/scale.rs")),
         (

@@ -1,15 +1,29 @@
-//! Synthetic 2D point sets for tests, examples and benchmarks of the search structures.
+//! Synthetic 2D point sets for tests, examples and benchmarks of the search structures, and the
+//! grid-box sizes the plane grid is tested with ([`BOX_SIZES`]).
 //!
 //! Deterministic for a given seed (a SplitMix64 sequence), with no dependency on the models.
 //! [`branching_cluster`] imitates the *local* structure of an off-lattice DLA cluster (chains of
 //! touching unit discs that branch) cheaply; it is not a DLA cluster and has no DLA statistics.
 
 use crate::orthtree::Orthtree;
+use crate::plane::BoxSize;
 use std::f64::consts::{PI, TAU};
 
 /// The SplitMix64 generator of [`core_lattice::rng`], under the name the benchmarks, examples
 /// and tests of this crate use.
 pub use core_lattice::rng::SplitMix64 as SplitMix;
+
+/// The grid-box sizes the plane grid's unit and property tests sweep: no grid (the exhaustive
+/// baseline), the smallest sides (boxes of one, two and three cells, where most queries cross
+/// box boundaries), an odd side and the animat vision radius 60.
+pub const BOX_SIZES: [BoxSize; 6] = [
+    BoxSize::None,
+    BoxSize::Side(1),
+    BoxSize::Side(2),
+    BoxSize::Side(3),
+    BoxSize::Side(7),
+    BoxSize::Side(60),
+];
 
 /// A DLA-like branched cluster of `n` touching unit discs, in growth order: persistent
 /// self-avoiding walks from the origin and from random earlier particles, branching with

@@ -12,12 +12,14 @@
 //! windows are refused); radii include 0, 2 (the 8 adjacent cells), 81, the animat vision
 //! radius 60 (3600), random ones and `u64::MAX`.
 
+mod common;
+use common::{EXTREME, config};
+
 use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 
 use proptest::prelude::*;
 use proptest::sample::{Index, select};
-use proptest::test_runner::Config;
 use spatial::cells::near::{
     NEAR_HALF, NEAR_ROWS, NEAR_WINDOW_MIN, Near, RING_CLASSES, count_in, kind_bits, lowest_in,
     row_byte, row_cell,
@@ -28,28 +30,13 @@ use spatial::plane::{Pos, dist2};
 /// Independent model: cell -> (id, kind byte).
 type Model = BTreeMap<Pos, (u64, u8)>;
 
-fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
 fn coord() -> impl Strategy<Value = i64> {
     prop_oneof![
         6 => -12i64..=12,
         // On and next to tile and block boundaries, both signs.
         4 => (-3i64..=3, select(vec![8i64, 64]), -1i64..=1).prop_map(|(m, s, o)| m * s + o),
         3 => -200i64..=200,
-        1 => select(vec![
-            i64::MIN,
-            i64::MIN + 1,
-            i64::MAX,
-            i64::MAX - 1,
-            -(1i64 << 40),
-            1i64 << 40,
-        ]),
+        1 => select(EXTREME.to_vec()),
     ]
 }
 

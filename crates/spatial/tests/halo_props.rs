@@ -6,9 +6,11 @@
 //! report exactly the clusters face-adjacent to the mover, in increasing id; sizes, live ids
 //! and the clusters' sites must follow the model, whatever the box side (requested or tuned).
 
+mod common;
+use common::config;
+
 use core_lattice::{Direction, Lattice};
 use proptest::prelude::*;
-use proptest::test_runner::Config;
 use spatial::lattice::{HaloGrid, ItemId, SiteSets};
 use std::collections::BTreeSet;
 
@@ -58,16 +60,8 @@ fn touching(l: &Lattice, a: &BTreeSet<u64>, b: &BTreeSet<u64>) -> bool {
         .any(|&x| l.neighbours(x).any(|n| n != x && b.contains(&n)))
 }
 
-fn config() -> Config {
-    Config {
-        cases: 400,
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
 proptest! {
-    #![proptest_config(config())]
+    #![proptest_config(config(400))]
 
     #[test]
     fn halo_grid_matches_brute_force(case in case()) {

@@ -11,38 +11,24 @@
 //! exactly equal to an item's distance (and one less or more), the animat vision radius 60 and
 //! `u64::MAX`.
 
+mod common;
+use common::{EXTREME, config};
+
 use std::collections::BTreeMap;
 
 use proptest::prelude::*;
 use proptest::sample::{Index, select};
-use proptest::test_runner::Config;
 use spatial::plane::{BoxSize, PlaneError, PlaneGrid, Pos, dist2};
+use spatial::testdata::BOX_SIZES;
 
 type Kind = u8;
 
 /// Independent model: id -> (position, kind).
 type Model = BTreeMap<u64, (Pos, Kind)>;
 
-/// Proptest configuration: `cases` per property; no regression files are written (the
-/// failing input is printed instead).
-fn config(cases: u32) -> Config {
-    Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    }
-}
-
 fn box_size() -> impl Strategy<Value = BoxSize> {
     prop_oneof![
-        4 => select(vec![
-            BoxSize::None,
-            BoxSize::Side(1),
-            BoxSize::Side(2),
-            BoxSize::Side(3),
-            BoxSize::Side(7),
-            BoxSize::Side(60),
-        ]),
+        4 => select(BOX_SIZES.to_vec()),
         1 => (1i64..=100).prop_map(BoxSize::Side),
     ]
 }
@@ -55,18 +41,13 @@ fn coord() -> impl Strategy<Value = i64> {
         4 => (-4i64..=4, select(vec![1i64, 2, 3, 7, 60]), -1i64..=1)
             .prop_map(|(m, s, o)| m * s + o),
         3 => -150i64..=150,
-        // Far away and extreme.
-        1 => select(vec![
-            i64::MIN,
-            i64::MIN + 1,
-            i64::MAX,
-            i64::MAX - 1,
-            -(1i64 << 40),
-            1i64 << 40,
-            -(1i64 << 32),
-            1i64 << 32,
-            (1i64 << 32) - 1,
-        ]),
+        // Far away and extreme, and around 2^32, where a square overflows 64 bits.
+        1 => select(
+            EXTREME
+                .into_iter()
+                .chain([-(1i64 << 32), 1i64 << 32, (1i64 << 32) - 1])
+                .collect::<Vec<_>>(),
+        ),
         1 => any::<i64>(),
     ]
 }
@@ -451,8 +432,7 @@ proptest! {
         other in 1i64..=300,
         queries in prop::collection::vec(((-260i64..=260, -260i64..=260), select(vec![0u64, 2, 100, 3600, 14400, 90_000])), 1..12),
     ) {
-        let sizes = [BoxSize::None, BoxSize::Side(1), BoxSize::Side(2), BoxSize::Side(3),
-                     BoxSize::Side(7), BoxSize::Side(60), BoxSize::Side(other)];
+        let sizes: Vec<BoxSize> = BOX_SIZES.into_iter().chain([BoxSize::Side(other)]).collect();
         let mut grids: Vec<PlaneGrid<Kind>> = Vec::new();
         for &s in &sizes {
             let mut g = PlaneGrid::new(s)?;

@@ -16,29 +16,13 @@ pub const INSTRUCTION_WORKLOADS: &[Workload] = &[
     Workload {
         name: "dla-2d-1e6-instructions",
         bin: "dla",
-        args: &[
-            "--dim",
-            "2",
-            "--particles",
-            "1e6",
-            "--seed",
-            "1",
-            "--no-checkpoint",
-        ],
+        args: "--dim 2 --particles 1e6 --seed 1 --no-checkpoint",
         unit: "particles",
     },
     Workload {
         name: "dla-3d-1e6-instructions",
         bin: "dla",
-        args: &[
-            "--dim",
-            "3",
-            "--particles",
-            "1e6",
-            "--seed",
-            "1",
-            "--no-checkpoint",
-        ],
+        args: "--dim 3 --particles 1e6 --seed 1 --no-checkpoint",
         unit: "particles",
     },
 ];
@@ -80,8 +64,7 @@ pub fn count_instructions(w: &Workload, bin_dir: &Path) -> Result<InstructionCou
     let bin = bin_dir.join(w.bin);
     let command = format!(
         "valgrind --tool=cachegrind --cache-sim=no target/release/{} {} -qq --out DIR",
-        w.bin,
-        w.args.join(" ")
+        w.bin, w.args
     );
     eprintln!("==> {}: {command}", w.name);
     let output = Command::new("valgrind")
@@ -92,7 +75,7 @@ pub fn count_instructions(w: &Workload, bin_dir: &Path) -> Result<InstructionCou
             out.path().join("cachegrind.out").display()
         ))
         .arg(&bin)
-        .args(w.args)
+        .args(w.arg_list())
         .arg("-qq")
         .arg("--out")
         .arg(out.path().join("run"))

@@ -16,7 +16,7 @@ use crate::round::{ceil, floor};
 /// every skipped cell strictly nearer `p`, so the rounding of the distances cannot make `q`'s
 /// quantised value the lower one.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Beside<const D: usize> {
+pub struct Beside<const D: usize> {
     mid: [f64; D],
     w: [f64; D],
     /// A bound of `|c_0 - m_0|` over the cells an insert visits.

@@ -42,17 +42,25 @@
 //!   cell.
 //! - Memory: one byte per cell, `(2 H / c)^D` bytes for a map of half side `H`; for a 2D DLA
 //!   cluster of 1e6 particles (radius about 3 000 diameters, `c = 8`) about 0.7 MB.
+//!
+//! # Where things are
+//!
+//! The dense map, [`DistanceMap`], is in `dense`; the sparse one, [`SparseDistanceMap`], in
+//! `sparse`. What they share is written once: the cells' geometry, tables and row ranges in
+//! `grid`, the half-space an insert beside a touched point keeps to in `beside`, and the bound
+//! and the inserts as provided methods of [`PointMap`], over the storage each map supplies.
 
-use crate::round::{ceil, floor};
-use std::fmt;
+use std::sync::atomic::AtomicU8;
 
 mod beside;
+mod dense;
+mod grid;
 mod sparse;
 use beside::Beside;
+pub use dense::DistanceMap;
+use grid::Grid;
 use sealed::Cells;
 pub use sparse::{SparseDistanceMap, UNKNOWN};
-
-use std::sync::atomic::{AtomicU8, Ordering};
 
 /// Largest stored value: the cell is at least `cap` from every point.
 const CAPPED: u8 = u8::MAX;
@@ -99,14 +107,20 @@ pub enum DistanceMapError {
 /// the map's own methods cost. Sealed: only the maps of this module implement it.
 pub trait PointMap<const D: usize>: Cells<D> {
     /// The cell side.
-    fn cell_side(&self) -> f64;
+    fn cell_side(&self) -> f64 {
+        self.grid().cell
+    }
 
     /// The cap distance: cells farther than this from every point only know "at least `cap`".
-    fn cap(&self) -> f64;
+    fn cap(&self) -> f64 {
+        self.grid().cap
+    }
 
     /// Points inserted through [`insert`](Self::insert) and
     /// [`insert_beside`](Self::insert_beside) (shared inserts are not counted).
-    fn len(&self) -> u64;
+    fn len(&self) -> u64 {
+        self.grid().points
+    }
 
     /// Whether no point has been counted by [`len`](Self::len).
     fn is_empty(&self) -> bool {
@@ -114,7 +128,9 @@ pub trait PointMap<const D: usize>: Cells<D> {
     }
 
     /// Half the side of the covered cube: positions with every `|x_i|` below this are inside.
-    fn reach(&self) -> f64;
+    fn reach(&self) -> f64 {
+        self.grid().reach()
+    }
 
     /// Heap bytes held.
     fn memory_bytes(&self) -> usize;
@@ -148,7 +164,7 @@ pub trait PointMap<const D: usize>: Cells<D> {
         let upper = if capped {
             f64::INFINITY
         } else {
-            (m + self.quantum() + e) * (1.0 + SHRINK) + 1e-12
+            (m + self.grid().quantum + e) * (1.0 + SHRINK) + 1e-12
         };
         Some((lower_from(m, e), upper, capped))
     }
@@ -186,31 +202,133 @@ pub trait PointMap<const D: usize>: Cells<D> {
     }
 }
 
-/// What [`PointMap`]'s provided methods are made of, private to this module.
+/// What [`PointMap`]'s provided methods are made of, private to this module: each map
+/// supplies its storage (reads, growth, the rows of cells an insert visits, how a cell is
+/// lowered); the inserts built on them are written once here.
 mod sealed {
-    use super::DistanceMapError;
+    use super::{
+        AtomicU8, Beside, DistanceMapError, Grid, finite_max_norm, finite_reach, next_row,
+    };
 
     pub trait Cells<const D: usize> {
+        /// The cells' geometry, tables and point count.
+        fn grid(&self) -> &Grid;
+
+        /// [`grid`](Self::grid), to count a point or record growth.
+        fn grid_mut(&mut self) -> &mut Grid;
+
         /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and
         /// its distance byte; `None` where the map has no answer.
         fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)>;
 
-        /// `cap / 255`, the distance one step of a stored byte stands for.
-        fn quantum(&self) -> f64;
+        /// Enlarges the map to cover `|x_i| < need` (by at least a quarter), keeping what
+        /// it holds.
+        fn grow(&mut self, need: f64) -> Result<(), DistanceMapError>;
 
-        /// Inserts `q`, beside the point `touched` if given (see `PointMap::insert_beside`).
+        /// What the map keeps from one row of an insert to the next (the sparse map's two
+        /// recent blocks).
+        type RowCache<'a>: Default
+        where
+            Self: 'a;
+
+        /// Calls `lower(cell, w)` for the cells `a..=b` (along axis 0) of the row at cell
+        /// indices `k[1..]`, at squared distance `s` from `q` along the other axes, with `w`
+        /// the value the map stores for the cell's quantised distance to `q`, whenever `w`
+        /// could improve on the stored value.
+        fn lower_row<'a>(
+            &'a self,
+            q: &[f64; D],
+            s: f64,
+            k: &[i64; D],
+            ab: (i64, i64),
+            lower: &mut impl FnMut(&AtomicU8, u8),
+            cache: &mut Self::RowCache<'a>,
+        );
+
+        /// The `lower` of an exclusive insert: stores `w` if it is nearer than the cell's
+        /// value (plain loads and stores, which relaxed atomics compile to).
+        fn keep_nearer(v: &AtomicU8, w: u8);
+
+        /// The `lower` of a shared insert: the same through an atomic read-modify-write, so
+        /// that concurrent inserts never undo each other.
+        fn keep_nearer_shared(v: &AtomicU8, w: u8);
+
+        /// Makes room for the cells one insert may write (the sparse map's chunk slots);
+        /// nothing for a map whose cells all exist.
+        fn make_room(&mut self) {}
+
+        /// Grows the map (if needed) so that it covers `|x_i| < reach`.
+        fn cover(&mut self, reach: f64) -> Result<(), DistanceMapError> {
+            if finite_reach(reach)? >= self.grid().reach() {
+                self.grow(reach)?;
+            }
+            Ok(())
+        }
+
+        /// Calls `lower(cell, w)` (see [`lower_row`](Self::lower_row)) for every cell of the
+        /// map whose centre lies within `cap` of `q`, and only in the half-space `side` if
+        /// given: an odometer over the rows (axes `1..D`), each row's range along axis 0
+        /// solved for.
+        #[inline]
+        fn lower_rows(
+            &self,
+            q: &[f64; D],
+            side: Option<&Beside<D>>,
+            mut lower: impl FnMut(&AtomicU8, u8),
+        ) {
+            let g = self.grid();
+            let Some((lo, hi)) = g.cells_near(q, q) else {
+                return;
+            };
+            let mut k = lo;
+            let (t0, kq) = g.row_origin(q);
+            let mut cache = Self::RowCache::default();
+            loop {
+                let (s, j2) = g.row_offset(q, &k, &kq);
+                if let Some(range) = g.row_range(q[0], s, t0, j2) {
+                    let (a, b) = g.clip_row(range, lo[0], hi[0], &k, side);
+                    if a <= b {
+                        self.lower_row(q, s, &k, (a, b), &mut lower, &mut cache);
+                    }
+                }
+                if !next_row(&mut k, &lo, &hi) {
+                    return;
+                }
+            }
+        }
+
+        /// Inserts `q`, beside the point `touched` if given (see `PointMap::insert_beside`),
+        /// growing the map first if `q` comes within `cap + c` of its edge.
         fn insert_with(
             &mut self,
             q: &[f64; D],
             touched: Option<&[f64; D]>,
-        ) -> Result<(), DistanceMapError>;
+        ) -> Result<(), DistanceMapError> {
+            let g = self.grid();
+            let side = touched.and_then(|p| Beside::new(q, p, g.cap, g.cell));
+            let need = finite_max_norm(q)? + g.cap + g.cell;
+            if need >= g.reach() {
+                self.grow(need)?;
+            }
+            self.make_room();
+            self.grid_mut().points += 1;
+            self.lower_rows(q, side.as_ref(), Self::keep_nearer);
+            Ok(())
+        }
 
-        /// Inserts `q` through a shared reference (see `PointMap::insert_shared_beside`).
+        /// Inserts `q` through a shared reference (see `PointMap::insert_shared_beside`);
+        /// `false` when part of its ball fell outside the map.
         fn insert_shared_with(
             &self,
             q: &[f64; D],
             touched: Option<&[f64; D]>,
-        ) -> Result<bool, DistanceMapError>;
+        ) -> Result<bool, DistanceMapError> {
+            let g = self.grid();
+            let side = touched.and_then(|p| Beside::new(q, p, g.cap, g.cell));
+            let inside = finite_max_norm(q)? + g.cap + g.cell < g.reach();
+            self.lower_rows(q, side.as_ref(), Self::keep_nearer_shared);
+            Ok(inside)
+        }
     }
 }
 
@@ -230,490 +348,6 @@ fn finite_reach(reach: f64) -> Result<f64, DistanceMapError> {
             axis: 0,
             value: reach,
         })
-    }
-}
-
-/// The coarse distance map (see the module docs).
-pub struct DistanceMap<const D: usize> {
-    cell: f64,
-    inv_cell: f64,
-    cap: f64,
-    quantum: f64,
-    inv_quantum: f64,
-    /// The map covers cells `k` in `[-half, half)` per axis, i.e. `|x| < half * cell`.
-    half: i64,
-    /// `2 * half`: cells per axis.
-    side: usize,
-    /// One byte per cell, axis 0 fastest. Atomic so that PDLA threads can share one map
-    /// ([`DistanceMap::insert_shared`]); relaxed loads and stores are plain moves.
-    values: Vec<AtomicU8>,
-    points: u64,
-    /// `below[v]`: a squared distance below which a cell holding `v` may be lowered,
-    /// `(v u)^2` widened by a relative `2^-40` (so rounding never skips a lowering).
-    below: Box<[f64; 256]>,
-    /// `widths[j]`: for a row of cells whose centres lie at a squared distance of at least
-    /// `j` squared cell sides from the inserted point along the other axes, half the length,
-    /// in cells, of the part of the row within `cap` of it, widened a little (so a row never
-    /// misses a cell). Empty when `(cap / cell)^2` exceeds [`WIDTHS_MAX`]; rows then solve
-    /// for their range exactly.
-    widths: Box<[f64]>,
-}
-
-/// Largest `(cap / cell)^2` for which [`DistanceMap`] tabulates its row widths.
-const WIDTHS_MAX: f64 = 4096.0;
-
-/// What a map with cells of side `cell` capped at `cap` derives from them (see [`tables`]).
-struct Tables {
-    /// `cap / 255`.
-    quantum: f64,
-    /// `below[v]`: the squared distance below which a cell holding `v` may be lowered,
-    /// `(v u)^2` widened by a relative [`SHRINK`].
-    below: Box<[f64; 256]>,
-    /// Row half-widths by squared distance in whole cells; empty when `(cap / cell)^2` exceeds
-    /// [`WIDTHS_MAX`].
-    widths: Box<[f64]>,
-}
-
-/// The [`Tables`] of a map with cells of side `cell` capped at `cap`, both checked.
-fn tables(cell: f64, cap: f64) -> Result<Tables, DistanceMapError> {
-    if !(cell.is_finite() && cell > 0.0) {
-        return Err(DistanceMapError::CellSide(cell));
-    }
-    if !(cap.is_finite() && cap > 0.0) {
-        return Err(DistanceMapError::Cap(cap));
-    }
-    let quantum = cap / f64::from(CAPPED);
-    let mut below = Box::new([0.0; 256]);
-    for (v, b) in below.iter_mut().enumerate() {
-        let d = v as f64 * quantum;
-        *b = d * d * (1.0 + SHRINK);
-    }
-    let r2 = (cap / cell) * (cap / cell);
-    let widths = if r2 <= WIDTHS_MAX {
-        (0..=r2 as usize)
-            .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
-            .collect()
-    } else {
-        Box::default()
-    };
-    Ok(Tables {
-        quantum,
-        below,
-        widths,
-    })
-}
-
-impl<const D: usize> Clone for DistanceMap<D> {
-    fn clone(&self) -> Self {
-        DistanceMap {
-            cell: self.cell,
-            inv_cell: self.inv_cell,
-            cap: self.cap,
-            quantum: self.quantum,
-            inv_quantum: self.inv_quantum,
-            half: self.half,
-            side: self.side,
-            values: self
-                .values
-                .iter()
-                .map(|v| AtomicU8::new(v.load(Ordering::Relaxed)))
-                .collect(),
-            points: self.points,
-            below: self.below.clone(),
-            widths: self.widths.clone(),
-        }
-    }
-}
-
-impl<const D: usize> fmt::Debug for DistanceMap<D> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("DistanceMap")
-            .field("cell", &self.cell)
-            .field("cap", &self.cap)
-            .field("cells_per_axis", &self.side)
-            .field("points", &self.points)
-            .finish()
-    }
-}
-
-impl<const D: usize> DistanceMap<D> {
-    /// An empty map with cell side `cell` and cap distance `cap` (both in the units of the
-    /// points). Nothing is allocated until the first insert.
-    pub fn new(cell: f64, cap: f64) -> Result<Self, DistanceMapError> {
-        let Tables {
-            quantum,
-            below,
-            widths,
-        } = tables(cell, cap)?;
-        Ok(DistanceMap {
-            below,
-            widths,
-            cell,
-            inv_cell: 1.0 / cell,
-            cap,
-            quantum,
-            inv_quantum: 1.0 / quantum,
-            half: 0,
-            side: 0,
-            values: Vec::new(),
-            points: 0,
-        })
-    }
-
-    /// The cell index of `p`, or `None` outside the map.
-    #[inline]
-    fn index(&self, p: &[f64; D]) -> Option<(usize, [f64; D])> {
-        let mut idx = 0usize;
-        let mut stride = 1usize;
-        let mut centre = [0.0; D];
-        for i in 0..D {
-            let k = floor(p[i] * self.inv_cell);
-            // The cube is `side = 2 half` cells a side; a signed integer converts to `f64` in
-            // one instruction, an unsigned one in several. NaN fails the test.
-            let half = self.half as f64;
-            if !(k >= -half && k < half) {
-                return None;
-            }
-            let j = k + half;
-            // j is a whole number in [0, side): through i64 the conversion is one instruction
-            // and a check, where a direct f64 -> usize conversion is a longer sequence.
-            idx += j as i64 as usize * stride;
-            stride *= self.side;
-            centre[i] = (k + 0.5) * self.cell;
-        }
-        Some((idx, centre))
-    }
-
-    /// Adds every point of the closed box `[lo, hi]` at once: lowers each cell to the
-    /// quantised distance from its centre to the box, which is at most the distance to any
-    /// point in it. A caller that has added a box need not add the points inside it later: the
-    /// map stays a lower bound, looser by at most the box's diagonal near it. Grows the map
-    /// first like [`insert`](Self::insert). `lo <= hi` on every axis.
-    pub fn insert_box(&mut self, lo: &[f64; D], hi: &[f64; D]) -> Result<(), DistanceMapError> {
-        let need = finite_max_norm(lo)?.max(finite_max_norm(hi)?) + self.cap + self.cell;
-        if need >= self.reach() {
-            self.grow(need)?;
-        }
-        self.points += 1;
-        self.lower_box_rows(lo, hi, |v, w| {
-            if w < v.load(Ordering::Relaxed) {
-                v.store(w, Ordering::Relaxed);
-            }
-        });
-        Ok(())
-    }
-
-    /// [`insert_box`](Self::insert_box) through a shared reference, as
-    /// [`insert_shared`](Self::insert_shared) is to [`insert`](Self::insert): atomic
-    /// `fetch_min`, no growth (cells outside the map are skipped; `false` then).
-    pub fn insert_box_shared(
-        &self,
-        lo: &[f64; D],
-        hi: &[f64; D],
-    ) -> Result<bool, DistanceMapError> {
-        let inside =
-            finite_max_norm(lo)?.max(finite_max_norm(hi)?) + self.cap + self.cell < self.reach();
-        self.lower_box_rows(lo, hi, |v, w| {
-            if w < v.load(Ordering::Relaxed) {
-                v.fetch_min(w, Ordering::Relaxed);
-            }
-        });
-        Ok(inside)
-    }
-
-    /// Lowers cell `v` to the squared distance `d2` (in length units) if that is below its
-    /// value, through `lower` (a plain or an atomic store); cells at or beyond the cap stay.
-    #[inline(always)]
-    fn lower_cell(&self, v: &AtomicU8, d2: f64, lower: &mut impl FnMut(&AtomicU8, u8)) {
-        // Most cells are already nearer another point: one table read and a compare, no
-        // square root.
-        if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
-            let d = d2.sqrt() * self.inv_quantum;
-            if d < f64::from(CAPPED) {
-                lower(v, d as u8);
-            }
-        }
-    }
-
-    /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of the
-    /// box `[blo, bhi]`, with `w` the quantised distance from the centre to the box, whenever
-    /// `w` could be below the stored value.
-    fn lower_box_rows(&self, blo: &[f64; D], bhi: &[f64; D], mut lower: impl FnMut(&AtomicU8, u8)) {
-        let mut lo = [0i64; D];
-        let mut hi = [0i64; D];
-        for i in 0..D {
-            lo[i] = (ceil((blo[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
-            hi[i] = (floor((bhi[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
-            if lo[i] > hi[i] {
-                return;
-            }
-        }
-        let cap2 = self.cap * self.cap;
-        // Distance along axis i from the centre of cell k to the box.
-        let gap = |i: usize, k: i64| {
-            let z = (k as f64 + 0.5) * self.cell;
-            (blo[i] - z).max(z - bhi[i]).max(0.0)
-        };
-        let mut k = lo;
-        loop {
-            let mut s = 0.0;
-            let mut base = 0usize;
-            let mut stride = self.side;
-            for i in 1..D {
-                let e = gap(i, k[i]);
-                s += e * e;
-                base += (k[i] + self.half) as usize * stride;
-                stride *= self.side;
-            }
-            if s < cap2 {
-                // Centres within sqrt(cap^2 - s) of the box along axis 0.
-                let w = (cap2 - s).sqrt();
-                let a = (ceil((blo[0] - w) * self.inv_cell - 0.5) as i64).max(lo[0]);
-                let b = (floor((bhi[0] + w) * self.inv_cell - 0.5) as i64).min(hi[0]);
-                if a <= b {
-                    let row = &self.values
-                        [base + (a + self.half) as usize..=base + (b + self.half) as usize];
-                    for (j, v) in row.iter().enumerate() {
-                        let e = gap(0, a + j as i64);
-                        self.lower_cell(v, e * e + s, &mut lower);
-                    }
-                }
-            }
-            if !next_row(&mut k, &lo, &hi) {
-                return;
-            }
-        }
-    }
-
-    /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of `q`,
-    /// with `w` the quantised distance from the centre to `q`, whenever `w` could be below the
-    /// stored value (`(w u)^2` under the table's threshold for that value).
-    #[inline]
-    fn lower_rows(
-        &self,
-        q: &[f64; D],
-        side: Option<&Beside<D>>,
-        mut lower: impl FnMut(&AtomicU8, u8),
-    ) {
-        // Cell ranges per axis: centres (k + 1/2) c within cap of q, clipped to the map.
-        let mut lo = [0i64; D];
-        let mut hi = [0i64; D];
-        for i in 0..D {
-            lo[i] = (ceil((q[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
-            hi[i] = (floor((q[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
-            if lo[i] > hi[i] {
-                return;
-            }
-        }
-        // Odometer over axes 1..D; axis 0 is a contiguous row whose range is solved for.
-        let mut k = lo;
-        let cap2 = self.cap * self.cap;
-        // q in units of cells, with the cells' centres at whole numbers, and the lower of the
-        // two centre indices around it on each axis: the centres of a row `j_i` whole cells
-        // beyond that pair on axis i are at least `j_i` cells from q along that axis.
-        let t0 = q[0] * self.inv_cell - 0.5;
-        let kq: [i64; D] = std::array::from_fn(|i| floor(q[i] * self.inv_cell - 0.5) as i64);
-        loop {
-            let mut s = 0.0;
-            let mut j2 = 0usize;
-            let mut base = 0usize;
-            let mut stride = self.side;
-            for i in 1..D {
-                let e = q[i] - (k[i] as f64 + 0.5) * self.cell;
-                s += e * e;
-                let j = if k[i] <= kq[i] {
-                    kq[i] - k[i]
-                } else {
-                    k[i] - kq[i] - 1
-                };
-                j2 += (j * j) as usize;
-                base += (k[i] + self.half) as usize * stride;
-                stride *= self.side;
-            }
-            // The row's range along axis 0: from the table of widths (no square root per
-            // row; a few cells more than the exact range, which the per-cell test rejects),
-            // or solved exactly when there is no table.
-            let range = if self.widths.is_empty() {
-                (s < cap2).then(|| {
-                    let w = (cap2 - s).sqrt();
-                    (
-                        ceil((q[0] - w) * self.inv_cell - 0.5),
-                        floor((q[0] + w) * self.inv_cell - 0.5),
-                    )
-                })
-            } else {
-                // `j2` is at most the row's squared distance from q in cells, so its width in
-                // the table is at least the exact one. It is integer arithmetic: the row's
-                // range does not wait for the floating-point distance (which only the
-                // per-cell test below uses), and the rows' set-up overlaps.
-                self.widths.get(j2).map(|&h| (ceil(t0 - h), floor(t0 + h)))
-            };
-            if let Some((a, b)) = range {
-                let a = (a as i64).max(lo[0]);
-                let b = (b as i64).min(hi[0]);
-                let (a, b) = match side {
-                    Some(side) => side.clip(&k, self.cell, self.inv_cell, a, b),
-                    None => (a, b),
-                };
-                if a <= b {
-                    let row = &self.values
-                        [base + (a + self.half) as usize..=base + (b + self.half) as usize];
-                    let x0 = (a as f64 + 0.5) * self.cell - q[0];
-                    for (j, v) in row.iter().enumerate() {
-                        // Rows are far shorter than 2^31 cells; i32 converts in one instruction.
-                        let x = x0 + f64::from(j as i32) * self.cell;
-                        self.lower_cell(v, x * x + s, &mut lower);
-                    }
-                }
-            }
-            // Next row.
-            if !next_row(&mut k, &lo, &hi) {
-                return;
-            }
-        }
-    }
-
-    /// Enlarges the map so that it covers `|x_i| < need` (by at least a quarter of its half
-    /// side), copying the old cells into the middle of the new ones. The caller guarantees
-    /// that every point inserted so far lies farther than `cap` from the new cells.
-    fn grow(&mut self, need: f64) -> Result<(), DistanceMapError> {
-        let cells = (need * self.inv_cell)
-            .ceil()
-            .max(self.half as f64 * 1.25)
-            .ceil();
-        let side = 2.0 * cells;
-        let total = side.powi(D as i32);
-        if !(side < f64::from(u32::MAX) && total < (isize::MAX as f64) / 2.0) {
-            return Err(DistanceMapError::TooLarge {
-                cells_per_axis: side,
-            });
-        }
-        let half = cells as i64;
-        let side = side as usize;
-        // Fallible, so a map that does not fit is an error rather than an abort.
-        let mut values: Vec<AtomicU8> = Vec::new();
-        values
-            .try_reserve_exact(total as usize)
-            .map_err(|_| DistanceMapError::Alloc {
-                bytes: total as u64,
-            })?;
-        values.extend((0..total as usize).map(|_| AtomicU8::new(CAPPED)));
-        if self.side > 0 {
-            let off = (half - self.half) as usize;
-            // Copy old rows (along axis 0) into the new array.
-            let rows = self.side.pow(D as u32 - 1);
-            for r in 0..rows {
-                let mut rem = r;
-                let mut base = off;
-                let mut stride = side;
-                for _ in 1..D {
-                    base += (rem % self.side + off) * stride;
-                    rem /= self.side;
-                    stride *= side;
-                }
-                for (new, old) in values[base..base + self.side]
-                    .iter_mut()
-                    .zip(&self.values[r * self.side..(r + 1) * self.side])
-                {
-                    *new.get_mut() = old.load(Ordering::Relaxed);
-                }
-            }
-        }
-        self.values = values;
-        self.half = half;
-        self.side = side;
-        Ok(())
-    }
-}
-
-impl<const D: usize> PointMap<D> for DistanceMap<D> {
-    fn cell_side(&self) -> f64 {
-        self.cell
-    }
-
-    fn cap(&self) -> f64 {
-        self.cap
-    }
-
-    fn len(&self) -> u64 {
-        self.points
-    }
-
-    fn reach(&self) -> f64 {
-        self.half as f64 * self.cell
-    }
-
-    /// Heap bytes held (one byte per cell, counting the vector's capacity).
-    fn memory_bytes(&self) -> usize {
-        self.values.capacity()
-    }
-
-    fn value(&self, p: &[f64; D]) -> Option<u8> {
-        self.index(p)
-            .map(|(i, _)| self.values[i].load(Ordering::Relaxed))
-    }
-
-    fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
-        if finite_reach(reach)? >= self.reach() {
-            self.grow(reach)?;
-        }
-        Ok(())
-    }
-}
-
-impl<const D: usize> Cells<D> for DistanceMap<D> {
-    /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and the
-    /// stored byte.
-    #[inline(always)]
-    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
-        let (idx, z) = self.index(p)?;
-        let v = self.values[idx].load(Ordering::Relaxed);
-        let mut e2 = 0.0;
-        for i in 0..D {
-            let e = p[i] - z[i];
-            e2 += e * e;
-        }
-        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
-    }
-
-    #[inline(always)]
-    fn quantum(&self) -> f64 {
-        self.quantum
-    }
-
-    fn insert_with(
-        &mut self,
-        q: &[f64; D],
-        touched: Option<&[f64; D]>,
-    ) -> Result<(), DistanceMapError> {
-        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
-        let need = finite_max_norm(q)? + self.cap + self.cell;
-        if need >= self.reach() {
-            self.grow(need)?;
-        }
-        self.points += 1;
-        // Exclusive access: plain loads and stores (relaxed atomics compile to plain moves).
-        self.lower_rows(q, side.as_ref(), |v, w| {
-            if w < v.load(Ordering::Relaxed) {
-                v.store(w, Ordering::Relaxed);
-            }
-        });
-        Ok(())
-    }
-
-    fn insert_shared_with(
-        &self,
-        q: &[f64; D],
-        touched: Option<&[f64; D]>,
-    ) -> Result<bool, DistanceMapError> {
-        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
-        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, side.as_ref(), |v, w| {
-            if w < v.load(Ordering::Relaxed) {
-                v.fetch_min(w, Ordering::Relaxed);
-            }
-        });
-        Ok(inside)
     }
 }
 

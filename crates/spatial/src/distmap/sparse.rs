@@ -49,11 +49,9 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::{
-    Beside, CAPPED, Cells, DistanceMapError, PointMap, Tables, finite_max_norm, finite_reach,
-    next_row, tables,
-};
-use crate::round::{ceil, floor};
+use super::grid::Grid;
+use super::{CAPPED, Cells, DistanceMapError, PointMap};
+use crate::round::floor;
 use std::fmt;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU8, AtomicU32, AtomicUsize, Ordering};
@@ -68,26 +66,32 @@ const CHUNK_BYTES: usize = 1 << 16;
 /// The two blocks an insert used last, by table index: consecutive rows of a point's ball
 /// mostly fall in the same one or two blocks. A published block never changes its entry, so
 /// they stay valid.
-struct Recent<'a> {
+pub struct Recent<'a> {
     at: [usize; 2],
     block: [&'a [AtomicU8]; 2],
 }
 
+impl Default for Recent<'_> {
+    /// No block yet.
+    fn default() -> Self {
+        Recent {
+            at: [usize::MAX; 2],
+            block: [&[]; 2],
+        }
+    }
+}
+
 /// The sparse fine distance map (see the module documentation).
 pub struct SparseDistanceMap<const D: usize> {
-    cell: f64,
-    inv_cell: f64,
-    cap: f64,
-    quantum: f64,
-    inv_quantum: f64,
+    /// Cells, tables (`below` indexed by nearness: `below[s]` is the dense map's
+    /// `below[255 - s]`) and points; `grid.half` is a multiple of `B`.
+    grid: Grid,
     /// `log2` of the block side in cells.
     shift: u32,
     /// Block side in cells, less one.
     mask: usize,
     /// Cells per block, `B^D`.
     block_cells: usize,
-    /// The table covers cells `k` in `[-half, half)` per axis; `half` is a multiple of `B`.
-    half: i64,
     /// `2 * half`: cells per axis.
     side: usize,
     /// Blocks per axis.
@@ -100,23 +104,17 @@ pub struct SparseDistanceMap<const D: usize> {
     chunk_shift: u32,
     /// Slab numbers handed out.
     next: AtomicUsize,
-    points: u64,
-    /// `below[s]`: a squared distance below which a cell of nearness `s` may be lowered,
-    /// `((255 - s) u)^2` widened by a relative `2^-40`.
-    below: Box<[f64; 256]>,
-    /// Row half-widths by squared distance in whole cells, as in the dense map.
-    widths: Box<[f64]>,
 }
 
 impl<const D: usize> fmt::Debug for SparseDistanceMap<D> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("SparseDistanceMap")
-            .field("cell", &self.cell)
-            .field("cap", &self.cap)
+            .field("cell", &self.grid.cell)
+            .field("cap", &self.grid.cap)
             .field("block_side", &(self.mask + 1))
             .field("cells_per_axis", &self.side)
             .field("blocks", &self.blocks())
-            .field("points", &self.points)
+            .field("points", &self.grid.points)
             .finish()
     }
 }
@@ -126,11 +124,7 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// cells (`block_side` a power of two, `block_side^D` at most 2^20). Nothing is allocated
     /// until the first insert.
     pub fn new(cell: f64, cap: f64, block_side: usize) -> Result<Self, DistanceMapError> {
-        let Tables {
-            quantum,
-            mut below,
-            widths,
-        } = tables(cell, cap)?;
+        let mut grid = Grid::new(cell, cap)?;
         let block_cells = block_side.checked_pow(D as u32).unwrap_or(usize::MAX);
         if !block_side.is_power_of_two() || block_cells > 1 << 20 {
             return Err(DistanceMapError::TooLarge {
@@ -138,32 +132,24 @@ impl<const D: usize> SparseDistanceMap<D> {
             });
         }
         // Cells store their nearness `255 - v`: the dense map's table read backwards.
-        below.reverse();
-        if widths.is_empty() {
+        grid.below.reverse();
+        if grid.widths.is_empty() {
             return Err(DistanceMapError::TooLarge {
                 cells_per_axis: 2.0 * cap / cell,
             });
         }
         let chunk_blocks = (CHUNK_BYTES / block_cells).max(1);
         Ok(SparseDistanceMap {
-            cell,
-            inv_cell: 1.0 / cell,
-            cap,
-            quantum,
-            inv_quantum: 1.0 / quantum,
+            grid,
             shift: block_side.trailing_zeros(),
             mask: block_side - 1,
             block_cells,
-            half: 0,
             side: 0,
             bside: 0,
             table: Vec::new(),
             chunks: Vec::new(),
             chunk_shift: chunk_blocks.trailing_zeros(),
             next: AtomicUsize::new(0),
-            points: 0,
-            below,
-            widths,
         })
     }
 
@@ -211,77 +197,6 @@ impl<const D: usize> SparseDistanceMap<D> {
         }
     }
 
-    /// Calls `lower(cell, s)` for every cell whose centre lies within `cap` of `q` and whose
-    /// nearness could rise to `s` (the quantised distance's complement), allocating a block at
-    /// its first such cell.
-    #[inline]
-    fn lower_rows(
-        &self,
-        q: &[f64; D],
-        side: Option<&Beside<D>>,
-        mut lower: impl FnMut(&AtomicU8, u8),
-    ) {
-        let mut lo = [0i64; D];
-        let mut hi = [0i64; D];
-        for i in 0..D {
-            lo[i] = (ceil((q[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
-            hi[i] = (floor((q[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
-            if lo[i] > hi[i] {
-                return;
-            }
-        }
-        let mut k = lo;
-        let t0 = q[0] * self.inv_cell - 0.5;
-        let kq: [i64; D] = std::array::from_fn(|i| floor(q[i] * self.inv_cell - 0.5) as i64);
-        let shift = self.shift as usize;
-        let mut recent = Recent {
-            at: [usize::MAX; 2],
-            block: [&[]; 2],
-        };
-        loop {
-            let mut s = 0.0;
-            let mut j2 = 0usize;
-            let mut brow = 0usize;
-            let mut crow = 0usize;
-            let mut stride = self.bside;
-            for i in 1..D {
-                let e = q[i] - (k[i] as f64 + 0.5) * self.cell;
-                s += e * e;
-                let j = if k[i] <= kq[i] {
-                    kq[i] - k[i]
-                } else {
-                    k[i] - kq[i] - 1
-                };
-                j2 += (j * j) as usize;
-                let u = (k[i] + self.half) as usize;
-                brow += (u >> shift) * stride;
-                stride *= self.bside;
-                crow |= (u & self.mask) << (shift * i);
-            }
-            if let Some(&h) = self.widths.get(j2) {
-                let a = (ceil(t0 - h) as i64).max(lo[0]);
-                let b = (floor(t0 + h) as i64).min(hi[0]);
-                let (a, b) = match side {
-                    Some(side) => side.clip(&k, self.cell, self.inv_cell, a, b),
-                    None => (a, b),
-                };
-                if a <= b {
-                    let last = (b + self.half) as usize;
-                    let mut u = (a + self.half) as usize;
-                    // The row's cells block by block.
-                    while u <= last {
-                        let end = (u | self.mask).min(last);
-                        self.lower_segment(q, s, brow, crow, u, end, &mut lower, &mut recent);
-                        u = end + 1;
-                    }
-                }
-            }
-            if !next_row(&mut k, &lo, &hi) {
-                return;
-            }
-        }
-    }
-
     /// Lowers cells `u..=end` (table coordinates along axis 0, one block) of the row with
     /// squared off-axis distance `s`, block row `brow` and in-block offset `crow`.
     #[inline(always)]
@@ -298,7 +213,7 @@ impl<const D: usize> SparseDistanceMap<D> {
         recent: &mut Recent<'a>,
     ) {
         let at = brow + (u >> self.shift);
-        let x0 = ((u as i64 - self.half) as f64 + 0.5) * self.cell - q[0];
+        let x0 = ((u as i64 - self.grid.half) as f64 + 0.5) * self.grid.cell - q[0];
         let block = if recent.at[0] == at {
             recent.block[0]
         } else if recent.at[1] == at {
@@ -313,10 +228,10 @@ impl<const D: usize> SparseDistanceMap<D> {
         };
         let row = &block[crow | (u & self.mask)..=crow | (end & self.mask)];
         for (n, v) in row.iter().enumerate() {
-            let x = x0 + f64::from(n as i32) * self.cell;
+            let x = x0 + f64::from(n as i32) * self.grid.cell;
             let d2 = x * x + s;
-            if d2 < self.below[usize::from(v.load(Ordering::Relaxed))] {
-                let d = d2.sqrt() * self.inv_quantum;
+            if d2 < self.grid.below[usize::from(v.load(Ordering::Relaxed))] {
+                let d = d2.sqrt() * self.grid.inv_quantum;
                 if d < f64::from(CAPPED) {
                     lower(v, CAPPED - d as u8);
                 }
@@ -335,9 +250,9 @@ impl<const D: usize> SparseDistanceMap<D> {
             ABSENT => {
                 // Allocate only if some cell of the segment comes within the cap: the centre
                 // nearest q along the row.
-                let n = (-x0 * self.inv_cell + 0.5).max(0.0).min(len as f64);
-                let x = x0 + floor(n) * self.cell;
-                if x * x + s >= self.cap * self.cap {
+                let n = (-x0 * self.grid.inv_cell + 0.5).max(0.0).min(len as f64);
+                let x = x0 + floor(n) * self.grid.cell;
+                if x * x + s >= self.grid.cap * self.grid.cap {
                     return None;
                 }
                 match self.allocate(slot) {
@@ -349,62 +264,9 @@ impl<const D: usize> SparseDistanceMap<D> {
         };
         (entry != UNKNOWN).then(|| self.block(entry))
     }
-
-    /// Enlarges the table to cover `|x_i| < need` (by at least a quarter), copying the old
-    /// entries into the middle of the new table (blocks keep their slab numbers).
-    fn grow(&mut self, need: f64) -> Result<(), DistanceMapError> {
-        let b = (self.mask + 1) as f64;
-        let cells = ((need * self.inv_cell).ceil().max(self.half as f64 * 1.25) / b).ceil() * b;
-        let side = 2.0 * cells;
-        let bside = side / b;
-        let total = bside.powi(D as i32);
-        if !(side < f64::from(u32::MAX) && total < (u32::MAX as f64) / 2.0) {
-            return Err(DistanceMapError::TooLarge {
-                cells_per_axis: side,
-            });
-        }
-        let half = cells as i64;
-        let bside = bside as usize;
-        let mut table: Vec<AtomicU32> = (0..total as usize).map(|_| AtomicU32::new(0)).collect();
-        if self.bside > 0 {
-            let off = ((half - self.half) as usize) >> self.shift;
-            for (r, old) in self.table.iter_mut().enumerate() {
-                let mut rem = r;
-                let mut at = 0;
-                let mut stride = 1;
-                for _ in 0..D {
-                    at += (rem % self.bside + off) * stride;
-                    rem /= self.bside;
-                    stride *= bside;
-                }
-                *table[at].get_mut() = *old.get_mut();
-            }
-        }
-        self.table = table;
-        self.half = half;
-        self.side = side as usize;
-        self.bside = bside;
-        Ok(())
-    }
 }
 
 impl<const D: usize> PointMap<D> for SparseDistanceMap<D> {
-    fn cell_side(&self) -> f64 {
-        self.cell
-    }
-
-    fn cap(&self) -> f64 {
-        self.cap
-    }
-
-    fn len(&self) -> u64 {
-        self.points
-    }
-
-    fn reach(&self) -> f64 {
-        self.half as f64 * self.cell
-    }
-
     /// Heap bytes held: the table and the chunks created.
     fn memory_bytes(&self) -> usize {
         let chunk = self.block_cells << self.chunk_shift;
@@ -421,15 +283,23 @@ impl<const D: usize> PointMap<D> for SparseDistanceMap<D> {
     /// As [`PointMap::reserve`], and reserves chunk slots for every block of the table, so
     /// that shared inserts can allocate any block.
     fn reserve(&mut self, reach: f64) -> Result<(), DistanceMapError> {
-        if finite_reach(reach)? >= self.reach() {
-            self.grow(reach)?;
-        }
+        self.cover(reach)?;
         self.ensure_slots(self.blocks() + self.table.len());
         Ok(())
     }
 }
 
 impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
+    #[inline(always)]
+    fn grid(&self) -> &Grid {
+        &self.grid
+    }
+
+    #[inline(always)]
+    fn grid_mut(&mut self) -> &mut Grid {
+        &mut self.grid
+    }
+
     /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and its
     /// distance byte `v`; `None` outside the table or in an [`UNKNOWN`] block.
     #[inline(always)]
@@ -439,9 +309,9 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
         let mut stride = 1usize;
         let mut e2 = 0.0;
         for i in 0..D {
-            let k = floor(p[i] * self.inv_cell);
+            let k = floor(p[i] * self.grid.inv_cell);
             // `side = 2 half`, tested through the signed `half` as the dense map does.
-            let half = self.half as f64;
+            let half = self.grid.half as f64;
             if !(k >= -half && k < half) {
                 return None;
             }
@@ -450,7 +320,7 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
             bidx += (j >> self.shift) * stride;
             stride *= self.bside;
             cidx |= (j & self.mask) << (self.shift as usize * i);
-            let e = p[i] - (k + 0.5) * self.cell;
+            let e = p[i] - (k + 0.5) * self.grid.cell;
             e2 += e * e;
         }
         let v = match self.table[bidx].load(Ordering::Acquire) {
@@ -458,49 +328,106 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
             UNKNOWN => return None,
             entry => CAPPED - self.block(entry)[cidx].load(Ordering::Relaxed),
         };
-        Some((f64::from(v) * self.quantum, e2.sqrt(), v))
+        Some((f64::from(v) * self.grid.quantum, e2.sqrt(), v))
     }
 
-    #[inline(always)]
-    fn quantum(&self) -> f64 {
-        self.quantum
-    }
-
-    fn insert_with(
-        &mut self,
-        q: &[f64; D],
-        touched: Option<&[f64; D]>,
-    ) -> Result<(), DistanceMapError> {
-        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
-        let need = finite_max_norm(q)? + self.cap + self.cell;
-        if need >= self.reach() {
-            self.grow(need)?;
+    /// Enlarges the table to cover `|x_i| < need` (by at least a quarter), copying the old
+    /// entries into the middle of the new table (blocks keep their slab numbers).
+    fn grow(&mut self, need: f64) -> Result<(), DistanceMapError> {
+        let b = (self.mask + 1) as f64;
+        let cells = ((need * self.grid.inv_cell)
+            .ceil()
+            .max(self.grid.half as f64 * 1.25)
+            / b)
+            .ceil()
+            * b;
+        let side = 2.0 * cells;
+        let bside = side / b;
+        let total = bside.powi(D as i32);
+        if !(side < f64::from(u32::MAX) && total < (u32::MAX as f64) / 2.0) {
+            return Err(DistanceMapError::TooLarge {
+                cells_per_axis: side,
+            });
         }
-        // Room for every block the point's ball can touch.
-        let per_axis = (2.0 * self.cap * self.inv_cell) as usize / (self.mask + 1) + 2;
-        self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
-        self.points += 1;
-        self.lower_rows(q, side.as_ref(), |v, s| {
-            if s > v.load(Ordering::Relaxed) {
-                v.store(s, Ordering::Relaxed);
+        let half = cells as i64;
+        let bside = bside as usize;
+        let mut table: Vec<AtomicU32> = (0..total as usize).map(|_| AtomicU32::new(0)).collect();
+        if self.bside > 0 {
+            let off = ((half - self.grid.half) as usize) >> self.shift;
+            for (r, old) in self.table.iter_mut().enumerate() {
+                let mut rem = r;
+                let mut at = 0;
+                let mut stride = 1;
+                for _ in 0..D {
+                    at += (rem % self.bside + off) * stride;
+                    rem /= self.bside;
+                    stride *= bside;
+                }
+                *table[at].get_mut() = *old.get_mut();
             }
-        });
+        }
+        self.table = table;
+        self.grid.half = half;
+        self.side = side as usize;
+        self.bside = bside;
         Ok(())
     }
 
-    fn insert_shared_with(
-        &self,
+    /// Stores the nearness `s` if it is above the cell's (exclusive access).
+    #[inline(always)]
+    fn keep_nearer(v: &AtomicU8, s: u8) {
+        if s > v.load(Ordering::Relaxed) {
+            v.store(s, Ordering::Relaxed);
+        }
+    }
+
+    /// Raises the cell to the nearness `s` with an atomic `fetch_max`.
+    #[inline(always)]
+    fn keep_nearer_shared(v: &AtomicU8, s: u8) {
+        if s > v.load(Ordering::Relaxed) {
+            v.fetch_max(s, Ordering::Relaxed);
+        }
+    }
+
+    /// Room in the slab for every block the point's ball can touch.
+    fn make_room(&mut self) {
+        let per_axis = (2.0 * self.grid.cap * self.grid.inv_cell) as usize / (self.mask + 1) + 2;
+        self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
+    }
+
+    type RowCache<'a> = Recent<'a>;
+
+    /// Raises the row's cells to their nearness `s`, block by block, allocating a block at its
+    /// first cell within the cap.
+    #[inline(always)]
+    fn lower_row<'a>(
+        &'a self,
         q: &[f64; D],
-        touched: Option<&[f64; D]>,
-    ) -> Result<bool, DistanceMapError> {
-        let side = touched.and_then(|p| Beside::new(q, p, self.cap, self.cell));
-        let inside = finite_max_norm(q)? + self.cap + self.cell < self.reach();
-        self.lower_rows(q, side.as_ref(), |v, s| {
-            if s > v.load(Ordering::Relaxed) {
-                v.fetch_max(s, Ordering::Relaxed);
-            }
-        });
-        Ok(inside)
+        s: f64,
+        k: &[i64; D],
+        (a, b): (i64, i64),
+        lower: &mut impl FnMut(&AtomicU8, u8),
+        recent: &mut Recent<'a>,
+    ) {
+        let half = self.grid.half;
+        let shift = self.shift as usize;
+        // The row's block row in the table and its cells' offset within a block.
+        let mut brow = 0usize;
+        let mut crow = 0usize;
+        let mut stride = self.bside;
+        for i in 1..D {
+            let u = (k[i] + half) as usize;
+            brow += (u >> shift) * stride;
+            stride *= self.bside;
+            crow |= (u & self.mask) << (shift * i);
+        }
+        let last = (b + half) as usize;
+        let mut u = (a + half) as usize;
+        while u <= last {
+            let end = (u | self.mask).min(last);
+            self.lower_segment(q, s, brow, crow, u, end, lower, recent);
+            u = end + 1;
+        }
     }
 }
 

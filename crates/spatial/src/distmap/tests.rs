@@ -2,8 +2,10 @@
 
 use super::*;
 use proptest::prelude::*;
+use std::sync::atomic::Ordering;
 
-fn brute<const D: usize>(pts: &[[f64; D]], p: &[f64; D]) -> f64 {
+/// The exact distance from `p` to the nearest of `pts` (`+inf` for none).
+pub(super) fn brute<const D: usize>(pts: &[[f64; D]], p: &[f64; D]) -> f64 {
     pts.iter()
         .map(|q| {
             let mut s = 0.0;
@@ -45,7 +47,8 @@ fn check<const D: usize>(cell: f64, cap: f64, pts: &[[f64; D]], probes: &[[f64; 
     }
 }
 
-fn pt<const D: usize>(range: f64) -> impl Strategy<Value = [f64; D]> {
+/// Points with every coordinate in `[-range, range)`.
+pub(super) fn pt<const D: usize>(range: f64) -> impl Strategy<Value = [f64; D]> {
     proptest::array::uniform::<_, D>(-range..range)
 }
 
@@ -167,21 +170,19 @@ proptest! {
     }
 }
 
-/// A cell's value is a minimum over the points, independent of their order: two threads
-/// adding halves of a point set to one reserved map through `insert_shared` leave exactly
-/// the bytes of the sequential map; points beyond the map are clipped, never wrong.
-#[test]
-fn shared_inserts_from_two_threads_equal_sequential_inserts() {
-    let mut rng = crate::testdata::SplitMix::new(0x9e37_79b9_7f4a_7c15);
-    let mut next = || rng.uniform();
-    let pts: Vec<[f64; 2]> = (0..4000)
-        .map(|_| [next() * 400.0 - 200.0, next() * 400.0 - 200.0])
-        .collect();
-    let mut seq = DistanceMap::<2>::new(8.0, 64.0).unwrap();
-    for q in &pts {
+/// Inserts `pts` one by one into a map from `new` and, from two threads that each add half
+/// of them through `insert_shared`, into another reserved to the first one's reach; checks
+/// that the two hold the same byte at every probe, and returns both (sequential, shared).
+pub(super) fn shared_and_sequential<M: PointMap<D> + Sync, const D: usize>(
+    new: impl Fn() -> M,
+    pts: &[[f64; D]],
+    probes: impl IntoIterator<Item = [f64; D]>,
+) -> (M, M) {
+    let mut seq = new();
+    for q in pts {
         seq.insert(q).unwrap();
     }
-    let mut shared = DistanceMap::<2>::new(8.0, 64.0).unwrap();
+    let mut shared = new();
     shared.reserve(seq.reach()).unwrap();
     assert_eq!(shared.reach(), seq.reach());
     let (a, b) = pts.split_at(pts.len() / 2);
@@ -195,12 +196,27 @@ fn shared_inserts_from_two_threads_equal_sequential_inserts() {
             });
         }
     });
-    for x in (-260..260).step_by(3) {
-        for y in (-260..260).step_by(5) {
-            let p = [x as f64, y as f64];
-            assert_eq!(seq.value(&p), shared.value(&p), "{p:?}");
-        }
+    for p in probes {
+        assert_eq!(seq.value(&p), shared.value(&p), "{p:?}");
     }
+    (seq, shared)
+}
+
+/// A cell's value is a minimum over the points, independent of their order: two threads
+/// adding halves of a point set to one reserved map through `insert_shared` leave exactly
+/// the bytes of the sequential map; points beyond the map are clipped, never wrong.
+#[test]
+fn shared_inserts_from_two_threads_equal_sequential_inserts() {
+    let mut rng = crate::testdata::SplitMix::new(0x9e37_79b9_7f4a_7c15);
+    let mut next = || rng.uniform();
+    let pts: Vec<[f64; 2]> = (0..4000)
+        .map(|_| [next() * 400.0 - 200.0, next() * 400.0 - 200.0])
+        .collect();
+    let probes = (-260..260)
+        .step_by(3)
+        .flat_map(|x| (-260..260).step_by(5).map(move |y| [x as f64, y as f64]));
+    let (seq, shared) =
+        shared_and_sequential(|| DistanceMap::<2>::new(8.0, 64.0).unwrap(), &pts, probes);
     // A point beyond the map: clipped, reported, and the stored cells stay valid bounds.
     let far = [seq.reach() - 10.0, 0.0];
     assert!(!shared.insert_shared(&far).unwrap());
@@ -212,10 +228,11 @@ fn shared_inserts_from_two_threads_equal_sequential_inserts() {
     assert!(shared.insert_shared(&[f64::NAN, 0.0]).is_err());
 }
 
-/// The rows' ranges from the table of widths cover every cell the exactly solved ranges
-/// cover, and the extra cells they visit are never lowered: the same bytes either way,
-/// in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
-/// centres among random ones.
+/// Every byte of a dense map, in order.
+fn bytes<const D: usize>(m: &DistanceMap<D>) -> Vec<u8> {
+    m.values.iter().map(|v| v.load(Ordering::Relaxed)).collect()
+}
+
 /// Uniform numbers in `[0, 1)` from a xorshift generator seeded with `seed` (non-zero).
 fn uniform(seed: u64) -> impl FnMut() -> f64 {
     let mut rng = seed;
@@ -227,6 +244,10 @@ fn uniform(seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
+/// The rows' ranges from the table of widths cover every cell the exactly solved ranges
+/// cover, and the extra cells they visit are never lowered: the same bytes either way,
+/// in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
+/// centres among random ones.
 #[test]
 fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
     fn same<const D: usize>(cell: f64, cap: f64, seed: u64) {
@@ -241,17 +262,14 @@ fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
             pts.push(std::array::from_fn(|i| (k as f64 + 0.5 + i as f64) * cell));
         }
         let mut table = DistanceMap::<D>::new(cell, cap).unwrap();
-        assert!(!table.widths.is_empty());
+        assert!(!table.grid.widths.is_empty());
         let mut exact = table.clone();
-        exact.widths = Box::default();
+        exact.grid.widths = Box::default();
         for q in &pts {
             table.insert(q).unwrap();
             exact.insert(q).unwrap();
         }
         assert_eq!(table.side, exact.side);
-        let bytes = |m: &DistanceMap<D>| -> Vec<u8> {
-            m.values.iter().map(|v| v.load(Ordering::Relaxed)).collect()
-        };
         let lowered = bytes(&table).iter().filter(|&&v| v < CAPPED).count();
         assert!(lowered > 100, "{lowered} cells lowered");
         assert!(bytes(&table) == bytes(&exact), "cell {cell}, cap {cap}");
@@ -359,9 +377,6 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
                 None => beside.insert(q).unwrap(),
             }
         }
-        let bytes = |m: &DistanceMap<D>| -> Vec<u8> {
-            m.values.iter().map(|v| v.load(Ordering::Relaxed)).collect()
-        };
         let lowered = bytes(&full).iter().filter(|&&v| v < CAPPED).count();
         assert!(lowered > 100, "{lowered} cells lowered");
         assert!(bytes(&full) == bytes(&beside), "cell {cell}, cap {cap}");

@@ -2,7 +2,7 @@
 //! back-indices, extreme coordinates, random worlds against brute force, work counters.
 
 use super::*;
-use crate::testdata::SplitMix;
+use crate::testdata::{BOX_SIZES, SplitMix};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Species {
@@ -294,15 +294,7 @@ fn extreme_coordinates_are_exact() {
 #[test]
 fn random_worlds_match_brute_force_and_each_other() {
     let mut rng = SplitMix::new(0x5EED);
-    let sizes = [
-        BoxSize::None,
-        BoxSize::Side(1),
-        BoxSize::Side(2),
-        BoxSize::Side(3),
-        BoxSize::Side(7),
-        BoxSize::Side(60),
-        BoxSize::Side(240),
-    ];
+    let sizes: Vec<BoxSize> = BOX_SIZES.into_iter().chain([BoxSize::Side(240)]).collect();
     for world in 0..6 {
         let span = [20, 80, 300, 1000, 50, 5000][world];
         let n = [50, 300, 800, 1500, 400, 200][world];

@@ -4,10 +4,14 @@
 //! defaults sit on them, in 2D and 3D and for the far-field modes at 1e6 particles; then the
 //! distribution of `vpdist` errors against the exact nearest distance.
 
+mod pareto;
+mod setting;
 mod sweep;
 mod vpdist;
 
-pub use sweep::{Setting, Sweep, pareto, replot};
+pub use pareto::{pareto, replot};
+pub use setting::Setting;
+pub use sweep::Sweep;
 pub use vpdist::vpdist_chart;
 
 use super::Ctx;

@@ -3,132 +3,14 @@
 //! the R_g prefactor (both against the sweep's first setting, its reference), the Pareto
 //! fronts, and where the defaults sit on them.
 
-use crate::plot::{self, Chart, Series, Style};
+use super::Setting;
+use super::pareto::{CSV_LEAD, pareto, pareto_chart};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use crate::scaling::Ctx;
 use crate::scaling::dla::fit_from;
 use crate::scaling::ensemble::columns;
-use anyhow::{Context, Result};
-use dla_pdla::{FarField, Params};
-use std::path::{Path, PathBuf};
-
-/// One point of a sweep: the flags of `dla` that change the walk.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Setting {
-    /// `--precision`.
-    pub precision: f64,
-    /// `--step-min`.
-    pub step_min: f64,
-    /// `--far-field`.
-    pub far_field: FarField,
-    /// `--death-ratio` (used by `--far-field jump` only).
-    pub death_ratio: f64,
-    /// `--distance-map`.
-    pub distance_map: bool,
-}
-
-impl Setting {
-    /// The defaults' walk with another precision, step and far field.
-    pub fn new(precision: f64, step_min: f64, far_field: FarField) -> Self {
-        let d = Params::default();
-        Setting {
-            precision,
-            step_min,
-            far_field,
-            death_ratio: d.death_ratio,
-            distance_map: d.distance_map,
-        }
-    }
-
-    /// The defaults of `dla`.
-    pub fn default_walk() -> Self {
-        let d = Params::default();
-        Setting::new(d.precision, d.step_min, d.far_field)
-    }
-
-    /// `dla --paper-settings`.
-    pub fn paper() -> Self {
-        let d = Params::default().paper_settings();
-        Setting {
-            death_ratio: d.death_ratio,
-            distance_map: d.distance_map,
-            ..Setting::new(d.precision, d.step_min, d.far_field)
-        }
-    }
-
-    /// The `--far-field jump` walk with death radius `ratio` birth radii.
-    pub fn jump(self, ratio: f64) -> Self {
-        Setting {
-            far_field: FarField::Jump,
-            death_ratio: ratio,
-            ..self
-        }
-    }
-
-    fn is_default(&self) -> bool {
-        *self == Setting::default_walk()
-    }
-
-    fn is_paper(&self) -> bool {
-        *self == Setting::paper()
-    }
-
-    fn precision_name(&self) -> String {
-        if self.precision.is_finite() {
-            format!("{}", self.precision)
-        } else {
-            "inf".into()
-        }
-    }
-
-    /// `k2 s0.5 jump100`: a point label for the plots.
-    fn short(&self) -> String {
-        let ff = match self.far_field {
-            FarField::Return => String::new(),
-            FarField::Jump => format!(" jump{}", self.death_ratio),
-        };
-        let map = if self.distance_map { "" } else { " no map" };
-        format!("k{} s{}{ff}{map}", self.precision_name(), self.step_min)
-    }
-
-    /// `precision 2, step 0.5, jump (death ratio 100)`: the table's label.
-    fn label(&self) -> String {
-        let ff = match self.far_field {
-            FarField::Return => "return".to_string(),
-            FarField::Jump => format!("jump (death ratio {})", self.death_ratio),
-        };
-        format!(
-            "precision {}, step {}, {ff}{}",
-            self.precision_name(),
-            self.step_min,
-            if self.distance_map {
-                ""
-            } else {
-                ", distance map off"
-            }
-        )
-    }
-
-    /// The flags of `dla` for this setting.
-    fn flags(&self) -> Vec<String> {
-        if self.is_paper() {
-            return vec!["--paper-settings".into()];
-        }
-        let mut f = vec![
-            format!("--precision={}", self.precision),
-            format!("--step-min={}", self.step_min),
-            format!("--far-field={}", self.far_field.name()),
-            format!(
-                "--distance-map={}",
-                if self.distance_map { "on" } else { "off" }
-            ),
-        ];
-        if self.far_field == FarField::Jump {
-            f.push(format!("--death-ratio={}", self.death_ratio));
-        }
-        f
-    }
-}
+use anyhow::Result;
+use dla_pdla::FarField;
 
 /// A sweep: its settings (the first is the reference), the runs' size and where it writes.
 pub struct Sweep {
@@ -337,27 +219,25 @@ impl Sweep {
             "Pareto front for the prefactor",
             "note",
         ]);
-        let mut data = Table::new(&[
-            "dim",
-            "particles",
-            "precision",
-            "step_min",
-            "far_field",
-            "death_ratio",
-            "distance_map",
-            "us_per_particle",
-            "us_per_particle_se",
-            "d",
-            "d_se",
-            "d_minus_ref",
-            "d_minus_ref_se",
-            "prefactor_rel_err",
-            "prefactor_rel_err_se",
-            "pareto_d",
-            "pareto_prefactor",
-            "default",
-            "paper_settings",
-        ]);
+        let mut data = Table::new(
+            &[
+                &CSV_LEAD[..],
+                &[
+                    "us_per_particle_se",
+                    "d",
+                    "d_se",
+                    "d_minus_ref",
+                    "d_minus_ref_se",
+                    "prefactor_rel_err",
+                    "prefactor_rel_err_se",
+                    "pareto_d",
+                    "pareto_prefactor",
+                    "default",
+                    "paper_settings",
+                ],
+            ]
+            .concat(),
+        );
         let yes = |b: bool| if b { "yes" } else { "" }.to_string();
         for (i, (m, p)) in measured.iter().zip(points).enumerate() {
             let (dm, dse) = mean_stderr(&m.d);
@@ -486,225 +366,5 @@ fn converged(p: &Point) -> &'static str {
             "Its R_g prefactor differs from the reference's by more than two standard errors."
         }
         (false, false) => "Both differ from the reference's by more than two standard errors.",
-    }
-}
-
-/// Cost against error for every setting, the Pareto front as a line, the default and the
-/// reference marked (a zero error is drawn at 1e-4 on the log axis).
-#[allow(clippy::too_many_arguments)]
-fn pareto_chart(
-    path: &Path,
-    title: &str,
-    y_label: &str,
-    pts: &[(f64, f64)],
-    errors: &[f64],
-    labels: &[String],
-    default: Option<usize>,
-) -> Result<()> {
-    const FLOOR: f64 = 1e-4;
-    let at = |i: usize| (pts[i].0, pts[i].1.max(FLOOR));
-    let mut fp: Vec<(f64, f64)> = pareto(pts).into_iter().map(at).collect();
-    fp.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut series = vec![
-        Series::new(
-            "settings (± standard error)",
-            (0..pts.len()).map(at).collect(),
-            Style::Points,
-        )
-        .with_labels(labels.to_vec())
-        .with_y_errors(errors.to_vec()),
-        Series::new("Pareto front", fp, Style::Line),
-    ];
-    if let Some(i) = default.filter(|&i| i != 0) {
-        let d = Params::default();
-        series.push(Series::new(
-            format!(
-                "default (precision {}, step {}, return)",
-                d.precision, d.step_min
-            ),
-            vec![at(i)],
-            Style::Highlight,
-        ));
-    }
-    series.push(Series::new(
-        if default == Some(0) {
-            "reference = default (error 0, drawn at 1e-4)"
-        } else {
-            "reference (error 0, drawn at 1e-4)"
-        },
-        vec![at(0)],
-        Style::Highlight,
-    ));
-    plot::write_png(
-        &Chart {
-            title: title.into(),
-            x_label: "microseconds per particle".into(),
-            y_label: y_label.into(),
-            log_x: false,
-            log_y: true,
-            series,
-        },
-        path,
-    )
-}
-
-/// The accuracy sweeps' stems and the titles of their charts (`{dim}` and `{n}` filled in from
-/// the CSV), as [`super::run`] names them.
-const REPLOTTED: [(&str, &str); 3] = [
-    ("accuracy", "{dim}D DLA, N = {n}"),
-    ("accuracy_farfield", "{dim}D DLA far field, N = {n}"),
-    ("accuracy_3d", "{dim}D DLA, N = {n}"),
-];
-
-/// Draws the Pareto charts of every accuracy sweep again from its CSV in `dir` (as written by
-/// [`Sweep::run`]), without running anything: for a change of the charts' style. Returns the
-/// charts written.
-pub fn replot(dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut written = Vec::new();
-    for (stem, title) in REPLOTTED {
-        let csv_path = dir.join(format!("{stem}.csv"));
-        if !csv_path.exists() {
-            continue;
-        }
-        let mut r = csv::Reader::from_path(&csv_path)
-            .with_context(|| format!("reading {}", csv_path.display()))?;
-        let head = r.headers()?.clone();
-        let col = |name: &str| {
-            head.iter()
-                .position(|h| h == name)
-                .with_context(|| format!("{}: no column {name}", csv_path.display()))
-        };
-        let cols = [
-            "dim",
-            "particles",
-            "precision",
-            "step_min",
-            "far_field",
-            "death_ratio",
-            "distance_map",
-            "us_per_particle",
-            "d_minus_ref",
-            "d_minus_ref_se",
-            "prefactor_rel_err",
-            "prefactor_rel_err_se",
-            "default",
-        ]
-        .into_iter()
-        .map(col)
-        .collect::<Result<Vec<usize>>>()?;
-        let mut rows = Vec::new();
-        for rec in r.records() {
-            let rec = rec?;
-            let mut f = [""; 13];
-            for (k, &c) in cols.iter().enumerate() {
-                f[k] = rec.get(c).unwrap_or("");
-            }
-            let num = |s: &str| -> Result<f64> {
-                s.parse::<f64>()
-                    .with_context(|| format!("{}: {s:?} is not a number", csv_path.display()))
-            };
-            let setting = Setting {
-                precision: num(f[2])?,
-                step_min: num(f[3])?,
-                far_field: if f[4] == "jump" {
-                    FarField::Jump
-                } else {
-                    FarField::Return
-                },
-                death_ratio: num(f[5])?,
-                distance_map: f[6] == "true",
-            };
-            rows.push((
-                f[0].to_string(),
-                f[1].to_string(),
-                setting.short(),
-                num(f[7])?,
-                [num(f[8])?, num(f[9])?, num(f[10])?, num(f[11])?],
-                f[12] == "true",
-            ));
-        }
-        let Some(first) = rows.first() else {
-            continue;
-        };
-        let title = title.replace("{dim}", &first.0).replace("{n}", &first.1);
-        let short: Vec<String> = rows.iter().map(|r| r.2.clone()).collect();
-        let default = rows.iter().position(|r| r.5);
-        for (what, y_label, value, se, file) in [
-            ("D", "|D - D_ref|", 0, 1, format!("{stem}_pareto.png")),
-            (
-                "the R_g prefactor",
-                "|relative error of the R_g prefactor|",
-                2,
-                3,
-                format!("{stem}_pareto_prefactor.png"),
-            ),
-        ] {
-            let pts: Vec<(f64, f64)> = rows.iter().map(|r| (r.3, r.4[value].abs())).collect();
-            // The reference's own error is zero by definition.
-            let errors: Vec<f64> = rows
-                .iter()
-                .enumerate()
-                .map(|(i, r)| if i == 0 { 0.0 } else { r.4[se] })
-                .collect();
-            let path = dir.join(&file);
-            pareto_chart(
-                &path,
-                &format!("{title}: cost against error of {what}"),
-                y_label,
-                &pts,
-                &errors,
-                &short,
-                default,
-            )?;
-            written.push(path);
-        }
-    }
-    Ok(written)
-}
-
-/// Indices of the points not dominated in (cost, error): sorted by cost, keep each point whose
-/// error is below every cheaper point's.
-pub fn pareto(points: &[(f64, f64)]) -> Vec<usize> {
-    let mut idx: Vec<usize> = (0..points.len()).collect();
-    idx.sort_by(|&a, &b| {
-        points[a]
-            .0
-            .total_cmp(&points[b].0)
-            .then(points[a].1.total_cmp(&points[b].1))
-    });
-    let mut best = f64::INFINITY;
-    let mut front = Vec::new();
-    for i in idx {
-        if points[i].1 < best {
-            best = points[i].1;
-            front.push(i);
-        }
-    }
-    front.sort_unstable();
-    front
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn pareto_front() {
-        let pts = [(1.0, 0.5), (2.0, 0.1), (3.0, 0.2), (0.5, 0.9), (4.0, 0.0)];
-        assert_eq!(pareto(&pts), vec![0, 1, 3, 4]);
-    }
-
-    #[test]
-    fn settings_name_their_flags() {
-        assert_eq!(Setting::paper().flags(), vec!["--paper-settings"]);
-        let j = Setting::default_walk().jump(10.0);
-        assert!(j.flags().contains(&"--death-ratio=10".to_string()));
-        assert!(
-            !Setting::default_walk()
-                .flags()
-                .iter()
-                .any(|f| f.contains("death"))
-        );
-        assert!(Setting::default_walk().is_default() && !Setting::paper().is_default());
     }
 }

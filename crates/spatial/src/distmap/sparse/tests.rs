@@ -2,20 +2,9 @@
 //! against brute force, serial and shared.
 
 use super::super::DistanceMap;
+use super::super::tests::{brute, pt, shared_and_sequential};
 use super::*;
 use proptest::prelude::*;
-
-fn brute<const D: usize>(pts: &[[f64; D]], p: &[f64; D]) -> f64 {
-    pts.iter()
-        .map(|q| {
-            let mut s = 0.0;
-            for i in 0..D {
-                s += (p[i] - q[i]) * (p[i] - q[i]);
-            }
-            s.sqrt()
-        })
-        .fold(f64::INFINITY, f64::min)
-}
 
 /// Inserts `pts` one by one into a sparse and a dense map of the same cells, checking after
 /// every few inserts (so table growth in the middle is covered) that at every probe both
@@ -58,10 +47,6 @@ fn check<const D: usize>(cell: f64, cap: f64, block: usize, pts: &[[f64; D]], pr
         }
     }
     assert_eq!(sparse.len(), pts.len() as u64);
-}
-
-fn pt<const D: usize>(range: f64) -> impl Strategy<Value = [f64; D]> {
-    proptest::array::uniform::<_, D>(-range..range)
 }
 
 proptest! {
@@ -129,32 +114,15 @@ fn shared_inserts_from_two_threads_equal_sequential_inserts() {
     let pts: Vec<[f64; 3]> = (0..3000)
         .map(|_| std::array::from_fn(|_| next() * 80.0 - 40.0))
         .collect();
-    let mut seq = SparseDistanceMap::<3>::new(2.0, 8.0, 8).unwrap();
-    for q in &pts {
-        seq.insert(q).unwrap();
-    }
-    let mut shared = SparseDistanceMap::<3>::new(2.0, 8.0, 8).unwrap();
-    shared.reserve(seq.reach()).unwrap();
-    assert_eq!(shared.reach(), seq.reach());
-    let (a, b) = pts.split_at(pts.len() / 2);
-    std::thread::scope(|s| {
-        for half in [a, b] {
-            let map = &shared;
-            s.spawn(move || {
-                for q in half {
-                    assert!(map.insert_shared(q).unwrap());
-                }
-            });
-        }
+    let probes = (-60..60).step_by(3).flat_map(|x| {
+        (-60..60).step_by(5).flat_map(move |y| {
+            (-60..60)
+                .step_by(7)
+                .map(move |z| [x as f64 + 0.3, y as f64, z as f64 - 0.2])
+        })
     });
-    for x in (-60..60).step_by(3) {
-        for y in (-60..60).step_by(5) {
-            for z in (-60..60).step_by(7) {
-                let p = [x as f64 + 0.3, y as f64, z as f64 - 0.2];
-                assert_eq!(seq.value(&p), shared.value(&p), "{p:?}");
-            }
-        }
-    }
+    let new = || SparseDistanceMap::<3>::new(2.0, 8.0, 8).unwrap();
+    let (seq, shared) = shared_and_sequential(new, &pts, probes);
     let far = [seq.reach() - 3.0, 0.0, 0.0];
     assert!(!shared.insert_shared(&far).unwrap());
     assert!(shared.insert_shared(&[f64::NAN, 0.0, 0.0]).is_err());

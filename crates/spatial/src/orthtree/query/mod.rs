@@ -6,9 +6,34 @@
 //! (`TRACK`). Distances to points are compared squared; a square root is taken only when the
 //! best value improves (the paper's section 3.3: "managing orthogonal distances whenever
 //! possible, avoiding ... unnecessary calls to the standard function sqrt()").
+//!
+//! The walk is here; the nodes a bounded query starts from are found in `cover`, the leaf
+//! scan is in `leaf` and the range query in `range`.
 
 use super::{EMPTY, Orthtree, decode};
-use crate::round::{ceil, floor};
+use leaf::nearest_in_leaf;
+
+/// Declares `$cc`, the centre of child `$ci` (bit `i` set: the upper half along axis `i`) of
+/// the node of centre `$c`, with `$q` a quarter of the node's side. A macro rather than a
+/// function: the walk and the range query are the tree's hottest loops, and this expands to
+/// exactly the code they had written out, where a function (even `#[inline(always)]`)
+/// changed the machine code the compiler made of `visit`.
+macro_rules! child_centre {
+    ($cc:ident = $c:expr, $ci:expr, $q:expr) => {
+        let mut $cc = $c;
+        for (i, x) in $cc.iter_mut().enumerate() {
+            if $ci >> i & 1 == 1 {
+                *x += $q;
+            } else {
+                *x -= $q;
+            }
+        }
+    };
+}
+
+mod cover;
+mod leaf;
+mod range;
 
 /// Relative shrink applied to far-node lower bounds `|p - c| - r`, so that rounding in the
 /// distance to the centre can never push the bound above a point's computed distance. `2^-44`
@@ -150,34 +175,6 @@ impl<const D: usize> Orthtree<D> {
         })
     }
 
-    /// Calls `f` with the stored position of every point at distance `<= r` from `p` (inclusive,
-    /// comparing squared distances summed axis by axis, as
-    /// [`nearest_distance`](Self::nearest_distance) does). Order unspecified. Nothing is called if
-    /// `r` is negative or NaN. Used by DLA to find the first contact along a step (the
-    /// variable-precision paper, section 3.2, Fig. 6).
-    pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, mut f: F) {
-        if self.root == EMPTY || r.is_nan() || r < 0.0 {
-            return;
-        }
-        let r_sq = r * r;
-        let cell = |tree: &Self, node, level, c, half| {
-            if box_dist_sq(p, &c, half) > r_sq {
-                return;
-            }
-            // SAFETY: `for_each_cover_cell` passes reached nodes (leaves at level 0) with
-            // their levels.
-            unsafe {
-                if level == 0 {
-                    tree.range_leaf(p, r_sq, node, c, half, &mut f);
-                } else {
-                    tree.range_node(p, r_sq, node, level, c, half, &mut f);
-                }
-            }
-        };
-        // SAFETY: the tree is not empty (checked above).
-        unsafe { self.for_each_cover_cell(p, r, cell) };
-    }
-
     /// [`vpdist_detailed`](Self::vpdist_detailed) given an upper bound `upper` of the exact
     /// nearest distance (for example the last answer's `distance + 2 half_diagonal` plus the
     /// distance moved since; the bound stays valid while points are only added).
@@ -292,131 +289,6 @@ impl<const D: usize> Orthtree<D> {
         if s.best < upper { Ok(s) } else { Err(s.nodes) }
     }
 
-    /// Calls `f(tree, node, level, centre, half side)` for each existing node of a set of at
-    /// most `2^D` nodes, all at one level, whose cells cover the ball of radius `r` around `p`
-    /// (with a relative margin against rounding): the nodes of the smallest level whose side
-    /// is at least `2 r`, or the root if that level is not below the root. `level == 0` means
-    /// `node` is a leaf index. Finding the nodes costs one descent per node with no distance
-    /// computation (the range and bounded queries then start there, not at the root).
-    ///
-    /// Every `node` passed to `f` is a reached node of level `level` (a reached leaf for
-    /// `level == 0`): the root, or read from the slots of reached nodes.
-    ///
-    /// # Safety
-    ///
-    /// The tree is not empty.
-    #[inline]
-    unsafe fn for_each_cover_cell<F: FnMut(&Self, u32, u32, [f64; D], f64)>(
-        &self,
-        p: &[f64; D],
-        r: f64,
-        mut f: F,
-    ) {
-        let mut pmax: f64 = 0.0;
-        for x in p {
-            pmax = pmax.max(x.abs());
-        }
-        let mut omax: f64 = 0.0;
-        for o in &self.root_origin {
-            omax = omax.max((*o as f64).abs());
-        }
-        // Rounding of p +- r and of the divisions below is far below this margin. `u` below is
-        // rounded at the magnitude of the root's corner, which may be far larger than p's (a
-        // point a few ulps below a cell boundary near the origin of a wide tree rounds onto the
-        // boundary): the margin covers that too.
-        let r = r + (1.0 + r + pmax) * 1e-9 + (omax * self.leaf_side + pmax) * 1e-12;
-        let side_leaves = (r + r) / self.leaf_side;
-        // Smallest level whose side (2^level leaf sides) is >= 2 r.
-        let level = if side_leaves <= 1.0 {
-            0
-        } else if side_leaves.is_finite() && side_leaves < (1u64 << 62) as f64 {
-            64 - ((ceil(side_leaves) as u64) - 1).leading_zeros()
-        } else {
-            u32::MAX
-        };
-        if level >= self.root_level || !p.iter().all(|x| x.is_finite()) {
-            let (c, half) = self.root_geometry();
-            f(self, self.root, self.root_level, c, half);
-            return;
-        }
-        // Cells of this level are aligned on the root's corner: index them from it.
-        let cells = (1u64 << level) as f64;
-        let r_leaves = r / self.leaf_side;
-        let last = (1u64 << (self.root_level - level)) as f64 - 1.0;
-        let mut lo = [0i64; D];
-        let mut two = [false; D];
-        let mut home = 0usize;
-        for i in 0..D {
-            let u = p[i] / self.leaf_side - self.root_origin[i] as f64;
-            let a = floor((u - r_leaves) / cells);
-            let b = floor((u + r_leaves) / cells);
-            if b < 0.0 || a > last {
-                return;
-            }
-            let a = a.max(0.0);
-            let b = b.min(last);
-            lo[i] = a as i64;
-            two[i] = b > a;
-            if two[i] && u >= b * cells {
-                // p lies in the upper of the two cells.
-                home |= 1 << i;
-            }
-        }
-        let half = self.leaf_side * cells * 0.5;
-        // The cells' paths from the root are one path down to the first level whose child
-        // index differs between them (the bit of `k - root_origin` it reads, `l - 1`, lies
-        // above every bit in which an axis's two cell indices differ): walk it once.
-        let mut split = level;
-        for i in 0..D {
-            if two[i] {
-                let diff = ((lo[i] ^ (lo[i] + 1)) as u64) << level;
-                split = split.max(64 - diff.leading_zeros());
-            }
-        }
-        let k0: [i64; D] = std::array::from_fn(|i| self.root_origin[i] + (lo[i] << level));
-        let mut top = self.root;
-        let mut top_level = self.root_level;
-        while top_level > split {
-            // SAFETY: `top` is the root (the tree is not empty: the caller's contract) or was
-            // read from its parent's slot at level top_level + 1 >= 2.
-            let child = unsafe {
-                self.child(top as usize * Self::FANOUT + self.child_index(&k0, top_level))
-            };
-            if child == EMPTY {
-                return;
-            }
-            top = child;
-            top_level -= 1;
-        }
-        // p's own cell first, then by number of flipped axes (good bounds early).
-        'cells: for &m in &CHILD_ORDER[D][..Self::FANOUT] {
-            let combo = home ^ m as usize;
-            let mut k = [0i64; D];
-            for i in 0..D {
-                let bit = (combo >> i) & 1;
-                if bit == 1 && !two[i] {
-                    continue 'cells;
-                }
-                k[i] = self.root_origin[i] + ((lo[i] + bit as i64) << level);
-            }
-            let mut node = top;
-            let mut l = top_level;
-            while l > level {
-                // SAFETY: `node` is `top` (reached) or was read from its parent's slot at
-                // level l + 1 >= 2.
-                let child =
-                    unsafe { self.child(node as usize * Self::FANOUT + self.child_index(&k, l)) };
-                if child == EMPTY {
-                    continue 'cells;
-                }
-                node = child;
-                l -= 1;
-            }
-            let c = k.map(|x| x as f64 * self.leaf_side + half);
-            f(self, node, level, c, half);
-        }
-    }
-
     /// Centre and half side of the root.
     #[inline]
     fn root_geometry(&self) -> ([f64; D], f64) {
@@ -526,14 +398,7 @@ impl<const D: usize> Orthtree<D> {
             if d2 >= s.best_sq {
                 continue;
             }
-            let mut cc = c;
-            for (i, x) in cc.iter_mut().enumerate() {
-                if ci >> i & 1 == 1 {
-                    *x += q;
-                } else {
-                    *x -= q;
-                }
-            }
+            child_centre!(cc = c, ci, q);
             // SAFETY: a non-empty slot of a reached node of level `level`: a reached leaf
             // if `level == 1`, else a reached node of level `level - 1`.
             unsafe {
@@ -579,157 +444,6 @@ impl<const D: usize> Orthtree<D> {
             }
         }
     }
-
-    /// Range query below a node (centre `c`, half side `half`) already known to meet the ball.
-    ///
-    /// # Safety
-    ///
-    /// `node` is a reached node of level `level`, as for [`visit`](Self::visit).
-    #[allow(clippy::too_many_arguments)]
-    unsafe fn range_node<F: FnMut([f64; D])>(
-        &self,
-        p: &[f64; D],
-        r_sq: f64,
-        node: u32,
-        level: u32,
-        c: [f64; D],
-        half: f64,
-        f: &mut F,
-    ) {
-        let q = half * 0.5;
-        // Per axis, the squared distance from p to the lower and the upper half of the node,
-        // summed into each child's `box_dist_sq` bit for bit (as in `visit`).
-        let mut slab = [[0.0f64; 2]; D];
-        for i in 0..D {
-            let x = p[i];
-            let lo = (c[i] - half - x).max(x - c[i]).max(0.0);
-            let hi = (c[i] - x).max(x - (c[i] + half)).max(0.0);
-            slab[i] = [lo * lo, hi * hi];
-        }
-        let base = node as usize * Self::FANOUT;
-        for ci in 0..Self::FANOUT {
-            // SAFETY: `node` is a reached node (the caller's contract), `ci < FANOUT`.
-            let child = unsafe { self.child(base + ci) };
-            if child == EMPTY {
-                continue;
-            }
-            let mut d2 = 0.0;
-            for (i, sl) in slab.iter().enumerate() {
-                d2 += sl[ci >> i & 1];
-            }
-            if d2 > r_sq {
-                continue;
-            }
-            let mut cc = c;
-            for (i, x) in cc.iter_mut().enumerate() {
-                if ci >> i & 1 == 1 {
-                    *x += q;
-                } else {
-                    *x -= q;
-                }
-            }
-            // SAFETY: a non-empty slot of a reached node of level `level`: a reached leaf
-            // if `level == 1`, else a reached node of level `level - 1`.
-            unsafe {
-                if level == 1 {
-                    self.range_leaf(p, r_sq, child, cc, q, f);
-                } else {
-                    self.range_node(p, r_sq, child, level - 1, cc, q, f);
-                }
-            }
-        }
-    }
-}
-
-impl<const D: usize> Orthtree<D> {
-    /// Range query inside a leaf (centre `c`, half side `half`).
-    ///
-    /// # Safety
-    ///
-    /// `leaf` is a reached leaf, as for [`visit_leaf`](Self::visit_leaf).
-    #[inline]
-    unsafe fn range_leaf<F: FnMut([f64; D])>(
-        &self,
-        p: &[f64; D],
-        r_sq: f64,
-        leaf: u32,
-        c: [f64; D],
-        half: f64,
-        f: &mut F,
-    ) {
-        let origin = c.map(|x| x - half);
-        // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
-        for code in unsafe { self.leaf_points(leaf) } {
-            let mut x = [0.0; D];
-            let mut d2 = 0.0;
-            for i in 0..D {
-                x[i] = decode(origin[i], code[i], self.step);
-                let e = p[i] - x[i];
-                d2 += e * e;
-            }
-            if d2 <= r_sq {
-                f(x);
-            }
-        }
-    }
-}
-
-/// Lanes of the leaf scan: independent running minima, so consecutive points do not wait for
-/// each other's comparison (the scan was bound by that dependency chain) and the compiler can
-/// keep each lane in a vector register.
-const LANES: usize = 4;
-
-/// The smallest squared distance below `best_sq` from `p` to a point of a leaf (origin
-/// `origin`), and the index of the first point reaching it (`usize::MAX` if none is below
-/// `best_sq`). Each point's squared distance is computed exactly as the scalar loop
-/// `sum_i (p_i - decode(origin_i, code_i, step))^2` would, so the result is bit for bit the same
-/// as scanning the points one by one; ties go to the lowest index, as in that scan.
-#[inline(always)]
-fn nearest_in_leaf<const D: usize>(
-    p: &[f64; D],
-    origin: &[f64; D],
-    step: f64,
-    pts: &[[u32; D]],
-    best_sq: f64,
-) -> (f64, usize) {
-    let mut m = [best_sq; LANES];
-    let mut at = [usize::MAX; LANES];
-    let chunks = pts.chunks_exact(LANES);
-    let tail = chunks.remainder();
-    for (c, chunk) in chunks.enumerate() {
-        let mut d2 = [0.0f64; LANES];
-        for i in 0..D {
-            for k in 0..LANES {
-                let e = p[i] - decode(origin[i], chunk[k][i], step);
-                d2[k] += e * e;
-            }
-        }
-        for k in 0..LANES {
-            if d2[k] < m[k] {
-                m[k] = d2[k];
-                at[k] = c * LANES + k;
-            }
-        }
-    }
-    let base = pts.len() - tail.len();
-    for (k, code) in tail.iter().enumerate() {
-        let d2 = dist_sq(
-            p,
-            &std::array::from_fn(|i| decode(origin[i], code[i], step)),
-        );
-        if d2 < m[k] {
-            m[k] = d2;
-            at[k] = base + k;
-        }
-    }
-    // Combine the lanes: smallest value, then lowest index among equal values.
-    let mut best = (best_sq, usize::MAX);
-    for k in 0..LANES {
-        if m[k] < best.0 || (m[k] == best.0 && at[k] < best.1) {
-            best = (m[k], at[k]);
-        }
-    }
-    best
 }
 
 /// `kappa^2 D` for the far test `|p - c|^2 > kappa^2 D a^2` (a node of side `a` has diagonal

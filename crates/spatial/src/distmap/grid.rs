@@ -1,0 +1,181 @@
+//! What the dense and the sparse maps share: the cells' geometry, the quantum, the tables an
+//! insert reads and the count of points ([`Grid`]), and the ranges of cells a point's ball
+//! covers, row by row.
+
+use super::beside::Beside;
+use super::{CAPPED, DistanceMapError, SHRINK};
+use crate::round::{ceil, floor};
+
+/// Largest `(cap / cell)^2` for which a map tabulates its row widths.
+const WIDTHS_MAX: f64 = 4096.0;
+
+/// The cells of a map of side `cell` capped at `cap`, how far the map reaches, its points,
+/// and the tables its inserts read (see [`Grid::new`]).
+#[derive(Clone)]
+pub struct Grid {
+    pub(super) cell: f64,
+    pub(super) inv_cell: f64,
+    pub(super) cap: f64,
+    /// `cap / 255`, the distance one step of a stored byte stands for.
+    pub(super) quantum: f64,
+    pub(super) inv_quantum: f64,
+    /// The map covers cells `k` in `[-half, half)` per axis, i.e. `|x| < half * cell`.
+    pub(super) half: i64,
+    /// Points counted by `PointMap::len`.
+    pub(super) points: u64,
+    /// `below[v]`: a squared distance below which a cell holding `v` may be lowered,
+    /// `(v u)^2` widened by a relative `2^-40` (so rounding never skips a lowering). The sparse
+    /// map, which stores nearness `255 - v`, holds it reversed.
+    pub(super) below: Box<[f64; 256]>,
+    /// `widths[j]`: for a row of cells whose centres lie at a squared distance of at least
+    /// `j` squared cell sides from the inserted point along the other axes, half the length,
+    /// in cells, of the part of the row within `cap` of it, widened a little (so a row never
+    /// misses a cell). Empty when `(cap / cell)^2` exceeds [`WIDTHS_MAX`]; rows then solve
+    /// for their range exactly.
+    pub(super) widths: Box<[f64]>,
+}
+
+impl Grid {
+    /// An empty grid (covering nothing) of cells of side `cell` capped at `cap`, both checked.
+    pub(super) fn new(cell: f64, cap: f64) -> Result<Self, DistanceMapError> {
+        if !(cell.is_finite() && cell > 0.0) {
+            return Err(DistanceMapError::CellSide(cell));
+        }
+        if !(cap.is_finite() && cap > 0.0) {
+            return Err(DistanceMapError::Cap(cap));
+        }
+        let quantum = cap / f64::from(CAPPED);
+        let mut below = Box::new([0.0; 256]);
+        for (v, b) in below.iter_mut().enumerate() {
+            let d = v as f64 * quantum;
+            *b = d * d * (1.0 + SHRINK);
+        }
+        let r2 = (cap / cell) * (cap / cell);
+        let widths = if r2 <= WIDTHS_MAX {
+            (0..=r2 as usize)
+                .map(|j| (r2 - j as f64).max(0.0).sqrt() * (1.0 + 1e-9) + 1e-9)
+                .collect()
+        } else {
+            Box::default()
+        };
+        Ok(Grid {
+            cell,
+            inv_cell: 1.0 / cell,
+            cap,
+            quantum,
+            inv_quantum: 1.0 / quantum,
+            half: 0,
+            points: 0,
+            below,
+            widths,
+        })
+    }
+
+    /// Half the side of the covered cube.
+    #[inline(always)]
+    pub(super) fn reach(&self) -> f64 {
+        self.half as f64 * self.cell
+    }
+
+    /// Per axis, the cells whose centres `(k + 1/2) c` lie within `cap` of the box
+    /// `[blo, bhi]` (a point when `blo == bhi`), clipped to the map; `None` if none do.
+    #[inline(always)]
+    pub(super) fn cells_near<const D: usize>(
+        &self,
+        blo: &[f64; D],
+        bhi: &[f64; D],
+    ) -> Option<([i64; D], [i64; D])> {
+        let mut lo = [0i64; D];
+        let mut hi = [0i64; D];
+        for i in 0..D {
+            lo[i] = (ceil((blo[i] - self.cap) * self.inv_cell - 0.5) as i64).max(-self.half);
+            hi[i] = (floor((bhi[i] + self.cap) * self.inv_cell - 0.5) as i64).min(self.half - 1);
+            if lo[i] > hi[i] {
+                return None;
+            }
+        }
+        Some((lo, hi))
+    }
+
+    /// Where the point `q` sits among the cells, for [`row_offset`](Self::row_offset) and
+    /// [`row_range`](Self::row_range): `q_0` in units of cells with the cells' centres
+    /// at whole numbers, and per axis the lower of the two centre indices around `q`.
+    #[inline(always)]
+    pub(super) fn row_origin<const D: usize>(&self, q: &[f64; D]) -> (f64, [i64; D]) {
+        let t0 = q[0] * self.inv_cell - 0.5;
+        let kq: [i64; D] = std::array::from_fn(|i| floor(q[i] * self.inv_cell - 0.5) as i64);
+        (t0, kq)
+    }
+
+    /// For the row of cells at indices `k[1..]` (axis 0 runs along it): the squared distance
+    /// `s` from `q` to the row's centres along the other axes, and `j2`, a whole number of
+    /// squared cell sides at most that distance (the centres of a row `j_i` whole cells beyond
+    /// the pair `kq_i, kq_i + 1` around `q` are at least `j_i` cells from `q` along axis `i`).
+    #[inline(always)]
+    pub(super) fn row_offset<const D: usize>(
+        &self,
+        q: &[f64; D],
+        k: &[i64; D],
+        kq: &[i64; D],
+    ) -> (f64, usize) {
+        let mut s = 0.0;
+        let mut j2 = 0usize;
+        for i in 1..D {
+            let e = q[i] - (k[i] as f64 + 0.5) * self.cell;
+            s += e * e;
+            let j = if k[i] <= kq[i] {
+                kq[i] - k[i]
+            } else {
+                k[i] - kq[i] - 1
+            };
+            j2 += (j * j) as usize;
+        }
+        (s, j2)
+    }
+
+    /// The range along axis 0 (in cells, as floats) of the cells within `cap` of the point
+    /// (`q_0` its first coordinate, `t0` from [`row_origin`](Self::row_origin)) in a row at
+    /// squared distance `s` from it along the other axes, `j2` squared cell sides at most (see
+    /// [`row_offset`](Self::row_offset)); `None` when no cell of the row is that near.
+    ///
+    /// From the table of widths when there is one: integer arithmetic, so the row's range does
+    /// not wait for the floating-point distance (which only the per-cell test uses) and the
+    /// rows' set-up overlaps; no square root per row; a few cells more than the exact range,
+    /// which the per-cell test rejects. Without a table, solved exactly.
+    #[inline(always)]
+    pub(super) fn row_range(&self, q0: f64, s: f64, t0: f64, j2: usize) -> Option<(f64, f64)> {
+        if self.widths.is_empty() {
+            let cap2 = self.cap * self.cap;
+            (s < cap2).then(|| {
+                let w = (cap2 - s).sqrt();
+                (
+                    ceil((q0 - w) * self.inv_cell - 0.5),
+                    floor((q0 + w) * self.inv_cell - 0.5),
+                )
+            })
+        } else {
+            // `j2` is at most the row's squared distance from q in cells, so its width in the
+            // table is at least the exact one.
+            self.widths.get(j2).map(|&h| (ceil(t0 - h), floor(t0 + h)))
+        }
+    }
+
+    /// The cells `a..=b` of a row's range (as floats from the range computation) clipped to
+    /// `lo_0..=hi_0` and, for an insert beside a touched point, to its half-space.
+    #[inline(always)]
+    pub(super) fn clip_row<const D: usize>(
+        &self,
+        (a, b): (f64, f64),
+        lo0: i64,
+        hi0: i64,
+        k: &[i64; D],
+        side: Option<&Beside<D>>,
+    ) -> (i64, i64) {
+        let a = (a as i64).max(lo0);
+        let b = (b as i64).min(hi0);
+        match side {
+            Some(side) => side.clip(k, self.cell, self.inv_cell, a, b),
+            None => (a, b),
+        }
+    }
+}

@@ -1,0 +1,118 @@
+//! The fixed-radius range query: every stored point within a distance of a position.
+
+use super::super::{EMPTY, Orthtree, decode};
+use super::box_dist_sq;
+
+impl<const D: usize> Orthtree<D> {
+    /// Calls `f` with the stored position of every point at distance `<= r` from `p` (inclusive,
+    /// comparing squared distances summed axis by axis, as
+    /// [`nearest_distance`](Self::nearest_distance) does). Order unspecified. Nothing is called if
+    /// `r` is negative or NaN. Used by DLA to find the first contact along a step (the
+    /// variable-precision paper, section 3.2, Fig. 6).
+    pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, mut f: F) {
+        if self.root == EMPTY || r.is_nan() || r < 0.0 {
+            return;
+        }
+        let r_sq = r * r;
+        let cell = |tree: &Self, node, level, c, half| {
+            if box_dist_sq(p, &c, half) > r_sq {
+                return;
+            }
+            // SAFETY: `for_each_cover_cell` passes reached nodes (leaves at level 0) with
+            // their levels.
+            unsafe {
+                if level == 0 {
+                    tree.range_leaf(p, r_sq, node, c, half, &mut f);
+                } else {
+                    tree.range_node(p, r_sq, node, level, c, half, &mut f);
+                }
+            }
+        };
+        // SAFETY: the tree is not empty (checked above).
+        unsafe { self.for_each_cover_cell(p, r, cell) };
+    }
+
+    /// Range query below a node (centre `c`, half side `half`) already known to meet the ball.
+    ///
+    /// # Safety
+    ///
+    /// `node` is a reached node of level `level`, as for [`visit`](Self::visit).
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn range_node<F: FnMut([f64; D])>(
+        &self,
+        p: &[f64; D],
+        r_sq: f64,
+        node: u32,
+        level: u32,
+        c: [f64; D],
+        half: f64,
+        f: &mut F,
+    ) {
+        let q = half * 0.5;
+        // Per axis, the squared distance from p to the lower and the upper half of the node,
+        // summed into each child's `box_dist_sq` bit for bit (as in `visit`).
+        let mut slab = [[0.0f64; 2]; D];
+        for i in 0..D {
+            let x = p[i];
+            let lo = (c[i] - half - x).max(x - c[i]).max(0.0);
+            let hi = (c[i] - x).max(x - (c[i] + half)).max(0.0);
+            slab[i] = [lo * lo, hi * hi];
+        }
+        let base = node as usize * Self::FANOUT;
+        for ci in 0..Self::FANOUT {
+            // SAFETY: `node` is a reached node (the caller's contract), `ci < FANOUT`.
+            let child = unsafe { self.child(base + ci) };
+            if child == EMPTY {
+                continue;
+            }
+            let mut d2 = 0.0;
+            for (i, sl) in slab.iter().enumerate() {
+                d2 += sl[ci >> i & 1];
+            }
+            if d2 > r_sq {
+                continue;
+            }
+            child_centre!(cc = c, ci, q);
+            // SAFETY: a non-empty slot of a reached node of level `level`: a reached leaf
+            // if `level == 1`, else a reached node of level `level - 1`.
+            unsafe {
+                if level == 1 {
+                    self.range_leaf(p, r_sq, child, cc, q, f);
+                } else {
+                    self.range_node(p, r_sq, child, level - 1, cc, q, f);
+                }
+            }
+        }
+    }
+
+    /// Range query inside a leaf (centre `c`, half side `half`).
+    ///
+    /// # Safety
+    ///
+    /// `leaf` is a reached leaf, as for [`visit_leaf`](Self::visit_leaf).
+    #[inline]
+    unsafe fn range_leaf<F: FnMut([f64; D])>(
+        &self,
+        p: &[f64; D],
+        r_sq: f64,
+        leaf: u32,
+        c: [f64; D],
+        half: f64,
+        f: &mut F,
+    ) {
+        let origin = c.map(|x| x - half);
+        // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
+        for code in unsafe { self.leaf_points(leaf) } {
+            let mut x = [0.0; D];
+            let mut d2 = 0.0;
+            for i in 0..D {
+                x[i] = decode(origin[i], code[i], self.step);
+                let e = p[i] - x[i];
+                d2 += e * e;
+            }
+            if d2 <= r_sq {
+                f(x);
+            }
+        }
+    }
+}
