@@ -258,7 +258,7 @@ fn sigterm_as_interrupt(py: Python<'_>) -> PyResult<Option<Py<PyAny>>> {
 }
 
 /// The parameters that differ between a checkpoint's and the call's, named as the keyword
-/// arguments: `birth_gap 5 in the checkpoint, 3 given`. `renames` names a field otherwise
+/// arguments: `step_min 0.1 in the checkpoint, 0.2 given`. `renames` names a field otherwise
 /// (`None`: not compared). Both sides as `serde_json::to_value` gives them.
 pub fn differences(
     checkpointed: serde_json::Result<serde_json::Value>,

@@ -9,6 +9,7 @@ use core_lattice::spec::{DeclaredParams, Input, Kind, ParamSpec};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use sim_run::declared::key_line;
 use std::path::Path;
 
 /// Sets the declared parameters given as keyword arguments `kwargs` of `function` on `p`,
@@ -144,16 +145,6 @@ pub fn declared_rows<P: DeclaredParams>() -> Vec<serde_json::Value> {
         .collect()
 }
 
-/// The 1-based line where `key` is set in `text` (0 if not found).
-fn key_line(text: &str, key: &str) -> usize {
-    text.lines()
-        .position(|l| {
-            l.trim_start()
-                .strip_prefix(key)
-                .is_some_and(|rest| rest.trim_start().starts_with('='))
-        })
-        .map_or(0, |i| i + 1)
-}
 
 /// Reads the TOML file `path` of a model's parameters onto `p`, as the binaries' `--config`
 /// reads one (keys are the declared names, with dashes or underscores; flags that are not

@@ -167,15 +167,14 @@ impl DlaResult {
 /// The model and every parameter are those of the ``dla`` binary (``dla --help``), keyword
 /// names being its flags with dashes as underscores; the defaults are its defaults, from the
 /// library (see :func:`aggsim.defaults`). A seed particle sits at the origin; walkers
-/// (balls of diameter 1) are born on the sphere of radius R_b = R_ext + birth_gap, jump by the
+/// (balls of diameter 1) are born on a sphere just outside the cluster, jump by the
 /// variable-precision distance to the cluster when far from it (Sosa-Herrera &
 /// Rodriguez-Romo, "Variable precision distance search for random fractal cluster
-/// simulations"), take steps of step_min near it, and stick at exact contact. With one thread
+/// simulations"), take short steps near it, and stick at exact contact. With one thread
 /// the run is a pure function of (parameters, seed) and its ``state_hash`` is the binary's.
 ///
-/// The model's parameters (``birth_gap``, ``step_min``, ...) are keyword arguments made from
-/// the library's declaration of them, listed last below; ``dim``, ``particles`` and ``threads``
-/// may also be given by position.
+/// The model's parameters are keyword arguments made from the library's declaration of them,
+/// listed last below; ``dim``, ``particles`` and ``threads`` may also be given by position.
 ///
 /// Parameters
 /// ----------
@@ -189,9 +188,8 @@ impl DlaResult {
 /// threads : int
 ///     Walkers moving at once (PDLA), 1..=1024 (default 1, which is DLA and deterministic).
 /// paper_settings : bool
-///     The variable-precision paper's walk (the binary's ``--paper-settings``):
-///     ``far_field="jump"``, ``death_ratio=100``, ``step_min=0.5``, ``precision=2``,
-///     ``distance_map=False`` (default False). Those five may then not be given.
+///     The variable-precision paper's walk (the binary's ``--paper-settings``, whose help lists
+///     the values it sets) (default False). The parameters it sets may then not be given.
 /// progress : bool or callable
 ///     True prints progress to ``sys.stderr``; a callable is called as
 ///     ``progress(done, total)`` about twice a second (default None: quiet).

@@ -8,9 +8,10 @@ use animat::output::{self, PopulationRow};
 use animat::{Params, World};
 use anyhow::Context;
 use clap::Parser;
-use sim_run::cli::{Model, Own, ParamFlags, RunArgs, flag_differences, usage};
+use sim_run::cli::{ParamFlags, flag_differences, usage};
 use sim_run::ensemble::{Combine, Curve};
 use sim_run::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
+use sim_run::model::{Model, Own, RunArgs};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -213,7 +214,7 @@ impl Model for Animat {
 }
 
 fn main() -> ExitCode {
-    sim_run::cli::model::main::<Animat>()
+    sim_run::model::main::<Animat>()
 }
 
 /// File name of checkpoints in the output directory.

@@ -380,7 +380,7 @@ pub fn write_png(
         log_y: true,
         series,
     };
-    crate::output::write_chart(&chart, path)
+    sim_run::plot::write_chart(&chart, path)
 }
 
 #[cfg(test)]

@@ -400,7 +400,7 @@ pub fn write_png(
         "density; surviving trees (fraction)",
         series,
     );
-    crate::output::write_chart(&chart, path)
+    sim_run::plot::write_chart(&chart, path)
 }
 
 #[cfg(test)]

@@ -7,17 +7,18 @@ use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side_of, write_outputs};
 use dla_pdla::{Dim, Params, ParamsError, SimError, Simulation, Space};
-use sim_run::cli::{Model, Own, ParamFlags, RunArgs, flag_differences, stopped, usage};
+use sim_run::cli::{ParamFlags, flag_differences, stopped, usage};
 use sim_run::ensemble::{Combine, Curve};
 use sim_run::io::RunClock;
+use sim_run::model::{Model, Own, RunArgs};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Off-lattice diffusion-limited aggregation (DLA) and parallel DLA (PDLA), 2D to 5D.
 ///
-/// A seed particle sits at the origin. Walkers (balls of diameter 1) are born on the sphere of
-/// radius R_b = R_ext + birth-gap, jump by the variable-precision distance to the cluster when
-/// far from it, take steps of step-min near it, and stick at exact contact. Outputs go into
+/// A seed particle sits at the origin. Walkers (balls of diameter 1) are born on a sphere just
+/// outside the cluster, jump by the variable-precision distance to the cluster when far from
+/// it, take short steps near it, and stick at exact contact. Outputs go into
 /// --out DIR (see docs/dla.md).
 // The model's flags are made from its one declaration (`ParamFlags<Params>`); `cli_spec_tests`
 // checks them and the docs' table against `dla_pdla::params::PARAMS`.
@@ -30,10 +31,8 @@ struct Cli {
     #[command(flatten)]
     run: RunArgs,
 
-    /// The variable-precision paper's walk, to reproduce its numbers: --far-field jump
-    /// --death-ratio 100 --step-min 0.5 --precision 2 --distance-map off (the step of 0.5
-    /// biases the R_g prefactor about 5 % low against the default; docs/dla.md, "Accuracy").
-    #[arg(long, conflicts_with_all = dla_pdla::params::PAPER_SETTINGS)]
+    // Its help names what it sets, from the declaration.
+    #[arg(long, conflicts_with_all = dla_pdla::params::PAPER_SETTINGS, help = paper_settings_help())]
     paper_settings: bool,
 
     /// Write the positions in arrival order. They stream to positions.npy (float64, shape
@@ -88,6 +87,15 @@ struct Cli {
     /// the memory available (MemAvailable, or a lower cgroup limit).
     #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
     max_memory: Option<u64>,
+}
+
+/// The help of `--paper-settings`.
+fn paper_settings_help() -> String {
+    format!(
+        "The variable-precision paper's walk, to reproduce its numbers: {} (its near-field step \
+         biases the R_g prefactor about 5 % low against the default; docs/dla.md, \"Accuracy\")",
+        Params::paper_settings_flags()
+    )
 }
 
 fn params(cli: &Cli) -> Result<Params, String> {
@@ -284,7 +292,7 @@ impl Model for Dla {
 }
 
 fn main() -> ExitCode {
-    sim_run::cli::model::main::<Dla>()
+    sim_run::model::main::<Dla>()
 }
 
 fn run<const D: usize>(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()>

@@ -205,13 +205,6 @@ where
     Ok(m)
 }
 
-/// Draws `chart` to a PNG at `path` ([`sim_run::plot::write_png`]), for the charts of the
-/// analyses (`branches.png`, `deposit.png`), with its error as an [`OutputError`].
-#[cfg(feature = "figures")]
-pub(crate) fn write_chart(chart: &sim_run::plot::Chart, path: &Path) -> Result<(), OutputError> {
-    sim_run::plot::write_png(chart, path).map_err(|e| std::io::Error::other(e.to_string()).into())
-}
-
 /// The run's manifest, `run.json` as [`write_outputs`] writes it: parameters, seed, the
 /// measurements of `clock` taken now, and every result (`particles`, `radius_of_gyration`,
 /// `r_ext`, `state_hash`, the fractal dimension or `fit_error`, the PDLA and memory figures).

@@ -537,6 +537,28 @@ impl Params {
         }
     }
 
+    /// What `--paper-settings` sets, as flags with their values (`--far-field jump
+    /// --death-ratio 100 ...`), from the declaration and [`paper_settings`](Self::paper_settings):
+    /// the help of every front end says it with this.
+    pub fn paper_settings_flags() -> String {
+        let values = Params::default().paper_settings().to_text();
+        PAPER_SETTINGS
+            .iter()
+            .map(|name| {
+                let flag = Params::DECLARED
+                    .iter()
+                    .find(|d| d.spec.name == *name)
+                    .map_or_else(|| name.replace('_', "-"), |d| d.spec.flag_or_name());
+                let value = values
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map_or("", |(_, v)| v.as_str());
+                format!("{flag} {value}")
+            })
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
     /// [`paper_settings`](Self::paper_settings) for a front end, refusing a field of
     /// [`PAPER_SETTINGS`] that was also given (`given(name)`), since `--paper-settings` would
     /// override it silently. Every front end applies the rule with this: the `dla` binary

@@ -7,10 +7,11 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use dlca::params::{LATTICE_FLAGS, Settings};
 use dlca::{Params, Simulation, Snapshot};
-use sim_run::cli::{Model, Own, ParamFlags, Plain, RunArgs, flag_differences, usage};
+use sim_run::cli::{ParamFlags, Plain, flag_differences, usage};
 use sim_run::ensemble::{Combine, Curve, MemberRun, Pooled, PooledResult};
 use sim_run::io::{Positions, RunClock};
 use sim_run::io::{read_checkpoint, write_checkpoint};
+use sim_run::model::{Model, Own, RunArgs};
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
@@ -259,7 +260,7 @@ impl Model for Dlca {
 }
 
 fn main() -> ExitCode {
-    sim_run::cli::model::main::<Dlca>()
+    sim_run::model::main::<Dlca>()
 }
 
 fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {

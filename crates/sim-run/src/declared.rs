@@ -8,6 +8,18 @@ use core_lattice::spec::{Declared, DeclaredParams, Kind, Range, help_text, show_
 use serde::Serialize;
 use serde_json::{Map, Value};
 
+/// The 1-based line where `key` is set in the TOML text `text` (0 if not found): where a config
+/// file's error is reported, by the binaries' `--config` and by Python's `config=`.
+pub fn key_line(text: &str, key: &str) -> usize {
+    text.lines()
+        .position(|l| {
+            l.trim_start()
+                .strip_prefix(key)
+                .is_some_and(|rest| rest.trim_start().starts_with('='))
+        })
+        .map_or(0, |i| i + 1)
+}
+
 /// How a binary shows its declared parameters as flags: [`Annotated`] or [`Plain`].
 pub trait FlagStyle: 'static {
     /// Whether the help is the declaration's doc as written ([`Plain`]).

@@ -55,6 +55,8 @@ pub mod fuzz;
 pub mod guard;
 pub mod io;
 pub mod memory;
+#[cfg(feature = "cli")]
+pub mod model;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod schema;

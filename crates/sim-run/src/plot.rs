@@ -211,6 +211,15 @@ pub fn write_png(chart: &Chart, path: &Path) -> Result<()> {
         .with_context(|| format!("writing {}", path.display()))
 }
 
+/// [`write_png`] for a model's outputs (the charts of its analyses), with the error as an
+/// [`OutputError`](crate::io::OutputError).
+///
+/// # Errors
+/// The chart cannot be drawn or the file written.
+pub fn write_chart(chart: &Chart, path: &Path) -> std::result::Result<(), crate::io::OutputError> {
+    write_png(chart, path).map_err(|e| std::io::Error::other(format!("{e:#}")).into())
+}
+
 /// Where [`write_png`] puts the point labels of `chart`, in pixels (`None`: left out for want
 /// of room); for checking that they never overlap.
 pub fn label_boxes(chart: &Chart) -> Result<Vec<Option<Rect>>> {

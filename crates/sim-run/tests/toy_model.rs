@@ -1,7 +1,7 @@
 //! "Adding a model" (`docs/architecture.md`), followed to the letter by a test: a toy model
 //! (a biased one-dimensional random walk) declares its parameters once
-//! (`core_lattice::declare_params!`), implements `sim_run::cli::Model` and runs
-//! `sim_run::cli::model::main`, and gets every front end of the contract without a line of its
+//! (`core_lattice::declare_params!`), implements `sim_run::model::Model` and runs
+//! `sim_run::model::main`, and gets every front end of the contract without a line of its
 //! own: flags with their help and ranges, `--config`, `--dump-config`, usage errors that exit 2
 //! and write nothing, the claim of `--out`, `config.toml` that repeats the run, and ensembles.
 //!
@@ -10,9 +10,10 @@
 
 use core_lattice::rng::{RngExt, stream};
 use core_lattice::spec::{End, Range};
-use sim_run::cli::{Model, Own, ParamFlags, RunArgs};
+use sim_run::cli::ParamFlags;
 use sim_run::ensemble::{Combine, Curve};
 use sim_run::io::RunClock;
+use sim_run::model::{Model, Own, RunArgs};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Output};
 
@@ -200,7 +201,7 @@ fn checks() {
 
 fn main() -> ExitCode {
     if std::env::var_os("TOY_MODEL_CHILD").is_some() {
-        return sim_run::cli::model::main::<Toy>();
+        return sim_run::model::main::<Toy>();
     }
     checks();
     println!("toy model: every front end of the contract from one declaration: ok");

@@ -393,7 +393,7 @@ impl AnimatResult {
 /// Performance Optimisation", section II.B). The run is a pure function of (parameters, seed):
 /// its ``state_hash`` is the binary's.
 ///
-/// The model's parameters (``foxes``, ``vision``, ``fox_breed_p``, ...) are keyword arguments
+/// The model's parameters (``foxes``, ``vision``, ...) are keyword arguments
 /// made from the library's declaration of them, listed last below;
 /// ``aggsim.defaults("animat")`` lists every default.
 ///

@@ -10,6 +10,7 @@
 //! config keys. An unknown key, a key that is not allowed or a value of the wrong kind is a
 //! usage error naming the file and the line.
 
+use crate::declared::key_line;
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -99,17 +100,6 @@ fn line_of(text: &str, span: Option<std::ops::Range<usize>>) -> usize {
     span.map_or(0, |s| {
         text[..s.start.min(text.len())].matches('\n').count() + 1
     })
-}
-
-/// The 1-based line where `key` is set in `text` (0 if not found).
-fn key_line(text: &str, key: &str) -> usize {
-    text.lines()
-        .position(|l| {
-            l.trim_start()
-                .strip_prefix(key)
-                .is_some_and(|rest| rest.trim_start().starts_with('='))
-        })
-        .map_or(0, |i| i + 1)
 }
 
 /// `args` with the flags `--config FILE` stands for put first, right after the program name,

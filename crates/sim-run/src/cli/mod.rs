@@ -18,7 +18,6 @@
 
 pub mod checkpoints;
 pub mod config;
-pub mod model;
 mod out_dir;
 pub mod params;
 mod progress;
@@ -27,7 +26,6 @@ mod resume;
 pub use crate::count::{count, count_at_least_1, seed};
 pub use checkpoints::{CheckpointArgs, guard_signals, stopped};
 pub use config::ConfigArgs;
-pub use model::{Model, Own, RunArgs};
 pub(crate) use out_dir::held;
 pub use out_dir::{
     Claim, ClaimError, ENSEMBLE_FILES, EarlierRun, LOCK_FILE, LockHolder, OutDirLock,

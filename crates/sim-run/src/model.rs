@@ -1,5 +1,5 @@
-//! The model contract: what a model binary tells the run machinery ([`Model`]), the flags every
-//! model binary shares ([`RunArgs`]) and the one `main` they all run ([`main`]). The machinery
+//! The model contract (feature `cli`): what a model binary tells the run machinery ([`Model`]),
+//! the flags every model binary shares ([`RunArgs`]) and the one `main` they all run ([`main`]). The machinery
 //! owns the life of a process (the ensemble's and the merge's command lines, parsing with
 //! `--config` and `--dump-config`, logging, the usage-error contract, `--seeds` over child
 //! processes or MPI ranks, the claim of `--out` and its `config.toml`); the model owns its
@@ -7,8 +7,8 @@
 //! memory watch), its result files, curves and pictures. A new model is a library with a
 //! `Params` declaration and a binary that implements [`Model`] and calls [`main`].
 
-use super::config::{self, ConfigArgs};
-use super::{CheckpointArgs, Claim, LogArgs, OutDirLock, OverwriteArgs, main_with_config};
+use crate::cli::config::{self, ConfigArgs};
+use crate::cli::{CheckpointArgs, Claim, LogArgs, OutDirLock, OverwriteArgs, main_with_config};
 use crate::ensemble::{Combine, EnsembleArgs, Owner};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -50,7 +50,7 @@ pub struct RunArgs {
 }
 
 /// A model as the run machinery sees it: implemented by each model binary on a unit type, which
-/// then runs `sim_run::cli::model::main::<ItsModel>()`.
+/// then runs `sim_run::model::main::<ItsModel>()`.
 pub trait Model {
     /// The binary's name: in messages, progress lines and the ensemble's files.
     const NAME: &'static str;
@@ -97,8 +97,8 @@ pub trait Model {
     /// [`Own::take`]), take `--out` with `own`, run under the guard, write the outputs.
     ///
     /// # Errors
-    /// A [`UsageError`](super::UsageError) (see [`usage`](super::usage)) before `--out` is
-    /// taken, an interruption ([`stopped`](super::stopped)), or a failed run.
+    /// A [`UsageError`](crate::cli::UsageError) (see [`usage`](crate::cli::usage)) before `--out` is
+    /// taken, an interruption ([`stopped`](crate::cli::stopped)), or a failed run.
     fn run(cli: &Self::Cli, params: Self::Params, own: Own<'_>) -> anyhow::Result<()>;
 }
 
@@ -116,7 +116,7 @@ impl Own<'_> {
     /// # Errors
     /// A usage error for a directory another run owns; an I/O error writing `config.toml`.
     pub fn take(self) -> anyhow::Result<OutDirLock> {
-        let lock = super::own_out_dir(&self.claim)?;
+        let lock = crate::cli::own_out_dir(&self.claim)?;
         config::save(self.claim.out)
             .with_context(|| format!("writing {}/config.toml", self.claim.out.display()))?;
         Ok(lock)
@@ -126,7 +126,7 @@ impl Own<'_> {
 /// The whole life of model `M`'s binary: the ensemble's and the merge's command lines, then
 /// parsing (with `--config` and `--dump-config`), logging, [`Model::params`] and the check of
 /// `--out`, then either an ensemble of `--seeds` or one [`Model::run`]. Exit codes as in
-/// [`super::main_with`].
+/// [`crate::cli::main_with`].
 pub fn main<M: Model>() -> ExitCode {
     if let Some(code) = crate::ensemble::before_parsing(M::NAME, M::COMBINE) {
         return code;
@@ -136,7 +136,7 @@ pub fn main<M: Model>() -> ExitCode {
         |cli: &M::Cli| M::run_args(cli).log,
         |cli| {
             let params = M::params(cli)?;
-            super::check_out_dir(&M::run_args(cli).out)?;
+            crate::cli::check_out_dir(&M::run_args(cli).out)?;
             Ok(params)
         },
         |cli, params| {
