@@ -28,9 +28,6 @@ struct Cli {
     steps: u64,
 
     #[command(flatten)]
-    run: RunArgs,
-
-    #[command(flatten)]
     params: ParamFlags<Params>,
 
     // Float flags take values starting with `-` (`-inf`), so that validation names the flag;
@@ -93,6 +90,10 @@ struct Cli {
     /// (--steps may grow; output flags may change).
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
+
+    // Seed, --out and how the process runs: after the model's own flags in --help.
+    #[command(flatten)]
+    run: RunArgs,
 }
 
 /// Builds validated parameters: the defaults, then the flags (those of `--config` first).

@@ -28,9 +28,6 @@ struct Cli {
     #[command(flatten)]
     params: ParamFlags<Params>,
 
-    #[command(flatten)]
-    run: RunArgs,
-
     // Its help names what it sets, from the declaration.
     #[arg(long, conflicts_with_all = dla_pdla::params::PAPER_SETTINGS, help = paper_settings_help())]
     paper_settings: bool,
@@ -87,6 +84,10 @@ struct Cli {
     /// the memory available (MemAvailable, or a lower cgroup limit).
     #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
     max_memory: Option<u64>,
+
+    // Seed, --out and how the process runs: after the model's own flags in --help.
+    #[command(flatten)]
+    run: RunArgs,
 }
 
 /// The help of `--paper-settings`.

@@ -33,9 +33,6 @@ struct Cli {
     #[command(flatten)]
     lattice: ParamFlags<Settings, Plain, 0, LATTICE_FLAGS>,
 
-    #[command(flatten)]
-    run: RunArgs,
-
     /// Also save the run's state to OUT/checkpoint.bin every N sweeps (atomically), and keep
     /// it at the end.
     #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
@@ -76,6 +73,10 @@ struct Cli {
     /// particles.xyz (extended XYZ: OVITO, VMD), or none.
     #[arg(long, value_enum, value_name = "FORMAT", default_value_t = Positions::Csv)]
     positions: Positions,
+
+    // Seed, --out and how the process runs: after the model's own flags in --help.
+    #[command(flatten)]
+    run: RunArgs,
 }
 
 /// Turn the flags into validated parameters.
