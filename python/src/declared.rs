@@ -145,7 +145,6 @@ pub fn declared_rows<P: DeclaredParams>() -> Vec<serde_json::Value> {
         .collect()
 }
 
-
 /// Reads the TOML file `path` of a model's parameters onto `p`, as the binaries' `--config`
 /// reads one (keys are the declared names, with dashes or underscores; flags that are not
 /// declared parameters, such as `steps`, are the function's own arguments), and returns the

@@ -21,8 +21,8 @@ use std::process::ExitCode;
 #[derive(Debug, Clone, clap::Args)]
 #[allow(missing_docs)]
 pub struct RunArgs {
-    /// Seed of every random stream of the run: the same seed and flags give the same run
-    /// (for PDLA, with more than one thread, a valid run of the same statistics).
+    /// Seed of every random stream of the run: the same seed and flags give the same run (on
+    /// one thread).
     #[arg(long, default_value_t = 1, value_parser = crate::count::seed)]
     pub seed: u64,
 
