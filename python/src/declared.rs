@@ -145,6 +145,14 @@ pub fn declared_rows<P: DeclaredParams>() -> Vec<serde_json::Value> {
         .collect()
 }
 
+/// What [`read_config`] read besides the parameters it set.
+pub struct ConfigRead {
+    /// The parameters the file set.
+    pub given: Vec<&'static str>,
+    /// The numbers of the front end's own keys (`extra`), by name.
+    pub extras: Vec<(String, f64)>,
+}
+
 /// Reads the TOML file `path` of a model's parameters onto `p`, as the binaries' `--config`
 /// reads one (keys are the declared names, with dashes or underscores; flags that are not
 /// declared parameters, such as `steps`, are the function's own arguments), and returns the
@@ -158,7 +166,7 @@ pub fn read_config<P: DeclaredParams>(
     p: &mut P,
     path: &Path,
     extra: &[&str],
-) -> PyResult<(Vec<&'static str>, Vec<(String, f64)>)> {
+) -> PyResult<ConfigRead> {
     let shown = path.display();
     let text = std::fs::read_to_string(path)
         .map_err(|e| PyValueError::new_err(format!("config {shown}: cannot read it: {e}")))?;
@@ -228,5 +236,5 @@ pub fn read_config<P: DeclaredParams>(
             .map_err(|e| PyValueError::new_err(format!("{at}: `{key}` = {value}: {e}")))?;
         given.push(d.spec.name);
     }
-    Ok((given, extras))
+    Ok(ConfigRead { given, extras })
 }

@@ -129,3 +129,6 @@ def test_a_config_file_key_that_is_not_a_parameter_is_refused(tmp_path):
     with pytest.raises(ValueError) as e:
         aggsim.AnimatWorld(config=config)
     assert str(e.value).startswith(f"config {config}, line 2: `foxes` = \"many\""), str(e.value)
+    config.write_text("start_radius = 30\ndensity = 0.1\n")
+    with pytest.raises(ValueError, match="start_radius cannot be used with density"):
+        aggsim.animat(config=config)

@@ -48,8 +48,15 @@ impl Args<'_, '_> {
         let mut p = Params::default();
         let mut density = None;
         if let Some(path) = &self.config {
-            let (_, extras) = read_config(&mut p, path, &["density"])?;
-            density = extras.into_iter().map(|(_, d)| d).next_back();
+            let read = read_config(&mut p, path, &["density"])?;
+            density = read.extras.into_iter().map(|(_, d)| d).next_back();
+            // As the binary, whose --start-radius and --density conflict in a config file too.
+            if density.is_some() && read.given.contains(&"start_radius") {
+                return Err(value_error(format!(
+                    "config {}: start_radius cannot be used with density (it sets the start radius)",
+                    path.display()
+                )));
+            }
         }
         let given = set_keywords(&mut p, PARAMS, self.function, POSITIONAL, self.keywords)?;
         let radius_given = given.iter().any(|g| g == "start_radius");
