@@ -224,11 +224,9 @@ impl ParamValue for GridBox {
     const KIND: Kind = Kind::Text;
     const PYTHON: &'static str = "GridBox";
     fn from_input(v: &Input) -> Result<Self, String> {
+        // Every front end gives a text value its text (Python's ints too).
         match v {
-            Input::Text(s) | Input::Choice(s) => s.parse(),
-            Input::Count(n) => i64::try_from(*n)
-                .map(GridBox::Side)
-                .map_err(|_| format!("grid box {n} is too large")),
+            Input::Text(s) => s.parse(),
             other => Err(format!(
                 "expected `none`, `vision` or a positive integer, not {other:?}"
             )),
