@@ -4,7 +4,7 @@
 //! `positions.npy` and `growth.csv`), so `--resume DIR` continues a checkpoint written from
 //! Python and the other way round.
 //!
-//! A run with a checkpoint polls a `sim_run::guard::Guard`: its watch thread requests a
+//! A run with a checkpoint polls a `run_io::guard::Guard`: its watch thread requests a
 //! checkpoint every `checkpoint_interval` and a stop when memory is about to run out, and the
 //! waiting thread (`run::interruptible_guarded`) requests a stop on `KeyboardInterrupt` or an
 //! exception of the callback. For the run's duration SIGTERM raises `KeyboardInterrupt`, as
@@ -13,7 +13,7 @@
 use crate::convert::{run_error, value_error};
 use pyo3::exceptions::{PyKeyboardInterrupt, PyMemoryError, PyValueError};
 use pyo3::prelude::*;
-use sim_run::guard::{Guard, MemoryWatch, Request, StopReason, Watch};
+use run_io::guard::{Guard, MemoryWatch, Request, StopReason, Watch};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 /// Default of `checkpoint_interval`, seconds: the binaries' `--checkpoint-interval`.
-pub const DEFAULT_INTERVAL: f64 = sim_run::guard::DEFAULT_INTERVAL.as_secs() as f64;
+pub const DEFAULT_INTERVAL: f64 = run_io::guard::DEFAULT_INTERVAL.as_secs() as f64;
 
 /// The binaries' name of a checkpoint in a run's directory.
 pub const FILE: &str = "checkpoint.bin";

@@ -6,7 +6,7 @@ use pyo3::exceptions::{PyOverflowError, PyRuntimeError, PyTypeError, PyValueErro
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat, PyList};
 use serde_json::Value;
-use sim_run::io::RunManifest;
+use run_io::RunManifest;
 
 /// A JSON value as the Python object `json.loads` would give.
 pub fn json<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {

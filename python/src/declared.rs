@@ -9,7 +9,7 @@ use core_lattice::spec::{DeclaredParams, Input, Kind, ParamSpec};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
-use sim_run::declared::key_line;
+use run_cli::declared::key_line;
 use std::path::Path;
 
 /// Sets the declared parameters given as keyword arguments `kwargs` of `function` on `p`,

@@ -15,7 +15,7 @@ use numpy::IntoPyArray;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use sim_run::io::RunClock;
+use run_io::RunClock;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
 

@@ -1,6 +1,6 @@
 //! The binaries' figures from results: `dla.png`, `dla.gif`, `dlca.png` and the animat
 //! snapshots, drawn by the libraries' own picture code (`dla_pdla::picture`,
-//! `dlca::picture`, `animat::output::SnapshotFrame`, all framed by `sim_run::figure`) from the
+//! `dlca::picture`, `animat::output::SnapshotFrame`, all framed by `figures`) from the
 //! arrays and results a result object holds, so that a file equals the binary's for the same
 //! run byte for byte.
 
@@ -8,9 +8,9 @@ use crate::convert::{Count, count, value_error};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
-use sim_run::figure::animation::ANIMATION_MAX_SIDE;
-use sim_run::figure::{PNG_SIZE_MAX, PNG_SIZE_MIN};
-use sim_run::io::OutputError;
+use figures::animation::ANIMATION_MAX_SIDE;
+use figures::{PNG_SIZE_MAX, PNG_SIZE_MIN};
+use run_io::OutputError;
 use std::path::PathBuf;
 
 /// The side of a picture in pixels, as `--png-size` takes it: a count in

@@ -43,8 +43,8 @@ struct Registered {
     positional: &'static [&'static str],
     /// The argument of the signatures the declared keywords come before (empty: at the end).
     before: &'static str,
-    /// The output schema (`sim_run::schema`).
-    schema: &'static [sim_run::schema::Output],
+    /// The output schema (`run_io::schema`).
+    schema: &'static [run_io::schema::Output],
 }
 
 /// Every model of the package.
@@ -145,7 +145,7 @@ fn declared_table<'py>(py: Python<'py>, model: &str) -> PyResult<Bound<'py, PyAn
 }
 
 /// The output schema of ``model`` (``"dla"``, ``"dlca"`` or ``"animat"``), from the library
-/// (``sim_run::schema``): a list of dicts, one per file, with ``file`` (a positions set: its
+/// (``run_io::schema``): a list of dicts, one per file, with ``file`` (a positions set: its
 /// stem), ``form`` (``kind`` ``"csv"`` or ``"points"``, with the coordinates' ``axes``, ``dtype``
 /// and ``unit``), ``python`` (the result's attribute), ``when`` and ``columns`` (``name``,
 /// ``dtype`` as NumPy names it, ``unit``, ``when``, ``labels``, ``measured``). The tests check

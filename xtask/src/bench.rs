@@ -4,8 +4,8 @@
 
 use crate::report::{build_id, machine, utc_now};
 use anyhow::{Context, Result, bail};
+use run_io::{RunManifest, write_atomic};
 use serde::{Deserialize, Serialize};
-use sim_run::io::{RunManifest, write_atomic};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;

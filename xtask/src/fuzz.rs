@@ -1,7 +1,7 @@
 //! `cargo xtask fuzz [--cases N] [--only TEXT]`: the fuzz targets of every reader of a file a
 //! user can hand the programs, run with many cases. Each target is one proptest test in the
-//! reader's crate (`fuzz_*`, inputs from `sim_run::fuzz`); `cargo test` runs a few cases of
-//! each (`sim_run::fuzz::DEFAULT_CASES`), this runs `--cases` of each (default 1e5) through
+//! reader's crate (`fuzz_*`, inputs from `run_cli::fuzz`); `cargo test` runs a few cases of
+//! each (`run_cli::fuzz::DEFAULT_CASES`), this runs `--cases` of each (default 1e5) through
 //! `AGGSIM_FUZZ_CASES`, one target at a time, and prints the cases and seconds per reader. A
 //! failing case is shrunk by proptest and its seed saved under the crate's
 //! `proptest-regressions/`, so it stays a regression test.
@@ -32,35 +32,35 @@ const FUZZ: &[&str] = &["--test", "fuzz"];
 /// Every fuzz target, one per reader.
 pub const TARGETS: &[Target] = &[
     Target {
-        reader: "checkpoint envelope (sim_run::io::checkpoint)",
+        reader: "checkpoint envelope (run_io::checkpoint)",
         package: "sim-run",
         select: SIM_RUN,
         file: "crates/sim-run/src/fuzz.rs",
         test: "fuzz::tests::fuzz_checkpoint_envelope",
     },
     Target {
-        reader: ".npy reader (sim_run::io::npy)",
+        reader: ".npy reader (run_io::npy)",
         package: "sim-run",
         select: SIM_RUN,
         file: "crates/sim-run/src/fuzz.rs",
         test: "fuzz::tests::fuzz_npy_reader",
     },
     Target {
-        reader: "run.json (sim_run::io::manifest)",
+        reader: "run.json (run_io::manifest)",
         package: "sim-run",
         select: SIM_RUN,
         file: "crates/sim-run/src/fuzz.rs",
         test: "fuzz::tests::fuzz_run_manifest",
     },
     Target {
-        reader: "--config TOML (sim_run::cli::config)",
+        reader: "--config TOML (run_cli::cli::config)",
         package: "sim-run",
         select: SIM_RUN,
         file: "crates/sim-run/src/fuzz.rs",
         test: "fuzz::tests::fuzz_config_file",
     },
     Target {
-        reader: "--merge members (sim_run::ensemble::merge)",
+        reader: "--merge members (run_cli::ensemble::merge)",
         package: "sim-run",
         select: SIM_RUN,
         file: "crates/sim-run/src/fuzz.rs",

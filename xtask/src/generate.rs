@@ -6,7 +6,7 @@
 //! the test suite, so in CI) fails when a file is not what this would write.
 
 use anyhow::{Context, Result};
-use sim_run::declared::{Plain, docs_table, docs_table_in, pyi_keywords, replace_generated};
+use run_cli::declared::{Plain, docs_table, docs_table_in, pyi_keywords, replace_generated};
 use std::path::Path;
 
 /// Parameters `aggsim.dla` takes as its own arguments (by position too), not among the

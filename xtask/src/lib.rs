@@ -9,7 +9,7 @@ pub mod ci;
 pub mod codemap;
 pub mod fuzz;
 pub mod generate;
-pub mod plot;
+
 pub mod probe;
 pub mod quoted;
 pub mod report;

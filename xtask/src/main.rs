@@ -63,7 +63,7 @@ enum Cmd {
         #[arg(long)]
         out: Option<PathBuf>,
         /// Base seed; the runs of an ensemble use seed, seed + 1, ...
-        #[arg(long, default_value_t = 1, value_parser = sim_run::count::count::<u64>)]
+        #[arg(long, default_value_t = 1, value_parser = run_io::count::count::<u64>)]
         seed: u64,
         /// Run size: overrides --quick (`tiny` is the harness test's size).
         #[arg(long, value_enum, hide = true)]
@@ -101,7 +101,7 @@ enum Cmd {
         only: Option<String>,
         /// Run every workload this many times, in rounds, and keep each one's fastest run
         /// (for shared or noisy machines; every repeat's time is in the JSON).
-        #[arg(long, default_value_t = 1, value_parser = sim_run::count::count_at_least_1::<usize>)]
+        #[arg(long, default_value_t = 1, value_parser = run_io::count::count_at_least_1::<usize>)]
         repeat: usize,
         /// Count instructions instead of timing: 2D and 3D DLA at 1e6, one thread, under
         /// `valgrind --tool=cachegrind --cache-sim=no` (a few minutes; the same count on a busy
@@ -115,7 +115,7 @@ enum Cmd {
     /// memory read, docs/benchmarks.md "DLA at scale"). Run it on a quiet machine.
     Latency {
         /// Largest working set, in bytes (suffixes K, M, G).
-        #[arg(long, default_value = "4G", value_parser = sim_run::memory::parse_bytes)]
+        #[arg(long, default_value = "4G", value_parser = run_io::memory::parse_bytes)]
         max: u64,
         /// Dependent loads timed per size.
         #[arg(long, default_value_t = 20_000_000)]
@@ -130,7 +130,7 @@ enum Cmd {
     /// mutated valid files; prints cases and seconds per reader (xtask/src/fuzz.rs).
     Fuzz {
         /// Cases per reader.
-        #[arg(long, default_value_t = 100_000, value_parser = sim_run::count::count::<u64>)]
+        #[arg(long, default_value_t = 100_000, value_parser = run_io::count::count::<u64>)]
         cases: u64,
         /// Only readers (or tests) whose name contains this text.
         #[arg(long)]

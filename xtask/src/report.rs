@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result};
 use core_lattice::Welford;
-use sim_run::io::{CsvField, CsvWriter, write_atomic};
+use run_io::{CsvField, CsvWriter, write_atomic};
 use std::fmt::Write as _;
 use std::path::Path;
 use std::time::SystemTime;
@@ -126,12 +126,12 @@ pub fn std_dev(xs: &[f64]) -> f64 {
 
 /// Today's date and time in UTC, `YYYY-MM-DD HH:MM UTC`, from the system clock.
 pub fn utc_now() -> String {
-    sim_run::io::provenance::utc_minutes(SystemTime::now())
+    run_io::provenance::utc_minutes(SystemTime::now())
 }
 
 /// The build: `aggsim 0.1.0 at commit <hash>` (the commit when built from a git checkout).
 pub fn build_id() -> String {
-    match sim_run::io::provenance::GIT_COMMIT {
+    match run_io::provenance::GIT_COMMIT {
         Some(c) => format!("aggsim {} at commit {c}", env!("CARGO_PKG_VERSION")),
         None => format!(
             "aggsim {} (not built from a git checkout)",
@@ -142,7 +142,7 @@ pub fn build_id() -> String {
 
 /// One line describing the machine: CPU model, logical cores, memory, kernel, rustc.
 pub fn machine() -> String {
-    let cpu = sim_run::io::provenance::cpu_model();
+    let cpu = run_io::provenance::cpu_model();
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);

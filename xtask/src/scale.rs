@@ -17,8 +17,8 @@ use crate::bench::{build, target_dir};
 use crate::report::{Doc, Table, build_id, machine, pm, sig, utc_now};
 use anyhow::{Context, Result, bail};
 use core_lattice::Fit;
+use run_io::RunManifest;
 use serde::Deserialize;
-use sim_run::io::RunManifest;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -1,6 +1,6 @@
 //! The files generated from the parameter declarations are what `cargo xtask generate` writes.
 
-use sim_run::declared::check_generated;
+use run_cli::declared::check_generated;
 
 #[test]
 fn generated_blocks_are_current() {

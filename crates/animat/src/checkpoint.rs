@@ -1,6 +1,6 @@
 //! What a checkpoint of an animat run holds ([`Saved`]), shared by the `animat` binary
 //! (`--resume`) and the Python bindings (`checkpoint=`), so that either continues the other's.
-//! It is written in `sim_run::io`'s checksummed envelope under model [`CHECKPOINT_MODEL`], to
+//! It is written in `run_io`'s checksummed envelope under model [`CHECKPOINT_MODEL`], to
 //! [`CHECKPOINT_FILE`] in the run's directory.
 
 use crate::output::PopulationRow;
@@ -24,7 +24,7 @@ pub struct Saved {
 /// Memory a checkpoint of `world` with `rows` population rows needs while it is written,
 /// beside the world itself: the snapshot and its encoding, 128 bytes an animat and 128 a row
 /// (each holds a few dozen), and 16 MiB for buffers. Front ends keep this free
-/// (`sim_run::guard::MemoryWatch::reserve`).
+/// (`run_io::guard::MemoryWatch::reserve`).
 pub fn reserve_bytes(world: &crate::World, rows: usize) -> u64 {
     (16 << 20) + 128 * (world.foxes() + world.rabbits()) + 128 * rows as u64
 }

@@ -8,10 +8,10 @@ use animat::output::{self, PopulationRow};
 use animat::{Params, World};
 use anyhow::Context;
 use clap::Parser;
-use sim_run::cli::{ParamFlags, flag_differences, usage};
-use sim_run::ensemble::{Combine, Curve};
-use sim_run::io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
-use sim_run::model::{Model, Own, RunArgs};
+use run_cli::cli::{ParamFlags, flag_differences, usage};
+use run_cli::ensemble::{Combine, Curve};
+use run_cli::model::{Model, Own, RunArgs};
+use run_io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -21,10 +21,10 @@ use std::process::ExitCode;
 /// win); every model parameter is a flag and a config key. Outputs go into --out DIR: run.json,
 /// populations.csv, and on request PNG snapshots and positions.csv (see docs/animat.md).
 #[derive(Parser, Debug)]
-#[command(name = "animat", version = sim_run::cli::version(), allow_negative_numbers = true)]
+#[command(name = "animat", version = run_cli::cli::version(), allow_negative_numbers = true)]
 struct Cli {
     /// Steps to run.
-    #[arg(long, value_parser = sim_run::cli::count::<u64>, default_value_t = animat::params::DEFAULT_STEPS)]
+    #[arg(long, value_parser = run_cli::cli::count::<u64>, default_value_t = animat::params::DEFAULT_STEPS)]
     steps: u64,
 
     #[command(flatten)]
@@ -46,24 +46,24 @@ struct Cli {
     /// one (a dilute world takes 36 KiB per animat): a start that needs more is refused, a run
     /// that grows past it stops with an error. Default: 4 GiB, or the memory available
     /// (MemAvailable, or a lower cgroup limit) if less.
-    #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
+    #[arg(long, value_name = "BYTES", value_parser = run_io::memory::parse_bytes)]
     max_memory: Option<u64>,
 
     /// Write a PNG snapshot every K steps (and of the start and the end): a figure of the world
     /// on the run's fixed frame (axes in cells, scale bar, step, populations, seed, key).
-    #[arg(long, value_parser = sim_run::cli::count::<u64>)]
+    #[arg(long, value_parser = run_cli::cli::count::<u64>)]
     snapshot_every: Option<u64>,
 
     /// Half the side of the one frame of every snapshot and animation frame, in cells around
     /// the origin, 1.. (default: 3 start radii); animats outside it are counted in the header.
-    #[arg(long, value_name = "CELLS", value_parser = sim_run::cli::count::<i64>)]
+    #[arg(long, value_name = "CELLS", value_parser = run_cli::cli::count::<i64>)]
     frame_radius: Option<i64>,
 
     /// Side of the picture in the snapshots and animat.gif in pixels (the axes and legend come
     /// on top), 16 to 65536, at most 16384 with --animate (default: a whole number of pixels
     /// per cell and at least 512, or one per cell up to 1024).
     #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
-        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
+        i64::from(figures::PNG_SIZE_MIN)..=i64::from(figures::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write animat.gif: the world at the start, every --animate-every steps and at the end.
@@ -71,7 +71,7 @@ struct Cli {
     animate: bool,
 
     /// Steps between frames of animat.gif, 1.. (default: a hundredth of --steps).
-    #[arg(long, value_name = "N", requires = "animate", value_parser = sim_run::cli::count::<u64>)]
+    #[arg(long, value_name = "N", requires = "animate", value_parser = run_cli::cli::count::<u64>)]
     animate_every: Option<u64>,
 
     /// Write every live animat at the end (id, species, x, y, age, hunger): positions.csv
@@ -82,7 +82,7 @@ struct Cli {
 
     /// Also save the run to OUT/checkpoint.bin every N steps, and keep one at the end
     /// (atomically), so that --resume with a larger --steps goes on from there.
-    #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
+    #[arg(long, value_name = "N", value_parser = run_cli::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
     /// Continue the run saved in DIR/checkpoint.bin (a checkpoint, or a stopped run) to the same state
@@ -108,7 +108,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.frame_radius == Some(0) {
         return Err("--frame-radius 0 is outside the accepted range 1..".into());
     }
-    sim_run::figure::animation::check_picture_flags(
+    figures::animation::check_picture_flags(
         cli.png_size,
         cli.animate,
         cli.animate_every,
@@ -145,8 +145,8 @@ fn params(cli: &Cli) -> Result<Params, String> {
 const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
 /// The memory the run may take: `--max-memory`, else 4 GiB or the memory available if less.
-fn memory_limit(cli: &Cli) -> sim_run::memory::Limit {
-    sim_run::memory::Limit::with_default_cap(cli.max_memory, DEFAULT_MAX_MEMORY)
+fn memory_limit(cli: &Cli) -> run_io::memory::Limit {
+    run_io::memory::Limit::with_default_cap(cli.max_memory, DEFAULT_MAX_MEMORY)
 }
 
 /// The files of a run in --out besides run.json, checkpoint.bin and config.toml: what makes a directory an
@@ -170,10 +170,7 @@ const CURVES: &[Curve] = &[Curve {
     log_x: false,
     log_y: false,
     // The species' colours of the snapshots.
-    colours: &[
-        sim_run::figure::palette::FOX,
-        sim_run::figure::palette::RABBIT,
-    ],
+    colours: &[figures::palette::FOX, figures::palette::RABBIT],
 }];
 
 /// The animat model as the run machinery sees it.
@@ -215,7 +212,7 @@ impl Model for Animat {
 }
 
 fn main() -> ExitCode {
-    sim_run::model::main::<Animat>()
+    run_cli::model::main::<Animat>()
 }
 
 /// File name of checkpoints in the output directory.
@@ -338,7 +335,7 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
     while world.steps() < cli.steps {
         if guard.is_set() {
             let at = || format!("after step {}", world.steps());
-            sim_run::cli::checkpoints::honour(
+            run_cli::cli::checkpoints::honour(
                 &guard,
                 enabled,
                 &cli.run.out,
@@ -406,7 +403,7 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
     } else {
         // A checkpoint the run did not ask for (a timed one, or the one it was resumed from)
         // goes.
-        sim_run::cli::checkpoints::remove_unasked_checkpoint(&cli.run.out, false)
+        run_cli::cli::checkpoints::remove_unasked_checkpoint(&cli.run.out, false)
             .context("removing checkpoint.bin")?;
     }
     if let Some(k) = cli.snapshot_every {

@@ -11,15 +11,15 @@
 
 use crate::params::Species;
 use crate::world::{StepStats, World};
-use sim_run::io::{
+use run_io::{
     Attribute, Coords, CsvWriter, PointFormat, PointSet, RunClock, RunManifest, write_points,
 };
 use std::path::Path;
 
-pub use sim_run::io::OutputError;
-use sim_run::schema::{Axes, Column, Dtype, Form, Output, output};
+pub use run_io::OutputError;
+use run_io::schema::{Axes, Column, Dtype, Form, Output, output};
 
-// The snapshots and the animation draw with `sim_run::figure` (plotting, colour maps, GIF):
+// The snapshots and the animation draw with `figures` (plotting, colour maps, GIF):
 // behind feature `figures`, so that the library alone builds without them.
 #[cfg(feature = "figures")]
 mod figures;
@@ -34,7 +34,7 @@ pub use figures::{
 pub const SPECIES_NAMES: [&str; 2] = [Species::Fox.name(), Species::Rabbit.name()];
 
 /// Every output of `animat` with its columns, names, dtypes and units (`docs/outputs.md`; see
-/// [`sim_run::schema`]). The writers below take their headers and attribute names from it.
+/// [`run_io::schema`]). The writers below take their headers and attribute names from it.
 pub const SCHEMA: &[Output] = &[
     Output {
         file: "populations.csv",
@@ -130,7 +130,7 @@ pub fn write_populations(
     Ok(())
 }
 
-/// Writes `positions.<format>` (see [`sim_run::io::points`]): every live animat at the
+/// Writes `positions.<format>` (see [`run_io::points`]): every live animat at the
 /// end, in id order, with its `id`, `species` (0 fox, 1 rabbit in `.npy` and VTK; the name in
 /// CSV and XYZ), `age` and `hunger`.
 ///
@@ -219,7 +219,7 @@ mod schema_tests {
     #[test]
     fn the_outputs_document_lists_the_schema() {
         let doc = include_str!("../../../docs/outputs.md");
-        sim_run::schema::check_doc(doc, "## `animat`", SCHEMA);
+        run_io::schema::check_doc(doc, "## `animat`", SCHEMA);
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! location is refused before any work with exit code 2, one line on stderr naming the culprit,
 //! and nothing created.
 
-use sim_run::testing::refusals;
+use run_cli::testing::refusals;
 use std::path::Path;
 use std::process::Command;
 
@@ -45,7 +45,7 @@ fn fixtures(dir: &Path) {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    sim_run::testing::broken_checkpoints(dir, "dlca");
+    run_cli::testing::broken_checkpoints(dir, "dlca");
 }
 
 #[test]

@@ -142,7 +142,7 @@ fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
     cmd.args(world)
         .args(steps)
         .args(["--checkpoint-every", "5", "--out", cut.to_str().unwrap()]);
-    if !sim_run::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+    if !run_cli::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
         eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
     }
 
@@ -171,7 +171,7 @@ fn a_run_killed_and_resumed_ends_like_the_uninterrupted_run() {
         .args(steps)
         .args(["--checkpoint-every", "5", "--out", term.to_str().unwrap()]);
     let (running, code) =
-        sim_run::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+        run_cli::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
     if running {
         assert_eq!(code, Some(130));
     }
@@ -291,7 +291,7 @@ fn a_quiet_run_without_a_terminal_sends_a_heartbeat_and_qq_silences_it() {
 #[test]
 fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::provenance_and_color_contract(
+    run_cli::testing::provenance_and_color_contract(
         Path::new(env!("CARGO_BIN_EXE_animat")),
         dir.path(),
         &["--steps", "5", "--seed", "2"],
@@ -493,7 +493,7 @@ fn snapshots_share_one_frame_and_the_animation_has_its_frames() {
     let steps = run_json(&out)["results"]["steps"].as_u64().unwrap();
     assert_eq!(steps, 40);
     // Steps 0, 15, 30 and 40.
-    let (gif_size, frames) = sim_run::figure::animation::read_gif(&out.join("animat.gif")).unwrap();
+    let (gif_size, frames) = figures::animation::read_gif(&out.join("animat.gif")).unwrap();
     assert_eq!(frames, 4);
     assert_eq!(gif_size, first);
 }

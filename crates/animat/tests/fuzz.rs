@@ -1,6 +1,6 @@
-//! Fuzz targets of `animat`'s reader of checkpoints (`sim_run::fuzz`): `--resume DIR`
+//! Fuzz targets of `animat`'s reader of checkpoints (`run_cli::fuzz`): `--resume DIR`
 //! (`checkpoint.bin`: the envelope, the world's snapshot and its checks in `World::restore`);
-//! `--config FILE` is the binaries' one config reader, fuzzed in `sim_run`. Arbitrary bytes and mutations of
+//! `--config FILE` is the binaries' one config reader, fuzzed in `run_cli`. Arbitrary bytes and mutations of
 //! valid files (the checkpoint's checksum made right again, so the state's decoding is
 //! reached) give a typed error or a valid world, never a panic, a hang or an allocation sized
 //! by a corrupted field. `cargo xtask fuzz` runs many more cases.
@@ -8,8 +8,8 @@
 use animat::output::PopulationRow;
 use animat::{Params, Snapshot, World};
 use proptest::prelude::*;
-use sim_run::fuzz::{cases, checkpoint_payload, mutate, seal_checkpoint};
-use sim_run::io::checkpoint::{decode_checkpoint, encode_checkpoint};
+use run_cli::fuzz::{cases, checkpoint_payload, mutate, seal_checkpoint};
+use run_io::checkpoint::{decode_checkpoint, encode_checkpoint};
 use std::sync::OnceLock;
 
 /// What the binary's checkpoint holds (its `Saved`: the world, then the population rows;

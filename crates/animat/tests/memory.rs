@@ -1,9 +1,9 @@
-//! Memory checked before the work (`sim_run::memory`): an `animat` run whose estimated start
+//! Memory checked before the work (`run_io::memory`): an `animat` run whose estimated start
 //! does not fit `--max-memory` (4 GiB, or the memory available if less, by default) is refused
 //! with exit code 2 and one line; the estimate bounds the measured peak RSS from above.
 
 use animat::Params;
-use sim_run::testing::memory_contract;
+use run_cli::testing::memory_contract;
 use std::path::Path;
 
 const ANIMAT: &str = env!("CARGO_BIN_EXE_animat");

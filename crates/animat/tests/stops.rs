@@ -3,7 +3,7 @@
 //! (exit code 1), and `--resume` ends it with the uninterrupted run's state hash; a run that
 //! ends normally leaves no `checkpoint.bin`.
 
-use sim_run::testing::stop_contract;
+use run_cli::testing::stop_contract;
 use std::path::Path;
 
 #[test]

@@ -17,7 +17,7 @@
 
 use animat::params::{ANIMAT_BYTES, MAX_ANIMATS, MAX_RADIUS};
 use animat::{GridBox, Params, Species, World};
-use sim_run::testing::refusals;
+use run_cli::testing::refusals;
 use std::collections::HashSet;
 use std::path::Path;
 

@@ -94,7 +94,7 @@ impl Branches {
     pub fn from_npy(path: &std::path::Path, n: u64) -> Result<Self, String> {
         use std::io::{Read, Seek, SeekFrom};
         let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-        let header = sim_run::io::NpyReader::open_ints(path).map_err(|e| what(&e))?;
+        let header = run_io::NpyReader::open_ints(path).map_err(|e| what(&e))?;
         if header.rows() != n {
             return Err(what(&format!("{} parents, not {n}", header.rows())));
         }
@@ -112,7 +112,7 @@ impl Branches {
                 let start = end.saturating_sub(BLOCK);
                 let bytes = &mut buf[..((end - start) * 8) as usize];
                 let read = file
-                    .seek(SeekFrom::Start(sim_run::io::npy::HEADER_BYTES + start * 8))
+                    .seek(SeekFrom::Start(run_io::npy::HEADER_BYTES + start * 8))
                     .and_then(|_| file.read_exact(bytes));
                 if let Err(e) = read {
                     failed = Some(what(&e));
@@ -252,51 +252,51 @@ impl Branches {
 }
 
 /// `branches.csv` in the schema: a row per Horton-Strahler order.
-pub const BRANCHES: sim_run::schema::Output = sim_run::schema::Output {
+pub const BRANCHES: run_io::schema::Output = run_io::schema::Output {
     file: "branches.csv",
-    form: sim_run::schema::Form::Csv,
+    form: run_io::schema::Form::Csv,
     python: "branches",
     // Whenever the parents are recorded: a run that streams its positions (the default, for
     // its checkpoints, or `--positions`).
     when: None,
     columns: &[
-        sim_run::schema::Column::new(
+        run_io::schema::Column::new(
             "order",
-            sim_run::schema::Dtype::Uint64,
+            run_io::schema::Dtype::Uint64,
             "Horton-Strahler order k",
         ),
-        sim_run::schema::Column::new(
+        run_io::schema::Column::new(
             "branches",
-            sim_run::schema::Dtype::Uint64,
+            run_io::schema::Dtype::Uint64,
             "N_k, branches of order k",
         ),
-        sim_run::schema::Column::new(
+        run_io::schema::Column::new(
             "particles",
-            sim_run::schema::Dtype::Uint64,
+            run_io::schema::Dtype::Uint64,
             "particles of order k",
         ),
-        sim_run::schema::Column::new(
+        run_io::schema::Column::new(
             "mean_length",
-            sim_run::schema::Dtype::Float64,
+            run_io::schema::Dtype::Float64,
             "L_k, particles per branch",
         ),
-        sim_run::schema::Column::new(
+        run_io::schema::Column::new(
             "bifurcation_ratio",
-            sim_run::schema::Dtype::Float64,
+            run_io::schema::Dtype::Float64,
             "N_k / N_(k+1) (empty at the highest order)",
         ),
-        sim_run::schema::Column::new(
+        run_io::schema::Column::new(
             "length_ratio",
-            sim_run::schema::Dtype::Float64,
+            run_io::schema::Dtype::Float64,
             "L_(k+1) / L_k (empty at the highest order)",
         ),
     ],
 };
 
 /// Writes `branches.csv` (see [`BRANCHES`]) into `dir`.
-pub fn write_csv(b: &Branches, dir: &std::path::Path) -> Result<(), sim_run::io::OutputError> {
+pub fn write_csv(b: &Branches, dir: &std::path::Path) -> Result<(), run_io::OutputError> {
     let names: Vec<&str> = BRANCHES.columns.iter().map(|c| c.name).collect();
-    let mut w = sim_run::io::CsvWriter::create(dir.join(BRANCHES.file), &names)?;
+    let mut w = run_io::CsvWriter::create(dir.join(BRANCHES.file), &names)?;
     for (o, (rb, rl)) in b.orders.iter().zip(b.ratios()) {
         let text = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
         w.row(&[
@@ -320,8 +320,8 @@ pub fn write_png(
     particles: u64,
     seed: u64,
     path: &std::path::Path,
-) -> Result<(), sim_run::io::OutputError> {
-    use sim_run::plot::{Chart, Series, Style};
+) -> Result<(), run_io::OutputError> {
+    use figures::chart::{Chart, Series, Style};
     let pts = |y: &dyn Fn(&Order) -> f64| -> Vec<(f64, f64)> {
         b.orders
             .iter()
@@ -372,7 +372,7 @@ pub fn write_png(
     let chart = Chart {
         title: format!(
             "Horton-Strahler branches, {} particles, seed {seed}",
-            sim_run::figure::group_digits(particles)
+            figures::group_digits(particles)
         ),
         x_label: "order k".into(),
         y_label: "N_k and L_k".into(),
@@ -380,7 +380,7 @@ pub fn write_png(
         log_y: true,
         series,
     };
-    sim_run::plot::write_chart(&chart, path)
+    figures::chart::write_chart(&chart, path)
 }
 
 #[cfg(test)]

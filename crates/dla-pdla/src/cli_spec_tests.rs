@@ -8,11 +8,11 @@ use super::Cli;
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
 use dla_pdla::params::{PARAMS, Params, defaults};
-use sim_run::declared::{check_generated, docs_table};
-use sim_run::spec_check::{CliSpec, DocColumns};
+use run_cli::declared::{check_generated, docs_table};
+use run_cli::spec_check::{CliSpec, DocColumns};
 
 /// Flags of `dla` that are not model parameters, beyond the run flags every binary has
-/// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
+/// (`run_cli::spec_check::SHARED_RUN_FLAGS`).
 const NOT_PARAMS: &[&str] = &[
     "paper-settings",
     "png",
@@ -50,7 +50,7 @@ fn the_docs_list_every_run_flag() {
     assert_eq!(rows[0], ["flag", "default", "meaning"]);
     let mut listed: Vec<String> = rows[1..]
         .iter()
-        .flat_map(|r| sim_run::spec_check::flags_of(&r[0]))
+        .flat_map(|r| run_cli::spec_check::flags_of(&r[0]))
         .collect();
     listed.extend(PARAMS.iter().map(|s| format!("--{}", s.flag.unwrap())));
     for a in Cli::command().get_arguments() {

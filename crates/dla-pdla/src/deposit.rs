@@ -16,8 +16,8 @@
 //! Memory: 4 bytes a particle (each particle's tree) while the analysis runs, plus a few
 //! numbers per layer and per tree.
 
+use run_io::schema::{Column, Dtype, Form, Output};
 use serde::Serialize;
-use sim_run::schema::{Column, Dtype, Form, Output};
 
 /// `deposit.csv`: one row per layer of one diameter.
 pub const DEPOSIT: Output = Output {
@@ -302,15 +302,15 @@ impl Deposit {
 }
 
 /// Writes `deposit.csv` and `deposit_growth.csv` into `dir`.
-pub fn write_csv(d: &Deposit, dir: &std::path::Path) -> Result<(), sim_run::io::OutputError> {
+pub fn write_csv(d: &Deposit, dir: &std::path::Path) -> Result<(), run_io::OutputError> {
     let names: Vec<&str> = DEPOSIT.columns.iter().map(|c| c.name).collect();
-    let mut w = sim_run::io::CsvWriter::create(dir.join(DEPOSIT.file), &names)?;
+    let mut w = run_io::CsvWriter::create(dir.join(DEPOSIT.file), &names)?;
     for (k, trees) in d.surviving_trees().into_iter().enumerate() {
         w.row(&[&(k as f64), &d.layers[k], &d.density(k), &trees])?;
     }
     w.finish()?;
     let names: Vec<&str> = DEPOSIT_GROWTH.columns.iter().map(|c| c.name).collect();
-    let mut w = sim_run::io::CsvWriter::create(dir.join(DEPOSIT_GROWTH.file), &names)?;
+    let mut w = run_io::CsvWriter::create(dir.join(DEPOSIT_GROWTH.file), &names)?;
     for b in &d.blocks {
         w.row(&[
             &b.n,
@@ -325,7 +325,7 @@ pub fn write_csv(d: &Deposit, dir: &std::path::Path) -> Result<(), sim_run::io::
 }
 
 /// The deposit's results in `run.json`.
-pub fn set_results(m: &mut sim_run::io::RunManifest, d: &Deposit) {
+pub fn set_results(m: &mut run_io::RunManifest, d: &Deposit) {
     let fit = d.density_dimension();
     let trees = d.tree_mass_exponent();
     let range = d
@@ -352,8 +352,8 @@ pub fn write_png(
     d: &Deposit,
     seed: u64,
     path: &std::path::Path,
-) -> Result<(), sim_run::io::OutputError> {
-    use sim_run::plot::{Chart, Series, Style};
+) -> Result<(), run_io::OutputError> {
+    use figures::chart::{Chart, Series, Style};
     let mid = |k: usize| k as f64 + 0.5;
     let density: Vec<(f64, f64)> = (0..d.layers.len())
         .filter(|&k| d.layers[k] > 0)
@@ -394,13 +394,13 @@ pub fn write_png(
             "Deposit, {}D, width {}, {} particles, seed {seed}",
             d.dim,
             d.width,
-            sim_run::figure::group_digits(d.particles)
+            figures::group_digits(d.particles)
         ),
         "height h (diameters)",
         "density; surviving trees (fraction)",
         series,
     );
-    sim_run::plot::write_chart(&chart, path)
+    figures::chart::write_chart(&chart, path)
 }
 
 #[cfg(test)]

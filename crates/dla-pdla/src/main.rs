@@ -7,10 +7,10 @@ use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side_of, write_outputs};
 use dla_pdla::{Dim, Params, ParamsError, SimError, Simulation, Space};
-use sim_run::cli::{ParamFlags, flag_differences, stopped, usage};
-use sim_run::ensemble::{Combine, Curve};
-use sim_run::io::RunClock;
-use sim_run::model::{Model, Own, RunArgs};
+use run_cli::cli::{ParamFlags, flag_differences, stopped, usage};
+use run_cli::ensemble::{Combine, Curve};
+use run_cli::model::{Model, Own, RunArgs};
+use run_io::RunClock;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -23,7 +23,7 @@ use std::process::ExitCode;
 // The model's flags are made from its one declaration (`ParamFlags<Params>`); `cli_spec_tests`
 // checks them and the docs' table against `dla_pdla::params::PARAMS`.
 #[derive(Parser, Debug)]
-#[command(name = "dla", version = sim_run::cli::version(), allow_negative_numbers = true)]
+#[command(name = "dla", version = run_cli::cli::version(), allow_negative_numbers = true)]
 struct Cli {
     #[command(flatten)]
     params: ParamFlags<Params>,
@@ -46,7 +46,7 @@ struct Cli {
     /// to. With one thread a run continued with --resume ends with the same state_hash; with
     /// more (PDLA), a checkpoint ends a parallel phase at a quiescent point, and a resumed run
     /// is a valid PDLA cluster.
-    #[arg(long, value_parser = sim_run::cli::count::<u64>, value_name = "N")]
+    #[arg(long, value_parser = run_cli::cli::count::<u64>, value_name = "N")]
     checkpoint_every: Option<u64>,
 
     /// Continue the run checkpointed in DIR (checkpoint.bin and positions.npy). The run flags
@@ -67,7 +67,7 @@ struct Cli {
     /// 16 to 65536, at most 16384 with --animate (default: dla.png one pixel per diameter, 512
     /// to 4096; dla.gif 512).
     #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
-        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
+        i64::from(figures::PNG_SIZE_MIN)..=i64::from(figures::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write dla.gif: the growth of the cluster, one frame every --animate-every particles and
@@ -76,13 +76,13 @@ struct Cli {
     animate: bool,
 
     /// Particles between frames of dla.gif, 1.. (default: a hundredth of --particles).
-    #[arg(long, value_name = "N", requires = "animate", value_parser = sim_run::cli::count::<u64>)]
+    #[arg(long, value_name = "N", requires = "animate", value_parser = run_cli::cli::count::<u64>)]
     animate_every: Option<u64>,
 
     /// Memory the run may take, in bytes; suffixes K, M, G, T (powers of 1024). A run whose
     /// estimated peak (docs/dla.md, "Memory") is larger is refused before it starts. Default:
     /// the memory available (MemAvailable, or a lower cgroup limit).
-    #[arg(long, value_name = "BYTES", value_parser = sim_run::memory::parse_bytes)]
+    #[arg(long, value_name = "BYTES", value_parser = run_io::memory::parse_bytes)]
     max_memory: Option<u64>,
 
     // Seed, --out and how the process runs: after the model's own flags in --help.
@@ -127,18 +127,18 @@ fn params(cli: &Cli) -> Result<Params, String> {
         ));
     }
     cli.run.checkpoints.check(cli.checkpoint_every)?;
-    sim_run::figure::animation::check_picture_flags(
+    figures::animation::check_picture_flags(
         cli.png_size,
         cli.animate,
         cli.animate_every,
         cli.png,
         "--png",
     )?;
-    if cli.positions == PositionsFormat::Vtk && p.particles > sim_run::io::points::VTK_MAX_POINTS {
+    if cli.positions == PositionsFormat::Vtk && p.particles > run_io::points::VTK_MAX_POINTS {
         return Err(format!(
             "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
              use --positions npy",
-            sim_run::io::points::VTK_MAX_POINTS,
+            run_io::points::VTK_MAX_POINTS,
             p.particles
         ));
     }
@@ -182,7 +182,7 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
             ""
         }
     );
-    sim_run::memory::Limit::from_flag(cli.max_memory).check(
+    run_io::memory::Limit::from_flag(cli.max_memory).check(
         p.peak_memory_bytes().saturating_add(png),
         &what,
         "lower --particles",
@@ -293,7 +293,7 @@ impl Model for Dla {
 }
 
 fn main() -> ExitCode {
-    sim_run::model::main::<Dla>()
+    run_cli::model::main::<Dla>()
 }
 
 fn run<const D: usize>(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()>
@@ -373,7 +373,7 @@ where
     let m = write_outputs(&sim, &clock, &cli.run.out, cli.positions, png)?;
     // What only the checkpoints needed goes, the checkpoint first (it refers to the
     // positions); what was asked for stays.
-    sim_run::cli::checkpoints::remove_unasked_checkpoint(
+    run_cli::cli::checkpoints::remove_unasked_checkpoint(
         &cli.run.out,
         cli.checkpoint_every.is_some(),
     )

@@ -20,20 +20,20 @@
 
 use crate::sim::{GROWTH, GROWTH_COLUMNS, Simulation};
 use crate::space::{Dim, Space};
-use serde_json::json;
-use sim_run::io::{
+use run_io::{
     AtomicFile, Attribute, Coords, CsvWriter, PointFormat, PointSet, ProcessUsage, RunClock,
     RunManifest, write_points,
 };
+use serde_json::json;
 use std::io::Write;
 use std::path::Path;
 
 pub use crate::sim::{each_particle, each_position};
-pub use sim_run::io::OutputError;
-use sim_run::schema::{Axes, Column, Dtype, Form, Output};
+pub use run_io::OutputError;
+use run_io::schema::{Axes, Column, Dtype, Form, Output};
 
 /// Every output of `dla` with its columns, names, dtypes and units (`docs/outputs.md`; see
-/// [`sim_run::schema`]).
+/// [`run_io::schema`]).
 pub const SCHEMA: &[Output] = &[
     GROWTH,
     crate::branches::BRANCHES,
@@ -467,6 +467,6 @@ mod schema_tests {
     #[test]
     fn the_outputs_document_lists_the_schema() {
         let doc = include_str!("../../../docs/outputs.md");
-        sim_run::schema::check_doc(doc, "## `dla`", SCHEMA);
+        run_io::schema::check_doc(doc, "## `dla`", SCHEMA);
     }
 }

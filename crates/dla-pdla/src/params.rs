@@ -459,7 +459,7 @@ impl ParamsError {
 
 /// Memory a checkpoint needs while it is written, beside the run: the streams' buffers are
 /// flushed and the checkpoint itself is a few kilobytes. Front ends keep this free
-/// (`sim_run::guard::MemoryWatch::reserve`).
+/// (`run_io::guard::MemoryWatch::reserve`).
 pub const CHECKPOINT_RESERVE_BYTES: u64 = 16 << 20;
 
 /// Peak memory of a run, bytes per particle by dimension (2 to 5): an upper bound of the peak

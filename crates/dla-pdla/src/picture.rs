@@ -12,10 +12,10 @@
 
 use crate::sim::{Simulation, each_position};
 use crate::space::{Dim, Space};
-use sim_run::figure::animation::Gif;
-use sim_run::figure::palette::{self, Sequential};
-use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
-use sim_run::io::OutputError;
+use figures::animation::Gif;
+use figures::palette::{self, Sequential};
+use figures::{Extent, Figure, Legend, Raster, group_digits};
+use run_io::OutputError;
 use std::path::Path;
 
 /// How the picture shows particles at its scale and dimension.

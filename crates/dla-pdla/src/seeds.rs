@@ -60,8 +60,8 @@ pub fn read<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
 fn read_npy<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
     // The reader's messages name the file, which `read` names already.
     let prefix = format!("{}: ", path.display());
-    let why = |e: sim_run::io::NpyError| e.to_string().replace(&prefix, "");
-    let mut r = sim_run::io::NpyReader::open(path).map_err(why)?;
+    let why = |e: run_io::NpyError| e.to_string().replace(&prefix, "");
+    let mut r = run_io::NpyReader::open(path).map_err(why)?;
     if r.cols() != D {
         return Err(format!("{} columns, not {D}", r.cols()));
     }

@@ -1,7 +1,7 @@
 //! The usage-error contract of `dla`: every bad flag, checkpoint or output location is refused
 //! before any work with exit code 2, one line on stderr naming the culprit, and nothing created.
 
-use sim_run::testing::{permissions_are_bypassed, refusals};
+use run_cli::testing::{permissions_are_bypassed, refusals};
 use std::path::Path;
 use std::process::Command;
 
@@ -55,7 +55,7 @@ fn fixtures(dir: &Path) {
             "ck3",
         ],
     );
-    sim_run::testing::broken_checkpoints(dir, "animat");
+    run_cli::testing::broken_checkpoints(dir, "animat");
     // A checkpoint without its positions log, and one with another run's log.
     std::fs::create_dir(dir.join("nolog")).unwrap();
     std::fs::copy(

@@ -173,7 +173,7 @@ fn a_run_killed_mid_growth_and_resumed_ends_like_the_uninterrupted_run() {
     cmd.args(run)
         .args(["--checkpoint-every", "20000", "--out"])
         .arg(&cut);
-    if !sim_run::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+    if !run_cli::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
         eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
     }
     let resumed = dir.path().join("resumed");
@@ -202,7 +202,7 @@ fn a_run_killed_mid_growth_and_resumed_ends_like_the_uninterrupted_run() {
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
     let running = child.try_wait().unwrap().is_none();
-    sim_run::testing::send_sigterm(child.id());
+    run_cli::testing::send_sigterm(child.id());
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     if running {
@@ -281,7 +281,7 @@ fn a_failure_after_the_start_is_one_line_with_exit_code_1() {
 #[test]
 fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::provenance_and_color_contract(
+    run_cli::testing::provenance_and_color_contract(
         std::path::Path::new(env!("CARGO_BIN_EXE_dla")),
         dir.path(),
         &["--particles", "200", "--seed", "2"],
@@ -292,7 +292,7 @@ fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
 #[test]
 fn config_files_repeat_runs_and_flags_override_them() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::config_contract(
+    run_cli::testing::config_contract(
         std::path::Path::new(env!("CARGO_BIN_EXE_dla")),
         dir.path(),
         &["--particles", "300", "--seed", "4", "--step-min", "0.2"],
@@ -416,7 +416,7 @@ fn png_size_and_animation() {
     let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
     assert!(side(16) > 64 && side(20) > 64);
     // 100, 200 and the whole cluster of 300.
-    let ((w, h), frames) = sim_run::figure::animation::read_gif(&out.join("dla.gif")).unwrap();
+    let ((w, h), frames) = figures::animation::read_gif(&out.join("dla.gif")).unwrap();
     assert_eq!(frames, 3);
     assert_eq!((w, h), (side(16), side(20)));
 }

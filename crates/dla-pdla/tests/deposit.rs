@@ -361,7 +361,7 @@ fn a_tall_deposit_keeps_its_maps_small_and_valid() {
 #[test]
 fn growth_from_a_seed_set_in_every_format() {
     use dla_pdla::output::{PositionsFormat, write_outputs};
-    use sim_run::io::RunClock;
+    use run_io::RunClock;
     let dir = tempfile::tempdir().unwrap();
     let mut first = Simulation::<2>::new(
         Params {

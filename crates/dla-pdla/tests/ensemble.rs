@@ -6,7 +6,7 @@ use std::path::Path;
 #[test]
 fn ensembles_run_combine_restart_and_merge() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::ensemble_contract(
+    run_cli::testing::ensemble_contract(
         Path::new(env!("CARGO_BIN_EXE_dla")),
         "dla",
         dir.path(),
@@ -30,7 +30,7 @@ fn checkpointed_members_are_resumed() {
         .arg(&ens)
         .args(flags);
     let running =
-        sim_run::testing::kill_group_once_written(&mut cmd, &ens.join("seed-0001/checkpoint.bin"));
+        run_cli::testing::kill_group_once_written(&mut cmd, &ens.join("seed-0001/checkpoint.bin"));
     assert!(running, "the ensemble ended before it could be killed");
     assert!(
         !ens.join("seed-0001/run.json").exists(),
@@ -76,7 +76,7 @@ fn a_member_directory_held_by_a_live_process_is_not_shared() {
     let dir = tempfile::tempdir().unwrap();
     let ens = dir.path().join("ens");
     let held = ens.join("seed-0002");
-    let lock = sim_run::cli::claim_out_dir(&sim_run::cli::Claim::single(&held, &[], None, false))
+    let lock = run_cli::cli::claim_out_dir(&run_cli::cli::Claim::single(&held, &[], None, false))
         .expect("the test holds member 2's directory");
     std::fs::write(held.join("member.log"), "the holder's log\n").unwrap();
     let run = || {

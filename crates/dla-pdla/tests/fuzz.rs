@@ -1,4 +1,4 @@
-//! Fuzz targets of `dla`'s readers of user files (`sim_run::fuzz`): `--resume DIR` reads
+//! Fuzz targets of `dla`'s readers of user files (`run_cli::fuzz`): `--resume DIR` reads
 //! `checkpoint.bin` (the envelope and the model's state) and `positions.npy`. Arbitrary bytes
 //! and mutations of a valid run's files (with the checkpoint's checksum made right again, so
 //! the state's decoding and checks are reached) give a typed error or a valid run, never a
@@ -7,7 +7,7 @@
 
 use dla_pdla::{Params, Simulation};
 use proptest::prelude::*;
-use sim_run::fuzz::{cases, checkpoint_payload, mutate, seal_checkpoint};
+use run_cli::fuzz::{cases, checkpoint_payload, mutate, seal_checkpoint};
 use std::path::Path;
 use std::sync::OnceLock;
 

@@ -1,9 +1,9 @@
-//! Memory checked before the work (`sim_run::memory`): a `dla` run whose estimated peak does
+//! Memory checked before the work (`run_io::memory`): a `dla` run whose estimated peak does
 //! not fit `--max-memory`, or the memory available, is refused with exit code 2 and one line;
 //! the estimate bounds the measured peak RSS from above.
 
 use dla_pdla::Params;
-use sim_run::testing::{memory_contract, refusals};
+use run_cli::testing::{memory_contract, refusals};
 use std::path::Path;
 
 const DLA: &str = env!("CARGO_BIN_EXE_dla");

@@ -137,13 +137,13 @@ mod under_mpirun {
             assert_eq!(p["cpus"], cpus, "seed {seed}: {p}");
             let rank = p["mpi"]["rank"].as_u64().unwrap_or_else(|| panic!("{p}"));
             assert!(rank < 2, "{p}");
-            let share = sim_run::ensemble::node_share(cpus, 2, rank as usize);
+            let share = run_cli::ensemble::node_share(cpus, 2, rank as usize);
             assert_eq!(
                 p["mpi"],
                 serde_json::json!({"rank": rank, "ranks": 2, "cpus": share}),
                 "seed {seed}"
             );
-            assert_eq!(p["host"], sim_run::io::provenance::host_name());
+            assert_eq!(p["host"], run_io::provenance::host_name());
         }
         // `dla: MPI rank 0 dispatched 4 members over 2 ranks in W s of wall time, using C s of
         // CPU itself`

@@ -1,12 +1,12 @@
 //! `--out` belongs to one run: reruns, concurrent runs, stale locks, ensembles and
-//! `--overwrite` (`sim_run::testing::ownership_contract`).
+//! `--overwrite` (`run_cli::testing::ownership_contract`).
 
 use std::path::Path;
 
 #[test]
 fn an_output_directory_belongs_to_one_run() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::ownership_contract(&sim_run::testing::Ownership {
+    run_cli::testing::ownership_contract(&run_cli::testing::Ownership {
         binary: Path::new(env!("CARGO_BIN_EXE_dla")),
         program: "dla",
         dir: dir.path(),

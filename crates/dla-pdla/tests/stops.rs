@@ -3,7 +3,7 @@
 //! code 1), and `--resume` ends it with the uninterrupted run's state hash; a run that ends
 //! normally leaves neither `checkpoint.bin` nor the `positions.npy` only the checkpoints needed.
 
-use sim_run::testing::stop_contract;
+use run_cli::testing::stop_contract;
 use std::path::Path;
 
 #[test]
@@ -25,7 +25,7 @@ fn every_stop_is_a_checkpoint_and_resumes_to_the_uninterrupted_run() {
 #[cfg(unix)]
 #[test]
 fn an_ensemble_signalled_mid_member_continues_to_the_same_members() {
-    use sim_run::testing::state_hash;
+    use run_cli::testing::state_hash;
     use std::process::{Command, Stdio};
     let dla = env!("CARGO_BIN_EXE_dla");
     let dir = tempfile::tempdir().unwrap();
@@ -49,7 +49,7 @@ fn an_ensemble_signalled_mid_member_continues_to_the_same_members() {
     }
     std::thread::sleep(std::time::Duration::from_millis(300));
     let running = child.try_wait().unwrap().is_none();
-    sim_run::testing::send_sigterm(child.id());
+    run_cli::testing::send_sigterm(child.id());
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(running, "the ensemble ended before the signal: {err}");
@@ -104,7 +104,7 @@ fn a_pdla_run_signalled_mid_growth_resumes_to_a_full_cluster() {
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(400));
     let running = child.try_wait().unwrap().is_none();
-    sim_run::testing::send_sigterm(child.id());
+    run_cli::testing::send_sigterm(child.id());
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(running, "the run ended before the signal: {err}");

@@ -23,7 +23,7 @@ use core_lattice::Gyration;
 use dla_pdla::params::{MAX_BIRTH_GAP, MAX_DEATH_RATIO, MAX_PARTICLES};
 use dla_pdla::sim::POSITIONS_FILE;
 use dla_pdla::{Dim, FarField, Params, ParamsError, SimError, Simulation, Space};
-use sim_run::testing::refusals;
+use run_cli::testing::refusals;
 use spatial::distmap::PointMap;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;

@@ -8,11 +8,11 @@ use super::Cli;
 use clap::CommandFactory;
 use core_lattice::spec::markdown_table;
 use dlca::params::{PARAMS, Settings, defaults};
-use sim_run::declared::{Plain, check_generated, docs_table_in};
-use sim_run::spec_check::{CliSpec, DocColumns, flags_of};
+use run_cli::declared::{Plain, check_generated, docs_table_in};
+use run_cli::spec_check::{CliSpec, DocColumns, flags_of};
 
 /// Flags of `dlca` that are not model parameters, beyond the run flags every binary has
-/// (`sim_run::spec_check::SHARED_RUN_FLAGS`).
+/// (`run_cli::spec_check::SHARED_RUN_FLAGS`).
 const NOT_PARAMS: &[&str] = &["png", "png-size", "animate", "animate-every"];
 
 fn spec() -> CliSpec<'static> {

@@ -7,11 +7,11 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use dlca::params::{LATTICE_FLAGS, Settings};
 use dlca::{Params, Simulation, Snapshot};
-use sim_run::cli::{ParamFlags, Plain, flag_differences, usage};
-use sim_run::ensemble::{Combine, Curve, MemberRun, Pooled, PooledResult};
-use sim_run::io::{Positions, RunClock};
-use sim_run::io::{read_checkpoint, write_checkpoint};
-use sim_run::model::{Model, Own, RunArgs};
+use run_cli::cli::{ParamFlags, Plain, flag_differences, usage};
+use run_cli::ensemble::{Combine, Curve, MemberRun, Pooled, PooledResult};
+use run_cli::model::{Model, Own, RunArgs};
+use run_io::{Positions, RunClock};
+use run_io::{read_checkpoint, write_checkpoint};
 
 /// File name of checkpoints in the output directory.
 const CHECKPOINT: &str = "checkpoint.bin";
@@ -28,14 +28,14 @@ use std::process::ExitCode;
 // around the run flags; `cli_spec_tests` checks them and the docs' table against
 // `dlca::params::PARAMS`.
 #[derive(Parser, Debug)]
-#[command(name = "dlca", version = sim_run::cli::version(), allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
+#[command(name = "dlca", version = run_cli::cli::version(), allow_negative_numbers = true, group(ArgGroup::new("amount").required(true).args(["fill", "particles"])))]
 struct Cli {
     #[command(flatten)]
     lattice: ParamFlags<Settings, Plain, 0, LATTICE_FLAGS>,
 
     /// Also save the run's state to OUT/checkpoint.bin every N sweeps (atomically), and keep
     /// it at the end.
-    #[arg(long, value_name = "N", value_parser = sim_run::cli::count_at_least_1::<u64>)]
+    #[arg(long, value_name = "N", value_parser = run_cli::cli::count_at_least_1::<u64>)]
     checkpoint_every: Option<u64>,
 
     /// Continue the run saved in DIR/checkpoint.bin (a checkpoint, or a stopped run) to the same final
@@ -56,7 +56,7 @@ struct Cli {
     /// on top), 16 to 65536, at most 16384 with --animate (default: dlca.png a whole number of
     /// pixels per site and at least 512, or one per site up to 8192; dlca.gif 512).
     #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
-        i64::from(sim_run::figure::PNG_SIZE_MIN)..=i64::from(sim_run::figure::PNG_SIZE_MAX)))]
+        i64::from(figures::PNG_SIZE_MIN)..=i64::from(figures::PNG_SIZE_MAX)))]
     png_size: Option<u32>,
 
     /// Write dlca.gif: the aggregation, a frame of the start, one every --animate-every sweeps
@@ -65,7 +65,7 @@ struct Cli {
     animate: bool,
 
     /// Sweeps between frames of dlca.gif, 1.. (default 10).
-    #[arg(long, value_name = "N", requires = "animate", value_parser = sim_run::cli::count::<u64>)]
+    #[arg(long, value_name = "N", requires = "animate", value_parser = run_cli::cli::count::<u64>)]
     animate_every: Option<u64>,
 
     /// Every particle's final site and cluster id: particles.csv (x1..xd,cluster), particles.npy
@@ -84,7 +84,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     let mut settings = cli.model.params();
     cli.lattice.apply(&mut settings);
     let p = settings.to_params(|name| cli.lattice.given(name) || cli.model.given(name))?;
-    sim_run::figure::animation::check_picture_flags(
+    figures::animation::check_picture_flags(
         cli.png_size,
         cli.animate,
         cli.animate_every,
@@ -101,7 +101,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     } else {
         0
     };
-    sim_run::memory::Limit::from_flag(given).check(
+    run_io::memory::Limit::from_flag(given).check(
         dlca::sim::peak_memory_bytes(&p).saturating_add(picture),
         &format!(
             "{n} particles on {} sites with the {} search",
@@ -261,7 +261,7 @@ impl Model for Dlca {
 }
 
 fn main() -> ExitCode {
-    sim_run::model::main::<Dlca>()
+    run_cli::model::main::<Dlca>()
 }
 
 fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
@@ -336,7 +336,7 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
         }
         if !s.is_done() && guard.is_set() {
             let at = || format!("after sweep {} ({} clusters)", s.sweeps(), s.clusters());
-            sim_run::cli::checkpoints::honour(&guard, enabled, &cli.run.out, || save(s), at)
+            run_cli::cli::checkpoints::honour(&guard, enabled, &cli.run.out, || save(s), at)
                 .inspect_err(|_| progress.finish())?;
         }
     }
@@ -360,7 +360,7 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
         tracing::info!(frames, "dlca.gif");
     }
     // A checkpoint the run did not ask for (a timed one, or the one it was resumed from) goes.
-    sim_run::cli::checkpoints::remove_unasked_checkpoint(
+    run_cli::cli::checkpoints::remove_unasked_checkpoint(
         &cli.run.out,
         cli.checkpoint_every.is_some(),
     )

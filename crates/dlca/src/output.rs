@@ -6,7 +6,7 @@
 //! | `run.json` | manifest: parameters, seed, timings, peak memory, results |
 //! | `sweeps.csv` | `sweep,clusters,largest` (and `seconds` with `--timing`), from sweep 0 |
 //! | `sizes.csv` | `size,count`: the final cluster size distribution |
-//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`sim_run::io::points`]) |
+//! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`run_io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
 //! | `dlca.png` | with `--png`: the figure of the final state, touching clusters in different colours (feature `figures`, see [`crate::picture`]) |
@@ -16,16 +16,16 @@ use crate::analysis::{
     ClusterMeasure, fractal_dimension, gyration, pooled_fractal_dimension, size_distribution,
 };
 use crate::sim::Simulation;
-use serde_json::json;
-use sim_run::io::{
+use run_io::schema::{Axes, Column, Dtype, Form, Output, output};
+use run_io::{
     Attribute, Coords, CsvWriter, OutputError, PointFormat, PointSet, RunClock, write_points,
 };
-use sim_run::schema::{Axes, Column, Dtype, Form, Output, output};
+use serde_json::json;
 use spatial::lattice::ItemId;
 use std::path::Path;
 
 /// Every output of `dlca` with its columns, names, dtypes and units (`docs/outputs.md`; see
-/// [`sim_run::schema`]). The writers below take their headers and attribute names from it.
+/// [`run_io::schema`]). The writers below take their headers and attribute names from it.
 pub const SCHEMA: &[Output] = &[
     Output {
         file: "sweeps.csv",
@@ -99,7 +99,7 @@ pub fn write_outputs(
     dir: &Path,
     png: Option<Option<u32>>,
     positions: Option<PointFormat>,
-) -> Result<sim_run::io::RunManifest, OutputError> {
+) -> Result<run_io::RunManifest, OutputError> {
     // Without feature `figures` the library cannot draw: refused before any file is written.
     if png.is_some() && !cfg!(feature = "figures") {
         let e = std::io::Error::new(
@@ -216,7 +216,7 @@ pub fn manifest(
     seed: u64,
     clock: &RunClock,
     measures: Option<&[ClusterMeasure]>,
-) -> Result<sim_run::io::RunManifest, OutputError> {
+) -> Result<run_io::RunManifest, OutputError> {
     let params = sim.params();
     let mut fit_results = serde_json::Map::new();
     if let Some(measures) = measures {
@@ -370,6 +370,6 @@ mod schema_tests {
     #[test]
     fn the_outputs_document_lists_the_schema() {
         let doc = include_str!("../../../docs/outputs.md");
-        sim_run::schema::check_doc(doc, "## `dlca`", SCHEMA);
+        run_io::schema::check_doc(doc, "## `dlca`", SCHEMA);
     }
 }

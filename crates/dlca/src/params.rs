@@ -195,7 +195,7 @@ pub enum ParamError {
     /// A large allocation of the set-up (the particles' sites, the occupancy lattice) was
     /// refused by the system: not bad input, a run that failed (the binary exits with code 1).
     #[error(transparent)]
-    Alloc(#[from] sim_run::memory::AllocError),
+    Alloc(#[from] run_io::memory::AllocError),
     /// A checkpoint whose state no run can be in (damaged, or made by hand).
     #[error("the saved state is inconsistent: {0}")]
     Checkpoint(String),
@@ -402,14 +402,14 @@ pub mod flags {
     pub fn parse_size(s: &str) -> Result<Vec<u64>, String> {
         s.split('x')
             .map(|p| {
-                sim_run::count::count::<u64>(p.trim())
+                run_io::count::count::<u64>(p.trim())
                     .map_err(|_| format!("'{s}' is not a size like 1024, 1024x512 or 1e3"))
             })
             .collect()
     }
 
     /// `--max-memory`: a byte count, with an optional suffix K, M, G or T (powers of 1024).
-    pub use sim_run::io::parse_bytes;
+    pub use run_io::parse_bytes;
 
     /// The axes of `--dim`, `--size` (the lengths given: one for every axis, or one per axis)
     /// and `--boundary` (`periodic` or `wall` for every axis, or one per axis separated by

@@ -5,16 +5,16 @@
 //! Clusters are coloured so that neighbouring clusters in the picture (less than about a 16th of
 //! its side apart, nothing between them) always differ: a greedy colouring of the graph of
 //! neighbours
-//! ([`sim_run::figure::palette::colour_regions`]) over the Okabe-Ito colours other than black
+//! ([`figures::palette::colour_regions`]) over the Okabe-Ito colours other than black
 //! plus a light grey, on black, every colour at least 4:1 against the background. In an
 //! animation each cluster keeps its previous frame's colour whenever no neighbour has it, so
 //! colours change only where clusters meet.
 
 use crate::sim::Simulation;
-use sim_run::figure::animation::Gif;
-use sim_run::figure::palette::{self, ON_BLACK, colour_regions};
-use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
-use sim_run::io::OutputError;
+use figures::animation::Gif;
+use figures::palette::{self, ON_BLACK, colour_regions};
+use figures::{Extent, Figure, Legend, Raster, group_digits};
+use run_io::OutputError;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -459,7 +459,7 @@ mod tests {
             .count();
         assert!(kept > 0);
         assert_eq!(a.finish().unwrap(), 7);
-        let ((w, h), frames) = sim_run::figure::animation::read_gif(&path).unwrap();
+        let ((w, h), frames) = figures::animation::read_gif(&path).unwrap();
         assert_eq!(frames, 7);
         assert!(w > 48 && h > 48);
     }

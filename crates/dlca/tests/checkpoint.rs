@@ -3,7 +3,7 @@
 
 use core_lattice::Boundary;
 use dlca::{Init, Params, Search, Simulation, Snapshot};
-use sim_run::io::checkpoint::{decode_checkpoint, encode_checkpoint};
+use run_io::checkpoint::{decode_checkpoint, encode_checkpoint};
 
 fn configs() -> Vec<Params> {
     vec![

@@ -188,7 +188,7 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_dlca"));
     cmd.args(run)
         .args(["--checkpoint-every", "50", "--out", cut.to_str().unwrap()]);
-    if !sim_run::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
+    if !run_cli::testing::kill_once_written(&mut cmd, &cut.join("checkpoint.bin")) {
         eprintln!("the run ended before it could be killed; resuming from its last checkpoint");
     }
     let resumed = tmp.path().join("resumed");
@@ -216,7 +216,7 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
     cmd.args(run)
         .args(["--checkpoint-every", "50", "--out", term.to_str().unwrap()]);
     let (running, code) =
-        sim_run::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
+        run_cli::testing::terminate_once_written(&mut cmd, &term.join("checkpoint.bin"));
     if running {
         assert_eq!(code, Some(130));
     }
@@ -243,7 +243,7 @@ fn a_run_killed_mid_run_and_resumed_ends_like_the_uninterrupted_run() {
 #[test]
 fn run_json_has_provenance_and_redirected_logs_have_no_colour_codes() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::provenance_and_color_contract(
+    run_cli::testing::provenance_and_color_contract(
         Path::new(env!("CARGO_BIN_EXE_dlca")),
         dir.path(),
         &["--size", "32", "--fill", "0.05", "--seed", "2"],
@@ -333,7 +333,7 @@ fn positions_in_every_format_hold_the_same_particles() {
 #[test]
 fn config_files_repeat_runs_and_flags_override_them() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::config_contract(
+    run_cli::testing::config_contract(
         Path::new(env!("CARGO_BIN_EXE_dlca")),
         dir.path(),
         &["--size", "32x16", "--fill", "0.05", "--seed", "4", "--png"],
@@ -441,7 +441,7 @@ fn png_size_and_animation() {
     // A 64 x 32 picture with axes and legend around it.
     assert!(side(16) > 64 && side(20) > 32);
     // Sweeps 0, 2, 4 and 5.
-    let ((w, h), frames) = sim_run::figure::animation::read_gif(&out.join("dlca.gif")).unwrap();
+    let ((w, h), frames) = figures::animation::read_gif(&out.join("dlca.gif")).unwrap();
     assert_eq!(frames, 4);
     assert_eq!((w, h), (side(16), side(20)));
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 #[test]
 fn ensembles_run_combine_restart_and_merge() {
     let dir = tempfile::tempdir().unwrap();
-    sim_run::testing::ensemble_contract(
+    run_cli::testing::ensemble_contract(
         Path::new(env!("CARGO_BIN_EXE_dlca")),
         "dlca",
         dir.path(),

@@ -1,4 +1,4 @@
-//! Fuzz target of `dlca`'s reader of user files (`sim_run::fuzz`): `--resume DIR` reads
+//! Fuzz target of `dlca`'s reader of user files (`run_cli::fuzz`): `--resume DIR` reads
 //! `checkpoint.bin` (the envelope, the snapshot and its checks in `Simulation::restore`).
 //! Arbitrary bytes and mutations of a valid checkpoint (its checksum made right again, so the
 //! state's decoding is reached) give a typed error or a valid simulation, never a panic, a
@@ -8,8 +8,8 @@ use core_lattice::Boundary;
 use dlca::params::Init;
 use dlca::{Params, Simulation, Snapshot};
 use proptest::prelude::*;
-use sim_run::fuzz::{cases, checkpoint_payload, mutate, seal_checkpoint};
-use sim_run::io::checkpoint::{decode_checkpoint, encode_checkpoint};
+use run_cli::fuzz::{cases, checkpoint_payload, mutate, seal_checkpoint};
+use run_io::checkpoint::{decode_checkpoint, encode_checkpoint};
 use std::sync::OnceLock;
 
 fn valid_checkpoint() -> &'static Vec<u8> {

@@ -1,11 +1,11 @@
-//! Memory checked before the work (`sim_run::memory`): a `dlca` run whose estimated peak does
+//! Memory checked before the work (`run_io::memory`): a `dlca` run whose estimated peak does
 //! not fit `--max-memory` (when given), or the memory available, is refused with exit code 2
 //! and one line; the estimate bounds the measured peak RSS from above.
 
 use core_lattice::Boundary;
 use dlca::Params;
 use dlca::params::Init;
-use sim_run::testing::{memory_contract, refusals};
+use run_cli::testing::{memory_contract, refusals};
 use std::path::Path;
 
 const DLCA: &str = env!("CARGO_BIN_EXE_dlca");

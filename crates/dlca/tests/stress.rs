@@ -22,7 +22,7 @@ use core_lattice::Boundary;
 use dlca::analysis::{fractal_dimension, gyration};
 use dlca::params::MAX_SIDE;
 use dlca::{Init, Params, Search, Simulation};
-use sim_run::testing::refusals;
+use run_cli::testing::refusals;
 use std::path::Path;
 
 const STRATEGIES: [Search; 5] = [

@@ -16,7 +16,7 @@ use numpy::ndarray::{Array1, Array2};
 use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
-use sim_run::io::{OutputError, RunClock, read_checkpoint, write_checkpoint};
+use run_io::{OutputError, RunClock, read_checkpoint, write_checkpoint};
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;

@@ -3,8 +3,8 @@
 
 use super::{Workload, items};
 use anyhow::{Context, Result, bail};
+use run_io::RunManifest;
 use serde::{Deserialize, Serialize};
-use sim_run::io::RunManifest;
 use std::path::Path;
 use std::process::Command;
 

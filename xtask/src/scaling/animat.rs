@@ -4,12 +4,12 @@
 
 use super::Ctx;
 use super::csvfile::Csv;
-use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, pm, sig};
 use animat::bench::{SCALING_DENSITY, scaling_params, step_throughput};
 use animat::{GridBox, World};
 use anyhow::Result;
 use core_lattice::Fit;
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 
 /// Hawick, James & Scogings (2006), Table I: fitted gradients and their errors, as printed.
@@ -97,7 +97,7 @@ pub fn fig9_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         })
         .collect();
     let path = dir.join("animat_fig9.png");
-    plot::write_png(
+    chart::write_png(
         &Chart::log_log(
             "Animats: neighbour-search seconds per step against population",
             "animats",

@@ -6,9 +6,9 @@
 use super::Ctx;
 use super::csvfile::Csv;
 use super::ensemble::columns;
-use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 
 /// The density profiles, log-binned, per dimension and drift: the data of the charts.
@@ -339,7 +339,7 @@ pub fn charts(dir: &Path) -> Result<Vec<PathBuf>> {
             series,
         );
         let path = dir.join(format!("deposit_{dim}d.png"));
-        plot::write_png(&chart, &path)?;
+        chart::write_png(&chart, &path)?;
         out.push(path);
     }
     Ok(out)

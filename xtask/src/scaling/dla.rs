@@ -6,11 +6,11 @@
 use super::Ctx;
 use super::csvfile::Csv;
 use super::ensemble::Stats;
-use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;
 use core_lattice::Fit;
 use dla_pdla::{Dim, Params, Sample, Simulation, Space};
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -121,7 +121,7 @@ pub fn fig3_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         ));
     }
     let path = dir.join("dla_fig3.png");
-    plot::write_png(
+    chart::write_png(
         &Chart::log_log("DLA run time against N", "particles N", "seconds", series),
         &path,
     )?;

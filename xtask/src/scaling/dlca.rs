@@ -7,12 +7,12 @@
 use super::csvfile::Csv;
 use super::ensemble::columns;
 use super::{Ctx, log_spaced};
-use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Table, mean_stderr, pm, sig};
 use anyhow::{Context, Result, bail};
 use core_lattice::{Boundary, Fit};
 use dlca::record::SweepRecord;
 use dlca::{Init, Params, Search, Simulation};
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 
 const FILLS: [f64; 2] = [0.01, 0.05];
@@ -98,7 +98,7 @@ pub fn fig5_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         })
         .collect::<Result<Vec<_>>>()?;
     let path = dir.join("dlca_fig5.png");
-    plot::write_png(
+    chart::write_png(
         &Chart::log_log(
             format!(
                 "DLCA clusters against sweeps, {}",
@@ -130,7 +130,7 @@ pub fn fig6_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         })
         .collect::<Result<Vec<_>>>()?;
     let path = dir.join("dlca_fig6.png");
-    plot::write_png(
+    chart::write_png(
         &Chart::log_log(
             format!(
                 "DLCA seconds per sweep / clusters, {}",
@@ -168,7 +168,7 @@ pub fn histogram_charts(dir: &Path) -> Result<Vec<PathBuf>> {
             }
         }
         let path = dir.join(format!("dlca_histogram_{}pct.png", (fill * 100.0).round()));
-        plot::write_png(
+        chart::write_png(
             &Chart {
                 title: format!("Candidates examined per move, {} fill, {size}", pct(fill)),
                 x_label: "candidate clusters examined".into(),
@@ -205,7 +205,7 @@ pub fn cost_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         })
         .collect();
     let path = dir.join("dlca_cost.png");
-    plot::write_png(
+    chart::write_png(
         &Chart::log_log(
             format!(
                 "DLCA seconds per sweep against N ({} fill, first {sweeps} sweeps)",

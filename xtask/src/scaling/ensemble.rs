@@ -1,6 +1,6 @@
 //! The experiments' multi-seed runs, made by the models' own ensembles: `PROG --seeds A..=B
 //! [flags] --out DIR`, then `DIR/ensemble.json` read back. "Run seeds, combine" has one
-//! implementation (`sim_run::ensemble`), the one users run; the members stay on disk as
+//! implementation (`run_cli::ensemble`), the one users run; the members stay on disk as
 //! ordinary runs (`DIR/seed-NNNN/`, with `run.json` and the model's CSV files) for inspection.
 
 use super::Ctx;

@@ -5,9 +5,9 @@
 use super::Ctx;
 use super::csvfile::Csv;
 use super::ensemble::columns;
-use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, mean_stderr, pm, sig};
 use anyhow::Result;
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 
 /// `N_k` per order and size, averaged over the clusters: the data of `family_branches.png`.
@@ -42,7 +42,7 @@ pub fn branches_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         series,
     };
     let path = dir.join("family_branches.png");
-    plot::write_png(&chart, &path)?;
+    chart::write_png(&chart, &path)?;
     Ok(vec![path])
 }
 
@@ -377,6 +377,6 @@ pub fn sticking_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         series,
     };
     let path = dir.join("family_sticking.png");
-    plot::write_png(&chart, &path)?;
+    chart::write_png(&chart, &path)?;
     Ok(vec![path])
 }

@@ -1,7 +1,7 @@
 //! The charts of `cargo xtask scaling` as functions of the CSVs the experiments write: each
 //! experiment writes its data and calls its chart's function on the output directory, and
 //! `--replot` calls the same functions on a directory of committed results, so a change of
-//! the charts' style (say, the label placement of `sim_run::plot::place_labels`) redraws every
+//! the charts' style (say, the label placement of `figures::chart::place_labels`) redraws every
 //! chart without running anything.
 
 use anyhow::Result;

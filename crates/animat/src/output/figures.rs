@@ -5,9 +5,9 @@
 use super::OutputError;
 use crate::params::Species;
 use crate::world::World;
-use sim_run::figure::animation::Gif;
-use sim_run::figure::palette;
-use sim_run::figure::{Extent, Figure, Legend, Raster, group_digits};
+use figures::animation::Gif;
+use figures::palette;
+use figures::{Extent, Figure, Legend, Raster, group_digits};
 use std::path::Path;
 
 /// Largest default side of a snapshot's picture in pixels: a larger frame is scaled down.

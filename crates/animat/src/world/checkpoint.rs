@@ -118,7 +118,7 @@ impl World {
 mod tests {
     use super::*;
     use crate::params::GridBox;
-    use sim_run::io::checkpoint::{decode_checkpoint, encode_checkpoint};
+    use run_io::checkpoint::{decode_checkpoint, encode_checkpoint};
 
     fn params(grid_box: GridBox) -> Params {
         Params {

@@ -35,7 +35,7 @@ use spatial::cells::near::{NEAR_ROWS, NEAR_WINDOW_MIN, disc_mask};
 use spatial::cells::{CellIndex, KIND_A, KIND_B, WINDOW_MAX};
 
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
-use sim_run::io::StateHasher;
+use run_io::StateHasher;
 pub use spatial::cells::{TILE, TILE_BYTES};
 use spatial::plane::{BoxSize, PlaneError, PlaneGrid, Pos};
 

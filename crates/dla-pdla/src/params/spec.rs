@@ -11,7 +11,7 @@ pub const PARAMS: &[ParamSpec] = &spec_table::<{ Params::DECLARED.len() }>(Param
 
 /// The default of every parameter of [`PARAMS`], keyed by name, from [`Params::default`].
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
-    sim_run::declared::defaults_of::<Params>()
+    run_io::params_json::defaults_of::<Params>()
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! (`checkpoint.bin`, beside it) holds only what is not in that file: the parameters, the seed,
 //! the walk's random stream, the number of parallel phases run, the particle count `n` and the state hash after the first `n`
 //! rows, the growth samples and the seconds grown. It is a few kilobytes at any size, written
-//! atomically in `sim_run`'s checksummed `AGGSIMCK` envelope (model
+//! atomically in `run_cli`'s checksummed `AGGSIMCK` envelope (model
 //! [`CHECKPOINT_MODEL`]) after `positions.npy` has been flushed and synced.
 //!
 //! The payload is bincode, which is positional and not self-describing: a field added to a
@@ -28,8 +28,8 @@ use crate::error::SimError;
 use crate::params::{FarField, Params};
 use crate::space::{DIMENSIONS, Dim, Space};
 use core_lattice::rng::SimRng;
+use run_io::{CheckpointError, NpyReader, StateHasher};
 use serde::{Deserialize, Serialize};
-use sim_run::io::{CheckpointError, NpyReader, StateHasher};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -168,7 +168,7 @@ impl From<Snapshot<ParamsBeforeVariants>> for Snapshot {
 /// opens with its `dim`, 2 to 5, where a new one has its layout. A payload that is neither is
 /// refused with the error of today's layout.
 fn read_snapshot(path: &Path) -> Result<Snapshot, CheckpointError> {
-    let error = match sim_run::io::read_checkpoint::<Payload>(path, CHECKPOINT_MODEL) {
+    let error = match run_io::read_checkpoint::<Payload>(path, CHECKPOINT_MODEL) {
         Ok(p) if p.layout == LAYOUT => return Ok(p.snapshot),
         Ok(p) => CheckpointError::Decode(format!(
             "payload layout {} (this version reads {LAYOUT})",
@@ -177,7 +177,7 @@ fn read_snapshot(path: &Path) -> Result<Snapshot, CheckpointError> {
         Err(CheckpointError::Decode(e)) => CheckpointError::Decode(e),
         Err(e) => return Err(e),
     };
-    match sim_run::io::read_checkpoint::<Snapshot<ParamsBeforeVariants>>(path, CHECKPOINT_MODEL) {
+    match run_io::read_checkpoint::<Snapshot<ParamsBeforeVariants>>(path, CHECKPOINT_MODEL) {
         Ok(old) if DIMENSIONS.contains(&old.params.dim) => Ok(Snapshot::from(old)),
         _ => Err(error),
     }
@@ -232,7 +232,7 @@ pub(crate) fn write<const D: usize>(
         layout: LAYOUT,
         snapshot: snap,
     };
-    sim_run::io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &payload)?;
+    run_io::write_checkpoint(dir.join(CHECKPOINT_FILE), CHECKPOINT_MODEL, &payload)?;
     Ok(())
 }
 
@@ -420,9 +420,9 @@ mod tests {
         drop(sim);
         let path = dir.path().join(CHECKPOINT_FILE);
         let old = Snapshot::<ParamsBeforeVariants>::from(read_snapshot(&path).unwrap());
-        sim_run::io::write_checkpoint(&path, CHECKPOINT_MODEL, &old).unwrap();
+        run_io::write_checkpoint(&path, CHECKPOINT_MODEL, &old).unwrap();
         // The old payload opens with its dim where today's has its layout.
-        if let Ok(p) = sim_run::io::read_checkpoint::<Payload>(&path, CHECKPOINT_MODEL) {
+        if let Ok(p) = run_io::read_checkpoint::<Payload>(&path, CHECKPOINT_MODEL) {
             assert_eq!(p.layout, 2);
         }
         let mut resumed = Simulation::<2>::resume(dir.path(), None).unwrap();
@@ -435,13 +435,13 @@ mod tests {
             layout: LAYOUT + 1,
             snapshot: Snapshot::from(old),
         };
-        sim_run::io::write_checkpoint(&path, CHECKPOINT_MODEL, &later).unwrap();
+        run_io::write_checkpoint(&path, CHECKPOINT_MODEL, &later).unwrap();
         let e = read_snapshot(&path).err().unwrap().to_string();
         assert!(
             e.contains("payload layout 1002 (this version reads 1001)"),
             "{e}"
         );
-        sim_run::io::write_checkpoint(&path, CHECKPOINT_MODEL, &(1u8, "x")).unwrap();
+        run_io::write_checkpoint(&path, CHECKPOINT_MODEL, &(1u8, "x")).unwrap();
         assert!(matches!(
             read_snapshot(&path),
             Err(CheckpointError::Decode(_))

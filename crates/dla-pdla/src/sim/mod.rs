@@ -38,8 +38,8 @@ use crate::cluster::Cluster;
 use crate::params::{Params, ParamsError};
 use crate::space::{Dim, Space};
 use core_lattice::Fit;
-use sim_run::guard::{Guard, Request, StopReason};
-use sim_run::io::NpyWriter;
+use run_io::NpyWriter;
+use run_io::guard::{Guard, Request, StopReason};
 use spatial::orthtree::Orthtree;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -223,7 +223,7 @@ where
     ) -> Result<bool, SimError> {
         let poll = || {
             if stop.load(Ordering::Relaxed) {
-                Request::Stop(StopReason::Signal(sim_run::guard::PROGRAM_STOP))
+                Request::Stop(StopReason::Signal(run_io::guard::PROGRAM_STOP))
             } else {
                 Request::None
             }
@@ -233,7 +233,7 @@ where
     }
 
     /// Grows to the target while honouring `guard`'s requests (a front end's timed
-    /// checkpoints, signals and memory watch: `sim_run::guard`): a requested checkpoint is
+    /// checkpoints, signals and memory watch: `run_io::guard`): a requested checkpoint is
     /// written and the run goes on; a requested stop writes one and returns its reason. With
     /// `every`, a checkpoint every `every` particles and one at the end as well. With `write`
     /// false nothing is written (a stop just stops). Returns `None` when the target was

@@ -13,8 +13,8 @@ use std::path::Path;
 pub fn each_position<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
-    f: impl FnMut(u64, &[f64; D]) -> Result<(), sim_run::io::OutputError>,
-) -> Result<(), sim_run::io::OutputError> {
+    f: impl FnMut(u64, &[f64; D]) -> Result<(), run_io::OutputError>,
+) -> Result<(), run_io::OutputError> {
     positions_from(sim, dir, f)
 }
 
@@ -26,17 +26,17 @@ pub fn each_position<const D: usize>(
 pub fn each_particle<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
-    mut f: impl FnMut(u64, &[f64; D], Option<i64>) -> Result<(), sim_run::io::OutputError>,
-) -> Result<(), sim_run::io::OutputError> {
+    mut f: impl FnMut(u64, &[f64; D], Option<i64>) -> Result<(), run_io::OutputError>,
+) -> Result<(), run_io::OutputError> {
     if !sim.params().connectivity {
         return positions_from(sim, dir, |i, p| f(i, p, None));
     }
-    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
+    let npy = |e: run_io::NpyError| std::io::Error::other(e.to_string());
     if let Some(parents) = sim.parents() {
         return positions_from(sim, dir, |i, p| f(i, p, parents.get(i as usize).copied()));
     }
     let path = dir.join(PARENTS_FILE);
-    let mut r = sim_run::io::NpyReader::open_ints(&path).map_err(npy)?;
+    let mut r = run_io::NpyReader::open_ints(&path).map_err(npy)?;
     if r.rows() != sim.particles() {
         return Err(std::io::Error::other(format!(
             "{}: {} parents, not {}",
@@ -55,17 +55,17 @@ pub fn each_particle<const D: usize>(
 fn positions_from<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
-    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), sim_run::io::OutputError>,
-) -> Result<(), sim_run::io::OutputError> {
+    mut f: impl FnMut(u64, &[f64; D]) -> Result<(), run_io::OutputError>,
+) -> Result<(), run_io::OutputError> {
     if let Some(pos) = sim.positions() {
         for (i, p) in pos.iter().enumerate() {
             f(i as u64, p)?;
         }
         return Ok(());
     }
-    let npy = |e: sim_run::io::NpyError| std::io::Error::other(e.to_string());
+    let npy = |e: run_io::NpyError| std::io::Error::other(e.to_string());
     let path = dir.join(POSITIONS_FILE);
-    let mut r = sim_run::io::NpyReader::open(&path).map_err(npy)?;
+    let mut r = run_io::NpyReader::open(&path).map_err(npy)?;
     if r.cols() != D || r.rows() != sim.particles() {
         return Err(std::io::Error::other(format!(
             "{}: shape ({}, {}), not ({}, {D})",

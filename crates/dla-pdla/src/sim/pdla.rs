@@ -19,9 +19,9 @@ use crate::params::Params;
 use crate::space::{Dim, Space};
 use crate::walker::{WalkCounts, WalkState, Walker};
 use core_lattice::rng::{Rng, stream, stream_id};
-use parking_lot::Mutex;
 use spatial::orthtree::{OrthtreeError, dist_sq};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard, PoisonError, TryLockError};
 use std::time::Instant;
 
 /// Stream purpose of PDLA walker threads (`stream_id(PURPOSE_PDLA, thread)`).
@@ -163,7 +163,11 @@ where
         error: None,
         needs_room: false,
     });
-    let r_ext0 = log.lock().growth.r_ext;
+    let r_ext0 = log
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .growth
+        .r_ext;
     // Particles stored so far (log positions are absolute: the earlier ones come first).
     let published = Published {
         count: AtomicUsize::new(start),
@@ -220,7 +224,7 @@ where
     stats.walk.add(&walk);
     stats.seconds += started.elapsed().as_secs_f64();
     stats.lock_wait_seconds += wait_nanos.into_inner() as f64 * 1e-9;
-    let mut log = log.into_inner();
+    let mut log = log.into_inner().unwrap_or_else(PoisonError::into_inner);
     stats.discarded += log.guard.total;
     *growth = log.growth;
     match log.error.take() {
@@ -333,12 +337,16 @@ where
 {
     /// Takes the log's mutex, timing the wait when it is contended.
     #[inline]
-    fn lock(&self) -> parking_lot::MutexGuard<'_, Log<D>> {
-        if let Some(g) = self.log.try_lock() {
-            return g;
+    fn lock(&self) -> MutexGuard<'_, Log<D>> {
+        match self.log.try_lock() {
+            Ok(g) => return g,
+            // A thread that panicked holding the log ends the phase with its panic (the
+            // scope re-raises it); the log itself is only appended to, so it stays readable.
+            Err(TryLockError::Poisoned(p)) => return p.into_inner(),
+            Err(TryLockError::WouldBlock) => {}
         }
         let t = Instant::now();
-        let g = self.log.lock();
+        let g = self.log.lock().unwrap_or_else(PoisonError::into_inner);
         self.wait_nanos
             .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         g

@@ -20,7 +20,7 @@ core_lattice::declare_params! {
     /// here, from which the `dlca` binary's flags and config keys, the Python keyword
     /// arguments and stubs and the docs' flag table are made (`docs/architecture.md`, "Adding
     /// a parameter"). The docs are the flags' help as written (the binary shows them in the
-    /// `Plain` style of `sim_run::cli::ParamFlags`), so each states its unit and range.
+    /// `Plain` style of `run_cli::cli::ParamFlags`), so each states its unit and range.
     /// [`Settings::to_params`] makes the engine's [`Params`], whose validation checks the
     /// ranges.
     #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -269,7 +269,7 @@ impl ParamValue for Sweeps {
     }
     fn parse_text(s: &str) -> Result<Self, String> {
         s.split(',')
-            .map(|x| sim_run::count::count::<u64>(x.trim()))
+            .map(|x| run_io::count::count::<u64>(x.trim()))
             .collect::<Result<_, _>>()
             .map(Sweeps)
     }

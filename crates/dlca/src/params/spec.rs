@@ -17,7 +17,7 @@ pub const PARAMS: &[ParamSpec] = &spec_table::<{ Settings::DECLARED.len() }>(Set
 /// `null` where the front end must be given a value (`size`, and one of `fill` and
 /// `particles`) or where none means a choice (`max_sweeps`: no limit, `grid_box`: chosen).
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
-    sim_run::declared::defaults_of::<Settings>()
+    run_io::params_json::defaults_of::<Settings>()
 }
 
 #[cfg(test)]

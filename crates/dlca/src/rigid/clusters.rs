@@ -155,11 +155,11 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         sets: &SiteSets,
         geo: Geometry<D>,
         frame: F,
-    ) -> Result<Self, sim_run::memory::AllocError> {
+    ) -> Result<Self, run_io::memory::AllocError> {
         let lattice = sets.lattice().clone();
         let n = sets.id_bound();
         let cells =
-            sim_run::memory::try_vec(lattice.volume() as usize, EMPTY, "the occupancy lattice")?;
+            run_io::memory::try_vec(lattice.volume() as usize, EMPTY, "the occupancy lattice")?;
         let mut r = Rigid {
             frame,
             single: None,

@@ -59,7 +59,7 @@ pub(crate) enum RigidError {
     Side(u64),
     /// The occupancy lattice could not be allocated.
     #[error(transparent)]
-    Alloc(#[from] sim_run::memory::AllocError),
+    Alloc(#[from] run_io::memory::AllocError),
 }
 
 /// Defines [`RigidStore`] with one pair of variants (general frame, power-of-two frame) per

@@ -13,7 +13,7 @@ use spatial::lattice::ItemId;
 
 /// The state of a run between two sweeps: `Simulation::restore` continues it to the same final
 /// state as an uninterrupted run. Serialisable with serde (the `dlca` binary writes it in
-/// `sim_run::io`'s checkpoint envelope).
+/// `run_io`'s checkpoint envelope).
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct Snapshot {
     pub(super) params: Params,

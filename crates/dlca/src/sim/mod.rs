@@ -25,7 +25,7 @@ pub(crate) fn chosen_search(params: &Params, lattice: &Lattice, particles: u64) 
 /// Memory a checkpoint of a run with `particles` particles needs while it is written, beside
 /// the run itself: the snapshot (8 bytes a site and a little per cluster) and its encoding,
 /// 50 bytes a particle for both, and 16 MiB for buffers. Front ends keep this free
-/// (`sim_run::guard::MemoryWatch::reserve`).
+/// (`run_io::guard::MemoryWatch::reserve`).
 pub fn checkpoint_reserve_bytes(particles: u64) -> u64 {
     (16 << 20) + 50 * particles
 }
@@ -71,7 +71,7 @@ use crate::store::{ClusterArrays, ClusterStore, Engine};
 use core_lattice::Lattice;
 use core_lattice::rng::{DirectionSampler, SimRng, shuffle, stream, stream_id, uniform01};
 use placement::{initial_clusters, place_particles};
-use sim_run::io::StateHasher;
+use run_io::StateHasher;
 use spatial::lattice::{ItemId, SiteSets};
 use std::time::Instant;
 

@@ -7,7 +7,7 @@
 
 use core_lattice::Lattice;
 use core_lattice::rng::{SimRng, uniform01};
-use sim_run::memory::{AllocError, try_reserve, try_vec};
+use run_io::memory::{AllocError, try_reserve, try_vec};
 
 /// `n` distinct sites drawn uniformly (rejection sampling), in draw order. Taken sites are
 /// tracked in a bitset (one bit per site) when the lattice has at most 64 sites per particle,

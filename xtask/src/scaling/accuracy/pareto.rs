@@ -2,9 +2,9 @@
 //! charts, and the charts drawn again from a sweep's CSV.
 
 use super::Setting;
-use crate::plot::{self, Chart, Series, Style};
 use anyhow::{Context, Result};
 use dla_pdla::{FarField, Params};
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 
 /// The first columns of a sweep's `<stem>.csv` (the run's size, the setting and its cost), as
@@ -66,7 +66,7 @@ pub(super) fn pareto_chart(
         vec![at(0)],
         Style::Highlight,
     ));
-    plot::write_png(
+    chart::write_png(
         &Chart {
             title: title.into(),
             x_label: "microseconds per particle".into(),
@@ -76,7 +76,8 @@ pub(super) fn pareto_chart(
             series,
         },
         path,
-    )
+    )?;
+    Ok(())
 }
 
 /// The accuracy sweeps' stems and the titles of their charts (`{dim}` and `{n}` filled in from

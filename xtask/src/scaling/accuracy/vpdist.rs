@@ -1,13 +1,13 @@
 //! The distribution of `vpdist`'s errors against the exact nearest distance, around a grown 2D
 //! cluster: how far below the truth the variable-precision bound sits at each precision.
 
-use crate::plot::{self, Chart, Series, Style};
 use crate::report::{Doc, Table, sig};
 use crate::scaling::Ctx;
 use crate::scaling::csvfile::Csv;
 use anyhow::Result;
 use core_lattice::rng::{stream, uniform01};
 use dla_pdla::{Params, Simulation};
+use figures::chart::{self, Chart, Series, Style};
 use std::path::{Path, PathBuf};
 
 /// The distribution of `(d - vpdist) / d` over query points around a grown cluster.
@@ -132,7 +132,7 @@ pub fn vpdist_chart(dir: &Path) -> Result<Vec<PathBuf>> {
         })
         .collect();
     let path = dir.join("accuracy_vpdist.png");
-    plot::write_png(
+    chart::write_png(
         &Chart {
             title: "vpdist: fraction of queries with relative error above a level".into(),
             x_label: "relative error (d - vpdist) / d".into(),
