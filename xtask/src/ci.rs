@@ -63,22 +63,23 @@ pub const STEPS: &[Step] = &[
         needs: Needs::Rust,
         run: Run::Cargo("clippy --workspace --all-targets -- -D warnings", &[]),
     },
-    // The model libraries build without the command line (feature `cli`), as the Python
-    // bindings use them; core-lattice builds without serde, as spatial uses it.
+    // The model libraries build alone, without their command line, figures and files (the
+    // simulation alone); run-io without its files; core-lattice without serde, as spatial
+    // uses it.
     Step {
         name: "libraries-alone",
         needs: Needs::Rust,
         run: Run::Cargo(
             concat!(
-                "clippy -p dlca -p dla-pdla -p animat -p spatial -p core-lattice",
+                "clippy -p dlca -p dla-pdla -p animat -p spatial -p core-lattice -p run-io",
                 " --no-default-features -- -D warnings"
             ),
             &[],
         ),
     },
-    // ... and with their pictures (feature `figures`) but still without the command line, as
-    // the Python bindings build them. How many packages each library alone needs is held by
-    // xtask/tests/library_deps.rs (the tests step).
+    // ... and with their figures (feature `figures`, with their files) but still without the
+    // command line, as the Python bindings build them. How many packages each library alone
+    // needs is held by xtask/tests/library_deps.rs (the tests step).
     Step {
         name: "libraries-figures",
         needs: Needs::Rust,

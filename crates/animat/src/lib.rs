@@ -20,8 +20,10 @@
 //! ```
 
 pub mod bench;
+#[cfg(feature = "files")]
 pub mod checkpoint;
 mod hint;
+#[cfg(feature = "files")]
 pub mod output;
 pub mod params;
 pub mod world;

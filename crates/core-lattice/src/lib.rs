@@ -15,8 +15,8 @@
 //! - [`cpu`]: the processor features the build was compiled for, checked at start.
 //!
 //! Feature `serde` (default) makes lattices, random streams and statistics serialisable, for
-//! checkpoints and manifests. Everything around a run (outputs, checkpoints, the command line,
-//! ensembles, plots) is in the crate `sim-run`.
+//! checkpoints and manifests. Everything around a run is in the crates `run-io` (outputs,
+//! checkpoints), `run-cli` (the command line, ensembles) and `figures`.
 //!
 //! Conventions: a run is a pure function of its parameters and seed; bad input is a typed error,
 //! never a panic.

@@ -91,6 +91,7 @@ impl Branches {
     ///
     /// # Errors
     /// The file does not read or is not `n` parents forming a forest.
+    #[cfg(feature = "files")]
     pub fn from_npy(path: &std::path::Path, n: u64) -> Result<Self, String> {
         use std::io::{Read, Seek, SeekFrom};
         let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
@@ -294,6 +295,7 @@ pub const BRANCHES: run_io::schema::Output = run_io::schema::Output {
 };
 
 /// Writes `branches.csv` (see [`BRANCHES`]) into `dir`.
+#[cfg(feature = "files")]
 pub fn write_csv(b: &Branches, dir: &std::path::Path) -> Result<(), run_io::OutputError> {
     let names: Vec<&str> = BRANCHES.columns.iter().map(|c| c.name).collect();
     let mut w = run_io::CsvWriter::create(dir.join(BRANCHES.file), &names)?;

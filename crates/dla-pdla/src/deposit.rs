@@ -302,6 +302,7 @@ impl Deposit {
 }
 
 /// Writes `deposit.csv` and `deposit_growth.csv` into `dir`.
+#[cfg(feature = "files")]
 pub fn write_csv(d: &Deposit, dir: &std::path::Path) -> Result<(), run_io::OutputError> {
     let names: Vec<&str> = DEPOSIT.columns.iter().map(|c| c.name).collect();
     let mut w = run_io::CsvWriter::create(dir.join(DEPOSIT.file), &names)?;
@@ -325,6 +326,7 @@ pub fn write_csv(d: &Deposit, dir: &std::path::Path) -> Result<(), run_io::Outpu
 }
 
 /// The deposit's results in `run.json`.
+#[cfg(feature = "files")]
 pub fn set_results(m: &mut run_io::RunManifest, d: &Deposit) {
     let fit = d.density_dimension();
     let trees = d.tree_mass_exponent();

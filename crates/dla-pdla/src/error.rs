@@ -23,6 +23,7 @@ pub enum SimError {
     Map(#[from] DistanceMapError),
     /// A checkpoint could not be written or read (the message says so).
     #[error(transparent)]
+    #[cfg(feature = "files")]
     Checkpoint(#[from] run_io::CheckpointError),
     /// Checkpoints need one thread and the positions kept in memory; or a checkpoint does not
     /// match the run it should continue (the message says which).

@@ -41,6 +41,7 @@ pub mod deposit;
 pub mod error;
 pub mod farfield;
 mod near;
+#[cfg(feature = "files")]
 pub mod output;
 pub mod params;
 #[cfg(feature = "figures")]

@@ -9,7 +9,9 @@ use core_lattice::spec::{DeclaredParams, End, Input, Kind, ParamValue, Range, Ra
 use serde::{Deserialize, Serialize};
 
 mod spec;
-pub use spec::{PARAMS, defaults};
+pub use spec::PARAMS;
+#[cfg(feature = "files")]
+pub use spec::defaults;
 
 /// What happens to a walker outside the birth sphere (`|p| > R_b`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -29,7 +29,10 @@ pub fn read<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
         .to_ascii_lowercase();
     let at = |why: String| format!("--seed-set {}: {why}", path.display());
     let seeds = match ext.as_str() {
+        #[cfg(feature = "files")]
         "npy" => read_npy::<D>(path),
+        #[cfg(not(feature = "files"))]
+        "npy" => Err("reading .npy needs the `files` feature of dla-pdla".to_string()),
         "csv" => read_csv::<D>(path),
         "bin" => read_bin::<D>(path),
         "xyz" => read_xyz::<D>(path),
@@ -57,6 +60,7 @@ pub fn read<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
     Ok(seeds)
 }
 
+#[cfg(feature = "files")]
 fn read_npy<const D: usize>(path: &Path) -> Result<Vec<[f64; D]>, String> {
     // The reader's messages name the file, which `read` names already.
     let prefix = format!("{}: ", path.display());

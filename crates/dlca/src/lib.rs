@@ -28,6 +28,7 @@
 //! ```
 
 pub mod analysis;
+#[cfg(feature = "files")]
 pub mod output;
 pub mod params;
 #[cfg(feature = "figures")]

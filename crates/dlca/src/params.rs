@@ -9,7 +9,9 @@ use serde::{Deserialize, Serialize};
 mod settings;
 mod spec;
 pub use settings::{Boundaries, Bytes, LATTICE_FLAGS, Settings, Sizes, Sweeps};
-pub use spec::{PARAMS, defaults};
+pub use spec::PARAMS;
+#[cfg(feature = "files")]
+pub use spec::defaults;
 
 /// Largest dimension the model accepts (Hawick, James & Scogings 2006 run 2 to 5; 1 is
 /// included for tests and teaching).

@@ -605,3 +605,8 @@ mod tests {
         assert!(figure(&r, Legend::Note(vec![])).render().is_err());
     }
 }
+
+/// The README's examples, compiled and run as doctests so that they stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;

@@ -11,7 +11,9 @@ use spatial::plane::BoxSize;
 use std::fmt;
 
 mod spec;
-pub use spec::{PARAMS, defaults};
+pub use spec::PARAMS;
+#[cfg(feature = "files")]
+pub use spec::defaults;
 
 /// The two species of the model (Hawick, James & Scogings 2006, section II.B).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

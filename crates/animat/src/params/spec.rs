@@ -12,6 +12,7 @@ use core_lattice::spec::{DeclaredParams, ParamSpec, spec_table};
 pub const PARAMS: &[ParamSpec] = &spec_table::<{ Params::DECLARED.len() }>(Params::DECLARED);
 
 /// The default of every parameter of [`PARAMS`], keyed by name, from [`Params::default`].
+#[cfg(feature = "files")]
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
     run_io::params_json::defaults_of::<Params>()
 }

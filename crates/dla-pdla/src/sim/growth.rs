@@ -14,11 +14,16 @@ use crate::error::SimError;
 use crate::farfield::norm;
 use crate::params::Params;
 use core_lattice::Gyration;
+#[cfg(feature = "files")]
+use run_io::NpyWriter;
+use run_io::StateHasher;
 use run_io::schema::{Column, Dtype, Form, Output};
-use run_io::{NpyWriter, StateHasher};
 use serde::{Deserialize, Serialize};
+#[cfg(feature = "files")]
 use std::fs::File;
+#[cfg(feature = "files")]
 use std::io::{BufWriter, Write};
+#[cfg(feature = "files")]
 use std::path::Path;
 use std::time::Instant;
 
@@ -71,6 +76,7 @@ pub(crate) fn next_on_schedule(n: u64) -> u64 {
 }
 
 /// The files a run streams into its output directory as it grows.
+#[cfg(feature = "files")]
 #[derive(Debug)]
 pub(crate) struct Streams {
     /// `positions.npy`: every stored position, in arrival order.
@@ -85,6 +91,7 @@ pub(crate) struct Streams {
     pub(crate) error: Option<std::io::Error>,
 }
 
+#[cfg(feature = "files")]
 impl Streams {
     /// `growth.csv` in `dir` holding `samples`, and `positions` as given.
     pub(crate) fn open(
@@ -183,6 +190,7 @@ pub(crate) struct Growth<const D: usize> {
     /// The start of growth (moved back on resume by the seconds already grown).
     pub(crate) started: Instant,
     /// What the run streams to its output directory, once opened.
+    #[cfg(feature = "files")]
     pub(crate) streams: Option<Streams>,
 }
 
@@ -200,6 +208,7 @@ impl<const D: usize> Growth<D> {
             next_sample: 1,
             last_off_schedule: false,
             started: Instant::now(),
+            #[cfg(feature = "files")]
             streams: None,
         }
     }
@@ -231,6 +240,7 @@ impl<const D: usize> Growth<D> {
         if let Some(v) = &mut self.positions {
             v.push(q);
         }
+        #[cfg(feature = "files")]
         if let Some(s) = &mut self.streams
             && let Some(log) = &mut s.positions
             && s.error.is_none()
@@ -242,6 +252,7 @@ impl<const D: usize> Growth<D> {
             if let Some(v) = &mut self.parents {
                 v.push(parent);
             }
+            #[cfg(feature = "files")]
             if let Some(s) = &mut self.streams
                 && let Some(log) = &mut s.parents
                 && s.error.is_none()
@@ -259,6 +270,7 @@ impl<const D: usize> Growth<D> {
                 seconds: self.started.elapsed().as_secs_f64(),
             };
             self.samples.push(sample);
+            #[cfg(feature = "files")]
             if let Some(s) = &mut self.streams {
                 s.sample(&sample);
             }

@@ -16,6 +16,7 @@ pub const PARAMS: &[ParamSpec] = &spec_table::<{ Settings::DECLARED.len() }>(Set
 /// The default of every parameter of [`PARAMS`], keyed by name, from [`Settings::default`]:
 /// `null` where the front end must be given a value (`size`, and one of `fill` and
 /// `particles`) or where none means a choice (`max_sweeps`: no limit, `grid_box`: chosen).
+#[cfg(feature = "files")]
 pub fn defaults() -> serde_json::Map<String, serde_json::Value> {
     run_io::params_json::defaults_of::<Settings>()
 }

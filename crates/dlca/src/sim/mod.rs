@@ -283,6 +283,7 @@ impl Simulation {
 
     /// Log `what` and record it as an event of the search.
     fn note(&mut self, what: String) {
+        #[cfg(feature = "log")]
         tracing::info!(sweep = self.sweep, "{what}");
         self.events.push(SearchEvent {
             sweep: self.sweep,
