@@ -50,7 +50,7 @@ impl Table {
         s
     }
 
-    /// Write the table as CSV, atomically, through sim-run's [`CsvWriter`] (which quotes
+    /// Write the table as CSV, atomically, through run-io's [`CsvWriter`] (which quotes
     /// cells that need it).
     pub fn write_csv(&self, path: &Path) -> Result<()> {
         let header: Vec<&str> = self.header.iter().map(String::as_str).collect();
@@ -140,9 +140,22 @@ pub fn build_id() -> String {
     }
 }
 
-/// One line describing the machine: CPU model, logical cores, memory, kernel, rustc.
+/// One line describing the machine: CPU model (vendor, family, model, caches, whether
+/// virtualised, and how many of the kernel's known speculative-execution vulnerabilities it
+/// mitigates), logical cores, memory, kernel, rustc.
 pub fn machine() -> String {
-    let cpu = run_io::provenance::cpu_model();
+    let host = run_io::provenance::Host::now();
+    let mitigated = host
+        .mitigations
+        .values()
+        .filter(|v| v.starts_with("Mitigation"))
+        .count();
+    let cpu = format!(
+        "{} ({}; mitigations on for {mitigated} of {} known vulnerabilities)",
+        run_io::provenance::cpu_model(),
+        host.summary(),
+        host.mitigations.len()
+    );
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);

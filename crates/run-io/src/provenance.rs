@@ -1,8 +1,12 @@
-//! Where a result came from: date, version, git commit, command line, host and CPU. Every
-//! `run.json` carries it (`provenance`), as do the reports of `cargo xtask scaling`, so a number
-//! in a paper can be traced to the build and machine that produced it.
+//! Where a result came from: date, version, git commit, command line, host and CPU (with its
+//! family, caches and the kernel's speculative-execution mitigations, which a speed figure
+//! depends on). Every `run.json` carries it (`provenance`), as do the reports of `cargo xtask
+//! scaling` and `cargo xtask bench`, so a number in a paper can be traced to the build and
+//! machine that produced it.
 
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
 use std::time::{SystemTime, UNIX_EPOCH};
 
 /// The git commit this crate was built from (`git rev-parse HEAD` at build time, by
@@ -26,6 +30,10 @@ pub struct Provenance {
     pub host: String,
     /// The CPU model (`/proc/cpuinfo`'s `model name`; the architecture elsewhere).
     pub cpu: String,
+    /// What the kernel says of the processor: vendor, family and model numbers, caches and
+    /// mitigations ([`Host::now`]); absent in a `run.json` written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub host_cpu: Option<Host>,
     /// Worker threads the run used.
     pub threads: usize,
     /// Logical CPUs available to the process (its CPU affinity: under an MPI launcher, the
@@ -90,6 +98,7 @@ impl Provenance {
                 .collect(),
             host: host_name(),
             cpu: cpu_model(),
+            host_cpu: Some(Host::now()),
             threads,
             cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
             mpi: MpiPlace::from_env(),
@@ -119,6 +128,165 @@ pub fn cpu_model() -> String {
                 .map(|m| m.trim().to_string())
         })
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// The processor a run ran on as the kernel describes it (Linux's `/proc/cpuinfo` and
+/// `/sys/devices/system/cpu`; empty fields elsewhere): what makes a timing comparable, or not,
+/// with one from another machine.
+#[derive(Debug, Clone, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Host {
+    /// `vendor_id`: `GenuineIntel`, `AuthenticAMD`, ... (empty where unknown).
+    pub vendor: String,
+    /// `cpu family` (x86: 6 for most Intel cores, 25 for AMD Zen 3 and 4).
+    pub family: Option<u32>,
+    /// `model` within the family.
+    pub model: Option<u32>,
+    /// `stepping`.
+    pub stepping: Option<u32>,
+    /// The caches of CPU 0, innermost first.
+    pub caches: Vec<Cache>,
+    /// Each speculative-execution vulnerability the kernel knows of and its state
+    /// (`/sys/devices/system/cpu/vulnerabilities`): `Not affected`, `Mitigation: ...` or
+    /// `Vulnerable`. Mitigations cost time on some hosts (page-table isolation, retpolines).
+    pub mitigations: BTreeMap<String, String>,
+    /// Whether the kernel runs under a hypervisor (the `hypervisor` flag).
+    pub virtualised: bool,
+}
+
+/// One cache of a CPU.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Cache {
+    /// 1, 2, 3.
+    pub level: u32,
+    /// `Data`, `Instruction` or `Unified`.
+    pub kind: String,
+    /// Size in bytes.
+    pub bytes: u64,
+    /// Logical CPUs that share it.
+    pub shared_by: u32,
+}
+
+impl Host {
+    /// The processor this process runs on.
+    pub fn now() -> Self {
+        Self::read(
+            Path::new("/proc/cpuinfo"),
+            Path::new("/sys/devices/system/cpu"),
+        )
+    }
+
+    /// The processor as `cpuinfo` (a `/proc/cpuinfo`) and `sys` (a
+    /// `/sys/devices/system/cpu`) describe it; what cannot be read is left empty.
+    pub fn read(cpuinfo: &Path, sys: &Path) -> Self {
+        let info = std::fs::read_to_string(cpuinfo).unwrap_or_default();
+        // The first processor's block.
+        let field = |name: &str| {
+            info.lines()
+                .take_while(|l| !l.trim().is_empty())
+                .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        };
+        let number = |name: &str| field(name).and_then(|v| v.parse().ok());
+        let mut caches: Vec<Cache> = std::fs::read_dir(sys.join("cpu0/cache"))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().starts_with("index"))
+            .filter_map(|e| cache(&e.path()))
+            .collect();
+        caches.sort_by(|a, b| (a.level, &a.kind).cmp(&(b.level, &b.kind)));
+        let mitigations = std::fs::read_dir(sys.join("vulnerabilities"))
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter_map(|e| {
+                let state = std::fs::read_to_string(e.path()).ok()?;
+                Some((
+                    e.file_name().to_string_lossy().into_owned(),
+                    state.trim().to_string(),
+                ))
+            })
+            .collect();
+        Host {
+            vendor: field("vendor_id").unwrap_or_default(),
+            family: number("cpu family"),
+            model: number("model"),
+            stepping: number("stepping"),
+            caches,
+            mitigations,
+            virtualised: field("flags").is_some_and(|f| f.split(' ').any(|x| x == "hypervisor")),
+        }
+    }
+
+    /// One line for a report: `AuthenticAMD family 25 model 17; L1d 32 KiB, L2 1 MiB, L3 32
+    /// MiB; virtualised`.
+    pub fn summary(&self) -> String {
+        let mut s = self.vendor.clone();
+        if let (Some(f), Some(m)) = (self.family, self.model) {
+            s += &format!(" family {f} model {m}");
+        }
+        let caches: Vec<String> = self
+            .caches
+            .iter()
+            .filter(|c| c.kind != "Instruction")
+            .map(|c| {
+                let kind = if c.kind == "Data" { "d" } else { "" };
+                format!("L{}{kind} {}", c.level, crate::show_bytes(c.bytes))
+            })
+            .collect();
+        if !caches.is_empty() {
+            s += &format!("; {}", caches.join(", "));
+        }
+        if self.virtualised {
+            s += "; virtualised";
+        }
+        s
+    }
+}
+
+/// The cache described by a `cpuN/cache/indexK` directory.
+fn cache(dir: &Path) -> Option<Cache> {
+    let read = |f: &str| {
+        std::fs::read_to_string(dir.join(f))
+            .ok()
+            .map(|s| s.trim().to_string())
+    };
+    let size = read("size")?;
+    let (digits, unit) = size.split_at(
+        size.find(|c: char| !c.is_ascii_digit())
+            .unwrap_or(size.len()),
+    );
+    let scale = match unit {
+        "K" => 1 << 10,
+        "M" => 1 << 20,
+        "G" => 1 << 30,
+        "" => 1,
+        _ => return None,
+    };
+    let shared_by = read("shared_cpu_list").map_or(1, |l| cpu_list_len(&l));
+    Some(Cache {
+        level: read("level")?.parse().ok()?,
+        kind: read("type")?,
+        bytes: digits.parse::<u64>().ok()? * scale,
+        shared_by,
+    })
+}
+
+/// The CPUs a list such as `0-3,8-11` or `5` names.
+fn cpu_list_len(list: &str) -> u32 {
+    list.split(',')
+        .filter(|r| !r.is_empty())
+        .map(|r| match r.split_once('-') {
+            Some((a, b)) => match (a.parse::<u32>(), b.parse::<u32>()) {
+                (Ok(a), Ok(b)) if b >= a => b - a + 1,
+                _ => 1,
+            },
+            None => 1,
+        })
+        .sum()
 }
 
 /// `t` as `YYYY-MM-DDTHH:MM:SSZ`.
@@ -191,6 +359,71 @@ mod tests {
             serde_json::from_value::<Provenance>(plain).unwrap().mpi,
             None
         );
+    }
+
+    #[test]
+    fn the_host_is_read_from_the_kernel_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let info = dir.path().join("cpuinfo");
+        std::fs::write(
+            &info,
+            "processor\t: 0\nvendor_id\t: GenuineIntel\ncpu family\t: 6\nmodel\t\t: 106\n\
+             model name\t: Intel(R) Xeon(R)\nstepping\t: 6\nflags\t\t: fpu sse hypervisor\n\n\
+             processor\t: 1\nvendor_id\t: Other\n",
+        )
+        .unwrap();
+        let sys = dir.path().join("cpu");
+        for (i, level, kind, size, shared) in [
+            (0, "1", "Data", "48K", "0-1"),
+            (1, "1", "Instruction", "32K", "0-1"),
+            (2, "2", "Unified", "2048K", "0-1"),
+            (3, "3", "Unified", "300M", "0-1,4-7"),
+        ] {
+            let d = sys.join(format!("cpu0/cache/index{i}"));
+            std::fs::create_dir_all(&d).unwrap();
+            for (f, v) in [
+                ("level", level),
+                ("type", kind),
+                ("size", size),
+                ("shared_cpu_list", shared),
+            ] {
+                std::fs::write(d.join(f), format!("{v}\n")).unwrap();
+            }
+        }
+        std::fs::create_dir_all(sys.join("vulnerabilities")).unwrap();
+        std::fs::write(sys.join("vulnerabilities/meltdown"), "Not affected\n").unwrap();
+        std::fs::write(
+            sys.join("vulnerabilities/retbleed"),
+            "Mitigation: Enhanced IBRS\n",
+        )
+        .unwrap();
+        let h = Host::read(&info, &sys);
+        assert_eq!(
+            (h.vendor.as_str(), h.family, h.model, h.stepping),
+            ("GenuineIntel", Some(6), Some(106), Some(6))
+        );
+        assert!(h.virtualised);
+        assert_eq!(h.caches.len(), 4);
+        assert_eq!(
+            (
+                h.caches[0].level,
+                h.caches[0].kind.as_str(),
+                h.caches[0].bytes
+            ),
+            (1, "Data", 48 << 10)
+        );
+        assert_eq!((h.caches[3].bytes, h.caches[3].shared_by), (300 << 20, 6));
+        assert_eq!(h.mitigations["retbleed"], "Mitigation: Enhanced IBRS");
+        assert_eq!(
+            h.summary(),
+            "GenuineIntel family 6 model 106; L1d 48.0 KiB, L2 2.0 MiB, L3 300.0 MiB; virtualised"
+        );
+        // Nothing to read: an empty description, not an error.
+        let none = Host::read(&dir.path().join("missing"), &dir.path().join("missing"));
+        assert_eq!(none, Host::default());
+        // It round-trips through run.json.
+        let json = serde_json::to_value(&h).unwrap();
+        assert_eq!(serde_json::from_value::<Host>(json).unwrap(), h);
     }
 
     #[test]
