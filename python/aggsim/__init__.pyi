@@ -93,7 +93,7 @@ class DlaResult:
     simulation_peak_rss_bytes: Optional[int]
     """Peak resident memory of the process during the simulation."""
     output_peak_rss_bytes: Optional[int]
-    """Peak through the output stage (the binary's files and picture); None here, where the
+    """Peak through the output stage (the binary's files and figure); None here, where the
     run writes no files."""
     model: str
     version: str
@@ -199,7 +199,7 @@ class DlcaResult:
 
     def save_png(self, path: Union[str, PathLike[str]], size: Optional[Count] = None) -> None:
         """Write the ``dlca`` binary's ``dlca.png`` of this state, byte for byte the binary's
-        (the same Rust renderer); ``size`` is ``--png-size``, the picture's longer side
+        (the same Rust renderer); ``size`` is ``--png-size``, the raster's longer side
         (16..=65536, default a whole number of pixels per site, at least 512)."""
 
 Size = Union[Count, str, Sequence[Count]]

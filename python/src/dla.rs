@@ -82,7 +82,7 @@ pub struct DlaResult {}
 impl DlaResult {
     /// Write the ``dla`` binary's figure of the cluster, ``dla.png``, to ``path``: the same
     /// file, byte for byte, as ``dla --png`` writes for the same run (the libraries' renderer,
-    /// ``dla_pdla::picture``). Axes in particle diameters, a scale bar, N and the seed, and a
+    /// ``dla_pdla::figure``). Axes in particle diameters, a scale bar, N and the seed, and a
     /// colour bar: particles coloured by arrival order on magma (or, where a pixel spans more
     /// than a diameter, particles per pixel on a log scale); 3D to 5D as shaded spheres seen
     /// from +z. Drawn from :attr:`positions`, ``r_ext`` and ``seed``.
@@ -92,7 +92,7 @@ impl DlaResult {
     /// path : str or os.PathLike
     ///     The PNG file, written atomically.
     /// size : int or None
-    ///     Side of the picture in pixels (the binary's ``--png-size``), 16..=65536; the axes
+    ///     Side of the raster in pixels (the binary's ``--png-size``), 16..=65536; the axes
     ///     and legend come around it. Default: one pixel per diameter, 512 to 4096.
     #[pyo3(signature = (path, size = None))]
     fn save_png(slf: &Bound<'_, Self>, path: PathBuf, size: Option<Count>) -> PyResult<()> {
@@ -102,7 +102,7 @@ impl DlaResult {
         let side = side.unwrap_or_else(|| dla_pdla::output::default_png_side(r_ext));
         let flat = positions.as_slice()?;
         check_dim(flat.len(), positions.as_array().ncols(), dim)?;
-        dla_pdla::picture::write_png_of_positions(flat, dim, r_ext, seed, &path, side)
+        dla_pdla::figure::write_png_of_positions(flat, dim, r_ext, seed, &path, side)
             .map_err(|e| crate::figure::write_error(&path, e))
     }
 
@@ -118,7 +118,7 @@ impl DlaResult {
     /// path : str or os.PathLike
     ///     The GIF file, written atomically.
     /// size : int or None
-    ///     Side of the pictures in pixels (``--png-size``), 16..=16384 (default 512).
+    ///     Side of the figures in pixels (``--png-size``), 16..=16384 (default 512).
     /// every : int or None
     ///     Particles between frames (``--animate-every``), 1.. (default: a hundredth of the
     ///     particles).
@@ -144,9 +144,9 @@ impl DlaResult {
         let flat = positions.as_slice()?;
         check_dim(flat.len(), positions.as_array().ncols(), dim)?;
         let total = (flat.len() / dim.max(1)) as u64;
-        let side = side.unwrap_or(dla_pdla::picture::ANIMATION_DEFAULT_SIDE);
-        let every = every.unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));
-        dla_pdla::picture::write_animation_of_positions(flat, dim, r_ext, seed, &path, side, every)
+        let side = side.unwrap_or(dla_pdla::figure::ANIMATION_DEFAULT_SIDE);
+        let every = every.unwrap_or_else(|| dla_pdla::figure::default_animation_every(total));
+        dla_pdla::figure::write_animation_of_positions(flat, dim, r_ext, seed, &path, side, every)
             .map_err(|e| crate::figure::write_error(&path, e))
     }
 

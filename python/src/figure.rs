@@ -1,6 +1,6 @@
 //! The binaries' figures from results: `dla.png`, `dla.gif`, `dlca.png` and the animat
-//! snapshots, drawn by the libraries' own picture code (`dla_pdla::picture`,
-//! `dlca::picture`, `animat::output::SnapshotFrame`, all framed by `figures`) from the
+//! snapshots, drawn by the libraries' own raster code (`dla_pdla::figure`,
+//! `dlca::figure`, `animat::output::SnapshotFrame`, all framed by `figures`) from the
 //! arrays and results a result object holds, so that a file equals the binary's for the same
 //! run byte for byte.
 
@@ -13,14 +13,14 @@ use figures::{PNG_SIZE_MAX, PNG_SIZE_MIN};
 use run_io::OutputError;
 use std::path::PathBuf;
 
-/// The side of a picture in pixels, as `--png-size` takes it: a count in
+/// The side of a raster in pixels, as `--png-size` takes it: a count in
 /// [`PNG_SIZE_MIN`]..=`max` (`name` is the keyword argument, for messages).
 pub fn side(name: &str, v: Option<Count>, max: u32) -> PyResult<Option<u32>> {
     let Some(v) = v else { return Ok(None) };
     let range = format!("{PNG_SIZE_MIN}..={max}");
     let shown = v.to_string();
     let s: u32 = count(&[], name, v).map_err(|e| {
-        // `count`'s own range is u32's; the message names the picture's.
+        // `count`'s own range is u32's; the message names the raster's.
         let m = e.to_string();
         if m.contains("outside the accepted range") {
             value_error(format!(
@@ -43,12 +43,12 @@ pub fn side(name: &str, v: Option<Count>, max: u32) -> PyResult<Option<u32>> {
     Ok(Some(s))
 }
 
-/// The side of a PNG's picture (`--png-size`).
+/// The side of a PNG's raster (`--png-size`).
 pub fn png_side(v: Option<Count>) -> PyResult<Option<u32>> {
     side("size", v, PNG_SIZE_MAX)
 }
 
-/// The side of an animation's pictures (`--png-size` with `--animate`).
+/// The side of an animation's figures (`--png-size` with `--animate`).
 pub fn gif_side(v: Option<Count>) -> PyResult<Option<u32>> {
     side("size", v, ANIMATION_MAX_SIDE)
 }
@@ -78,7 +78,7 @@ pub struct Animate {
     pub path: PathBuf,
     /// Steps or sweeps between frames (default: the binary's).
     pub every: Option<u64>,
-    /// Side of the pictures in pixels (default: the binary's).
+    /// Side of the figures in pixels (default: the binary's).
     pub side: Option<u32>,
 }
 

@@ -10,7 +10,7 @@
 //! | `checkpoint` | `checkpoint=DIR`: the guard, SIGTERM, resuming, cleaning up |
 //! | `convert` | `run.json` onto result attributes, count arguments, columns as arrays |
 //! | `dla`, `dlca`, `animat` | one model each: its function, result class and step-wise class |
-//! | `figure` | the binaries' figures from a result's arrays, by the libraries' picture code |
+//! | `figure` | the binaries' figures from a result's arrays, by the libraries' raster code |
 
 mod animat;
 mod checkpoint;

@@ -1,5 +1,5 @@
 """The figures a result writes (save_png, DlaResult.save_gif) are the binaries' files byte for
-byte: the same run through the binary and through Python, the same picture size."""
+byte: the same run through the binary and through Python, the same raster size."""
 
 import math
 
@@ -24,7 +24,7 @@ def png_size(path):
     "flags, kwargs, size",
     [
         (["--particles", 1500, "--seed", 3], dict(particles=1500, seed=3), None),
-        # A picture narrower than the cluster: particles per pixel.
+        # A raster narrower than the cluster: particles per pixel.
         (["--particles", 1500, "--seed", 3], dict(particles=1500, seed=3), 40),
         (["--dim", 3, "--particles", 800, "--seed", 2], dict(dim=3, particles=800, seed=2), 200),
     ],
@@ -36,7 +36,7 @@ def test_dla_png_is_the_binarys(cli, tmp_path, flags, kwargs, size):
     r.save_png(tmp_path / "dla.png", size=size)
     assert same_bytes(tmp_path / "dla.png", out / "dla.png")
     if size is not None:
-        # The picture and the axes, header and legend around it.
+        # The raster and the axes, header and legend around it.
         w, h = png_size(tmp_path / "dla.png")
         assert w > size and h > size
 

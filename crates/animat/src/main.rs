@@ -108,7 +108,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     if cli.frame_radius == Some(0) {
         return Err("--frame-radius 0 is outside the accepted range 1..".into());
     }
-    figures::animation::check_picture_flags(
+    figures::animation::check_figure_flags(
         cli.png_size,
         cli.animate,
         cli.animate_every,

@@ -40,12 +40,12 @@ mod contact;
 pub mod deposit;
 pub mod error;
 pub mod farfield;
+#[cfg(feature = "figures")]
+pub mod figure;
 mod near;
 #[cfg(feature = "files")]
 pub mod output;
 pub mod params;
-#[cfg(feature = "figures")]
-pub mod picture;
 pub mod seeds;
 pub mod sim;
 pub mod space;

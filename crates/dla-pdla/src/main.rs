@@ -127,7 +127,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
         ));
     }
     cli.run.checkpoints.check(cli.checkpoint_every)?;
-    figures::animation::check_picture_flags(
+    figures::animation::check_figure_flags(
         cli.png_size,
         cli.animate,
         cli.animate_every,
@@ -357,11 +357,11 @@ where
     if cli.animate {
         let side = cli
             .png_size
-            .unwrap_or(dla_pdla::picture::ANIMATION_DEFAULT_SIDE);
+            .unwrap_or(dla_pdla::figure::ANIMATION_DEFAULT_SIDE);
         let every = cli
             .animate_every
-            .unwrap_or_else(|| dla_pdla::picture::default_animation_every(total));
-        let frames = dla_pdla::picture::write_animation(
+            .unwrap_or_else(|| dla_pdla::figure::default_animation_every(total));
+        let frames = dla_pdla::figure::write_animation(
             &sim,
             &cli.run.out,
             &cli.run.out.join("dla.gif"),

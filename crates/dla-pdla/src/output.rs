@@ -13,7 +13,7 @@
 //! | `positions.bin` | `--positions bin`: see [`write_positions_bin`] |
 //! | `positions.xyz` | `--positions xyz`: extended XYZ point cloud (OVITO, VMD, ASE), element `C`; 2D and 3D only |
 //! | `positions.vtk` | `--positions vtk`: legacy VTK points with the arrival index as a scalar (ParaView); 2D and 3D only |
-//! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (feature `figures`, see [`crate::picture`]) |
+//! | `dla.png` | `--png`: the figure of the cluster, coloured by arrival order or, when a pixel spans more than a diameter, by particles per pixel (feature `figures`, see [`crate::figure`]) |
 //! | `dla.gif` | `--animate`: the growth of the cluster, one frame every `--animate-every` particles |
 //! | `branches.csv`, `branches.png` | the Horton-Strahler analysis (whenever the parents are recorded; the chart with `--png`) |
 //! | `deposit.csv`, `deposit_growth.csv`, `deposit.png` | a deposit's profile, surviving trees and active zone (`--substrate-width`; the chart with `--png`; see [`crate::deposit`]) |
@@ -172,7 +172,7 @@ where
     }
     #[cfg(feature = "figures")]
     if let Some(side) = png {
-        crate::picture::write_png(sim, dir, &dir.join("dla.png"), side)?;
+        crate::figure::write_png(sim, dir, &dir.join("dla.png"), side)?;
     }
     let branches = branches_of(sim, dir)?;
     if let Some(b) = &branches {
@@ -425,9 +425,9 @@ pub fn reads_positions(params: &crate::Params) -> bool {
     params.substrate().is_some()
 }
 
-/// [`default_png_side`] of a run's frame ([`Simulation::picture_half`]).
+/// [`default_png_side`] of a run's frame ([`Simulation::figure_half`]).
 pub fn default_png_side_of<const D: usize>(sim: &Simulation<D>) -> u32 {
-    default_png_side(sim.picture_half())
+    default_png_side(sim.figure_half())
 }
 
 /// Side of `dla.png` in pixels when none is asked for: one pixel per diameter across the
@@ -437,7 +437,7 @@ pub fn default_png_side(r_ext: f64) -> u32 {
 }
 
 /// Memory the buffers of a `side` x `side` `dla.png` take while it is drawn: per pixel of the
-/// picture at most an arrival, a depth and a lighting value (16 bytes), its colour (3) and the
+/// raster at most an arrival, a depth and a lighting value (16 bytes), its colour (3) and the
 /// figure around it (axes and legend at most double the area: 6).
 pub fn png_memory_bytes(side: u64) -> u64 {
     side.saturating_mul(side).saturating_mul(25)

@@ -206,7 +206,7 @@ core_lattice::declare_params! {
         },
     }
     internal {
-        /// Keep every position in arrival order (needed for position files and pictures).
+        /// Keep every position in arrival order (needed for position files and figures).
         /// Costs `8 D` bytes per particle; off by default. Set by the front ends: the binary
         /// streams the positions to a file instead, Python keeps them.
         keep_positions: bool = false,

@@ -28,11 +28,11 @@
 //! ```
 
 pub mod analysis;
+#[cfg(feature = "figures")]
+pub mod figure;
 #[cfg(feature = "files")]
 pub mod output;
 pub mod params;
-#[cfg(feature = "figures")]
-pub mod picture;
 pub mod record;
 mod rigid;
 pub mod sim;

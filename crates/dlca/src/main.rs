@@ -84,7 +84,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     let mut settings = cli.model.params();
     cli.lattice.apply(&mut settings);
     let p = settings.to_params(|name| cli.lattice.given(name) || cli.model.given(name))?;
-    figures::animation::check_picture_flags(
+    figures::animation::check_figure_flags(
         cli.png_size,
         cli.animate,
         cli.animate_every,
@@ -97,7 +97,7 @@ fn params(cli: &Cli) -> Result<Params, String> {
     let n = p.particles().unwrap_or(0);
     let picture = if cli.png || cli.animate {
         let side = u64::from(cli.png_size.unwrap_or(PICTURE_MAX_DEFAULT_SIDE));
-        dlca::picture::png_memory_bytes(side, side)
+        dlca::figure::png_memory_bytes(side, side)
     } else {
         0
     };
@@ -231,7 +231,7 @@ const RUN_FILES: &[&str] = &[
 ];
 
 /// The largest default side of a picture, for the memory estimate before the run.
-const PICTURE_MAX_DEFAULT_SIDE: u32 = dlca::picture::PNG_MAX_SIDE as u32;
+const PICTURE_MAX_DEFAULT_SIDE: u32 = dlca::figure::PNG_MAX_SIDE as u32;
 
 /// DLCA as the run machinery sees it.
 struct Dlca;
@@ -301,10 +301,8 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
             .context("writing a checkpoint")
     };
     let mut animation = if cli.animate {
-        let side = cli
-            .png_size
-            .unwrap_or(dlca::picture::ANIMATION_DEFAULT_SIDE);
-        Some(dlca::picture::Animation::start(
+        let side = cli.png_size.unwrap_or(dlca::figure::ANIMATION_DEFAULT_SIDE);
+        Some(dlca::figure::Animation::start(
             &sim,
             cli.run.seed,
             &cli.run.out.join("dlca.gif"),
@@ -315,12 +313,12 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
     };
     let every = cli
         .animate_every
-        .unwrap_or(dlca::picture::ANIMATION_DEFAULT_EVERY);
+        .unwrap_or(dlca::figure::ANIMATION_DEFAULT_EVERY);
     while !sim.is_done() {
         sim.sweep();
         let s = &sim;
         if let Some(a) = animation.as_mut()
-            && dlca::picture::Animation::due(s, every)
+            && dlca::figure::Animation::due(s, every)
         {
             a.frame(s)?;
         }

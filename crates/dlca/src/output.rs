@@ -9,7 +9,7 @@
 //! | `particles.csv` | `x1,..,xd,cluster`: every particle's final site and cluster id (`--positions csv`, the default; `npy`, `vtk` and `xyz` write `particles.npy` with `particles_cluster.npy`, `particles.vtk` or `particles.xyz` instead, see [`run_io::points`]) |
 //! | `histogram.csv` | with `--histogram`: `sweep,candidates,moves` |
 //! | `clusters.csv` | with `--gyration`: `cluster,size,radius_of_gyration,wraps` |
-//! | `dlca.png` | with `--png`: the figure of the final state, touching clusters in different colours (feature `figures`, see [`crate::picture`]) |
+//! | `dlca.png` | with `--png`: the figure of the final state, touching clusters in different colours (feature `figures`, see [`crate::figure`]) |
 //! | `dlca.gif` | with `--animate`: the aggregation, a frame every `--animate-every` sweeps |
 
 use crate::analysis::{
@@ -89,8 +89,8 @@ pub const SCHEMA: &[Output] = &[
 
 /// Write every output of `sim` into `dir` (which must exist) and return the manifest written;
 /// the particles' sites and cluster ids go into `particles.<format>` if `positions` names one,
-/// and `dlca.png` is drawn if `png` is `Some` (the longer side of its picture, or `None` inside
-/// for the default, see [`crate::picture::picture_size`]; feature `figures`: without it, asking
+/// and `dlca.png` is drawn if `png` is `Some` (the longer side of its raster, or `None` inside
+/// for the default, see [`crate::figure::raster_size`]; feature `figures`: without it, asking
 /// for one is an error and nothing is written).
 pub fn write_outputs(
     sim: &Simulation,
@@ -198,7 +198,7 @@ pub fn write_outputs(
 
     #[cfg(feature = "figures")]
     if let Some(side) = png {
-        crate::picture::write_png(sim, seed, &dir.join("dlca.png"), side)?;
+        crate::figure::write_png(sim, seed, &dir.join("dlca.png"), side)?;
     }
 
     let m = manifest(sim, seed, clock, measures.as_deref())?;

@@ -78,7 +78,7 @@ fn writes_every_output() {
     let png = std::fs::read(out.join("dlca.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"));
     // 64x48 sites drawn 8x8 pixels each (so a small lattice is legible), with axes and legend
-    // around the picture.
+    // around the raster.
     let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
     assert!(side(16) > 512 && side(20) > 384);
 }
@@ -438,7 +438,7 @@ fn png_size_and_animation() {
     assert_eq!(run_json(&out)["results"]["sweeps"], 5);
     let png = std::fs::read(out.join("dlca.png")).unwrap();
     let side = |at: usize| u32::from_be_bytes(png[at..at + 4].try_into().unwrap());
-    // A 64 x 32 picture with axes and legend around it.
+    // A 64 x 32 raster with axes and legend around it.
     assert!(side(16) > 64 && side(20) > 32);
     // Sweeps 0, 2, 4 and 5.
     let ((w, h), frames) = figures::animation::read_gif(&out.join("dlca.gif")).unwrap();

@@ -154,11 +154,11 @@ pub fn read_gif(path: &Path) -> Result<((u32, u32), u64)> {
 /// Largest side in pixels of an animation frame (`--png-size` with `--animate`).
 pub const ANIMATION_MAX_SIDE: u32 = 16384;
 
-/// The checks every binary makes of its picture flags: `--animate-every` at least 1,
-/// `--png-size` only with a picture to size (`stills` names the flag of the still pictures:
+/// The checks every binary makes of its raster flags: `--animate-every` at least 1,
+/// `--png-size` only with a raster to size (`stills` names the flag of the still figures:
 /// `--png` or `--snapshot-every`, given or not as `still`), and at most
 /// [`ANIMATION_MAX_SIDE`] with `--animate`.
-pub fn check_picture_flags(
+pub fn check_figure_flags(
     png_size: Option<u32>,
     animate: bool,
     animate_every: Option<u64>,
@@ -170,7 +170,7 @@ pub fn check_picture_flags(
     }
     if png_size.is_some() && !still && !animate {
         return Err(format!(
-            "--png-size sizes the pictures of {stills} and --animate; give one"
+            "--png-size sizes the figures of {stills} and --animate; give one"
         ));
     }
     if let Some(side) = png_size.filter(|&s| animate && s > ANIMATION_MAX_SIDE) {

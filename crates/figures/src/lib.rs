@@ -11,8 +11,8 @@
 //! - [`palette`]: colour-blind-safe palettes and perceptual colour maps;
 //! - [`png`]: the PNG encoder every figure is written with, atomically.
 //!
-//! Layout of a figure of a state: the header strip above the picture, the axes left and below,
-//! the legend right; nothing is drawn over the data. Text grows with the picture, so a
+//! Layout of a figure of a state: the header strip above the raster, the axes left and below,
+//! the legend right; nothing is drawn over the data. Text grows with the raster, so a
 //! 4096-pixel figure is as legible as a 512-pixel one. Text uses the DejaVu Sans font committed
 //! under `assets/fonts/`, so no system font library is needed.
 
@@ -79,9 +79,9 @@ impl From<png::ImageError> for run_io::OutputError {
     }
 }
 
-/// Smallest side of a figure's picture in pixels that may be asked for (`--png-size`).
+/// Smallest side of a figure's raster in pixels that may be asked for (`--png-size`).
 pub const PNG_SIZE_MIN: u32 = 16;
-/// Largest side of a figure's picture in pixels that may be asked for (`--png-size`; an
+/// Largest side of a figure's raster in pixels that may be asked for (`--png-size`; an
 /// animation's is at most [`animation::ANIMATION_MAX_SIDE`]).
 pub const PNG_SIZE_MAX: u32 = 65536;
 
@@ -139,7 +139,7 @@ pub struct Extent {
     pub y: (f64, f64),
 }
 
-/// What the legend right of the picture shows.
+/// What the legend right of the raster shows.
 #[derive(Debug, Clone)]
 pub enum Legend {
     /// A colour bar of a sequential map from `lo` (bottom) to `hi` (top), with its label.
@@ -161,12 +161,12 @@ pub enum Legend {
     Note(Vec<String>),
 }
 
-/// A figure: a picture of the state and what makes it readable.
+/// A figure: a figure of the state and what makes it readable.
 #[derive(Debug, Clone)]
 pub struct Figure<'a> {
-    /// The picture.
+    /// The raster.
     pub raster: &'a Raster,
-    /// What the picture shows, in model units.
+    /// What the raster shows, in model units.
     pub extent: Extent,
     /// The unit of both axes and of the scale bar (`diameters`, `lattice cells`).
     pub unit: String,
@@ -178,7 +178,7 @@ pub struct Figure<'a> {
     pub legend: Legend,
 }
 
-/// The text scale of a figure whose picture is `side` pixels: 1 up to 640 pixels, growing in
+/// The text scale of a figure whose raster is `side` pixels: 1 up to 640 pixels, growing in
 /// proportion beyond.
 fn text_scale(side: u32) -> f64 {
     (f64::from(side) / 640.0).clamp(1.0, 8.0)
@@ -262,7 +262,7 @@ fn rgb(c: Rgb) -> RGBColor {
 }
 
 impl Figure<'_> {
-    /// The figure's margins for its picture, header and legend, from the widths of the text
+    /// The figure's margins for its raster, header and legend, from the widths of the text
     /// as the font lays it out.
     fn layout(&self) -> Layout {
         register_font();
@@ -288,14 +288,14 @@ impl Figure<'_> {
             }
             Legend::Note(lines) => lines.iter().map(|l| text_w(l, 13.0)).fold(0.0, f64::max),
         };
-        // The layout depends on the picture's size and the legend only, never on the
+        // The layout depends on the raster's size and the legend only, never on the
         // header's text, so that every frame of an animation has the same size: the header
         // has a line of its own above the scale bar's, and may run over the legend's column.
-        let picture_w = f64::from(self.raster.width) / u;
+        let raster_w = f64::from(self.raster.width) / u;
         let right = legend_w + 32.0;
         let header_w = text_w(&self.header, 16.0);
-        // A header wider than the figure is set smaller (small pictures only).
-        let header_size = 16.0 * ((picture_w + right - 8.0) / header_w).min(1.0);
+        // A header wider than the figure is set smaller (small figures only).
+        let header_size = 16.0 * ((raster_w + right - 8.0) / header_w).min(1.0);
         Layout {
             u,
             top: px(66.0),
@@ -312,7 +312,7 @@ impl Figure<'_> {
         let r = self.raster;
         ensure!(
             r.width > 0 && r.height > 0 && r.rgb.len() == r.width as usize * r.height as usize * 3,
-            "a figure's picture must be non-empty and {}x{}x3 bytes",
+            "a figure's raster must be non-empty and {}x{}x3 bytes",
             r.width,
             r.height
         );
@@ -373,7 +373,7 @@ impl Figure<'_> {
             &BitMapElement::with_ref((xs.start, ys.start), (r.width, r.height), &r.rgb)
                 .ok_or("raster size")?,
         )?;
-        // The picture's frame.
+        // The raster's frame.
         root.draw(&Rectangle::new(
             [(xs.start - 1, ys.start - 1), (xs.end, ys.end)],
             BLACK.stroke_width(1),
@@ -401,7 +401,7 @@ impl Figure<'_> {
             font(15.0).pos(Pos::new(HPos::Right, VPos::Center)),
         ))?;
 
-        // Legend, right of the picture.
+        // Legend, right of the raster.
         let x0 = xs.end + (16.0 * u) as i32;
         match &self.legend {
             Legend::ColourBar {
@@ -483,7 +483,7 @@ impl Figure<'_> {
     }
 }
 
-/// Margins around the picture, in pixels, and the text scale.
+/// Margins around the raster, in pixels, and the text scale.
 struct Layout {
     u: f64,
     top: u32,
@@ -512,7 +512,7 @@ mod tests {
     }
 
     #[test]
-    fn the_picture_is_copied_unchanged_into_the_figure() {
+    fn the_raster_is_copied_unchanged_into_the_figure() {
         let mut r = Raster::new(200, 150, palette::WHITE);
         for y in 0..150 {
             for x in 0..200 {

@@ -34,7 +34,7 @@ pub const RABBIT: Rgb = OKABE_ITO[5];
 
 /// White: the background of figures whose data are dark or saturated (DLA, animats).
 pub const WHITE: Rgb = [255, 255, 255];
-/// Black: the background of the cluster pictures, whose categorical colours are light.
+/// Black: the background of the cluster figures, whose categorical colours are light.
 pub const BLACK: Rgb = [0, 0, 0];
 
 /// The smallest contrast ratio of a colour drawn on a background (WCAG 2.1, non-text contrast).

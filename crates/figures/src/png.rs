@@ -1,10 +1,10 @@
-//! PNG pictures of model states (DLCA clusters, DLA clusters, animat snapshots), written with
+//! PNG figures of model states (DLCA clusters, DLA clusters, animat snapshots), written with
 //! the `png` crate and atomically.
 
 use run_io::AtomicFile;
 use std::path::Path;
 
-/// Why a picture could not be written.
+/// Why a raster could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum ImageError {
     /// Width or height is zero.

@@ -4,7 +4,7 @@
 //! `--config` and `--dump-config`, logging, the usage-error contract, `--seeds` over child
 //! processes or MPI ranks, the claim of `--out` and its `config.toml`); the model owns its
 //! parameters, its run (new or resumed, under the guard of timed checkpoints, signals and the
-//! memory watch), its result files, curves and pictures. A new model is a library with a
+//! memory watch), its result files, curves and figures. A new model is a library with a
 //! `Params` declaration and a binary that implements [`Model`] and calls [`main`].
 
 use crate::cli::config::{self, ConfigArgs};

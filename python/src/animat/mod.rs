@@ -347,7 +347,7 @@ impl AnimatResult {
     /// path : str or os.PathLike
     ///     The PNG file, written atomically.
     /// size : int or None
-    ///     Side of the picture in pixels (the binary's ``--png-size``), 16..=65536; the axes
+    ///     Side of the raster in pixels (the binary's ``--png-size``), 16..=65536; the axes
     ///     and legend come around it. Default: a whole number of pixels per cell and at least
     ///     512, or one pixel per cell up to 1024.
     /// frame_radius : int or None
@@ -431,7 +431,7 @@ impl AnimatResult {
 /// animate_every : int or None
 ///     Steps between frames (``--animate-every``), 1.. (default: a hundredth of ``steps``).
 /// animate_size : int or None
-///     Side of the pictures in pixels (``--png-size`` with ``--animate``), 16..=16384
+///     Side of the figures in pixels (``--png-size`` with ``--animate``), 16..=16384
 ///     (default: a whole number of pixels per cell and at least 512, or one pixel per cell up
 ///     to 1024).
 /// frame_radius : int or None

@@ -9,7 +9,7 @@ use crate::figure::Animate;
 use crate::run::{Progress, interruptible, interruptible_guarded};
 use ::dlca::analysis::{gyration, size_distribution};
 use ::dlca::params::{PARAMS, Settings, Sizes, flags};
-use ::dlca::picture::{ANIMATION_DEFAULT_EVERY, ANIMATION_DEFAULT_SIDE, Animation};
+use ::dlca::figure::{ANIMATION_DEFAULT_EVERY, ANIMATION_DEFAULT_SIDE, Animation};
 use ::dlca::{Params, Simulation, Snapshot};
 use numpy::IntoPyArray;
 use numpy::ndarray::{Array1, Array2};
@@ -358,7 +358,7 @@ pub struct DlcaResult {}
 impl DlcaResult {
     /// Write the ``dlca`` binary's figure of the final lattice, ``dlca.png``, to ``path``: the
     /// same file, byte for byte, as ``dlca --png`` writes for the same run (the libraries'
-    /// renderer, ``dlca::picture``). The whole lattice's first two axes (a projection for
+    /// renderer, ``dlca::figure``). The whole lattice's first two axes (a projection for
     /// d >= 3) in lattice cells, a scale bar, the sweep, clusters, particles and seed; each
     /// cluster in one of eight colour-blind-safe colours on black, neighbouring clusters always
     /// different. Drawn from :attr:`positions`, :attr:`cluster`, ``params["size"]`` and the
@@ -369,7 +369,7 @@ impl DlcaResult {
     /// path : str or os.PathLike
     ///     The PNG file, written atomically.
     /// size : int or None
-    ///     The picture's longer side in pixels (the binary's ``--png-size``), 16..=65536; the
+    ///     The raster's longer side in pixels (the binary's ``--png-size``), 16..=65536; the
     ///     axes and legend come around it. Default: a whole number of pixels per site and at
     ///     least 512, or one pixel per site up to 8192.
     #[pyo3(signature = (path, size = None))]
@@ -377,19 +377,19 @@ impl DlcaResult {
         let side = crate::figure::png_side(size)?;
         let sizes: Vec<u64> = slf.getattr("params")?.get_item("size")?.extract()?;
         let rows = crate::figure::dlca_rows(slf.as_any(), &sizes)?;
-        let view = ::dlca::picture::View {
+        let view = ::dlca::figure::View {
             sizes: &sizes,
             sweeps: slf.getattr("sweeps")?.extract()?,
             clusters: slf.getattr("clusters")?.extract()?,
             particles: slf.getattr("particles")?.extract()?,
             seed: slf.getattr("seed")?.extract()?,
-            each: |f: &mut ::dlca::picture::Visit<'_>| {
+            each: |f: &mut ::dlca::figure::Visit<'_>| {
                 for &(x, y, id) in &rows {
                     f(x, y, id);
                 }
             },
         };
-        ::dlca::picture::write_png_of(&view, &path, side)
+        ::dlca::figure::write_png_of(&view, &path, side)
             .map_err(|e| crate::figure::write_error(&path, e))
     }
 
@@ -446,7 +446,7 @@ impl DlcaResult {
 /// animate_every : int or None
 ///     Sweeps between frames (``--animate-every``), 1.. (default 10).
 /// animate_size : int or None
-///     Longer side of the pictures in pixels (``--png-size`` with ``--animate``), 16..=16384
+///     Longer side of the figures in pixels (``--png-size`` with ``--animate``), 16..=16384
 ///     (default 512).
 /// checkpoint : str, os.PathLike or None
 ///     A directory for the run's checkpoint (default None: no checkpoints). If it holds a

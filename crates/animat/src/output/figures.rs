@@ -1,4 +1,4 @@
-//! The pictures of a run (feature `figures`): the snapshots `snapshot_NNNNNN.png` and the
+//! The figures of a run (feature `figures`): the snapshots `snapshot_NNNNNN.png` and the
 //! animation `animat.gif`, on the run's one [`SnapshotFrame`]. Re-exported by
 //! [`crate::output`], where the binary and the Python bindings find them.
 
@@ -10,22 +10,22 @@ use figures::palette;
 use figures::{Extent, Figure, Legend, Raster, group_digits};
 use std::path::Path;
 
-/// Largest default side of a snapshot's picture in pixels: a larger frame is scaled down.
+/// Largest default side of a snapshot's raster in pixels: a larger frame is scaled down.
 pub const SNAPSHOT_MAX_SIDE: i64 = 1024;
-/// Smallest default side of a snapshot's picture in pixels: a smaller frame is zoomed by a
+/// Smallest default side of a snapshot's raster in pixels: a smaller frame is zoomed by a
 /// whole number of pixels per cell.
 pub const SNAPSHOT_MIN_SIDE: i64 = 512;
 
 /// The one frame of every snapshot and animation frame of a run: the square of cells from
 /// `-radius` to `radius` on both axes around the origin (where the animats start), drawn
-/// `side` pixels wide. It depends on the parameters and flags only, so every picture of a run
+/// `side` pixels wide. It depends on the parameters and flags only, so every raster of a run
 /// (and of its resumed continuation) has the same scale; animats outside it are counted in the
 /// header.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SnapshotFrame {
     /// Half the frame's side in cells.
     pub radius: i64,
-    /// The picture's side in pixels.
+    /// The raster's side in pixels.
     pub side: u32,
 }
 
@@ -77,13 +77,13 @@ impl SnapshotFrame {
         SnapshotFrame { radius, side }
     }
 
-    /// The picture of `world`: foxes (drawn over rabbits where both share a pixel) and rabbits
+    /// The raster of `world`: foxes (drawn over rabbits where both share a pixel) and rabbits
     /// on white, and the number of animats outside the frame.
     pub fn raster(&self, world: &World) -> (Raster, u64) {
         self.raster_of(|| world.animats().map(|a| (a.pos, a.species)))
     }
 
-    /// The picture of the animats `animats()` yields (cell and species; called twice, for
+    /// The raster of the animats `animats()` yields (cell and species; called twice, for
     /// the rabbits and then the foxes over them), as [`SnapshotFrame::raster`].
     pub fn raster_of<I: Iterator<Item = ([i64; 2], Species)>>(
         &self,
@@ -126,7 +126,7 @@ impl SnapshotFrame {
         self.figure_of(Census::of(world), raster, outside)
     }
 
-    /// The figure of a picture from [`SnapshotFrame::raster_of`], its header from `census`.
+    /// The figure of a raster from [`SnapshotFrame::raster_of`], its header from `census`.
     pub fn figure_of<'a>(&self, census: Census, raster: &'a Raster, outside: u64) -> Figure<'a> {
         let edge = self.radius as f64 + 0.5;
         let mut header = format!(

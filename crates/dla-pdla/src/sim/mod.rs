@@ -237,10 +237,10 @@ impl<const D: usize> Simulation<D> {
         self.growth.r_ext
     }
 
-    /// The half side of the square a picture of the run frames: `R_ext` for a radial cluster,
+    /// The half side of the square a figure of the run frames: `R_ext` for a radial cluster,
     /// half the larger of the strip's width and the height for a deposit (framed from the
     /// substrate up, centred at half the height).
-    pub fn picture_half(&self) -> f64 {
+    pub fn figure_half(&self) -> f64 {
         match self.params.substrate() {
             Some(s) => (0.5 * s.width).max(0.5 * self.growth.r_ext),
             None => self.growth.r_ext,

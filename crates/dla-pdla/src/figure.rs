@@ -18,7 +18,7 @@ use figures::{Extent, Figure, Legend, Raster, group_digits};
 use run_io::OutputError;
 use std::path::Path;
 
-/// How the picture shows particles at its scale and dimension.
+/// How the raster shows particles at its scale and dimension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Mode {
     /// 2D, a pixel at most a diameter: discs coloured by arrival.
@@ -29,12 +29,12 @@ enum Mode {
     Density,
 }
 
-/// The picture as particles are added: per pixel, the arrival fraction of the particle shown
+/// The raster as particles are added: per pixel, the arrival fraction of the particle shown
 /// (negative: none), its depth and lighting (spheres), or the particle count (density).
 struct Canvas {
     side: u32,
     extent: f64,
-    /// The frame's centre, `(x, y)` in the picture's plane.
+    /// The frame's centre, `(x, y)` in the raster's plane.
     centre: (f64, f64),
     scale: f64,
     total: u64,
@@ -46,7 +46,7 @@ struct Canvas {
 }
 
 impl Canvas {
-    /// An empty picture of `side` pixels of a cluster of `total` particles whose centres lie
+    /// An empty raster of `side` pixels of a cluster of `total` particles whose centres lie
     /// within `r_ext` of the origin.
     fn new(side: u32, frame: Frame, total: u64, dim: usize) -> Self {
         // Every centre lies within `half` of the frame's centre; one radius more holds every
@@ -135,7 +135,7 @@ impl Canvas {
         self.counts.iter().copied().max().unwrap_or(0)
     }
 
-    /// The picture, colours from `map`; in density mode on a log scale up to `top` particles.
+    /// The raster, colours from `map`; in density mode on a log scale up to `top` particles.
     fn raster(&self, map: &Sequential, top: u32) -> Raster {
         let mut r = Raster::new(self.side, self.side, palette::WHITE);
         let table = map.table(1024);
@@ -166,7 +166,7 @@ impl Canvas {
         r
     }
 
-    /// The figure of the picture: `shown` particles of `total`.
+    /// The figure of the raster: `shown` particles of `total`.
     fn figure<'a>(
         &self,
         raster: &'a Raster,
@@ -229,7 +229,7 @@ impl Canvas {
 struct Cluster<F> {
     dim: usize,
     frame: Frame,
-    /// A deposit: the positions `each` gives are already in the picture's axes (`x`, the
+    /// A deposit: the positions `each` gives are already in the raster's axes (`x`, the
     /// height, then `-y` as the depth).
     deposit: bool,
     total: u64,
@@ -262,7 +262,7 @@ where
     fn write_animation(&self, path: &Path, side: u32, every: u64) -> Result<u64, OutputError> {
         let total = self.total;
         let mut canvas = Canvas::new(side, self.frame, total, self.dim);
-        // A density picture's colours run to the finished cluster's densest pixel, so that a
+        // A density raster's colours run to the finished cluster's densest pixel, so that a
         // colour means the same count in every frame: one pass first to find it.
         let top = if canvas.mode == Mode::Density {
             let mut full = Canvas::new(side, self.frame, total, self.dim);
@@ -318,7 +318,7 @@ where
             // The strip and the deposit's height, in a square.
             Some(_) => Frame {
                 centre: (0.0, 0.5 * sim.r_ext()),
-                half: sim.picture_half(),
+                half: sim.figure_half(),
             },
             None => Frame::around_origin(sim.r_ext()),
         },
@@ -340,7 +340,7 @@ where
     }
 }
 
-/// The square a picture shows: every centre lies within `half` of `centre` along both axes.
+/// The square a raster shows: every centre lies within `half` of `centre` along both axes.
 #[derive(Debug, Clone, Copy)]
 struct Frame {
     centre: (f64, f64),
@@ -387,7 +387,7 @@ fn of_positions(
     })
 }
 
-/// Writes `dla.png` of `side` x `side` pixels of picture (plus axes and legend) to `path`.
+/// Writes `dla.png` of `side` x `side` pixels of raster (plus axes and legend) to `path`.
 ///
 /// # Errors
 /// The positions cannot be read or the file cannot be written.
@@ -420,7 +420,7 @@ pub fn write_png_of_positions(
     of_positions(positions, dim, r_ext, seed)?.write_png(path, side)
 }
 
-/// Side of the picture in `dla.gif` when none is asked for (`--png-size`).
+/// Side of the raster in `dla.gif` when none is asked for (`--png-size`).
 pub const ANIMATION_DEFAULT_SIDE: u32 = 512;
 
 /// Particles between frames of the animation when none is asked for: about 100 frames.
@@ -429,7 +429,7 @@ pub fn default_animation_every(particles: u64) -> u64 {
 }
 
 /// Writes the growth of the cluster as an animated GIF to `path`: one frame every `every`
-/// particles and one of the whole cluster, each `side` x `side` pixels of picture on the
+/// particles and one of the whole cluster, each `side` x `side` pixels of raster on the
 /// finished cluster's frame (so the scale never changes), colours as in `dla.png`. Returns the
 /// number of frames.
 ///
@@ -492,7 +492,7 @@ mod tests {
         let (a, b) = (dir.path().join("a.png"), dir.path().join("b.png"));
         let (sim2, flat2) = grown::<2>(300);
         let (sim3, flat3) = grown::<3>(200);
-        // Discs, spheres and density (a picture narrower than the cluster).
+        // Discs, spheres and density (a raster narrower than the cluster).
         for (side, dim) in [(64, 2), (512, 2), (48, 3), (16, 2)] {
             if dim == 2 {
                 write_png(&sim2, dir.path(), &a, side).unwrap();

@@ -2,7 +2,7 @@
 //! `dlca.gif` ([`Animation`]). Both show the lattice's first two axes (a projection for
 //! d >= 3, a strip for d = 1) on the whole lattice, in lattice cells, with the last axis up.
 //!
-//! Clusters are coloured so that neighbouring clusters in the picture (less than about a 16th of
+//! Clusters are coloured so that neighbouring clusters in the raster (less than about a 16th of
 //! its side apart, nothing between them) always differ: a greedy colouring of the graph of
 //! neighbours
 //! ([`figures::palette::colour_regions`]) over the Okabe-Ito colours other than black
@@ -18,17 +18,17 @@ use run_io::OutputError;
 use std::collections::HashMap;
 use std::path::Path;
 
-/// Smallest default longer side of the picture: a small lattice is drawn with a square of
+/// Smallest default longer side of the raster: a small lattice is drawn with a square of
 /// pixels per site.
 pub const PNG_MIN_SIDE: u64 = 512;
-/// Largest default longer side of the picture: a larger lattice is scaled down.
+/// Largest default longer side of the raster: a larger lattice is scaled down.
 pub const PNG_MAX_SIDE: u64 = 8192;
 
 /// What the figures show of a lattice's state: its sizes, the run's progress and seed, and a
 /// pass over its particles in the order of `particles.csv` (clusters by increasing id, each
 /// cluster's sites by increasing k-index), `each(f)` calling `f(x1, x2, cluster id)` with the
 /// site's first two coordinates (`x2` 0 on a 1D lattice). Where sites share a pixel the last
-/// one drawn shows, so the order is part of the picture.
+/// one drawn shows, so the order is part of the raster.
 pub struct View<'a, F> {
     /// The lattice's side along each axis.
     pub sizes: &'a [u64],
@@ -75,10 +75,10 @@ fn plane(sizes: &[u64]) -> (u64, u64) {
     (sizes[0], sizes.get(1).copied().unwrap_or(1))
 }
 
-/// Width and height of the picture of a lattice of `sizes` whose longer side is `side` pixels
+/// Width and height of the raster of a lattice of `sizes` whose longer side is `side` pixels
 /// (default: a whole number of pixels per site, at least [`PNG_MIN_SIDE`], or one pixel per
 /// site up to [`PNG_MAX_SIDE`]); the shorter side keeps the lattice's proportions.
-pub fn picture_size(sizes: &[u64], side: Option<u32>) -> (u32, u32) {
+pub fn raster_size(sizes: &[u64], side: Option<u32>) -> (u32, u32) {
     let (w0, h0) = plane(sizes);
     let long = w0.max(h0);
     let side = match side {
@@ -90,14 +90,14 @@ pub fn picture_size(sizes: &[u64], side: Option<u32>) -> (u32, u32) {
     (scaled(w0), scaled(h0))
 }
 
-/// Memory the buffers of a picture of `w` x `h` pixels take while drawn: a cluster id (4 bytes)
+/// Memory the buffers of a figure of `w` x `h` pixels take while drawn: a cluster id (4 bytes)
 /// and a colour (3) per pixel, and the figure around it (at most double the area: 6).
 pub fn png_memory_bytes(w: u64, h: u64) -> u64 {
     w.saturating_mul(h).saturating_mul(13)
 }
 
-/// The cluster id shown at each pixel of a `w` x `h` picture (`u32::MAX`: no particle), row 0
-/// at the top. Sites map to the pixels of their share of the picture (at least one each).
+/// The cluster id shown at each pixel of a `w` x `h` raster (`u32::MAX`: no particle), row 0
+/// at the top. Sites map to the pixels of their share of the raster (at least one each).
 fn labels<F: Fn(&mut Visit<'_>)>(view: &View<'_, F>, (w, h): (u32, u32)) -> Vec<u32> {
     let (w0, h0) = plane(view.sizes);
     let span = |c: u64, n: u64, px: u32| {
@@ -117,14 +117,14 @@ fn labels<F: Fn(&mut Visit<'_>)>(view: &View<'_, F>, (w, h): (u32, u32)) -> Vec<
     ids
 }
 
-/// How far (in pixels) clusters are grown to find their neighbours in a picture of `size`: a
+/// How far (in pixels) clusters are grown to find their neighbours in a figure of `size`: a
 /// 32nd of its longer side, at least 3 pixels, so clusters less than about a 16th of the
-/// picture apart differ in colour.
+/// raster apart differ in colour.
 fn reach((w, h): (u32, u32)) -> usize {
     (w.max(h) as usize / 32).max(3)
 }
 
-/// The picture of `view` and the colour (index into [`ON_BLACK`]) of each cluster in it, each
+/// The raster of `view` and the colour (index into [`ON_BLACK`]) of each cluster in it, each
 /// cluster keeping its colour in `previous` where no neighbour has it; the last value counts
 /// clusters that had to share a colour with a neighbour (none on a 2D lattice in practice).
 fn draw<F: Fn(&mut Visit<'_>)>(
@@ -150,7 +150,7 @@ fn draw<F: Fn(&mut Visit<'_>)>(
     (r, colours, clashes)
 }
 
-/// The figure of a picture of `view`.
+/// The figure of a figure of `view`.
 fn figure<'a, F>(view: &View<'_, F>, raster: &'a Raster) -> Figure<'a> {
     let sizes: Vec<String> = view.sizes.iter().map(u64::to_string).collect();
     let (w0, h0) = plane(view.sizes);
@@ -183,8 +183,8 @@ fn figure<'a, F>(view: &View<'_, F>, raster: &'a Raster) -> Figure<'a> {
     }
 }
 
-/// Writes `dlca.png`, the figure of `sim`'s state with a picture whose longer side is `side`
-/// pixels (default: see [`picture_size`]).
+/// Writes `dlca.png`, the figure of `sim`'s state with a raster whose longer side is `side`
+/// pixels (default: see [`raster_size`]).
 ///
 /// # Errors
 /// The file cannot be written.
@@ -209,7 +209,7 @@ pub fn write_png_of<F: Fn(&mut Visit<'_>)>(
     side: Option<u32>,
 ) -> Result<(), OutputError> {
     if view.sizes.is_empty() || view.sizes.contains(&0) {
-        return Err(std::io::Error::other("a lattice picture needs sides of 1 or more").into());
+        return Err(std::io::Error::other("a lattice raster needs sides of 1 or more").into());
     }
     let (w0, h0) = plane(view.sizes);
     let mut outside = None;
@@ -233,7 +233,7 @@ fn png<F: Fn(&mut Visit<'_>)>(
     path: &Path,
     side: Option<u32>,
 ) -> Result<(), OutputError> {
-    let (raster, _, clashes) = draw(view, picture_size(view.sizes, side), &HashMap::new());
+    let (raster, _, clashes) = draw(view, raster_size(view.sizes, side), &HashMap::new());
     if clashes > 0 {
         tracing::warn!("{clashes} clusters in dlca.png share a colour with a neighbour");
     }
@@ -241,7 +241,7 @@ fn png<F: Fn(&mut Visit<'_>)>(
     Ok(())
 }
 
-/// Longer side of the pictures in `dlca.gif` without `--png-size`.
+/// Longer side of the figures in `dlca.gif` without `--png-size`.
 pub const ANIMATION_DEFAULT_SIDE: u32 = 512;
 /// Sweeps between frames of `dlca.gif` without `--animate-every`.
 pub const ANIMATION_DEFAULT_EVERY: u64 = 10;
@@ -257,14 +257,14 @@ pub struct Animation {
 }
 
 impl Animation {
-    /// Starts an animation of `sim` at `path` with pictures whose longer side is `side` pixels,
+    /// Starts an animation of `sim` at `path` with figures whose longer side is `side` pixels,
     /// and adds its first frame.
     ///
     /// # Errors
     /// The file cannot be created or the frame not drawn.
     pub fn start(sim: &Simulation, seed: u64, path: &Path, side: u32) -> Result<Self, OutputError> {
         let view = view(sim, seed);
-        let size = picture_size(view.sizes, Some(side));
+        let size = raster_size(view.sizes, Some(side));
         let (raster, colours, _) = draw(&view, size, &HashMap::new());
         let image = figure(&view, &raster).render()?;
         let mut gif = Gif::create(path, image.width, image.height)?;
@@ -325,7 +325,7 @@ mod tests {
     #[test]
     fn neighbouring_clusters_have_different_colours() {
         let sim = small_run();
-        let size = picture_size(sim.lattice().sizes(), Some(96));
+        let size = raster_size(sim.lattice().sizes(), Some(96));
         assert_eq!(size, (96, 64));
         let ids = labels(&view(&sim, 7), size);
         let (r, colours, clashes) = draw(&view(&sim, 7), size, &HashMap::new());
@@ -431,7 +431,7 @@ mod tests {
     fn the_default_size_keeps_the_proportions() {
         let sim = small_run();
         // 48 x 32 sites: 11 pixels a site, so the longer side reaches 512.
-        assert_eq!(picture_size(sim.lattice().sizes(), None), (528, 352));
+        assert_eq!(raster_size(sim.lattice().sizes(), None), (528, 352));
     }
 
     #[test]
