@@ -1,6 +1,6 @@
 //! Library behind `cargo xtask`: the scaling experiments that regenerate the papers' tables and
 //! figures (`scaling`), the headline benchmarks (`bench`), DLA at the papers' scale (`scale`),
-//! and the tables and plots they write.
+//! and the tables and charts they write.
 //! The binary (`src/main.rs`) parses the command line and calls in here; the harness's own
 //! test (`tests/scaling.rs`) runs it at a tiny size.
 

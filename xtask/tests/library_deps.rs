@@ -1,6 +1,6 @@
 //! The model libraries alone (`--no-default-features`: without their binary's command line,
 //! feature `cli`, their figures, feature `figures`, and their files, feature `files`) stay
-//! small: a program that only simulates does not build a plotting stack, image encoders, clap,
+//! small: a program that only simulates does not build a figure stack, image encoders, clap,
 //! or the file formats of a run's outputs and checkpoints. Each library's packages are counted
 //! as the distinct names `cargo tree -p LIB --no-default-features -e normal --prefix none`
 //! lists, and held to the count in `LIMITS` (at most 20); a change that needs more raises it

@@ -1,4 +1,4 @@
-//! The scaling harness at a tiny size: every report, CSV and plot is produced and well formed,
+//! The scaling harness at a tiny size: every report, CSV and chart is produced and well formed,
 //! the papers' values appear beside ours, and the fit code recovers known slopes.
 
 use core_lattice::Fit;

@@ -19,7 +19,7 @@ use std::path::Path;
 pub use run_io::OutputError;
 use run_io::schema::{Axes, Column, Dtype, Form, Output, output};
 
-// The snapshots and the animation draw with `figures` (plotting, colour maps, GIF):
+// The snapshots and the animation draw with `figures` (charts, colour maps, GIF):
 // behind feature `figures`, so that the library alone builds without them.
 #[cfg(feature = "figures")]
 mod figures;

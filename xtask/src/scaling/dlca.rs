@@ -316,7 +316,7 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
             to_target.n.to_string(),
             pm(to_target.mean, to_target.stderr),
             pm(zm, zse),
-            "plot only; the 5% system loses clusters faster".into(),
+            "chart only; the 5% system loses clusters faster".into(),
         ]);
     }
     ctx.table(doc, &table, "dlca_fig5_summary.csv")?;
@@ -325,7 +325,7 @@ fn fig5(ctx: &Ctx, doc: &mut crate::report::Doc) -> Result<()> {
     fig5_chart(&ctx.out)?;
     doc.p(
         "Each run stops at 100 clusters. z is the log-log slope of clusters against sweeps from \
-         sweep 10 on, per run, then averaged (± standard error over runs). The plot shows the \
+         sweep 10 on, per run, then averaged (± standard error over runs). The chart shows the \
          mean cluster count over the runs, up to the sweep every run reached, with its \
          standard error as a band ([`dlca_fig5_mean.csv`](dlca_fig5_mean.csv)). Per-sweep data \
          at about 200 log-spaced sweeps per run: [`dlca_fig5.csv`](dlca_fig5.csv).",

@@ -2,7 +2,7 @@
 //!
 //! Each experiment writes, into the output directory, a markdown report (`<name>.md`) with our
 //! values, their standard errors and the papers' values side by side, the CSV data behind every
-//! table and plot, and PNG plots. `index.md` records the date, machine, command and the time
+//! table and chart, and PNG charts. `index.md` records the date, machine, command and the time
 //! each experiment took. Every number in the reports comes from runs made by the command that
 //! wrote them, except the papers' values, which are labelled as such.
 

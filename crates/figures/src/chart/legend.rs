@@ -5,10 +5,10 @@ use super::labels::Rect;
 use super::{Chart, HEIGHT, Style, WIDTH};
 use plotters::prelude::SeriesLabelPosition;
 
-/// The corner of the plot where the legend covers the least data: the share of the plot a
+/// The corner of the chart where the legend covers the least data: the share of the chart a
 /// legend of this chart's entries takes is estimated from their number and length, and the
 /// points (and the lines between them, sampled) that fall under it are counted in each corner.
-/// Returns the corner, how many samples it still covers, and the share of the plot's height
+/// Returns the corner, how many samples it still covers, and the share of the chart's height
 /// the legend takes.
 pub(super) fn legend_corner(
     chart: &Chart,
@@ -22,7 +22,7 @@ pub(super) fn legend_corner(
             (v - lo) / (hi - lo)
         }
     };
-    // Plot area in pixels: the chart less its margins, caption and label areas.
+    // Drawing area in pixels: the chart less its margins, caption and label areas.
     let (plot_w, plot_h) = (f64::from(WIDTH) - 112.0, f64::from(HEIGHT) - 130.0);
     let longest = chart
         .series

@@ -72,7 +72,7 @@ impl Setting {
         }
     }
 
-    /// `k2 s0.5 jump100`: a point label for the plots.
+    /// `k2 s0.5 jump100`: a point label for the charts.
     pub(super) fn short(&self) -> String {
         let ff = match self.far_field {
             FarField::Return => String::new(),

@@ -81,7 +81,7 @@ pub fn vpdist_errors(ctx: &Ctx, doc: &mut Doc, n: u64) -> Result<()> {
                 frac.to_string(),
             ]);
         }
-        // The complementary CDF at log-spaced error levels, for the plot.
+        // The complementary CDF at log-spaced error levels, for the chart.
         for k in 0..=40 {
             let level = 10f64.powf(-4.0 + 4.0 * k as f64 / 40.0);
             let above = errs.len() - errs.partition_point(|&e| e <= level);
