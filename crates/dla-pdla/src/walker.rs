@@ -98,6 +98,7 @@ where
     /// `VARIANT`: the walk may have a substrate, a drift or ballistic walkers
     /// ([`WalkState::variant`]); a plain walk is compiled without them (the callers choose
     /// once per walker).
+    #[inline(always)]
     pub(crate) fn advance<const VARIANT: bool, R: Rng + ?Sized>(
         &mut self,
         state: &mut WalkState<D>,
