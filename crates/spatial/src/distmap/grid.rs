@@ -25,6 +25,8 @@ pub struct Grid {
     pub(super) inv_quantum: f64,
     /// The map covers cells `k` in `[-half, half)` per axis, i.e. `|x| < half * cell`.
     pub(super) half: i64,
+    /// `half` as a float, for the reads' in-map test (set with `half`, by `set_half`).
+    pub(super) half_f: f64,
     /// Points counted by `PointMap::len`.
     pub(super) points: u64,
     /// `below[v]`: a squared distance below which a cell holding `v` may be lowered,
@@ -69,10 +71,18 @@ impl Grid {
             quantum,
             inv_quantum: 1.0 / quantum,
             half: 0,
+            half_f: 0.0,
             points: 0,
             below,
             widths,
         })
+    }
+
+    /// Sets the half side in cells (`half` and `half_f`).
+    #[inline]
+    pub(super) fn set_half(&mut self, half: i64) {
+        self.half = half;
+        self.half_f = half as f64;
     }
 
     /// Half the side of the covered cube.
