@@ -368,7 +368,8 @@ impl<const D: usize> Cluster<D> {
             .unwrap_or(maps.levels.len().saturating_sub(1));
         let mut best: Option<(f64, f64, bool)> = None;
         let mut finer = true;
-        for (k, map) in maps.levels.iter().enumerate().take(top + 1).rev() {
+        let levels = maps.levels.iter().zip(maps.enough.iter());
+        for (k, (map, &enough)) in levels.enumerate().take(top + 1).rev() {
             let Some((lb, mut ub, capped)) = map.bounds(p) else {
                 continue;
             };
@@ -384,7 +385,7 @@ impl<const D: usize> Cluster<D> {
                 break;
             }
             best = Some((lb, ub, false));
-            if lb >= maps.enough[k] {
+            if lb >= enough {
                 finer = false;
                 break;
             }

@@ -33,6 +33,42 @@
 use core_lattice::rng::{Rng, uniform01, unit_vector};
 use std::f64::consts::PI;
 
+/// A point `(x, y)` uniform in the unit disk (less a disk of radius 1e-6 around the centre) by
+/// rejection from the square (two 32-bit uniforms from one 64-bit draw, accepted with
+/// probability pi/4), and `s = x^2 + y^2`, uniform in `(1e-12, 1]`.
+#[inline(always)]
+pub(crate) fn disk_point<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64, f64) {
+    const SCALE: f64 = 1.0 / 2_147_483_648.0;
+    loop {
+        let b = rng.next_u64();
+        let x = ((b >> 32) as u32 as i32) as f64 * SCALE;
+        let y = (b as u32 as i32) as f64 * SCALE;
+        let s = x * x + y * y;
+        if s <= 1.0 && s > 1e-12 {
+            return (x, y, s);
+        }
+    }
+}
+
+/// A [`disk_point`] normalised: a uniform direction in the plane without trigonometric
+/// functions, isotropic exactly up to the 2^-31 granularity of the point.
+#[inline(always)]
+pub(crate) fn disk_direction<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64) {
+    let (x, y, s) = disk_point(rng);
+    let inv = 1.0 / s.sqrt();
+    (x * inv, y * inv)
+}
+
+/// A uniform unit vector in 3D: `z` uniform in `[-1, 1]` (Archimedes), then the azimuth from
+/// a [`disk_direction`].
+#[inline(always)]
+pub(crate) fn direction_3d<R: Rng + ?Sized>(rng: &mut R) -> [f64; 3] {
+    let z = 2.0 * uniform01(rng) - 1.0;
+    let rho = (1.0 - z * z).max(0.0).sqrt();
+    let (c, s) = disk_direction(rng);
+    [rho * c, rho * s, z]
+}
+
 /// 2D: the angle `phi` in `(-pi, pi)` between the walker's direction and the point where it
 /// first hits the circle, for `x = r / R > 1`. Density
 /// `(x^2 - 1) / (2 pi (x^2 - 2 x cos phi + 1))`, sampled by inversion:
@@ -59,11 +95,19 @@ pub fn return_cosine_3d<R: Rng + ?Sized>(r: f64, big_r: f64, rng: &mut R) -> Opt
 
 /// 2D: the point on the circle of radius `big_r` where a walker at `p` (`|p| > big_r`) first
 /// hits it: always a hit (Brownian motion in the plane is recurrent), at the walker's direction
-/// turned by [`return_angle_2d`].
+/// turned by the angle of [`return_angle_2d`], drawn without trigonometric functions:
+/// `tan(u pi / 2)` with `u` uniform in `(-1, 1)` is `b / |a|` for a point `(a, b)` uniform in
+/// the unit disk ([`disk_point`]), so `t = tan(phi / 2) = k b / |a|`, `k = (x - 1)/(x + 1)`,
+/// and `cos phi = (a^2 - k^2 b^2) / (a^2 + k^2 b^2)`, `sin phi = 2 k |a| b / (a^2 + k^2 b^2)`.
 pub fn return_to_circle<R: Rng + ?Sized>(p: &[f64; 2], big_r: f64, rng: &mut R) -> [f64; 2] {
     let r = norm(p);
-    let phi = return_angle_2d(r / big_r, rng);
-    let (s, c) = phi.sin_cos();
+    let x = r / big_r;
+    let k = (x - 1.0) / (x + 1.0);
+    let (a, b, _) = disk_point(rng);
+    let a = a.abs();
+    let kb = k * b;
+    let den = a * a + kb * kb;
+    let (c, s) = ((a * a - kb * kb) / den, 2.0 * a * kb / den);
     let (ex, ey) = (p[0] / r, p[1] / r);
     [big_r * (c * ex - s * ey), big_r * (s * ex + c * ey)]
 }
@@ -75,7 +119,7 @@ pub fn return_to_sphere_3d<R: Rng + ?Sized>(p: &[f64; 3], big_r: f64, rng: &mut 
     let r = norm(p);
     let mut out = [0.0; 3];
     match return_cosine_3d(r, big_r, rng) {
-        None => out = scale(unit_vector::<3, _>(rng), big_r),
+        None => out = scale(direction_3d(rng), big_r),
         Some(u) => {
             let e = scale(*p, 1.0 / r);
             // An orthonormal pair perpendicular to e.
@@ -97,7 +141,7 @@ pub fn return_to_sphere_3d<R: Rng + ?Sized>(p: &[f64; 3], big_r: f64, rng: &mut 
                 e[0] * v1[1] - e[1] * v1[0],
             ];
             let sin_t = (1.0 - u * u).max(0.0).sqrt();
-            let (sa, ca) = (2.0 * PI * uniform01(rng)).sin_cos();
+            let (ca, sa) = disk_direction(rng);
             for i in 0..3 {
                 out[i] = big_r * (u * e[i] + sin_t * (ca * v1[i] + sa * v2[i]));
             }

@@ -27,7 +27,10 @@
 //!    binary, the Python bindings and `cargo xtask scaling` use it);
 //! 4. check the orthtree's index limits against [`max_particles`](crate::params::max_particles).
 
-use crate::farfield::{return_to_circle, return_to_sphere_3d, return_to_sphere_nd};
+use crate::farfield::{
+    direction_3d, disk_direction, disk_point, return_to_circle, return_to_sphere_3d,
+    return_to_sphere_nd,
+};
 use core_lattice::rng::{Rng, uniform01};
 
 /// The dimensions with a [`Space`] implementation, the accepted values of `--dim`.
@@ -78,32 +81,6 @@ pub trait Space<const D: usize> {
     /// A generous estimate of `R_ext` for a cluster of `n` particles, for sizing PDLA's shared
     /// distance maps up front. A cluster that outgrows it only loses the maps' help at its rim.
     fn expected_r_ext(n: u64) -> f64;
-}
-
-/// A point `(x, y)` uniform in the unit disk (less a disk of radius 1e-6 around the centre) by
-/// rejection from the square (two 32-bit uniforms from one 64-bit draw, accepted with
-/// probability pi/4), and `s = x^2 + y^2`, uniform in `(1e-12, 1]`.
-#[inline(always)]
-fn disk_point<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64, f64) {
-    const SCALE: f64 = 1.0 / 2_147_483_648.0;
-    loop {
-        let b = rng.next_u64();
-        let x = ((b >> 32) as u32 as i32) as f64 * SCALE;
-        let y = (b as u32 as i32) as f64 * SCALE;
-        let s = x * x + y * y;
-        if s <= 1.0 && s > 1e-12 {
-            return (x, y, s);
-        }
-    }
-}
-
-/// A [`disk_point`] normalised: a uniform direction in the plane without trigonometric
-/// functions, isotropic exactly up to the 2^-31 granularity of the point.
-#[inline(always)]
-fn disk_direction<R: Rng + ?Sized>(rng: &mut R) -> (f64, f64) {
-    let (x, y, s) = disk_point(rng);
-    let inv = 1.0 / s.sqrt();
-    (x * inv, y * inv)
 }
 
 /// A uniform unit vector in 4D by Marsaglia's method ("Choosing a point from the surface of a
@@ -184,10 +161,7 @@ impl Space<3> for Dim<3> {
     /// `z` uniform in `[-1, 1]` (Archimedes), then the azimuth from a disk direction.
     #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 3] {
-        let z = 2.0 * uniform01(rng) - 1.0;
-        let rho = (1.0 - z * z).max(0.0).sqrt();
-        let (c, s) = disk_direction(rng);
-        [rho * c, rho * s, z]
+        direction_3d(rng)
     }
 
     /// [`return_to_sphere_3d`].

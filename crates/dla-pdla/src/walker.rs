@@ -98,6 +98,7 @@ where
     /// `VARIANT`: the walk may have a substrate, a drift or ballistic walkers
     /// ([`WalkState::variant`]); a plain walk is compiled without them (the callers choose
     /// once per walker).
+    #[inline(always)]
     pub(crate) fn advance<const VARIANT: bool, R: Rng + ?Sized>(
         &mut self,
         state: &mut WalkState<D>,
@@ -166,11 +167,23 @@ where
         // cluster the walker may be much farther from it, and jumps of the cap would take
         // (region / cap)^2 moves to cross them, a cost growing with the cluster. There the
         // tree's distance, a few hundred nanoseconds, gives the long jump instead.
+        //
+        // A walker known to be within `1 + MAP_JUMP_MIN` of the cluster skips the maps: their
+        // lower bound cannot send it jumping and no map's cell is capped that near. What it
+        // would lose is a map's upper bound, and where the tree's answer is exact (within
+        // `exact_within`) it is the same whatever bound its query starts from (and the near
+        // cache's is the tree's).
         let mut floor = 0.0;
-        state.counts.map_reads += 1;
-        let bounds = if DEPOSIT {
+        let bounds = if !DEPOSIT
+            && state.upper <= 1.0 + Dim::<D>::MAP_JUMP_MIN
+            && state.upper <= state.exact_within
+        {
+            None
+        } else if DEPOSIT {
+            state.counts.map_reads += 1;
             cluster.deposit_map_bounds(&self.p, state.upper)
         } else {
+            state.counts.map_reads += 1;
             cluster.map_bounds_within(&self.p, state.upper)
         };
         if let Some((lb, ub, capped)) = bounds {
@@ -463,6 +476,8 @@ pub(crate) struct WalkState<const D: usize> {
     /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
     /// wherever the cache answers (`(kappa - 1/2)` leaf diagonals cover [`NEAR_RADIUS`]).
     near_on: bool,
+    /// Distances within which the tree's `vpdist` is exact: `(kappa - 1/2)` leaf diagonals.
+    exact_within: f64,
     /// Whether a contact may be refused: `params.sticking_probability < 1`.
     pub(crate) refuse: bool,
     /// The direction of the step that ended in the last contact.
@@ -494,7 +509,8 @@ pub struct WalkCounts {
     pub moves: u64,
     /// Moves in the far field (returned to the birth sphere, or the paper's far jump).
     pub far_field: u64,
-    /// Distance-map reads (one per near-field move; each reads a cell of every level it
+    /// Distance-map reads (one per near-field move, except for a walker known to be too
+    /// near the cluster for a map to send it jumping; each reads a cell of every level it
     /// needs).
     pub map_reads: u64,
     /// Moves that ended in a jump by the map's bound, without a tree query.
@@ -547,6 +563,7 @@ impl<const D: usize> WalkState<D> {
             anchor: None,
             touched: None,
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
+            exact_within,
             refuse: params.sticking_probability < 1.0,
             step: [0.0; D],
             on_wall: false,

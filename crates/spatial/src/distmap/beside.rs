@@ -50,9 +50,23 @@ impl<const D: usize> Beside<D> {
         b: i64,
     ) -> (i64, i64) {
         let mut off = 0.0;
-        for i in 1..D {
-            off += ((k[i] as f64 + 0.5) * cell - self.mid[i]) * self.w[i];
+        for (i, &k) in k.iter().enumerate().skip(1) {
+            off += self.term(i, k, cell);
         }
+        self.clip_at(off, inv_cell, a, b)
+    }
+
+    /// The term of axis `i >= 1` in the offset of the rows at cell index `k` along it: what
+    /// [`clip`](Self::clip) sums over the axes, for an insert that tabulates it per axis.
+    #[inline(always)]
+    pub(super) fn term(&self, i: usize, k: i64, cell: f64) -> f64 {
+        ((k as f64 + 0.5) * cell - self.mid[i]) * self.w[i]
+    }
+
+    /// [`clip`](Self::clip) given the row's offset `off`, the sum of its [`term`](Self::term)s
+    /// over axes `1..D` in order.
+    #[inline(always)]
+    pub(super) fn clip_at(&self, off: f64, inv_cell: f64, a: i64, b: i64) -> (i64, i64) {
         // Keep the cells with (c_0 - m_0) w_0 < r; a cell on the boundary is kept.
         let r = Self::MARGIN - off;
         let w0 = self.w[0];

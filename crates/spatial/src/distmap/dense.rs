@@ -13,6 +13,8 @@ pub struct DistanceMap<const D: usize> {
     pub(super) grid: Grid,
     /// `2 * half`: cells per axis.
     pub(super) side: usize,
+    /// `side` as a float (exact).
+    pub(super) side_f: f64,
     /// One byte per cell, axis 0 fastest. Atomic so that PDLA threads can share one map
     /// ([`DistanceMap::insert_shared`]); relaxed loads and stores are plain moves.
     pub(super) values: Vec<AtomicU8>,
@@ -23,6 +25,7 @@ impl<const D: usize> Clone for DistanceMap<D> {
         DistanceMap {
             grid: self.grid.clone(),
             side: self.side,
+            side_f: self.side_f,
             values: self
                 .values
                 .iter()
@@ -50,6 +53,7 @@ impl<const D: usize> DistanceMap<D> {
         Ok(DistanceMap {
             grid: Grid::new(cell, cap)?,
             side: 0,
+            side_f: 0.0,
             values: Vec::new(),
         })
     }
@@ -58,25 +62,24 @@ impl<const D: usize> DistanceMap<D> {
     #[inline]
     fn index(&self, p: &[f64; D]) -> Option<(usize, [f64; D])> {
         let g = &self.grid;
-        let mut idx = 0usize;
-        let mut stride = 1usize;
+        let mut idx = 0.0;
+        let mut stride = 1.0;
         let mut centre = [0.0; D];
         for i in 0..D {
             let k = floor(p[i] * g.inv_cell);
-            // The cube is `side = 2 half` cells a side; a signed integer converts to `f64` in
-            // one instruction, an unsigned one in several. NaN fails the test.
-            let half = g.half as f64;
+            // The cube is `side = 2 half` cells a side. NaN fails the test.
+            let half = g.half_f;
             if !(k >= -half && k < half) {
                 return None;
             }
-            let j = k + half;
-            // j is a whole number in [0, side): through i64 the conversion is one instruction
-            // and a check, where a direct f64 -> usize conversion is a longer sequence.
-            idx += j as i64 as usize * stride;
-            stride *= self.side;
+            // `k + half` is a whole number in [0, side), and the index a whole number below
+            // the map's cells, under 2^53 (`grow`): exact in `f64`, converted once (through
+            // i64, one instruction and a check, where f64 -> usize is a longer sequence).
+            idx += (k + half) * stride;
+            stride *= self.side_f;
             centre[i] = (k + 0.5) * g.cell;
         }
-        Some((idx, centre))
+        Some((idx as i64 as usize, centre))
     }
 
     /// Adds every point of the closed box `[lo, hi]` at once: lowers each cell to the
@@ -229,7 +232,11 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
             .ceil();
         let side = 2.0 * cells;
         let total = side.powi(D as i32);
-        if !(side < f64::from(u32::MAX) && total < (isize::MAX as f64) / 2.0) {
+        // Under 2^53 cells in all, so that a read's index is exact in `f64`.
+        if !(side < f64::from(u32::MAX)
+            && total < (isize::MAX as f64) / 2.0
+            && total < 2f64.powi(53))
+        {
             return Err(DistanceMapError::TooLarge {
                 cells_per_axis: side,
             });
@@ -266,8 +273,9 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
             }
         }
         self.values = values;
-        self.grid.half = half;
+        self.grid.set_half(half);
         self.side = side;
+        self.side_f = side as f64;
         Ok(())
     }
 

@@ -9,6 +9,10 @@ use crate::round::{ceil, floor};
 /// Largest `(cap / cell)^2` for which a map tabulates its row widths.
 const WIDTHS_MAX: f64 = 4096.0;
 
+/// Most cells per axis over which an insert tabulates its rows' offsets ([`RowTables`]); an
+/// insert spanning more computes every row in full.
+const TABLE_ROWS: usize = 24;
+
 /// The cells of a map of side `cell` capped at `cap`, how far the map reaches, its points,
 /// and the tables its inserts read (see [`Grid::new`]).
 #[derive(Clone)]
@@ -21,6 +25,8 @@ pub struct Grid {
     pub(super) inv_quantum: f64,
     /// The map covers cells `k` in `[-half, half)` per axis, i.e. `|x| < half * cell`.
     pub(super) half: i64,
+    /// `half` as a float, for the reads' in-map test (set with `half`, by `set_half`).
+    pub(super) half_f: f64,
     /// Points counted by `PointMap::len`.
     pub(super) points: u64,
     /// `below[v]`: a squared distance below which a cell holding `v` may be lowered,
@@ -65,10 +71,18 @@ impl Grid {
             quantum,
             inv_quantum: 1.0 / quantum,
             half: 0,
+            half_f: 0.0,
             points: 0,
             below,
             widths,
         })
+    }
+
+    /// Sets the half side in cells (`half` and `half_f`).
+    #[inline]
+    pub(super) fn set_half(&mut self, half: i64) {
+        self.half = half;
+        self.half_f = half as f64;
     }
 
     /// Half the side of the covered cube.
@@ -175,6 +189,100 @@ impl Grid {
         let b = (b as i64).min(hi0);
         match side {
             Some(side) => side.clip(k, self.cell, self.inv_cell, a, b),
+            None => (a, b),
+        }
+    }
+}
+
+/// What the rows of one insert need from each axis `1..D`, tabulated once per cell index along
+/// that axis instead of once per row: the squared distance from the point to the cells'
+/// centres along the axis and its whole-cell lower bound ([`Grid::row_offset`] sums these over
+/// the axes, in the same order, so a row gets the same values bit for bit), and the axis's
+/// term of the half-space offset of an insert beside a touched point ([`Beside::clip`]). A
+/// row then costs a few table reads and additions.
+pub(super) struct RowTables<const D: usize> {
+    e2: [[f64; TABLE_ROWS]; D],
+    j2: [[usize; TABLE_ROWS]; D],
+    off: [[f64; TABLE_ROWS]; D],
+}
+
+impl<const D: usize> RowTables<D> {
+    /// Empty tables, to be [`fill`](Self::fill)ed.
+    #[inline(always)]
+    pub(super) fn new() -> Self {
+        RowTables {
+            e2: [[0.0; TABLE_ROWS]; D],
+            j2: [[0; TABLE_ROWS]; D],
+            off: [[0.0; TABLE_ROWS]; D],
+        }
+    }
+
+    /// Fills the tables for an insert of `q` over the cells `lo..=hi` (`kq` from
+    /// [`Grid::row_origin`]); `false` (tables unusable) when an axis spans more than
+    /// [`TABLE_ROWS`] cells.
+    #[inline(always)]
+    pub(super) fn fill(
+        &mut self,
+        g: &Grid,
+        q: &[f64; D],
+        lo: &[i64; D],
+        hi: &[i64; D],
+        kq: &[i64; D],
+        side: Option<&Beside<D>>,
+    ) -> bool {
+        if (1..D).any(|i| hi[i] - lo[i] >= TABLE_ROWS as i64) {
+            return false;
+        }
+        for i in 1..D {
+            for (m, k) in (lo[i]..=hi[i]).enumerate() {
+                let e = q[i] - (k as f64 + 0.5) * g.cell;
+                self.e2[i][m] = e * e;
+                let j = if k <= kq[i] { kq[i] - k } else { k - kq[i] - 1 };
+                self.j2[i][m] = (j * j) as usize;
+                if let Some(side) = side {
+                    self.off[i][m] = side.term(i, k, g.cell);
+                }
+            }
+        }
+        true
+    }
+
+    /// [`Grid::row_offset`] of the row at cell indices `k[1..]` (the cells from `lo`).
+    #[inline(always)]
+    pub(super) fn row_offset(&self, k: &[i64; D], lo: &[i64; D]) -> (f64, usize) {
+        let mut s = 0.0;
+        let mut j2 = 0usize;
+        for i in 1..D {
+            let m = (k[i] - lo[i]) as usize;
+            s += self.e2[i][m];
+            j2 += self.j2[i][m];
+        }
+        (s, j2)
+    }
+
+    /// [`Grid::clip_row`] of the row at cell indices `k[1..]` (the cells from `lo`).
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn clip_row(
+        &self,
+        g: &Grid,
+        (a, b): (f64, f64),
+        lo0: i64,
+        hi0: i64,
+        k: &[i64; D],
+        lo: &[i64; D],
+        side: Option<&Beside<D>>,
+    ) -> (i64, i64) {
+        let a = (a as i64).max(lo0);
+        let b = (b as i64).min(hi0);
+        match side {
+            Some(side) => {
+                let mut off = 0.0;
+                for i in 1..D {
+                    off += self.off[i][(k[i] - lo[i]) as usize];
+                }
+                side.clip_at(off, g.inv_cell, a, b)
+            }
             None => (a, b),
         }
     }

@@ -58,7 +58,7 @@ mod grid;
 mod sparse;
 use beside::Beside;
 pub use dense::DistanceMap;
-use grid::Grid;
+use grid::{Grid, RowTables};
 use sealed::Cells;
 pub use sparse::{SparseDistanceMap, UNKNOWN};
 
@@ -207,7 +207,8 @@ pub trait PointMap<const D: usize>: Cells<D> {
 /// lowered); the inserts built on them are written once here.
 mod sealed {
     use super::{
-        AtomicU8, Beside, DistanceMapError, Grid, finite_max_norm, finite_reach, next_row,
+        AtomicU8, Beside, DistanceMapError, Grid, RowTables, finite_max_norm, finite_reach,
+        next_row,
     };
 
     pub trait Cells<const D: usize> {
@@ -283,6 +284,22 @@ mod sealed {
             let mut k = lo;
             let (t0, kq) = g.row_origin(q);
             let mut cache = Self::RowCache::default();
+            // In 2D a row is one cell index along axis 1: nothing to share between rows.
+            let mut t = RowTables::new();
+            if D >= 3 && t.fill(g, q, &lo, &hi, &kq, side) {
+                loop {
+                    let (s, j2) = t.row_offset(&k, &lo);
+                    if let Some(range) = g.row_range(q[0], s, t0, j2) {
+                        let (a, b) = t.clip_row(g, range, lo[0], hi[0], &k, &lo, side);
+                        if a <= b {
+                            self.lower_row(q, s, &k, (a, b), &mut lower, &mut cache);
+                        }
+                    }
+                    if !next_row(&mut k, &lo, &hi) {
+                        return;
+                    }
+                }
+            }
             loop {
                 let (s, j2) = g.row_offset(q, &k, &kq);
                 if let Some(range) = g.row_range(q[0], s, t0, j2) {

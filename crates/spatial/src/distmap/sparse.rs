@@ -311,7 +311,7 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
         for i in 0..D {
             let k = floor(p[i] * self.grid.inv_cell);
             // `side = 2 half`, tested through the signed `half` as the dense map does.
-            let half = self.grid.half as f64;
+            let half = self.grid.half_f;
             if !(k >= -half && k < half) {
                 return None;
             }
@@ -367,7 +367,7 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
             }
         }
         self.table = table;
-        self.grid.half = half;
+        self.grid.set_half(half);
         self.side = side as usize;
         self.bside = bside;
         Ok(())
