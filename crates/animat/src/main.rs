@@ -172,8 +172,8 @@ impl Model for Animat {
         p.validate().map_err(|e| e.to_string())?;
         if cli.resume.is_none() {
             let what = format!(
-                "{} animats in a disc of radius {}: a 36 KiB tile of the cell index for each 64 x 64 \
-                 square holding an animat, 256 bytes per animat",
+                "{} animats in a disc of radius {}: a 36 KiB tile of the cell index for each \
+                 64 x 64 square holding an animat, 256 bytes per animat",
                 p.foxes.saturating_add(p.rabbits),
                 p.start_radius
             );
