@@ -106,6 +106,16 @@ impl Checkpoint {
         Ok(())
     }
 
+    /// Ends a run under `session` that ended normally: the session first (its watch, and the
+    /// SIGTERM handler put back), then the run's `result`, then `checkpoint.bin`, which stays
+    /// if the result cannot be made.
+    pub fn finish<T>(&self, session: Session, result: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
+        drop(session);
+        let out = result()?;
+        self.remove(&[])?;
+        Ok(out)
+    }
+
     /// The `OSError` of a checkpoint that could not be written.
     pub fn write_error(&self, e: impl std::fmt::Display) -> PyErr {
         pyo3::exceptions::PyOSError::new_err(format!("writing {}: {e}", self.file().display()))
@@ -217,6 +227,41 @@ pub fn raise_after_saving<E: std::fmt::Display>(
         failure.set_cause(py, Some(run_error(format!("the checkpoint: {e}"))));
     }
     failure
+}
+
+/// How a run of steps or sweeps between which it [`honour`]s its checkpoint ends, once
+/// `run::interruptible_guarded` has returned what its thread `made` (the steps or sweeps made,
+/// and the guard's reason if it stopped the run) and the exception that stopped it, if any
+/// (`failure`): that exception, raised after the checkpoint is saved with `save`
+/// ([`raise_after_saving`]); the error of a run stopped by its guard ([`Session::stopped`],
+/// `at` saying where); else the steps or sweeps made.
+///
+/// # Errors
+/// As above, or the run's own error.
+pub fn conclude<T>(
+    py: Python<'_>,
+    made: PyResult<(T, Option<StopReason>)>,
+    failure: Option<PyErr>,
+    checkpoint: Option<(&Checkpoint, &Session)>,
+    save: impl FnOnce(&Checkpoint) -> PyResult<()>,
+    at: impl FnOnce() -> String,
+) -> PyResult<T> {
+    if let Some(e) = failure {
+        return Err(match checkpoint {
+            Some((ck, _)) => {
+                let finished = made.as_ref().map(|(_, r)| r.is_none());
+                let finished = finished.map_err(ToString::to_string);
+                let save = || save(ck).map_err(|e| e.to_string());
+                raise_after_saving(py, e, finished, save)
+            }
+            None => e,
+        });
+    }
+    let (k, stopped) = made?;
+    if let (Some(r), Some((_, session))) = (stopped, checkpoint) {
+        return Err(session.stopped(&r, &at()));
+    }
+    Ok(k)
 }
 
 impl Drop for Session {

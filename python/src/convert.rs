@@ -5,8 +5,8 @@ use numpy::{Element, IntoPyArray};
 use pyo3::exceptions::{PyOverflowError, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyFloat, PyList};
-use serde_json::Value;
 use run_io::RunManifest;
+use serde_json::Value;
 
 /// A JSON value as the Python object `json.loads` would give.
 pub fn json<'py>(py: Python<'py>, v: &Value) -> PyResult<Bound<'py, PyAny>> {

@@ -5,11 +5,11 @@
 //! run byte for byte.
 
 use crate::convert::{Count, count, value_error};
+use figures::animation::ANIMATION_MAX_SIDE;
+use figures::{PNG_SIZE_MAX, PNG_SIZE_MIN};
 use numpy::{PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyOSError;
 use pyo3::prelude::*;
-use figures::animation::ANIMATION_MAX_SIDE;
-use figures::{PNG_SIZE_MAX, PNG_SIZE_MIN};
 use run_io::OutputError;
 use std::path::PathBuf;
 

@@ -7,9 +7,8 @@
 use super::Cli;
 use animat::params::{PARAMS, Params, defaults};
 use clap::CommandFactory;
-use core_lattice::spec::markdown_table;
-use run_cli::declared::{check_generated, docs_table};
-use run_cli::spec_check::{CliSpec, DocColumns};
+use run_cli::declared::docs_table;
+use run_cli::spec_check::CliSpec;
 
 /// Flags of `animat` that are not model parameters, beyond the run flags every binary has
 /// (`run_cli::spec_check::SHARED_RUN_FLAGS`).
@@ -52,29 +51,23 @@ fn the_default_config_file_has_every_parameter() {
 
 #[test]
 fn the_docs_parameter_table_is_the_declarations() {
-    let table = docs_table::<Params>();
-    check_generated("docs/animat.md", DOC, "animat-params", "<!--", &table).unwrap();
-    let rows = markdown_table(&format!("#\n{table}"), "#");
-    spec().check_params_table("docs/animat.md", &rows, DocColumns::new(0, 1, 2), |s, r| {
-        r[0] == format!("`--{}`", s.flag.unwrap())
-    });
+    spec().check_generated_table(
+        "docs/animat.md",
+        DOC,
+        "animat-params",
+        &docs_table::<Params>(),
+    );
 }
 
 #[test]
 fn the_docs_list_every_run_flag() {
-    let rows = markdown_table(DOC, "## Run flags");
-    assert_eq!(rows[0], ["flag", "default", "meaning"]);
-    let mut listed: Vec<String> = rows[1..]
-        .iter()
-        .flat_map(|r| run_cli::spec_check::flags_of(&r[0]))
-        .collect();
-    listed.extend(PARAMS.iter().map(|s| format!("--{}", s.flag.unwrap())));
-    for a in Cli::command().get_arguments() {
-        if let Some(long) = a.get_long().filter(|l| *l != "help") {
-            assert!(
-                listed.contains(&format!("--{long}")),
-                "--{long} is missing from docs/animat.md's flag tables"
-            );
-        }
-    }
+    let header = &["flag", "default", "meaning"];
+    spec().check_run_flags_listed(
+        "docs/animat.md",
+        DOC,
+        "## Run flags",
+        header,
+        0,
+        &Cli::command(),
+    );
 }

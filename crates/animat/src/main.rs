@@ -8,7 +8,7 @@ use animat::output::{self, PopulationRow};
 use animat::{Params, World};
 use anyhow::Context;
 use clap::Parser;
-use run_cli::cli::{ParamFlags, flag_differences, usage};
+use run_cli::cli::{FigureArgs, FigureHelp, ParamFlags, flag_differences, usage};
 use run_cli::ensemble::{Combine, Curve};
 use run_cli::model::{Model, Own, RunArgs};
 use run_io::{Positions, RunClock, read_checkpoint, show_bytes, write_checkpoint};
@@ -59,20 +59,10 @@ struct Cli {
     #[arg(long, value_name = "CELLS", value_parser = run_cli::cli::count::<i64>)]
     frame_radius: Option<i64>,
 
-    /// Side of the picture in the snapshots and animat.gif in pixels (the axes and legend come
-    /// on top), 16 to 65536, at most 16384 with --animate (default: a whole number of pixels
-    /// per cell and at least 512, or one per cell up to 1024).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
-        i64::from(figures::PNG_SIZE_MIN)..=i64::from(figures::PNG_SIZE_MAX)))]
-    png_size: Option<u32>,
-
-    /// Write animat.gif: the world at the start, every --animate-every steps and at the end.
-    #[arg(long)]
-    animate: bool,
-
-    /// Steps between frames of animat.gif, 1.. (default: a hundredth of --steps).
-    #[arg(long, value_name = "N", requires = "animate", value_parser = run_cli::cli::count::<u64>)]
-    animate_every: Option<u64>,
+    // --png-size, --animate and --animate-every (animat has no --png: its still figures are
+    // --snapshot-every's), with animat's help texts (`FigureHelp`).
+    #[command(flatten)]
+    figure: FigureArgs<Animat>,
 
     /// Write every live animat at the end (id, species, x, y, age, hunger): positions.csv
     /// (`--positions` alone), positions.npy with one positions_<attribute>.npy per attribute
@@ -94,51 +84,6 @@ struct Cli {
     // Seed, --out and how the process runs: after the model's own flags in --help.
     #[command(flatten)]
     run: RunArgs,
-}
-
-/// Builds validated parameters: the defaults, then the flags (those of `--config` first).
-fn params(cli: &Cli) -> Result<Params, String> {
-    let mut p = cli.params.params();
-    if let Some(d) = cli.density {
-        p.set_density(d)?;
-    }
-    if cli.snapshot_every == Some(0) {
-        return Err("--snapshot-every 0 is outside the accepted range 1..".into());
-    }
-    if cli.frame_radius == Some(0) {
-        return Err("--frame-radius 0 is outside the accepted range 1..".into());
-    }
-    figures::animation::check_figure_flags(
-        cli.png_size,
-        cli.animate,
-        cli.animate_every,
-        cli.snapshot_every.is_some(),
-        "--snapshot-every",
-    )?;
-    let pictures = cli.snapshot_every.is_some() || cli.animate;
-    if cli.frame_radius.is_some() && !pictures {
-        return Err(
-            "--frame-radius frames the pictures of --snapshot-every and --animate; give one".into(),
-        );
-    }
-    p.validate().map_err(|e| e.to_string())?;
-    if cli.resume.is_none() {
-        let what = format!(
-            "{} animats in a disc of radius {}: a 36 KiB tile of the cell index for each 64 x 64 \
-             square holding an animat, 256 bytes per animat",
-            p.foxes.saturating_add(p.rabbits),
-            p.start_radius
-        );
-        // The world's memory, as the cap on a growing world counts it (the program's own
-        // few MiB, in `peak_memory_bytes`, aside).
-        memory_limit(cli).check(
-            p.start_memory_bytes(),
-            &what,
-            "raise --density (or lower --start-radius)",
-        )?;
-    }
-    cli.run.checkpoints.check(cli.checkpoint_every)?;
-    Ok(p)
 }
 
 /// The default cap of `--max-memory` on the world.
@@ -176,6 +121,19 @@ const CURVES: &[Curve] = &[Curve {
 /// The animat model as the run machinery sees it.
 struct Animat;
 
+// The help texts of the figure flags, as `--help` shows them (clap would take them from doc
+// comments on the fields; `FigureArgs` is shared, so they are given here).
+impl FigureHelp for Animat {
+    const PNG: Option<&'static str> = None;
+    const PNG_SIZE: &'static str = "Side of the raster in the snapshots and animat.gif in pixels \
+         (the axes and legend come on top), 16 to 65536, at most 16384 with --animate (default: a \
+         whole number of pixels per cell and at least 512, or one per cell up to 1024)";
+    const ANIMATE: &'static str = "Write animat.gif: the world at the start, every --animate-every \
+         steps and at the end";
+    const ANIMATE_EVERY: &'static str = "Steps between frames of animat.gif, 1.. (default: a \
+         hundredth of --steps)";
+}
+
 impl Model for Animat {
     const NAME: &'static str = "animat";
     const RUN_FILES: &'static [&'static str] = RUN_FILES;
@@ -190,8 +148,45 @@ impl Model for Animat {
         &cli.run
     }
 
+    /// Builds validated parameters: the defaults, then the flags (those of `--config` first).
     fn params(cli: &Cli) -> Result<Params, String> {
-        params(cli)
+        let mut p = cli.params.params();
+        if let Some(d) = cli.density {
+            p.set_density(d)?;
+        }
+        if cli.snapshot_every == Some(0) {
+            return Err("--snapshot-every 0 is outside the accepted range 1..".into());
+        }
+        if cli.frame_radius == Some(0) {
+            return Err("--frame-radius 0 is outside the accepted range 1..".into());
+        }
+        cli.figure
+            .check_with(cli.snapshot_every.is_some(), "--snapshot-every")?;
+        let figures = cli.snapshot_every.is_some() || cli.figure.animate;
+        if cli.frame_radius.is_some() && !figures {
+            return Err(
+                "--frame-radius frames the figures of --snapshot-every and --animate; give one"
+                    .into(),
+            );
+        }
+        p.validate().map_err(|e| e.to_string())?;
+        if cli.resume.is_none() {
+            let what = format!(
+                "{} animats in a disc of radius {}: a 36 KiB tile of the cell index for each \
+                 64 x 64 square holding an animat, 256 bytes per animat",
+                p.foxes.saturating_add(p.rabbits),
+                p.start_radius
+            );
+            // The world's memory, as the cap on a growing world counts it (the program's own
+            // few MiB, in `peak_memory_bytes`, aside).
+            memory_limit(cli).check(
+                p.start_memory_bytes(),
+                &what,
+                "raise --density (or lower --start-radius)",
+            )?;
+        }
+        cli.run.checkpoints.check(cli.checkpoint_every)?;
+        Ok(p)
     }
 
     fn resume_dir(cli: &Cli) -> Option<&Path> {
@@ -296,14 +291,15 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
             .context("writing a checkpoint")?;
         Ok(())
     };
-    let frame = output::SnapshotFrame::new(world.params(), cli.frame_radius, cli.png_size);
+    let frame = output::SnapshotFrame::new(world.params(), cli.frame_radius, cli.figure.png_size);
     let snapshot = |w: &World| -> anyhow::Result<()> {
         let path = cli.run.out.join(format!("snapshot_{:06}.png", w.steps()));
         output::write_snapshot(&path, w, &frame)?;
         Ok(())
     };
-    let mut animation = if cli.animate {
+    let mut animation = if cli.figure.animate {
         let every = cli
+            .figure
             .animate_every
             .unwrap_or_else(|| output::default_animate_every(cli.steps));
         Some(output::Animation::start(

@@ -292,6 +292,29 @@ pub fn check_range_probes(
     }
 }
 
+/// Checks a model's parameter table against the fields of its parameters (`fields`: the keys
+/// of its defaults), as every model's unit tests do: each field has one entry, no name or flag
+/// occurs twice, and every flag is the name with dashes (`step_min`: `--step-min`).
+///
+/// # Panics
+/// On the first check that fails, naming what differs.
+pub fn check_table<'a>(params: &[ParamSpec], fields: impl IntoIterator<Item = &'a str>) {
+    let twice = duplicates(params);
+    assert!(twice.is_empty(), "in the table more than once: {twice:?}");
+    let mut names: Vec<&str> = params.iter().map(|s| s.name).collect();
+    let mut fields: Vec<&str> = fields.into_iter().collect();
+    names.sort_unstable();
+    fields.sort_unstable();
+    assert_eq!(
+        names, fields,
+        "the table against the fields of the parameters"
+    );
+    for s in params {
+        let dashed = s.name.replace('_', "-");
+        assert_eq!(s.flag, Some(dashed.as_str()), "the flag of {}", s.name);
+    }
+}
+
 /// Parameter names that occur more than once in `specs`, and flags likewise.
 pub fn duplicates(specs: &[ParamSpec]) -> Vec<String> {
     let mut seen = std::collections::BTreeSet::new();

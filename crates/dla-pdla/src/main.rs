@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Parser;
 use dla_pdla::output::{PositionsFormat, default_png_side_of, write_outputs};
 use dla_pdla::{Dim, Params, ParamsError, SimError, Simulation, Space};
-use run_cli::cli::{ParamFlags, flag_differences, stopped, usage};
+use run_cli::cli::{FigureArgs, FigureHelp, ParamFlags, flag_differences, stopped, usage};
 use run_cli::ensemble::{Combine, Curve};
 use run_cli::model::{Model, Own, RunArgs};
 use run_io::RunClock;
@@ -56,28 +56,9 @@ struct Cli {
     #[arg(long, value_name = "DIR")]
     resume: Option<PathBuf>,
 
-    /// Write dla.png: a figure of the cluster (axes in diameters, scale bar, N and seed, colour
-    /// bar), coloured by arrival order (3D: shaded spheres seen from +z; 4D and 5D: the same
-    /// picture of the projection on x, y, z), or, when a pixel spans more than a diameter, by
-    /// the number of particles per pixel on a log scale (projected on x, y).
-    #[arg(long)]
-    png: bool,
-
-    /// Side of the picture in dla.png and dla.gif in pixels (the axes and legend come on top),
-    /// 16 to 65536, at most 16384 with --animate (default: dla.png one pixel per diameter, 512
-    /// to 4096; dla.gif 512).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
-        i64::from(figures::PNG_SIZE_MIN)..=i64::from(figures::PNG_SIZE_MAX)))]
-    png_size: Option<u32>,
-
-    /// Write dla.gif: the growth of the cluster, one frame every --animate-every particles and
-    /// one of the whole cluster, all on the finished cluster's frame and colours.
-    #[arg(long)]
-    animate: bool,
-
-    /// Particles between frames of dla.gif, 1.. (default: a hundredth of --particles).
-    #[arg(long, value_name = "N", requires = "animate", value_parser = run_cli::cli::count::<u64>)]
-    animate_every: Option<u64>,
+    // --png, --png-size, --animate and --animate-every, with dla's help texts (`FigureHelp`).
+    #[command(flatten)]
+    figure: FigureArgs<Dla>,
 
     /// Memory the run may take, in bytes; suffixes K, M, G, T (powers of 1024). A run whose
     /// estimated peak (docs/dla.md, "Memory") is larger is refused before it starts. Default:
@@ -99,58 +80,11 @@ fn paper_settings_help() -> String {
     )
 }
 
-fn params(cli: &Cli) -> Result<Params, String> {
-    // Positions stream to positions.npy instead of `keep_positions` (see `run`).
-    let p = cli.params.params();
-    let p = if cli.paper_settings {
-        // clap has refused the flags it sets (`conflicts_with_all`, the same list).
-        p.with_paper_settings(|_| false)
-            .map_err(|e| e.to_string())?
-    } else {
-        p
-    };
-    // Flags that would be silently ignored are refused too.
-    p.validate_given(|name| cli.params.given(name))
-        .map_err(|e| e.to_string())?;
-    // Wherever the positions stream, each particle's parent goes with them: into the
-    // positions files, and to resume with.
-    let p = Params {
-        connectivity: streams_positions(cli),
-        ..p
-    };
-    if p.dim > 3 && matches!(cli.positions, PositionsFormat::Xyz | PositionsFormat::Vtk) {
-        return Err(format!(
-            "--positions {} holds three coordinates, not the {} of --dim {}; use npy, csv or bin",
-            cli.positions.name(),
-            p.dim,
-            p.dim
-        ));
-    }
-    cli.run.checkpoints.check(cli.checkpoint_every)?;
-    figures::animation::check_figure_flags(
-        cli.png_size,
-        cli.animate,
-        cli.animate_every,
-        cli.png,
-        "--png",
-    )?;
-    if cli.positions == PositionsFormat::Vtk && p.particles > run_io::points::VTK_MAX_POINTS {
-        return Err(format!(
-            "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
-             use --positions npy",
-            run_io::points::VTK_MAX_POINTS,
-            p.particles
-        ));
-    }
-    check_memory(cli, &p)?;
-    Ok(p)
-}
-
-/// Whether the run's outputs need the positions (files, pictures, or checkpoints every N
+/// Whether the run's outputs need the positions (files, figures, or checkpoints every N
 /// particles, which are kept).
 fn asked_positions(cli: &Cli) -> bool {
-    cli.png
-        || cli.animate
+    cli.figure.png
+        || cli.figure.animate
         || cli.positions != PositionsFormat::None
         || cli.checkpoint_every.is_some()
 }
@@ -161,12 +95,16 @@ fn streams_positions(cli: &Cli) -> bool {
     asked_positions(cli) || cli.run.checkpoints.enabled()
 }
 
-/// Refuses a run whose estimated peak memory (the cluster, and the picture's buffers with
+/// Refuses a run whose estimated peak memory (the cluster, and the raster's buffers with
 /// `--png`) does not fit `--max-memory` or the memory available. An ensemble runs its members
 /// one per job, so each member must fit.
 fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
-    let side = u64::from(cli.png_size.unwrap_or(dla_pdla::output::PNG_MAX_SIDE));
-    let png = if cli.png || cli.animate {
+    let side = u64::from(
+        cli.figure
+            .png_size
+            .unwrap_or(dla_pdla::output::PNG_MAX_SIDE),
+    );
+    let png = if cli.figure.png || cli.figure.animate {
         dla_pdla::output::png_memory_bytes(side)
     } else {
         0
@@ -176,8 +114,8 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
         p.particles,
         p.dim,
         p.peak_bytes_per_particle(),
-        if cli.png || cli.animate {
-            " and the picture"
+        if cli.figure.png || cli.figure.animate {
+            " and the raster"
         } else {
             ""
         }
@@ -260,6 +198,25 @@ const CURVES: &[Curve] = &[Curve {
 /// DLA and PDLA as the run machinery sees them.
 struct Dla;
 
+// The help texts of the figure flags, as `--help` shows them (clap would take them from doc
+// comments on the fields; `FigureArgs` is shared, so they are given here).
+impl FigureHelp for Dla {
+    const PNG: Option<&'static str> = Some(
+        "Write dla.png: a figure of the cluster (axes in diameters, scale bar, N and seed, colour \
+         bar), coloured by arrival order (3D: shaded spheres seen from +z; 4D and 5D: the same \
+         raster of the projection on x, y, z), or, when a pixel spans more than a diameter, by \
+         the number of particles per pixel on a log scale (projected on x, y)",
+    );
+    const PNG_SIZE: &'static str = "Side of the raster in dla.png and dla.gif in pixels (the axes \
+         and legend come on top), 16 to 65536, at most 16384 with --animate (default: dla.png one \
+         pixel per diameter, 512 to 4096; dla.gif 512)";
+    const ANIMATE: &'static str = "Write dla.gif: the growth of the cluster, one frame every \
+         --animate-every particles and one of the whole cluster, all on the finished cluster's \
+         frame and colours";
+    const ANIMATE_EVERY: &'static str = "Particles between frames of dla.gif, 1.. (default: a \
+         hundredth of --particles)";
+}
+
 impl Model for Dla {
     const NAME: &'static str = "dla";
     const RUN_FILES: &'static [&'static str] = RUN_FILES;
@@ -275,7 +232,44 @@ impl Model for Dla {
     }
 
     fn params(cli: &Cli) -> Result<Params, String> {
-        params(cli)
+        // Positions stream to positions.npy instead of `keep_positions` (see `run`).
+        let p = cli.params.params();
+        let p = if cli.paper_settings {
+            // clap has refused the flags it sets (`conflicts_with_all`, the same list).
+            p.with_paper_settings(|_| false)
+                .map_err(|e| e.to_string())?
+        } else {
+            p
+        };
+        // Flags that would be silently ignored are refused too.
+        p.validate_given(|name| cli.params.given(name))
+            .map_err(|e| e.to_string())?;
+        // Wherever the positions stream, each particle's parent goes with them: into the
+        // positions files, and to resume with.
+        let p = Params {
+            connectivity: streams_positions(cli),
+            ..p
+        };
+        if p.dim > 3 && matches!(cli.positions, PositionsFormat::Xyz | PositionsFormat::Vtk) {
+            return Err(format!(
+                "--positions {} holds three coordinates, not the {} of --dim {}; use npy, csv or bin",
+                cli.positions.name(),
+                p.dim,
+                p.dim
+            ));
+        }
+        cli.run.checkpoints.check(cli.checkpoint_every)?;
+        cli.figure.check()?;
+        if cli.positions == PositionsFormat::Vtk && p.particles > run_io::points::VTK_MAX_POINTS {
+            return Err(format!(
+                "--positions vtk holds at most {} points (legacy VTK's 32-bit cell list), not {}; \
+                 use --positions npy",
+                run_io::points::VTK_MAX_POINTS,
+                p.particles
+            ));
+        }
+        check_memory(cli, &p)?;
+        Ok(p)
     }
 
     fn resume_dir(cli: &Cli) -> Option<&Path> {
@@ -351,14 +345,18 @@ where
     let discard = !asked_positions && !read_back && sim.discard_positions();
     let remove = discard || (!asked_positions && read_back && sim.streams_positions());
     sim.sync_streams()?;
-    let png = cli
-        .png
-        .then(|| cli.png_size.unwrap_or_else(|| default_png_side_of(&sim)));
-    if cli.animate {
+    let png = cli.figure.png.then(|| {
+        cli.figure
+            .png_size
+            .unwrap_or_else(|| default_png_side_of(&sim))
+    });
+    if cli.figure.animate {
         let side = cli
+            .figure
             .png_size
             .unwrap_or(dla_pdla::figure::ANIMATION_DEFAULT_SIDE);
         let every = cli
+            .figure
             .animate_every
             .unwrap_or_else(|| dla_pdla::figure::default_animation_every(total));
         let frames = dla_pdla::figure::write_animation(

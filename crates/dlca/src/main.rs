@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::{ArgGroup, Parser};
 use dlca::params::{LATTICE_FLAGS, Settings};
 use dlca::{Params, Simulation, Snapshot};
-use run_cli::cli::{ParamFlags, Plain, flag_differences, usage};
+use run_cli::cli::{FigureArgs, FigureHelp, ParamFlags, Plain, flag_differences, usage};
 use run_cli::ensemble::{Combine, Curve, MemberRun, Pooled, PooledResult};
 use run_cli::model::{Model, Own, RunArgs};
 use run_io::{Positions, RunClock};
@@ -47,26 +47,9 @@ struct Cli {
     #[command(flatten)]
     model: ParamFlags<Settings, Plain, LATTICE_FLAGS>,
 
-    /// Write dlca.png: a figure of the final state on the first two axes (axes in lattice
-    /// cells, scale bar, sweep, clusters and seed), touching clusters in different colours.
-    #[arg(long)]
-    png: bool,
-
-    /// Longer side of the picture in dlca.png and dlca.gif in pixels (the axes and legend come
-    /// on top), 16 to 65536, at most 16384 with --animate (default: dlca.png a whole number of
-    /// pixels per site and at least 512, or one per site up to 8192; dlca.gif 512).
-    #[arg(long, value_name = "PX", value_parser = clap::value_parser!(u32).range(
-        i64::from(figures::PNG_SIZE_MIN)..=i64::from(figures::PNG_SIZE_MAX)))]
-    png_size: Option<u32>,
-
-    /// Write dlca.gif: the aggregation, a frame of the start, one every --animate-every sweeps
-    /// and one of the end.
-    #[arg(long)]
-    animate: bool,
-
-    /// Sweeps between frames of dlca.gif, 1.. (default 10).
-    #[arg(long, value_name = "N", requires = "animate", value_parser = run_cli::cli::count::<u64>)]
-    animate_every: Option<u64>,
+    // --png, --png-size, --animate and --animate-every, with dlca's help texts (`FigureHelp`).
+    #[command(flatten)]
+    figure: FigureArgs<Dlca>,
 
     /// Every particle's final site and cluster id: particles.csv (x1..xd,cluster), particles.npy
     /// with particles_cluster.npy (NumPy), particles.vtk (ParaView, cluster as a point scalar),
@@ -77,41 +60,6 @@ struct Cli {
     // Seed, --out and how the process runs: after the model's own flags in --help.
     #[command(flatten)]
     run: RunArgs,
-}
-
-/// Turn the flags into validated parameters.
-fn params(cli: &Cli) -> Result<Params, String> {
-    let mut settings = cli.model.params();
-    cli.lattice.apply(&mut settings);
-    let p = settings.to_params(|name| cli.lattice.given(name) || cli.model.given(name))?;
-    figures::animation::check_figure_flags(
-        cli.png_size,
-        cli.animate,
-        cli.animate_every,
-        cli.png,
-        "--png",
-    )?;
-    // The default 4G is the occupancy lattice's budget only; the run's limit is then the memory
-    // available.
-    let given = cli.model.given("max_memory").then_some(p.max_memory);
-    let n = p.particles().unwrap_or(0);
-    let picture = if cli.png || cli.animate {
-        let side = u64::from(cli.png_size.unwrap_or(PICTURE_MAX_DEFAULT_SIDE));
-        dlca::figure::png_memory_bytes(side, side)
-    } else {
-        0
-    };
-    run_io::memory::Limit::from_flag(given).check(
-        dlca::sim::peak_memory_bytes(&p).saturating_add(picture),
-        &format!(
-            "{n} particles on {} sites with the {} search",
-            p.size.iter().product::<u64>(),
-            dlca::sim::chosen_search_name(&p)
-        ),
-        "lower --size or --fill/--particles",
-    )?;
-    cli.run.checkpoints.check(cli.checkpoint_every)?;
-    Ok(p)
 }
 
 /// The run saved in `DIR/checkpoint.bin`, if it is one these flags continue (only
@@ -230,11 +178,27 @@ const RUN_FILES: &[&str] = &[
     "dlca.gif",
 ];
 
-/// The largest default side of a picture, for the memory estimate before the run.
-const PICTURE_MAX_DEFAULT_SIDE: u32 = dlca::figure::PNG_MAX_SIDE as u32;
+/// The largest default side of a raster, for the memory estimate before the run.
+const RASTER_MAX_DEFAULT_SIDE: u32 = dlca::figure::PNG_MAX_SIDE as u32;
 
 /// DLCA as the run machinery sees it.
 struct Dlca;
+
+// The help texts of the figure flags, as `--help` shows them (clap would take them from doc
+// comments on the fields; `FigureArgs` is shared, so they are given here).
+impl FigureHelp for Dlca {
+    const PNG: Option<&'static str> = Some(
+        "Write dlca.png: a figure of the final state on the first two axes (axes in lattice \
+         cells, scale bar, sweep, clusters and seed), touching clusters in different colours",
+    );
+    const PNG_SIZE: &'static str = "Longer side of the raster in dlca.png and dlca.gif in pixels \
+         (the axes and legend come on top), 16 to 65536, at most 16384 with --animate (default: \
+         dlca.png a whole number of pixels per site and at least 512, or one per site up to 8192; \
+         dlca.gif 512)";
+    const ANIMATE: &'static str = "Write dlca.gif: the aggregation, a frame of the start, one \
+         every --animate-every sweeps and one of the end";
+    const ANIMATE_EVERY: &'static str = "Sweeps between frames of dlca.gif, 1.. (default 10)";
+}
 
 impl Model for Dlca {
     const NAME: &'static str = "dlca";
@@ -247,8 +211,33 @@ impl Model for Dlca {
         &cli.run
     }
 
+    /// Turn the flags into validated parameters.
     fn params(cli: &Cli) -> Result<Params, String> {
-        params(cli)
+        let mut settings = cli.model.params();
+        cli.lattice.apply(&mut settings);
+        let p = settings.to_params(|name| cli.lattice.given(name) || cli.model.given(name))?;
+        cli.figure.check()?;
+        // The default 4G is the occupancy lattice's budget only; the run's limit is then the memory
+        // available.
+        let given = cli.model.given("max_memory").then_some(p.max_memory);
+        let n = p.particles().unwrap_or(0);
+        let raster = if cli.figure.png || cli.figure.animate {
+            let side = u64::from(cli.figure.png_size.unwrap_or(RASTER_MAX_DEFAULT_SIDE));
+            dlca::figure::png_memory_bytes(side, side)
+        } else {
+            0
+        };
+        run_io::memory::Limit::from_flag(given).check(
+            dlca::sim::peak_memory_bytes(&p).saturating_add(raster),
+            &format!(
+                "{n} particles on {} sites with the {} search",
+                p.size.iter().product::<u64>(),
+                dlca::sim::chosen_search_name(&p)
+            ),
+            "lower --size or --fill/--particles",
+        )?;
+        cli.run.checkpoints.check(cli.checkpoint_every)?;
+        Ok(p)
     }
 
     fn resume_dir(cli: &Cli) -> Option<&Path> {
@@ -300,8 +289,11 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
         write_checkpoint(cli.run.out.join(CHECKPOINT), "dlca", &s.snapshot())
             .context("writing a checkpoint")
     };
-    let mut animation = if cli.animate {
-        let side = cli.png_size.unwrap_or(dlca::figure::ANIMATION_DEFAULT_SIDE);
+    let mut animation = if cli.figure.animate {
+        let side = cli
+            .figure
+            .png_size
+            .unwrap_or(dlca::figure::ANIMATION_DEFAULT_SIDE);
         Some(dlca::figure::Animation::start(
             &sim,
             cli.run.seed,
@@ -312,6 +304,7 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
         None
     };
     let every = cli
+        .figure
         .animate_every
         .unwrap_or(dlca::figure::ANIMATION_DEFAULT_EVERY);
     while !sim.is_done() {
@@ -368,7 +361,7 @@ fn run(cli: &Cli, params: Params, own: Own<'_>) -> anyhow::Result<()> {
         cli.run.seed,
         &clock,
         &cli.run.out,
-        cli.png.then_some(cli.png_size),
+        cli.figure.png.then_some(cli.figure.png_size),
         cli.positions.format(),
     )?;
     if !cli.run.log.is_quiet() {

@@ -6,7 +6,7 @@
 //! columns.
 
 use clap::Command;
-use core_lattice::spec::{ParamSpec, Range, same_default};
+use core_lattice::spec::{ParamSpec, Range, markdown_table, same_default};
 use serde_json::{Map, Value};
 
 /// The flags every binary has that are not model parameters: the run, output, config,
@@ -226,6 +226,50 @@ impl<'a> CliSpec<'a> {
                     s.name,
                     row[columns.range]
                 ),
+            }
+        }
+    }
+
+    /// The generated parameter table of a model's document: `doc` (the document's text,
+    /// `path` its name in messages) holds `table` (from the declaration, as
+    /// [`crate::declared::docs_table`] makes it) between the marker lines of block `block`, and
+    /// that table states each parameter's default and range as the command line does (its
+    /// columns: flag, default, meaning).
+    pub fn check_generated_table(&self, path: &str, doc: &str, block: &str, table: &str) {
+        crate::declared::check_generated(path, doc, block, "<!--", table).unwrap();
+        let rows = markdown_table(&format!("#\n{table}"), "#");
+        self.check_params_table(path, &rows, DocColumns::new(0, 1, 2), |s, r| {
+            s.flag.is_some_and(|f| r[0] == format!("`--{f}`"))
+        });
+    }
+
+    /// Every long flag of `cmd` (but `--help`) is a parameter's or is named in the table of
+    /// run flags of a model's document `doc` (`path` its name in messages): the table under
+    /// the line `heading`, whose header row is `header` and whose column `flags` names the
+    /// flags.
+    pub fn check_run_flags_listed(
+        &self,
+        path: &str,
+        doc: &str,
+        heading: &str,
+        header: &[&str],
+        flags: usize,
+        cmd: &Command,
+    ) {
+        let rows = markdown_table(doc, heading);
+        assert_eq!(rows[0], header, "{path}: the header of {heading}");
+        let mut listed: Vec<String> = rows[1..].iter().flat_map(|r| flags_of(&r[flags])).collect();
+        listed.extend(
+            self.params
+                .iter()
+                .filter_map(|s| s.flag.map(|f| format!("--{f}"))),
+        );
+        for a in cmd.get_arguments() {
+            if let Some(long) = a.get_long().filter(|l| *l != "help") {
+                assert!(
+                    listed.contains(&format!("--{long}")),
+                    "--{long} is missing from {path}'s flag tables"
+                );
             }
         }
     }

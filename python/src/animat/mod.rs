@@ -2,7 +2,7 @@
 //! `animat` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 //! Performance Optimisation", section II.B).
 
-use crate::checkpoint::{Checkpoint, Session, differences, honour, raise_after_saving};
+use crate::checkpoint::{Checkpoint, Session, conclude, differences, honour};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::declared::{read_config, set_keywords};
 use crate::figure::Animate;
@@ -219,23 +219,14 @@ impl Run {
                 }
                 Ok((k, stopped))
             })?;
-        if let Some(e) = failure {
-            return Err(match checkpoint {
-                Some((ck, _)) => {
-                    let finished = made.as_ref().map(|(_, r)| r.is_none());
-                    let finished = finished.map_err(ToString::to_string);
-                    let save = || save(world, rows, ck).map_err(|e| e.to_string());
-                    raise_after_saving(py, e, finished, save)
-                }
-                None => e,
-            });
-        }
-        let (k, stopped) = made?;
-        if let (Some(r), Some((_, session))) = (stopped, checkpoint) {
-            let at = format!("after step {}", self.world.steps());
-            return Err(session.stopped(&r, &at));
-        }
-        Ok(k)
+        conclude(
+            py,
+            made,
+            failure,
+            checkpoint,
+            |ck| save(world, rows, ck),
+            || format!("after step {}", world.steps()),
+        )
     }
 
     /// The live animats' columns, named and typed as the binary's positions files
@@ -537,10 +528,7 @@ pub fn animat(
     )?;
     let more = steps - run.world.steps();
     run.steps(py, more, &progress, animate, Some((&ck, &session)))?;
-    drop(session);
-    let out = run.result(py)?;
-    ck.remove(&[])?;
-    Ok(out)
+    ck.finish(session, || run.result(py))
 }
 
 /// The `animat` binary's defaults, from the library's parameter declaration.

@@ -2,7 +2,7 @@
 //! the `dlca` library (Hawick, James & Scogings 2006, "Grid-Boxing for Spatial Simulation
 //! Performance Optimisation").
 
-use crate::checkpoint::{Checkpoint, Session, differences, honour, raise_after_saving};
+use crate::checkpoint::{Checkpoint, Session, conclude, differences, honour};
 use crate::convert::{Columns, Count, count, run_error, set_manifest, value_error};
 use crate::declared::set_keywords;
 use crate::figure::Animate;
@@ -201,27 +201,11 @@ impl Run {
             }
             Ok::<_, PyErr>((k, stopped))
         })?;
-        if let Some(e) = failure {
-            return Err(match checkpoint {
-                Some((ck, _)) => {
-                    let finished = made.as_ref().map(|(_, r)| r.is_none());
-                    let finished = finished.map_err(ToString::to_string);
-                    let save = || save(sim, ck).map_err(|e| e.to_string());
-                    raise_after_saving(py, e, finished, save)
-                }
-                None => e,
-            });
-        }
-        let (k, stopped) = made?;
-        if let (Some(r), Some((_, session))) = (stopped, checkpoint) {
-            let at = format!(
-                "after sweep {} ({} clusters)",
-                self.sim.sweeps(),
-                self.sim.clusters()
-            );
-            return Err(session.stopped(&r, &at));
-        }
-        Ok(k)
+        let at = || {
+            let (sweeps, clusters) = (sim.sweeps(), sim.clusters());
+            format!("after sweep {sweeps} ({clusters} clusters)")
+        };
+        conclude(py, made, failure, checkpoint, |ck| save(sim, ck), at)
     }
 
     /// Every particle's site (int64, (N, D)) and cluster id (int64, (N,)), in the order of
@@ -532,10 +516,7 @@ pub fn dlca(
     let reserve = ::dlca::sim::checkpoint_reserve_bytes(run.sim.particles());
     let session = ck.start(py, reserve)?;
     run.until_done(py, &progress, animate.as_ref(), Some((&ck, &session)))?;
-    drop(session);
-    let out = run.result(py)?;
-    ck.remove(&[])?;
-    Ok(out)
+    ck.finish(session, || run.result(py))
 }
 
 /// The `dlca` binary's defaults, from the library's parameter table (`size` and

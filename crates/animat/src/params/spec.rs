@@ -25,16 +25,7 @@ mod tests {
 
     #[test]
     fn the_table_names_every_field_once() {
-        assert!(core_lattice::spec::duplicates(PARAMS).is_empty());
-        let mut names: Vec<&str> = PARAMS.iter().map(|s| s.name).collect();
-        let d = defaults();
-        let mut keys: Vec<&str> = d.keys().map(String::as_str).collect();
-        names.sort_unstable();
-        keys.sort_unstable();
-        assert_eq!(names, keys, "PARAMS against the fields of Params");
-        for s in PARAMS {
-            assert_eq!(s.flag, Some(s.name.replace('_', "-")).as_deref());
-        }
+        core_lattice::spec::check_table(PARAMS, defaults().keys().map(String::as_str));
         assert_eq!(FoxRule::ALL.map(FoxRule::name), FoxRule::NAMES);
         assert_eq!(RabbitRule::ALL.map(RabbitRule::name), RabbitRule::NAMES);
     }

@@ -23,16 +23,7 @@ mod tests {
 
     #[test]
     fn the_table_names_every_field_once() {
-        assert!(core_lattice::spec::duplicates(PARAMS).is_empty());
-        let names: Vec<&str> = PARAMS.iter().map(|s| s.name).collect();
-        let mut fields: Vec<String> = defaults().keys().cloned().collect();
-        let mut sorted = names.clone();
-        sorted.sort_unstable();
-        fields.sort_unstable();
-        assert_eq!(sorted, fields, "PARAMS against the fields of Params");
-        for s in PARAMS {
-            assert_eq!(s.flag, Some(s.name.replace('_', "-")).as_deref());
-        }
+        core_lattice::spec::check_table(PARAMS, defaults().keys().map(String::as_str));
         assert_eq!(FarField::ALL.map(FarField::name), FarField::NAMES);
         for f in FarField::ALL {
             assert_eq!(f.name().parse::<FarField>(), Ok(f));

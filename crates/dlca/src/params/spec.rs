@@ -30,13 +30,7 @@ mod tests {
 
     #[test]
     fn the_table_has_a_default_for_every_parameter() {
-        assert!(core_lattice::spec::duplicates(PARAMS).is_empty());
-        let d = defaults();
-        assert_eq!(d.len(), PARAMS.len());
-        for s in PARAMS {
-            assert!(d.contains_key(s.name), "{}", s.name);
-            assert_eq!(s.flag, Some(s.name.replace('_', "-")).as_deref());
-        }
+        core_lattice::spec::check_table(PARAMS, defaults().keys().map(String::as_str));
         let lattice: Vec<&str> = PARAMS[..LATTICE_FLAGS].iter().map(|s| s.name).collect();
         assert_eq!(lattice, ["dim", "size", "fill", "particles"]);
         assert_eq!(Search::ALL.map(Search::name), Search::NAMES);

@@ -60,9 +60,7 @@ impl<const D: usize> Geometry<D> {
     /// relative coordinates), or `None` beyond a wall.
     #[inline(always)]
     pub(super) fn probe(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
-        let mut k = 0u64;
-        for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
+        self.index_by(o, r, &self.stride, |a, mut x| {
             if self.periodic[a] {
                 if x >= self.size[a] {
                     x -= self.size[a];
@@ -72,40 +70,54 @@ impl<const D: usize> Geometry<D> {
             } else if x < 0 || x >= self.size[a] {
                 return None;
             }
-            k += x as u64 * self.stride[a];
-        }
-        Some(k as usize)
+            Some(x)
+        })
     }
 
     /// Like [`Geometry::probe`] for any relative position (full modular reduction).
     pub(super) fn any(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
-        let mut k = 0u64;
-        for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
+        self.index_by(o, r, &self.stride, |a, x| {
             if self.periodic[a] {
-                x = x.rem_euclid(self.size[a]);
+                Some(x.rem_euclid(self.size[a]))
             } else if x < 0 || x >= self.size[a] {
-                return None;
+                None
+            } else {
+                Some(x)
             }
-            k += x as u64 * self.stride[a];
-        }
-        Some(k as usize)
+        })
     }
 
     /// Index in the extended lattice (one layer beyond each wall) of the site at `r` relative
     /// to `o`, or `None` further out.
     pub(super) fn ext(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {
+        self.index_by(o, r, &self.ext_stride, |a, x| {
+            if self.periodic[a] {
+                Some(x.rem_euclid(self.size[a]))
+            } else if x < -1 || x > self.size[a] {
+                None
+            } else {
+                Some(x + 1)
+            }
+        })
+    }
+
+    /// The index with strides `stride` of the site at `r` relative to `o`, each axis'
+    /// coordinate `x` placed by `place(axis, x)` (wrapped onto the lattice, or `None` off it):
+    /// the one loop of [`Geometry::probe`], [`Geometry::any`] and [`Geometry::ext`], which
+    /// differ only in `place`. Inlined, each still compiles to its own loop (`probe` is on the
+    /// contact search's hot path).
+    #[inline(always)]
+    fn index_by(
+        &self,
+        o: &[i64; D],
+        r: &[i32; D],
+        stride: &[u64; D],
+        place: impl Fn(usize, i64) -> Option<i64>,
+    ) -> Option<usize> {
         let mut k = 0u64;
         for a in 0..D {
-            let mut x = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
-                x = x.rem_euclid(self.size[a]);
-            } else if x < -1 || x > self.size[a] {
-                return None;
-            } else {
-                x += 1;
-            }
-            k += x as u64 * self.ext_stride[a];
+            let x = place(a, o[a] + i64::from(r[a]))?;
+            k += x as u64 * stride[a];
         }
         Some(k as usize)
     }

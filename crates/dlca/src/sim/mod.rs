@@ -84,19 +84,11 @@ const STREAM_DYNAMICS: u32 = 2;
 /// Built from `(Params, seed)`; the trajectory is a pure function of them, whatever the search
 /// strategy (tests check bit-identical state hashes across strategies).
 pub struct Simulation {
-    params: Params,
-    seed: u64,
-    lattice: Lattice,
+    /// What [`Simulation::new`] and [`Simulation::restore`] build differently.
+    run: RunState,
     /// The clusters and the contact search over them.
     engine: Engine,
-    strategy_reason: String,
-    rng: SimRng,
-    directions: DirectionSampler,
-    particles: u64,
-    sweep: u64,
-    largest: u64,
     events: Vec<SearchEvent>,
-    records: Records,
     check_invariants: bool,
     /// No cluster can move any more: see [`Simulation::is_frozen`].
     frozen: bool,
@@ -105,9 +97,10 @@ pub struct Simulation {
     order: Vec<ItemId>,
 }
 
-/// The state [`Simulation::new`] and [`Simulation::restore`] build differently; everything
-/// else starts out the same ([`Simulation::assemble`]).
-struct Assembly {
+/// The part of a [`Simulation`] that [`Simulation::new`] and [`Simulation::restore`] build
+/// differently (fresh, or from a snapshot); everything else starts out the same
+/// ([`Simulation::assemble`]).
+struct RunState {
     params: Params,
     seed: u64,
     lattice: Lattice,
@@ -124,7 +117,7 @@ impl Simulation {
     /// A simulation from `a` with strategy `kind` (grid box side `grid_box` for the grid)
     /// installed over `clusters`, and empty scratch buffers.
     fn assemble(
-        a: Assembly,
+        a: RunState,
         clusters: SiteSets,
         kind: Search,
         grid_box: Option<u64>,
@@ -138,17 +131,8 @@ impl Simulation {
             &mut notes,
         )?;
         let mut sim = Simulation {
-            records: a.records,
-            params: a.params,
-            seed: a.seed,
-            lattice: a.lattice,
+            run: a,
             engine,
-            strategy_reason: a.strategy_reason,
-            rng: a.rng,
-            directions: a.directions,
-            particles: a.particles,
-            sweep: a.sweep,
-            largest: a.largest,
             events: Vec::new(),
             check_invariants: false,
             frozen: false,
@@ -186,7 +170,7 @@ impl Simulation {
         let (kind, reason) = strategy::choose(&params, &lattice, n);
         let grid_box = params.grid_box;
         let mut sim = Simulation::assemble(
-            Assembly {
+            RunState {
                 records: Records::new(&params),
                 params,
                 seed,
@@ -202,7 +186,9 @@ impl Simulation {
             kind,
             grid_box,
         )?;
-        sim.records.record_sweep(0, sim.clusters(), largest, None);
+        sim.run
+            .records
+            .record_sweep(0, sim.clusters(), largest, None);
         Ok(sim)
     }
 
@@ -212,22 +198,22 @@ impl Simulation {
         let mut ids = sets.live().to_vec();
         ids.sort_unstable();
         Snapshot {
-            params: self.params.clone(),
-            seed: self.seed,
-            sweep: self.sweep,
-            rng: self.rng.clone(),
+            params: self.run.params.clone(),
+            seed: self.run.seed,
+            sweep: self.run.sweep,
+            rng: self.run.rng.clone(),
             clusters: ids
                 .into_iter()
                 .map(|id| (id, sets.sites(id).to_vec()))
                 .collect(),
             id_bound: sets.id_bound() as u64,
-            particles: self.particles,
-            largest: self.largest,
+            particles: self.run.particles,
+            largest: self.run.largest,
             strategy: self.strategy(),
             grid_side: self.engine.grid_side(),
-            strategy_reason: self.strategy_reason.clone(),
+            strategy_reason: self.run.strategy_reason.clone(),
             events: self.events.clone(),
-            records: self.records.clone(),
+            records: self.run.records.clone(),
         }
     }
 
@@ -261,7 +247,7 @@ impl Simulation {
             _ => s.params.grid_box,
         };
         let mut sim = Simulation::assemble(
-            Assembly {
+            RunState {
                 records: s.records,
                 params: s.params,
                 seed: s.seed,
@@ -284,9 +270,9 @@ impl Simulation {
     /// Log `what` and record it as an event of the search.
     fn note(&mut self, what: String) {
         #[cfg(feature = "log")]
-        tracing::info!(sweep = self.sweep, "{what}");
+        tracing::info!(sweep = self.run.sweep, "{what}");
         self.events.push(SearchEvent {
-            sweep: self.sweep,
+            sweep: self.run.sweep,
             what,
         });
     }
@@ -324,8 +310,12 @@ impl Simulation {
     /// Whether the run has reached `--target-clusters` or `--max-sweeps`, or no cluster can
     /// move any more ([`Simulation::is_frozen`]).
     pub fn is_done(&self) -> bool {
-        self.clusters() <= self.params.target_clusters
-            || self.params.max_sweeps.is_some_and(|m| self.sweep >= m)
+        self.clusters() <= self.run.params.target_clusters
+            || self
+                .run
+                .params
+                .max_sweeps
+                .is_some_and(|m| self.run.sweep >= m)
             || self.frozen
     }
 
@@ -339,10 +329,10 @@ impl Simulation {
 
     /// The move probability of a cluster of `size` particles (docs/dlca.md, "The model", step 1).
     fn move_probability(&self, size: usize) -> f64 {
-        if self.params.mobility_exponent == 0.0 {
-            self.params.temperature
+        if self.run.params.mobility_exponent == 0.0 {
+            self.run.params.temperature
         } else {
-            self.params.temperature * (size as f64).powf(-self.params.mobility_exponent)
+            self.run.params.temperature * (size as f64).powf(-self.run.params.mobility_exponent)
         }
     }
 
@@ -360,43 +350,44 @@ impl Simulation {
     /// One sweep: every cluster existing at its start, in a fresh random order, tries one move
     /// (skipping clusters merged away earlier in the sweep).
     pub fn sweep(&mut self) {
-        let start = self.params.timing.then(Instant::now);
+        let start = self.run.params.timing.then(Instant::now);
         self.engine.forget_views();
-        self.sweep += 1;
-        self.records.begin_sweep(self.sweep);
+        self.run.sweep += 1;
+        self.run.records.begin_sweep(self.run.sweep);
         let mut order = std::mem::take(&mut self.order);
         order.clear();
         order.extend_from_slice(self.engine.live());
         order.sort_unstable();
-        shuffle(&mut self.rng, &mut order);
+        shuffle(&mut self.run.rng, &mut order);
         for &id in &order {
             if self.engine.contains(id) {
                 self.visit(id);
             }
         }
         self.order = order;
-        if self.params.mobility_exponent > 0.0 {
+        if self.run.params.mobility_exponent > 0.0 {
             self.update_frozen();
         }
         let seconds = start.map(|t| t.elapsed().as_secs_f64());
-        self.records
-            .record_sweep(self.sweep, self.clusters(), self.largest, seconds);
+        self.run
+            .records
+            .record_sweep(self.run.sweep, self.clusters(), self.run.largest, seconds);
     }
 
     /// One cluster's turn (docs/dlca.md, "The model", steps 1-4).
     fn visit(&mut self, id: ItemId) {
         // 1. Move with probability temperature * size^-gamma (no draw when that is 1).
         let p = self.move_probability(self.engine.len_of(id));
-        if p < 1.0 && uniform01(&mut self.rng) >= p {
+        if p < 1.0 && uniform01(&mut self.run.rng) >= p {
             return;
         }
         // 2. A direction, weighted by gravity.
-        let dir = self.directions.sample(&mut self.rng);
+        let dir = self.run.directions.sample(&mut self.run.rng);
         // 3. Translate (a wall blocks the whole cluster) and find the clusters now in contact.
         let Ok(examined) = self.engine.try_move(id, dir, &mut self.contacts) else {
             return;
         };
-        self.records.record_move(examined);
+        self.run.records.record_move(examined);
         // 4. Merge with every cluster now in contact; the lowest id survives.
         if !self.contacts.is_empty() {
             self.merge_contacts(id);
@@ -414,7 +405,7 @@ impl Simulation {
         group.sort_unstable();
         let mut notes = Vec::new();
         let merged = self.engine.merge(group[0], &group[1..], &mut notes);
-        self.largest = self.largest.max(merged.size as u64);
+        self.run.largest = self.run.largest.max(merged.size as u64);
         group.clear();
         self.contacts = group;
         self.note_all(notes);
@@ -438,7 +429,7 @@ impl Simulation {
         }
         assert_eq!(
             owner.len() as u64,
-            self.particles,
+            self.run.particles,
             "particles not conserved"
         );
         for &id in sets.live() {
@@ -446,7 +437,7 @@ impl Simulation {
             let mut seen = HashSet::from([sites[0]]);
             let mut queue = VecDeque::from([sites[0]]);
             while let Some(k) = queue.pop_front() {
-                for n in self.lattice.neighbours(k) {
+                for n in self.run.lattice.neighbours(k) {
                     match owner.get(&n) {
                         Some(&o) if o == id && seen.insert(n) => queue.push_back(n),
                         Some(&o) if o == id => {}
@@ -460,17 +451,17 @@ impl Simulation {
     }
     /// The parameters.
     pub fn params(&self) -> &Params {
-        &self.params
+        &self.run.params
     }
 
     /// The seed the run was built from.
     pub fn seed(&self) -> u64 {
-        self.seed
+        self.run.seed
     }
 
     /// The lattice.
     pub fn lattice(&self) -> &Lattice {
-        &self.lattice
+        &self.run.lattice
     }
 
     /// The clusters as k-index arrays (absolute sites). With the `lattice` strategy, which
@@ -482,12 +473,12 @@ impl Simulation {
 
     /// Number of particles.
     pub fn particles(&self) -> u64 {
-        self.particles
+        self.run.particles
     }
 
     /// Sweeps done.
     pub fn sweeps(&self) -> u64 {
-        self.sweep
+        self.run.sweep
     }
 
     /// Number of clusters.
@@ -497,7 +488,7 @@ impl Simulation {
 
     /// Size of the largest cluster.
     pub fn largest(&self) -> u64 {
-        self.largest
+        self.run.largest
     }
 
     /// The search in use now.
@@ -507,7 +498,7 @@ impl Simulation {
 
     /// Why the strategy was chosen (for `auto`: the regime it found).
     pub fn strategy_reason(&self) -> &str {
-        &self.strategy_reason
+        &self.run.strategy_reason
     }
 
     /// Changes of the search during the run (box doublings, fall-back to all-pairs).
@@ -517,7 +508,7 @@ impl Simulation {
 
     /// What was recorded.
     pub fn records(&self) -> &Records {
-        &self.records
+        &self.run.records
     }
 
     /// Calls `f(cluster id, site k-index)` for every particle in a canonical order: clusters

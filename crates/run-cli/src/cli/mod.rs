@@ -18,6 +18,7 @@
 
 pub mod checkpoints;
 pub mod config;
+mod figure_flags;
 mod out_dir;
 pub mod params;
 mod progress;
@@ -25,6 +26,7 @@ mod resume;
 
 pub use checkpoints::{CheckpointArgs, guard_signals, stopped};
 pub use config::ConfigArgs;
+pub use figure_flags::{FigureArgs, FigureHelp};
 pub(crate) use out_dir::held;
 pub use out_dir::{
     Claim, ClaimError, ENSEMBLE_FILES, EarlierRun, LOCK_FILE, LockHolder, OutDirLock,
