@@ -97,7 +97,7 @@ pub fn return_cosine_3d<R: Rng + ?Sized>(r: f64, big_r: f64, rng: &mut R) -> Opt
 /// hits it: always a hit (Brownian motion in the plane is recurrent), at the walker's direction
 /// turned by the angle of [`return_angle_2d`], drawn without trigonometric functions:
 /// `tan(u pi / 2)` with `u` uniform in `(-1, 1)` is `b / |a|` for a point `(a, b)` uniform in
-/// the unit disk ([`disk_point`]), so `t = tan(phi / 2) = k b / |a|`, `k = (x - 1)/(x + 1)`,
+/// the unit disk (`disk_point`), so `t = tan(phi / 2) = k b / |a|`, `k = (x - 1)/(x + 1)`,
 /// and `cos phi = (a^2 - k^2 b^2) / (a^2 + k^2 b^2)`, `sin phi = 2 k |a| b / (a^2 + k^2 b^2)`.
 pub fn return_to_circle<R: Rng + ?Sized>(p: &[f64; 2], big_r: f64, rng: &mut R) -> [f64; 2] {
     let r = norm(p);
