@@ -9,6 +9,7 @@
 //! | `serial` | serial DLA: one walker at a time on one stream |
 //! | `pdla` | PDLA: threads on one shared tree, the shared log, the re-check, phases |
 //! | `checkpoint` | the checkpoint format, writing and rebuilding a run from it |
+//! | `files` | streaming into an output directory, checkpoints and their timing, resume (feature `files`) |
 //!
 //! Invariant: `growth.n` particles are stored in `cluster`, in the order `growth` accounted
 //! for them.
