@@ -121,13 +121,18 @@ pub fn host_name() -> String {
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
+        .and_then(|s| cpuinfo_field(&s, "model name"))
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// The value of `name` in the first processor's block of a `/proc/cpuinfo` text.
+fn cpuinfo_field(info: &str, name: &str) -> Option<String> {
+    info.lines()
+        .take_while(|l| !l.trim().is_empty())
+        .find_map(|l| {
+            let (k, v) = l.split_once(':')?;
+            (k.trim() == name).then(|| v.trim().to_string())
+        })
 }
 
 /// The processor a run ran on as the kernel describes it (Linux's `/proc/cpuinfo` and
@@ -181,14 +186,7 @@ impl Host {
     /// `/sys/devices/system/cpu`) describe it; what cannot be read is left empty.
     pub fn read(cpuinfo: &Path, sys: &Path) -> Self {
         let info = std::fs::read_to_string(cpuinfo).unwrap_or_default();
-        // The first processor's block.
-        let field = |name: &str| {
-            info.lines()
-                .take_while(|l| !l.trim().is_empty())
-                .find(|l| l.split(':').next().is_some_and(|k| k.trim() == name))
-                .and_then(|l| l.split_once(':'))
-                .map(|(_, v)| v.trim().to_string())
-        };
+        let field = |name: &str| cpuinfo_field(&info, name);
         let number = |name: &str| field(name).and_then(|v| v.parse().ok());
         let mut caches: Vec<Cache> = std::fs::read_dir(sys.join("cpu0/cache"))
             .into_iter()
