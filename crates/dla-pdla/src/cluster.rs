@@ -65,6 +65,17 @@ struct Maps<const D: usize> {
     leaf_diagonal: f64,
 }
 
+/// The dense map level a walker's last read answered from, where its next read starts
+/// ([`Cluster::map_bounds_from`]); the default starts at the coarsest level it may need.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct MapLevel(u8);
+
+impl Default for MapLevel {
+    fn default() -> Self {
+        MapLevel(u8::MAX)
+    }
+}
+
 impl<const D: usize> Maps<D> {
     fn new(
         sparse: Option<SparseDistanceMap<D>>,
@@ -355,6 +366,31 @@ impl<const D: usize> Cluster<D> {
     /// reads for a walker near the cluster).
     #[inline(always)]
     pub fn map_bounds_within(&self, p: &[f64; D], upper: f64) -> Option<(f64, f64, bool)> {
+        self.map_bounds_from(p, upper, &mut MapLevel::default())
+    }
+
+    /// [`map_bounds_within`](Self::map_bounds_within), read from the dense level that
+    /// answered the walker's last read (`level`, updated here) rather than from the coarsest
+    /// one the walker may need: the same answer in fewer reads for a walker that stays at one
+    /// distance from the cluster.
+    ///
+    /// The maps' caps are nested (each level's cap less its cell's half diagonal is above the
+    /// next finer level's cap plus its half diagonal), so where a level is not capped every
+    /// coarser one is not capped either and its bound is below the `enough` of the level
+    /// under it: the coarsest-first read passes through that level and continues from there
+    /// as this read does. Where the starting level is capped (or does not hold `p`), this
+    /// read climbs to the first level that is not, and answers as the coarsest-first read
+    /// would on arriving there: that level's bound, raised to the floor of the capped level
+    /// just under it when it is below its `enough`; or, if every level up to the first one
+    /// the walker may need is capped, the coarsest of them. `Cluster`'s tests hold the two
+    /// reads equal from every starting level.
+    #[inline(always)]
+    pub(crate) fn map_bounds_from(
+        &self,
+        p: &[f64; D],
+        upper: f64,
+        level: &mut MapLevel,
+    ) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
         if upper < maps.sure_sparse {
             if let Some(bounds) = maps.sparse.as_ref().and_then(|s| s.bounds(p)) {
@@ -366,16 +402,70 @@ impl<const D: usize> Cluster<D> {
             .iter()
             .position(|&sure| upper < sure)
             .unwrap_or(maps.levels.len().saturating_sub(1));
-        let mut best: Option<(f64, f64, bool)> = None;
+        let start = usize::from(level.0).min(top);
+        if start < top {
+            // Climb from `start` while the levels are capped, keeping the last capped read.
+            let mut floor = None;
+            for k in start..=top {
+                match self.level_bounds(k, p) {
+                    Some((lb, ub, false)) => {
+                        level.0 = k as u8;
+                        if lb >= maps.enough[k] {
+                            return Some((lb, ub, false));
+                        }
+                        if let Some((f, _)) = floor {
+                            return Some((lb.max(f), ub, false));
+                        }
+                        return self.descend(p, k, Some((lb, ub, false)), level);
+                    }
+                    Some((lb, ub, true)) => {
+                        level.0 = k as u8;
+                        floor = Some((lb, ub));
+                    }
+                    None => {}
+                }
+            }
+            if let Some((lb, ub)) = floor {
+                // Every level up to `top` is capped: the coarsest of them answers.
+                return Some((lb, ub, true));
+            }
+            // No level from `start` up holds `p`: read the finer ones as the coarsest-first
+            // read does.
+            return self.descend(p, start, None, level);
+        }
+        self.descend(p, top + 1, None, level)
+    }
+
+    /// Dense level `k`'s `(lower, upper, capped)` at `p` (a coarse level's upper bound widened
+    /// by a leaf diagonal: it holds the leaves' boxes), `None` where it does not hold `p`.
+    #[inline(always)]
+    fn level_bounds(&self, k: usize, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+        let maps = &*self.maps;
+        let (lb, mut ub, capped) = maps.levels[k].bounds(p)?;
+        if k > 0 {
+            ub += maps.leaf_diagonal;
+        }
+        Some((lb, ub, capped))
+    }
+
+    /// The coarsest-first read of the dense levels below `from`, then the sparse map, with
+    /// `best` the answer of level `from` when it is not capped and below its `enough` (see
+    /// [`map_bounds`](Self::map_bounds)); `level` becomes the finest dense level read.
+    #[inline(always)]
+    fn descend(
+        &self,
+        p: &[f64; D],
+        from: usize,
+        mut best: Option<(f64, f64, bool)>,
+        level: &mut MapLevel,
+    ) -> Option<(f64, f64, bool)> {
+        let maps = &*self.maps;
         let mut finer = true;
-        let levels = maps.levels.iter().zip(maps.enough.iter());
-        for (k, (map, &enough)) in levels.enumerate().take(top + 1).rev() {
-            let Some((lb, mut ub, capped)) = map.bounds(p) else {
+        for k in (0..from.min(maps.levels.len())).rev() {
+            let Some((lb, ub, capped)) = self.level_bounds(k, p) else {
                 continue;
             };
-            if k > 0 {
-                ub += maps.leaf_diagonal;
-            }
+            level.0 = k as u8;
             if capped {
                 best = Some(match best {
                     Some((b_lb, b_ub, _)) => (b_lb.max(lb), b_ub, false),
@@ -385,7 +475,7 @@ impl<const D: usize> Cluster<D> {
                 break;
             }
             best = Some((lb, ub, false));
-            if lb >= enough {
+            if lb >= maps.enough[k] {
                 finer = false;
                 break;
             }
@@ -532,14 +622,27 @@ mod tests {
                         let (f_lb, f_ub, f_capped) = finest_first(&c, &probe).unwrap();
                         assert!(lb >= f_lb, "{D}D: {lb} below the finest-first {f_lb}");
                         assert_eq!((ub, capped), (f_ub, f_capped), "{D}D at {probe:?}");
-                        // Starting lower for a walker known to be near gives the same.
-                        for slack in [1.0 + 1e-9, 1.5, 4.0] {
-                            assert_eq!(
-                                c.map_bounds_within(&probe, d * slack),
-                                Some((lb, ub, capped)),
-                                "{D}D: read from within {}",
-                                d * slack
-                            );
+                        // Starting lower for a walker known to be near gives the same, from
+                        // whichever level its last read answered.
+                        for slack in [1.0 + 1e-9, 1.5, 4.0, f64::INFINITY] {
+                            let within = c.map_bounds_within(&probe, d * slack);
+                            if slack.is_finite() {
+                                assert_eq!(
+                                    within,
+                                    Some((lb, ub, capped)),
+                                    "{D}D: read from within {}",
+                                    d * slack
+                                );
+                            }
+                            for start in 0..=c.maps.levels.len() {
+                                let mut level = MapLevel(start as u8);
+                                assert_eq!(
+                                    c.map_bounds_from(&probe, d * slack, &mut level),
+                                    within,
+                                    "{D}D: read from level {start} within {}",
+                                    d * slack
+                                );
+                            }
                         }
                     }
                     if let Some((lb, _)) = c.map_bound(&probe) {

@@ -19,7 +19,7 @@ mod counts;
 
 pub use counts::WalkCounts;
 
-use crate::cluster::Cluster;
+use crate::cluster::{Cluster, MapLevel};
 use crate::contact::{contact, first_contact_with, wall_contact};
 use crate::farfield::norm;
 use crate::near::{NEAR_RADIUS, NearCache, REBUILD_UPPER};
@@ -188,7 +188,7 @@ where
             cluster.deposit_map_bounds(&self.p, state.upper)
         } else {
             state.counts.map_reads += 1;
-            cluster.map_bounds_within(&self.p, state.upper)
+            cluster.map_bounds_from(&self.p, state.upper, &mut state.map_level)
         };
         if let Some((lb, ub, capped)) = bounds {
             // The map bounds the distance from above too: a walker with no answer yet (just
@@ -475,6 +475,8 @@ pub(crate) enum Motion {
 pub(crate) struct WalkState<const D: usize> {
     upper: f64,
     anchor: Option<[f64; D]>,
+    /// The distance map level that answered the walker's last read, where the next starts.
+    map_level: MapLevel,
     /// The stored particle the walker's last move ended in contact with.
     touched: Option<[f64; D]>,
     /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
@@ -510,6 +512,7 @@ impl<const D: usize> WalkState<D> {
         WalkState {
             upper: f64::INFINITY,
             anchor: None,
+            map_level: MapLevel::default(),
             touched: None,
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
             exact_within,
@@ -568,6 +571,7 @@ impl<const D: usize> WalkState<D> {
     fn forget(&mut self) {
         self.upper = f64::INFINITY;
         self.anchor = None;
+        self.map_level = MapLevel::default();
         self.touched = None;
         self.on_wall = false;
         self.near.reset();
