@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod ci;
 pub mod codemap;
+pub mod compare;
 pub mod fuzz;
 pub mod generate;
 

@@ -8,6 +8,8 @@
 //! - `cargo xtask bench [--save FILE] [--against FILE] [--repeat R] [--instructions]`: the
 //!   headline speed and memory figures as JSON, and their ratios to a saved baseline; with
 //!   `--instructions`, instructions per particle counted by cachegrind.
+//! - `cargo xtask compare [--fastdla P] [--dlaf P] [--dlca-cpp P] [--pairs N] [--save FILE]`:
+//!   our binaries against other public codes, in interleaved pairs (`xtask::compare`).
 //! - `cargo xtask generate`: the docs' flag tables and the Python stubs' keyword arguments
 //!   written from the models' parameter declarations (`xtask::generate`).
 //! - `cargo xtask fuzz [--cases N] [--only TEXT]`: every reader of user files fuzzed with N
@@ -108,6 +110,30 @@ enum Cmd {
         /// or quiet host), as instructions per particle.
         #[arg(long)]
         instructions: bool,
+    },
+    /// Time our binaries against other public codes on the same workloads, in interleaved
+    /// pairs (alternating which runs first), and print the medians and the median of the
+    /// per-pair ratios as a markdown table. The other codes are built by you from their own
+    /// sources, outside this repository (docs/benchmarks.md, "Against other codes"); give the
+    /// path of each one to compare with. Run it on a quiet machine.
+    Compare {
+        /// mathsjames/fastDLA's binary: 2D DLA with 1e6 particles, one thread.
+        #[arg(long)]
+        fastdla: Option<PathBuf>,
+        /// fogleman/dlaf's binary built with `D = 3` and `DefaultAttractionDistance = 1`: 3D
+        /// DLA with 1e5 particles.
+        #[arg(long)]
+        dlaf: Option<PathBuf>,
+        /// rob10campbell/DLCA's `bin/dlca`: DLCA on 1024^2 with 50 000 particles to one
+        /// cluster.
+        #[arg(long)]
+        dlca_cpp: Option<PathBuf>,
+        /// Pairs per comparison (seeds 1, 2, ...).
+        #[arg(long, default_value_t = 5, value_parser = run_io::count::count_at_least_1::<usize>)]
+        pairs: usize,
+        /// Write the JSON report to this file.
+        #[arg(long)]
+        save: Option<PathBuf>,
     },
     /// Measure this machine's memory latency: a pointer chase through one random cycle of
     /// cache lines, at working sets from 16 KiB to --max (powers of two), with 4 KiB pages and
@@ -226,6 +252,21 @@ fn main() -> Result<()> {
             against.as_deref(),
         )
         .map(|_| ()),
+        Cmd::Compare {
+            fastdla,
+            dlaf,
+            dlca_cpp,
+            pairs,
+            save,
+        } => {
+            let others: Vec<(&str, PathBuf)> =
+                [("fastdla", fastdla), ("dlaf", dlaf), ("dlca-cpp", dlca_cpp)]
+                    .into_iter()
+                    .filter_map(|(f, p)| p.map(|p| (f, p)))
+                    .collect();
+            xtask::compare::run(&workspace_root(), &cargo(), &others, pairs, save.as_deref())
+                .map(|_| ())
+        }
         Cmd::Latency { max, loads } => {
             print!("{}", xtask::probe::latency_table(max as usize, loads));
             Ok(())
