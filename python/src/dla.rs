@@ -102,7 +102,8 @@ impl DlaResult {
         let side = side.unwrap_or_else(|| dla_pdla::output::default_png_side(r_ext));
         let flat = positions.as_slice()?;
         check_dim(flat.len(), positions.as_array().ncols(), dim)?;
-        dla_pdla::figure::write_png_of_positions(flat, dim, r_ext, seed, &path, side)
+        dla_pdla::figure::of_positions(flat, dim, r_ext, seed)
+            .and_then(|f| f.write_png(&path, side))
             .map_err(|e| crate::figure::write_error(&path, e))
     }
 
@@ -146,7 +147,8 @@ impl DlaResult {
         let total = (flat.len() / dim.max(1)) as u64;
         let side = side.unwrap_or(dla_pdla::figure::ANIMATION_DEFAULT_SIDE);
         let every = every.unwrap_or_else(|| dla_pdla::figure::default_animation_every(total));
-        dla_pdla::figure::write_animation_of_positions(flat, dim, r_ext, seed, &path, side, every)
+        dla_pdla::figure::of_positions(flat, dim, r_ext, seed)
+            .and_then(|f| f.write_animation(&path, side, every))
             .map_err(|e| crate::figure::write_error(&path, e))
     }
 

@@ -1,7 +1,9 @@
 //! The figures of a cluster: `dla.png` ([`write_png`]) and the animation of its growth,
 //! `dla.gif` ([`write_animation`]). Both are drawn from the positions in arrival order (from
 //! memory or read back from `positions.npy` row by row), on one frame: the square of side
-//! `2 (R_ext + 1)` around the seed of the finished cluster, in particle diameters.
+//! `2 (R_ext + 1)` around the seed of the finished cluster, in particle diameters. A cluster
+//! held only as its positions (the Python bindings') has the same figures through
+//! [`of_positions`].
 //!
 //! While a pixel is at most a diameter wide, each particle is a disc of its true size coloured
 //! by arrival order (a perceptual map, magma, restricted to the colours that stand out on the
@@ -224,9 +226,11 @@ impl Canvas {
 }
 
 /// A finished cluster as its figures read it: dimension, R_ext (the frame), size, seed, and a
-/// pass over its positions in arrival order, `each(f)` calling `f(i, position)` for every
-/// particle (called twice for a density animation).
-struct Cluster<F> {
+/// pass over its positions in arrival order. Made by [`of_positions`] (and, for a
+/// simulation, by the free functions [`write_png`] and [`write_animation`]), it writes
+/// `dla.png` ([`write_png`](Self::write_png)) and `dla.gif`
+/// ([`write_animation`](Self::write_animation)).
+pub struct ClusterFigure<'a> {
     dim: usize,
     frame: Frame,
     /// A deposit: the positions `each` gives are already in the raster's axes (`x`, the
@@ -234,17 +238,23 @@ struct Cluster<F> {
     deposit: bool,
     total: u64,
     seed: u64,
-    each: F,
+    /// `each(f)` calls `f(i, position)` for every particle in arrival order (twice for a
+    /// density animation).
+    each: Box<Each<'a>>,
 }
 
 /// A callback over the positions of a cluster: arrival index and coordinates.
 type Visit<'v> = dyn FnMut(u64, &[f64]) -> Result<(), OutputError> + 'v;
 
-impl<F> Cluster<F>
-where
-    F: Fn(&mut Visit<'_>) -> Result<(), OutputError>,
-{
-    fn write_png(&self, path: &Path, side: u32) -> Result<(), OutputError> {
+/// A pass over the positions of a cluster, calling its [`Visit`] for each.
+type Each<'a> = dyn Fn(&mut Visit<'_>) -> Result<(), OutputError> + 'a;
+
+impl ClusterFigure<'_> {
+    /// Writes `dla.png` of `side` x `side` pixels of raster (plus axes and legend) to `path`.
+    ///
+    /// # Errors
+    /// The positions cannot be read or the file cannot be written.
+    pub fn write_png(&self, path: &Path, side: u32) -> Result<(), OutputError> {
         let mut canvas = Canvas::new(side, self.frame, self.total, self.dim);
         (self.each)(&mut |i, p| {
             canvas.add(i, p);
@@ -259,7 +269,14 @@ where
         Ok(())
     }
 
-    fn write_animation(&self, path: &Path, side: u32, every: u64) -> Result<u64, OutputError> {
+    /// Writes the growth of the cluster as an animated GIF to `path`: one frame every `every`
+    /// particles and one of the whole cluster, each `side` x `side` pixels of raster on the
+    /// finished cluster's frame (so the scale never changes), colours as in `dla.png`. Returns
+    /// the number of frames.
+    ///
+    /// # Errors
+    /// The positions cannot be read or the file cannot be written.
+    pub fn write_animation(&self, path: &Path, side: u32, every: u64) -> Result<u64, OutputError> {
         let total = self.total;
         let mut canvas = Canvas::new(side, self.frame, total, self.dim);
         // A density raster's colours run to the finished cluster's densest pixel, so that a
@@ -304,15 +321,12 @@ where
 
 /// The cluster of a simulation: its positions from memory, or read back from
 /// `dir/positions.npy`.
-fn of_sim<'s, const D: usize>(
-    sim: &'s Simulation<D>,
-    dir: &'s Path,
-) -> Cluster<impl Fn(&mut Visit<'_>) -> Result<(), OutputError> + 's>
+fn of_sim<'s, const D: usize>(sim: &'s Simulation<D>, dir: &'s Path) -> ClusterFigure<'s>
 where
     Dim<D>: Space<D>,
 {
     let substrate = sim.params().substrate();
-    Cluster {
+    ClusterFigure {
         dim: D,
         frame: match substrate {
             // The strip and the deposit's height, in a square.
@@ -325,7 +339,7 @@ where
         deposit: substrate.is_some(),
         total: sim.particles(),
         seed: sim.seed(),
-        each: move |f: &mut Visit<'_>| {
+        each: Box::new(move |f: &mut Visit<'_>| {
             each_position(sim, dir, |i, p: &[f64; D]| {
                 if substrate.is_none() || D == 2 {
                     return f(i, p);
@@ -336,7 +350,7 @@ where
                 q[2] = -p[1];
                 f(i, &q)
             })
-        },
+        }),
     }
 }
 
@@ -357,14 +371,19 @@ impl Frame {
     }
 }
 
-/// The cluster of `positions`, `dim` coordinates a particle in arrival order (row-major, as
-/// the Python bindings hold them).
-fn of_positions(
+/// The figures of a cluster held as `positions`: `dim` coordinates a particle, in arrival
+/// order, row-major (as the Python bindings hold them); `r_ext` and `seed` are the run's (its
+/// `run.json`'s). For the same cluster, `side` and `every` its files are byte for byte the
+/// binary's `dla.png` and `dla.gif`.
+///
+/// # Errors
+/// The positions are not whole particles of 2 to 5 coordinates.
+pub fn of_positions(
     positions: &[f64],
     dim: usize,
     r_ext: f64,
     seed: u64,
-) -> Result<Cluster<impl Fn(&mut Visit<'_>) -> Result<(), OutputError>>, OutputError> {
+) -> Result<ClusterFigure<'_>, OutputError> {
     if !(2..=5).contains(&dim) || positions.len() % dim != 0 || positions.is_empty() {
         return Err(std::io::Error::other(format!(
             "positions of {} numbers do not hold whole particles of {dim} coordinates (2 to 5)",
@@ -372,22 +391,23 @@ fn of_positions(
         ))
         .into());
     }
-    Ok(Cluster {
+    Ok(ClusterFigure {
         dim,
         frame: Frame::around_origin(r_ext),
         deposit: false,
         total: (positions.len() / dim) as u64,
         seed,
-        each: move |f: &mut Visit<'_>| {
+        each: Box::new(move |f: &mut Visit<'_>| {
             for (i, p) in positions.chunks_exact(dim).enumerate() {
                 f(i as u64, p)?;
             }
             Ok(())
-        },
+        }),
     })
 }
 
-/// Writes `dla.png` of `side` x `side` pixels of raster (plus axes and legend) to `path`.
+/// Writes `dla.png` of the simulation's cluster to `path` ([`ClusterFigure::write_png`]), its
+/// positions from memory or read back from `dir/positions.npy`.
 ///
 /// # Errors
 /// The positions cannot be read or the file cannot be written.
@@ -403,23 +423,6 @@ where
     of_sim(sim, dir).write_png(path, side)
 }
 
-/// Writes the figure [`write_png`] draws for a cluster held as `positions`: `dim` coordinates
-/// a particle, in arrival order, row-major; `r_ext` and `seed` are the run's (its
-/// `run.json`'s). For the same cluster the file is byte for byte the binary's `dla.png`.
-///
-/// # Errors
-/// The positions are not whole particles of 2 to 5 coordinates, or the file cannot be written.
-pub fn write_png_of_positions(
-    positions: &[f64],
-    dim: usize,
-    r_ext: f64,
-    seed: u64,
-    path: &Path,
-    side: u32,
-) -> Result<(), OutputError> {
-    of_positions(positions, dim, r_ext, seed)?.write_png(path, side)
-}
-
 /// Side of the raster in `dla.gif` when none is asked for (`--png-size`).
 pub const ANIMATION_DEFAULT_SIDE: u32 = 512;
 
@@ -428,9 +431,8 @@ pub fn default_animation_every(particles: u64) -> u64 {
     particles.div_ceil(100).max(1)
 }
 
-/// Writes the growth of the cluster as an animated GIF to `path`: one frame every `every`
-/// particles and one of the whole cluster, each `side` x `side` pixels of raster on the
-/// finished cluster's frame (so the scale never changes), colours as in `dla.png`. Returns the
+/// Writes `dla.gif`, the growth of the simulation's cluster, to `path`
+/// ([`ClusterFigure::write_animation`]), its positions as [`write_png`] reads them. Returns the
 /// number of frames.
 ///
 /// # Errors
@@ -446,23 +448,6 @@ where
     Dim<D>: Space<D>,
 {
     of_sim(sim, dir).write_animation(path, side, every)
-}
-
-/// [`write_animation`] of a cluster held as `positions` (as [`write_png_of_positions`]): the
-/// binary's `dla.gif` for the same cluster, `side` and `every`.
-///
-/// # Errors
-/// The positions are not whole particles of 2 to 5 coordinates, or the file cannot be written.
-pub fn write_animation_of_positions(
-    positions: &[f64],
-    dim: usize,
-    r_ext: f64,
-    seed: u64,
-    path: &Path,
-    side: u32,
-    every: u64,
-) -> Result<u64, OutputError> {
-    of_positions(positions, dim, r_ext, seed)?.write_animation(path, side, every)
 }
 
 #[cfg(test)]
@@ -496,10 +481,12 @@ mod tests {
         for (side, dim) in [(64, 2), (512, 2), (48, 3), (16, 2)] {
             if dim == 2 {
                 write_png(&sim2, dir.path(), &a, side).unwrap();
-                write_png_of_positions(&flat2, 2, sim2.r_ext(), sim2.seed(), &b, side).unwrap();
+                let of2 = of_positions(&flat2, 2, sim2.r_ext(), sim2.seed()).unwrap();
+                of2.write_png(&b, side).unwrap();
             } else {
                 write_png(&sim3, dir.path(), &a, side).unwrap();
-                write_png_of_positions(&flat3, 3, sim3.r_ext(), sim3.seed(), &b, side).unwrap();
+                let of3 = of_positions(&flat3, 3, sim3.r_ext(), sim3.seed()).unwrap();
+                of3.write_png(&b, side).unwrap();
             }
             assert_eq!(
                 std::fs::read(&a).unwrap(),
@@ -509,13 +496,12 @@ mod tests {
         }
         let (ga, gb) = (dir.path().join("a.gif"), dir.path().join("b.gif"));
         assert_eq!(write_animation(&sim2, dir.path(), &ga, 24, 50).unwrap(), 6);
-        let frames =
-            write_animation_of_positions(&flat2, 2, sim2.r_ext(), sim2.seed(), &gb, 24, 50);
-        assert_eq!(frames.unwrap(), 6);
+        let of2 = of_positions(&flat2, 2, sim2.r_ext(), sim2.seed()).unwrap();
+        assert_eq!(of2.write_animation(&gb, 24, 50).unwrap(), 6);
         assert_eq!(std::fs::read(&ga).unwrap(), std::fs::read(&gb).unwrap());
         // Positions that are not whole particles are refused.
-        assert!(write_png_of_positions(&flat2[1..], 2, 1.0, 1, &b, 16).is_err());
-        assert!(write_png_of_positions(&[], 2, 1.0, 1, &b, 16).is_err());
+        assert!(of_positions(&flat2[1..], 2, 1.0, 1).is_err());
+        assert!(of_positions(&[], 2, 1.0, 1).is_err());
     }
 
     #[test]

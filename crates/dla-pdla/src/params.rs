@@ -3,15 +3,17 @@
 //! Invariant: a [`Params`] that passed [`Params::validate`] has every field in its accepted
 //! range, which every other module assumes (in particular `dim` is one of
 //! [`DIMENSIONS`]).
+//!
+//! [`Params`]'s declaration also writes the table of the parameters a front end sets,
+//! [`PARAMS`] (name, flag, unit, meaning and accepted range), and with the feature `files`
+//! their defaults by name, `defaults()`.
 
 use crate::space::DIMENSIONS;
 use core_lattice::spec::{DeclaredParams, End, Input, Kind, ParamValue, Range, RangeError};
 use serde::{Deserialize, Serialize};
 
+#[cfg(test)]
 mod spec;
-pub use spec::PARAMS;
-#[cfg(feature = "files")]
-pub use spec::defaults;
 
 /// What happens to a walker outside the birth sphere (`|p| > R_b`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -217,6 +219,7 @@ core_lattice::declare_params! {
         /// either way.
         connectivity: bool = false,
     }
+    tables { const PARAMS; fn defaults; }
 }
 
 /// The path of a seed set (`--seed-set`), as given.

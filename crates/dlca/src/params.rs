@@ -2,16 +2,23 @@
 //!
 //! Invariant: a [`Params`] that passed [`Params::validate`] describes a run the simulation can
 //! set up (dimension 1..=5, a valid lattice, 1 to 2^32 - 3 particles, every rate in range).
+//!
+//! The front ends' parameters are [`Settings`], whose declaration also writes their table,
+//! [`PARAMS`], in the order of `dlca --help`: the ranges are those [`Params::validate`]
+//! accepts, written as its error messages write them (a unit test probes each bound). With the
+//! feature `files` it writes their defaults by name, `defaults()`: `null` where the front end
+//! must be given a value (`size`, and one of `fill` and `particles`) or where none means a
+//! choice (`max_sweeps`: no limit, `grid_box`: chosen).
 
 use core_lattice::{Boundary, Lattice, LatticeError};
 use serde::{Deserialize, Serialize};
 
 mod settings;
+#[cfg(test)]
 mod spec;
-pub use settings::{Boundaries, Bytes, LATTICE_FLAGS, Settings, Sizes, Sweeps};
-pub use spec::PARAMS;
 #[cfg(feature = "files")]
-pub use spec::defaults;
+pub use settings::defaults;
+pub use settings::{Boundaries, Bytes, LATTICE_FLAGS, PARAMS, Settings, Sizes, Sweeps};
 
 /// Largest dimension the model accepts (Hawick, James & Scogings 2006 run 2 to 5; 1 is
 /// included for tests and teaching).

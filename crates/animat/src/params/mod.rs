@@ -4,16 +4,19 @@
 //! Every field has a default ([`Params::default`]) chosen by the experiment documented in
 //! `docs/animat.md`; `data/animat-default.toml` spells the same values out. A config file may
 //! set any subset of the fields; unknown keys are rejected.
+//!
+//! [`Params`]'s declaration also writes the table of the parameters, [`PARAMS`] (name, flag,
+//! unit, meaning and accepted range of every field), and with the feature `files` their
+//! defaults by name, `defaults()`. `--density`, which sets `start_radius` from the start
+//! population, is the front ends' own ([`Params::set_density`]), not a declared parameter.
 
 use core_lattice::spec::{DeclaredParams, End, Input, Kind, ParamValue, Range, RangeError};
 use serde::{Deserialize, Serialize};
 use spatial::plane::BoxSize;
 use std::fmt;
 
+#[cfg(test)]
 mod spec;
-pub use spec::PARAMS;
-#[cfg(feature = "files")]
-pub use spec::defaults;
 
 /// The two species of the model (Hawick, James & Scogings 2006, section II.B).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -415,6 +418,7 @@ core_lattice::declare_params! {
         },
     }
     internal {}
+    tables { const PARAMS; fn defaults; }
 }
 
 /// The names of `all` rules, comma separated.

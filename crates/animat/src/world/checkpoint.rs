@@ -9,11 +9,10 @@
 //! restored world continues bit-identically. The counters (queries asked, distance
 //! evaluations) are carried over so they keep counting from where they were.
 
-use super::{QueryCounts, World, WorldError};
+use super::{Animat, QueryCounts, World, WorldError};
 use crate::params::{Params, Species};
 use core_lattice::rng::SimRng;
 use serde::{Deserialize, Serialize};
-use spatial::plane::Pos;
 
 /// A world between steps, as a checkpoint stores it (serde; see the module doc).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -22,8 +21,8 @@ pub struct Snapshot {
     seed: u64,
     steps: u64,
     next_id: u64,
-    /// Live animats in id order: id, species, cell, age, hunger.
-    animats: Vec<(u64, Species, Pos, u32, u32)>,
+    /// Live animats in id order.
+    animats: Vec<Animat>,
     order_rng: SimRng,
     action_rng: SimRng,
     /// Queries asked so far: adjacent, nearest, count.
@@ -58,10 +57,7 @@ impl World {
             seed: self.seed,
             steps: self.steps,
             next_id: self.next_id,
-            animats: self
-                .animats()
-                .map(|a| (a.id, a.species, a.pos, a.age, a.hunger))
-                .collect(),
+            animats: self.animats().collect(),
             order_rng: self.order_rng.clone(),
             action_rng: self.action_rng.clone(),
             queries: [q.adjacent, q.nearest, q.count],
@@ -79,21 +75,21 @@ impl World {
     pub fn restore(s: Snapshot) -> Result<World, WorldError> {
         let mut w = World::empty(s.params, s.seed)?;
         let mut last: Option<u64> = None;
-        for &(id, species, pos, age, hunger) in &s.animats {
-            if last.is_some_and(|l| id <= l) || id >= s.next_id {
+        for &a in &s.animats {
+            if last.is_some_and(|l| a.id <= l) || a.id >= s.next_id {
                 return Err(WorldError::BadSnapshot(format!(
-                    "animat id {id} is out of order or not below the next id {}",
-                    s.next_id
+                    "animat id {} is out of order or not below the next id {}",
+                    a.id, s.next_id
                 )));
             }
-            if species == Species::Rabbit && hunger != 0 {
+            if a.species == Species::Rabbit && a.hunger != 0 {
                 return Err(WorldError::BadSnapshot(format!(
-                    "rabbit {id} has hunger {hunger}; rabbits never hunger"
+                    "rabbit {} has hunger {}; rabbits never hunger",
+                    a.id, a.hunger
                 )));
             }
-            w.next_id = id;
-            w.add(species, pos, age, hunger)?;
-            last = Some(id);
+            w.insert(a)?;
+            last = Some(a.id);
         }
         w.next_id = s.next_id;
         w.steps = s.steps;
@@ -183,13 +179,13 @@ mod tests {
             WorldError::BadSnapshot(_)
         ));
         assert!(matches!(
-            bad(&|s| s.next_id = s.animats.last().unwrap().0),
+            bad(&|s| s.next_id = s.animats.last().unwrap().id),
             WorldError::BadSnapshot(_)
         ));
         assert!(matches!(
             bad(&|s| {
-                let p = s.animats[0].2;
-                s.animats[1].2 = p;
+                let p = s.animats[0].pos;
+                s.animats[1].pos = p;
             }),
             WorldError::Occupied(_)
         ));
@@ -198,9 +194,9 @@ mod tests {
                 let r = s
                     .animats
                     .iter_mut()
-                    .find(|a| a.1 == Species::Rabbit)
+                    .find(|a| a.species == Species::Rabbit)
                     .unwrap();
-                r.4 = 3;
+                r.hunger = 3;
             }),
             WorldError::BadSnapshot(_)
         ));

@@ -36,6 +36,7 @@ use spatial::cells::{CellIndex, KIND_A, KIND_B, WINDOW_MAX};
 
 use core_lattice::rng::{RngExt, SimRng, stream, stream_id};
 use run_io::StateHasher;
+use serde::{Deserialize, Serialize};
 pub use spatial::cells::{TILE, TILE_BYTES};
 use spatial::plane::{BoxSize, PlaneError, PlaneGrid, Pos};
 
@@ -67,8 +68,9 @@ pub const DIRECTIONS: [[i64; 2]; 8] = [
 const RING_MAX: i64 = 8;
 const _: () = assert!(RING_MAX <= WINDOW_MAX && RING_MAX >= NEAR_WINDOW_MIN);
 
-/// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// One animat (a copy of its state, as [`World::animats`] and [`World::get`] return it, and
+/// as a [`Snapshot`] keeps it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Animat {
     /// Unique id; ids increase with creation and are never reused.
     pub id: u64,
@@ -351,12 +353,26 @@ impl World {
         age: u32,
         hunger: u32,
     ) -> Result<u64, WorldError> {
-        let id = self.add_deferred(species, pos, age, hunger)?;
+        let id = self.next_id;
+        self.insert(Animat {
+            id,
+            species,
+            pos,
+            age,
+            hunger,
+        })?;
+        Ok(id)
+    }
+
+    /// Adds animat `a`, whose id is above every id so far (the next one, or a restored
+    /// animat's), listed in `ranks` and in the grid.
+    fn insert(&mut self, a: Animat) -> Result<(), WorldError> {
+        self.add_deferred(a)?;
         // `add_deferred` keeps the record count within u32.
         self.ranks.push((self.recs.len() - 1) as u32);
-        self.ids.push(id);
+        self.ids.push(a.id);
         self.flush_grid();
-        Ok(id)
+        Ok(())
     }
 
     /// Logs a change for the grid, which is kept only while the cell search is off (with it
@@ -388,42 +404,33 @@ impl World {
         }
     }
 
-    /// [`World::add`], with the grid's insertion logged in `pending` and without listing the
-    /// animat in `ranks` (a newborn is listed at the end of its birth step).
-    fn add_deferred(
-        &mut self,
-        species: Species,
-        pos: Pos,
-        age: u32,
-        hunger: u32,
-    ) -> Result<u64, WorldError> {
-        if self.cells.occupied(pos) {
-            return Err(WorldError::Occupied(pos));
+    /// [`World::insert`], with the grid's insertion logged in `pending` and without listing the
+    /// animat in `ranks` (a newborn is listed at the end of its birth step). The next id is
+    /// then the one after `a`'s.
+    fn add_deferred(&mut self, a: Animat) -> Result<(), WorldError> {
+        if self.cells.occupied(a.pos) {
+            return Err(WorldError::Occupied(a.pos));
         }
         if self.recs.len() >= u32::MAX as usize {
             return Err(WorldError::TooMany);
         }
-        let id = self.next_id;
-        self.log(GridOp::Insert(id, pos, species));
-        self.cells
-            .set(pos, kind_byte(species == Species::Rabbit), id);
-        self.next_id += 1;
+        debug_assert!(a.id >= self.next_id, "ids increase");
+        let rabbit = a.species == Species::Rabbit;
+        self.log(GridOp::Insert(a.id, a.pos, a.species));
+        self.cells.set(a.pos, kind_byte(rabbit), a.id);
+        self.next_id = a.id + 1;
         self.recs.push(Rec {
-            pos,
-            id,
-            age,
-            hunger: if species == Species::Fox { hunger } else { 0 },
+            pos: a.pos,
+            id: a.id,
+            age: a.age,
+            hunger: if rabbit { 0 } else { a.hunger },
         });
-        self.flags.push(if species == Species::Rabbit {
-            RABBIT
-        } else {
-            0
-        });
-        match species {
+        self.flags.push(if rabbit { RABBIT } else { 0 });
+        match a.species {
             Species::Fox => self.foxes += 1,
             Species::Rabbit => self.rabbits += 1,
         }
-        Ok(id)
+        Ok(())
     }
 
     /// The parameters.

@@ -241,8 +241,14 @@ impl World {
                     }
                 }
                 if n > 0 && self.may_give_birth() {
-                    let c = free[self.action_rng.random_range(0..n)];
-                    self.add_deferred(a.species, c, 0, 0)
+                    let child = Animat {
+                        id: self.next_id,
+                        species: a.species,
+                        pos: free[self.action_rng.random_range(0..n)],
+                        age: 0,
+                        hunger: 0,
+                    };
+                    self.add_deferred(child)
                         .expect("a birth on a free cell, within the record limit");
                 }
             }

@@ -114,8 +114,9 @@ impl Declared {
     }
 }
 
-/// The [`ParamSpec`]s of a declaration, as an array (`N` = `declared.len()`):
-/// `const PARAMS: &[ParamSpec] = &spec_table::<{ Params::DECLARED.len() }>(Params::DECLARED);`.
+/// The [`ParamSpec`]s of a declaration, as an array (`N` = `declared.len()`): the table
+/// [`declare_params!`](crate::declare_params)'s `tables` clause writes,
+/// `&spec_table::<{ Params::DECLARED.len() }>(Params::DECLARED)`.
 pub const fn spec_table<const N: usize>(declared: &[Declared]) -> [ParamSpec; N] {
     assert!(N == declared.len() && N > 0);
     let mut out = [declared[0].spec; N];
@@ -310,6 +311,18 @@ macro_rules! __declare_flag {
 /// per-field keys, in this order: `why` (the reason added to the range error), `required: true`
 /// (the command line requires the flag) and `optional: true` ([`Declared::optional`]). Fields under `internal` are set by front ends, not
 /// parameters of one. Doc comments are plain text: every front end shows them.
+///
+/// A model's library ends its declaration with `tables { const PARAMS; fn defaults; }`, which
+/// writes, beside the struct and with its visibility, what the front ends read of the model
+/// (the Python module, xtask, the binary's tests):
+/// - `const PARAMS: &[ParamSpec]`, the [`ParamSpec`] of every parameter in declaration order
+///   ([`DECLARED`](DeclaredParams::DECLARED) without what only the front ends need);
+/// - `fn defaults() -> serde_json::Map<String, serde_json::Value>`, the default of every
+///   parameter by name, compiled with the calling crate's feature `files`, which must bring
+///   the crates `run_io` (with its feature `files`) and `serde_json`, and the struct must
+///   implement `Serialize`.
+///
+/// The two names are the caller's.
 #[macro_export]
 macro_rules! declare_params {
     (
@@ -332,6 +345,7 @@ macro_rules! declare_params {
                 $ifield:ident : $ity:ty = $idefault:expr
             ),* $(,)?
         }
+        $(tables { const $table:ident; fn $defaults:ident; })?
     ) => {
         $(#[$smeta])*
         $vis struct $name {
@@ -436,6 +450,27 @@ macro_rules! declare_params {
                 Ok(false)
             }
         }
+
+        $(
+            #[doc = concat!(
+                "Every parameter a front end sets, in declaration order: name, flag, unit, ",
+                "meaning and accepted range, from [`", stringify!($name), "`]'s declaration ",
+                "(its names are the config files' keys and the Python keywords)."
+            )]
+            $vis const $table: &[$crate::spec::ParamSpec] = &$crate::spec::spec_table::<
+                { <$name as $crate::spec::DeclaredParams>::DECLARED.len() },
+            >(<$name as $crate::spec::DeclaredParams>::DECLARED);
+
+            #[doc = concat!(
+                "The default of every parameter of [`", stringify!($table), "`], keyed by ",
+                "name, from [`", stringify!($name), "::default`] (`null` for one unset by ",
+                "default)."
+            )]
+            #[cfg(feature = "files")]
+            $vis fn $defaults() -> ::serde_json::Map<::std::string::String, ::serde_json::Value> {
+                ::run_io::params_json::defaults_of::<$name>()
+            }
+        )?
     };
 }
 

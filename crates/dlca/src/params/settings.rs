@@ -1,6 +1,6 @@
 //! The parameters as the front ends take them ([`Settings`]): one flat declaration whose fields
 //! are the `dlca` binary's flags, its config keys and the Python keywords, from which the flags,
-//! the keywords, the parameter table ([`PARAMS`](super::PARAMS)), the docs' table and the stubs
+//! the keywords, the parameter table ([`PARAMS`]), the docs' table and the stubs
 //! are made. [`Settings::to_params`] turns them into the engine's [`Params`], where several
 //! of them become one field: `--dim`, `--size` and `--boundary` the axes, `--fill` or
 //! `--particles` the [`Init`](super::Init), `--histogram` and `--histogram-sweeps` the sweeps
@@ -110,6 +110,7 @@ core_lattice::declare_params! {
         },
     }
     internal {}
+    tables { const PARAMS; fn defaults; }
 }
 
 /// How many declared parameters the `dlca` binary shows before its run flags (`--seed`,
