@@ -18,12 +18,14 @@
 //! | `near` | a walker's near cache (private) |
 //! | [`walker`] | one walker's moves |
 //! | [`sim`] | the simulation: serial DLA, PDLA, checkpoints, observables |
-//! | [`output`] | the output files of a finished run |
+//! | `output` | the output files of a finished run (feature `files`) |
 //!
 //! Each module uses only modules above it in this list (no import cycles).
 //!
 //! With the default feature `cli` the parameter enums implement `clap::ValueEnum` and the `dla`
-//! binary is built; without it the library does not depend on clap.
+//! binary is built; without it the library does not depend on clap. Without `files` (implied
+//! by `cli` and `figures`) it writes no files: `output`, checkpoints and streamed positions
+//! are compiled out.
 //!
 //! ```
 //! use dla_pdla::{Params, Simulation};

@@ -9,9 +9,9 @@
 //! Layout: [`params`] (validated parameters), [`sim`] (the run: placement, sweep, strategy
 //! choice, checkpoints), `store` (the strategies behind one `ClusterStore` interface), `rigid`
 //! (the rigid-cluster kernels of the `lattice` strategy, one per dimension), [`record`] (what a
-//! run records as it goes), [`analysis`] and [`output`] (final measurements and files). The
-//! library builds without the command line (`--no-default-features`); feature `cli` (default)
-//! adds clap's derives and the `dlca` binary.
+//! run records as it goes), [`analysis`] and `output` (final measurements and files; feature
+//! `files`). The library builds without the command line (`--no-default-features`); feature
+//! `cli` (default) adds clap's derives and the `dlca` binary.
 //!
 //! ```
 //! use dlca::{Params, Init, Simulation};
