@@ -38,8 +38,8 @@ pub const DIMENSIONS: &[usize] = &[2, 3, 4, 5];
 
 /// A walker jumps by the distance map's bound `lb` when `lb - 1` exceeds this (diameters);
 /// closer to the cluster the tree's sharper bound pays for its cost. The default of
-/// [`Space::MAP_JUMP_MIN`]; 3D uses its own. (Here rather than in `walker`, which uses this
-/// module, so that the dependency points one way.)
+/// [`Space::MAP_JUMP_MIN`]; 2D and 3D, behind their sparse maps, use their own. (Here rather
+/// than in `walker`, which uses this module, so that the dependency points one way.)
 pub const MAP_JUMP_MIN: f64 = 2.0;
 
 /// The space dimension `D` as a type; see [`Space`].
@@ -97,21 +97,33 @@ fn marsaglia_4d<R: Rng + ?Sized>(rng: &mut R) -> [f64; 4] {
 }
 
 impl Space<2> for Dim<2> {
-    /// A fine map of 8-diameter cells capped at 64, then coarse ones of 64, 128, 512 and
-    /// 2048 capped at 512, 1024, 4096 and 16384 (about 200 cells lowered per insert and map;
-    /// the coarse maps by the box of each new tree leaf). Finer cells cost more memory than
-    /// they save time. The three coarsest levels answer the walkers in the wide empty regions
-    /// of a large cluster (beyond 512 of it), which would otherwise ask the tree at every
-    /// move: at 1e7 particles 3.9 tree queries per particle instead of 10.8
-    /// (`docs/benchmarks.md`, "DLA at scale"). They are read first and are small (half a
-    /// megabyte at 1e8 particles), so such a walker's move reads no uncached memory.
+    /// Behind the sparse map of 2-diameter cells ([`SPARSE_LEVEL`](Self::SPARSE_LEVEL)), dense
+    /// maps of 16, 64, 256 and 2048-diameter cells capped at 64, 512, 2048 and 16384: the
+    /// finest lowered by every particle (about 50 cells), the coarser by the box of each new
+    /// tree leaf. A walker at any
+    /// distance up to 16384 reads a bound within a cell's diagonal of a quarter of its
+    /// distance or better; the coarsest levels answer the walkers in the wide empty regions of
+    /// a large cluster, which would otherwise ask the tree at every move (`docs/benchmarks.md`,
+    /// "DLA at scale"). The three coarsest are small (about 3 MB at 1e8 particles) and read
+    /// first, so such a walker's move reads no uncached memory. These levels, the sparse map
+    /// and the jump threshold were chosen by instruction counts at 1e6: a dense level of
+    /// 8-diameter cells behind the sparse map saves nothing and costs 0.6 byte per particle
+    /// (`docs/benchmarks.md`, "2D distance maps").
     const MAP_LEVELS: &'static [(f64, f64)] = &[
-        (8.0, 64.0),
+        (16.0, 64.0),
         (64.0, 512.0),
-        (128.0, 1024.0),
-        (512.0, 4096.0),
+        (256.0, 2048.0),
         (2048.0, 16384.0),
     ];
+
+    /// Cells of 2 diameters capped at 8, in blocks of 16^2 cells (256 bytes, 32 diameters a
+    /// side), allocated only near the cluster: about 2.4 bytes per particle. Walkers 3-8
+    /// diameters from the cluster jump by its bound instead of asking the tree.
+    const SPARSE_LEVEL: Option<(f64, f64, usize)> = Some((2.0, 8.0, 16));
+
+    /// Half a diameter, as in 3D: behind the sparse map's tight bound even short jumps cost
+    /// less than the near-cache answers they replace.
+    const MAP_JUMP_MIN: f64 = 0.5;
 
     const AXES: [&'static str; 2] = ["x", "y"];
 

@@ -1,7 +1,8 @@
 //! Fractal dimensions over ensembles of seeds against the known values.
 //!
 //! Sizes are chosen so the suite stays fast (dev profile): 2D 8 x 5e4 particles, 3D 8 x 1e4,
-//! 4D 8 x 4e3, 5D 8 x 1.5e3, exact-vs-vpdist 2 x 8 x 2e4 in 2D. Off-lattice DLA has D = 1.71 (2D) and 2.50 (3D)
+//! 4D 8 x 4e3, 5D 8 x 1.5e3, exact-vs-vpdist 2 x 8 x 2e4 in 2D, map on-vs-off 2 x 16 x 2e4 in
+//! 2D. Off-lattice DLA has D = 1.71 (2D) and 2.50 (3D)
 //! (Sosa-Herrera & Rodriguez-Romo, "Variable precision distance search for random fractal
 //! cluster simulations", Table 2); fits that start at small N give a lower effective D, and the
 //! cluster-to-cluster spread falls like N^-0.33. The tolerances (+-0.05 in 2D, +-0.10 in 3D)
@@ -110,11 +111,14 @@ fn exact_and_vpdist_agree() {
 
 /// The distance map only changes which lower bound a jump uses, never the physics: the
 /// ensembles with and without it agree within their errors (and the tree-only walk is the
-/// paper's).
+/// paper's). 2D takes 16 clusters a side: the means of 8 clusters of 2e4 spread by about
+/// 0.013 (120 release clusters of each 2D map layout, `docs/benchmarks.md`, "2D distance
+/// maps"), so 8 against 8 leaves three standard errors of their difference too near the
+/// spread of two such means.
 #[test]
 fn distance_map_on_and_off_agree() {
-    let on = dims_with::<2>(20_000, 300..308, 2.0, true);
-    let off = dims_with::<2>(20_000, 400..408, 2.0, false);
+    let on = dims_with::<2>(20_000, 300..316, 2.0, true);
+    let off = dims_with::<2>(20_000, 400..416, 2.0, false);
     assert_agree("2D map on", &on, "off", &off);
     let on3 = dims_with::<3>(5_000, 300..308, 2.0, true);
     let off3 = dims_with::<3>(5_000, 400..408, 2.0, false);
