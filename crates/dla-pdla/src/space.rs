@@ -100,12 +100,12 @@ impl Space<2> for Dim<2> {
     /// Behind the sparse map of 2-diameter cells ([`SPARSE_LEVEL`](Self::SPARSE_LEVEL)), dense
     /// maps of 16, 64, 256 and 2048-diameter cells capped at 64, 512, 2048 and 16384: the
     /// finest lowered by every particle (about 50 cells), the coarser by the box of each new
-    /// tree leaf. A walker at any
-    /// distance up to 16384 reads a bound within a cell's diagonal of a quarter of its
-    /// distance or better; the coarsest levels answer the walkers in the wide empty regions of
-    /// a large cluster, which would otherwise ask the tree at every move (`docs/benchmarks.md`,
-    /// "DLA at scale"). The three coarsest are small (about 3 MB at 1e8 particles) and read
-    /// first, so such a walker's move reads no uncached memory. These levels, the sparse map
+    /// tree leaf. Each cap is four to eight times the finer level's, so a walker at any
+    /// distance up to 16384 reads a level whose cells are small beside its distance; the
+    /// coarsest levels answer the walkers in the wide empty regions of a large cluster, which
+    /// would otherwise ask the tree at every move (`docs/benchmarks.md`, "DLA at scale"). The
+    /// three coarsest are small (about 3 MB at 1e8 particles) and read first, so such a
+    /// walker's move reads no uncached memory. These levels, the sparse map
     /// and the jump threshold were chosen by instruction counts at 1e6: a dense level of
     /// 8-diameter cells behind the sparse map saves nothing and costs 0.6 byte per particle
     /// (`docs/benchmarks.md`, "2D distance maps").
