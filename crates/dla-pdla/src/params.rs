@@ -136,11 +136,11 @@ core_lattice::declare_params! {
         /// exact at those distances anyway ((precision - 1/2) leaf diagonals of at least 5
         /// diameters, as by default).
         near_cache: bool = true => { flag: "near-cache", unit: "", range: Range::Any },
-        /// The coarse distance maps in front of the orthtree: speed only, another trajectory.
-        /// One byte per cell of side 8 diameters plus a coarser map (under 1 byte per
-        /// particle at 1e6 in 2D; in 3D also a sparse map of 2-diameter cells near the
-        /// cluster, about 6 bytes per particle at 1e6): walkers away from the cluster jump by
-        /// their bound without a tree query. Off is the paper's tree-only walk.
+        /// The distance maps in front of the orthtree: speed only, another trajectory. One
+        /// byte per cell: a sparse map of 2-diameter cells near the cluster (2D and 3D) and
+        /// dense maps of coarser cells (about 2.7 bytes per particle at 1e6 in 2D, 7 in 3D):
+        /// walkers away from the cluster jump by their bound without a tree query. Off is the
+        /// paper's tree-only walk.
         distance_map: bool = true => { flag: "distance-map", unit: "", range: Range::Any },
         /// Walkers moving at once on the shared cluster (PDLA); 1 is DLA, exact and
         /// deterministic.
