@@ -34,11 +34,9 @@ pub const NEAR_RADIUS: f64 = 5.0;
 
 /// A cache is (re)built at the walker's position when its nearest distance is known to be
 /// at most this, so the answer lies inside the new ball (a diameter from its edge) and the
-/// cache answers that move at once. Tuned by instruction counts at 1e6 (2D) and 1e5 (3D),
-/// which do not change the walk: `NEAR_RADIUS` less 2, 1.5, 1 and 0.5 gave 1, 0.991, 0.988
-/// and 0.988 times the instructions in 2D, 1, 0.991, 0.987 and 0.986 in 3D; less 2.5, 1.015
-/// in 2D. A walker that close to the cluster would otherwise ask the tree, which costs about
-/// as much as a rebuild and answers only one move.
+/// cache answers that move at once: a walker that close to the cluster would otherwise ask
+/// the tree, which costs about as much as a rebuild and answers only one move. Tuned by
+/// instruction counts (`docs/dla.md`, "The near cache"); it changes no walk.
 pub const REBUILD_UPPER: f64 = NEAR_RADIUS - 1.0;
 
 /// Absolute slack on the containment tests (diameters): far above the rounding of distances
