@@ -65,14 +65,22 @@ struct Maps<const D: usize> {
     leaf_diagonal: f64,
 }
 
-/// The dense map level a walker's last read answered from, where its next read starts
-/// ([`Cluster::map_bounds_from`]); the default starts at the coarsest level it may need.
+/// Where a walker's next map read starts ([`Cluster::map_bounds_from`]): the dense level its
+/// last read answered from (the default starts at the coarsest level it may need), and
+/// whether that read was answered by the sparse map with a cell that is not capped (the next
+/// read then tries the sparse map first).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct MapLevel(u8);
+pub(crate) struct MapLevel {
+    dense: u8,
+    sparse: bool,
+}
 
 impl Default for MapLevel {
     fn default() -> Self {
-        MapLevel(u8::MAX)
+        MapLevel {
+            dense: u8::MAX,
+            sparse: false,
+        }
     }
 }
 
@@ -392,24 +400,34 @@ impl<const D: usize> Cluster<D> {
         level: &mut MapLevel,
     ) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
-        if upper < maps.sure_sparse {
-            if let Some(bounds) = maps.sparse.as_ref().and_then(|s| s.bounds(p)) {
+        // The sparse map first for a walker known to be within its cap less a cell's half
+        // diagonal (its answer then stands, capped or not), or one it answered last. Where
+        // its cell is not capped the nearest particle lies within its cap plus a half
+        // diagonal, so every dense level holds a bound below its `enough` there: the
+        // coarsest-first read would descend through them to the same sparse answer.
+        let sure = upper < maps.sure_sparse;
+        if sure || level.sparse {
+            if let Some(bounds) = maps.sparse.as_ref().and_then(|s| s.bounds(p))
+                && (sure || !bounds.2)
+            {
+                level.sparse = !bounds.2;
                 return Some(bounds);
             }
+            level.sparse = false;
         }
         let top = maps
             .sure
             .iter()
             .position(|&sure| upper < sure)
             .unwrap_or(maps.levels.len().saturating_sub(1));
-        let start = usize::from(level.0).min(top);
+        let start = usize::from(level.dense).min(top);
         if start < top {
             // Climb from `start` while the levels are capped, keeping the last capped read.
             let mut floor = None;
             for k in start..=top {
                 match self.level_bounds(k, p) {
                     Some((lb, ub, false)) => {
-                        level.0 = k as u8;
+                        level.dense = k as u8;
                         if lb >= maps.enough[k] {
                             return Some((lb, ub, false));
                         }
@@ -419,7 +437,7 @@ impl<const D: usize> Cluster<D> {
                         return self.descend(p, k, Some((lb, ub, false)), level);
                     }
                     Some((lb, ub, true)) => {
-                        level.0 = k as u8;
+                        level.dense = k as u8;
                         floor = Some((lb, ub));
                     }
                     None => {}
@@ -465,7 +483,7 @@ impl<const D: usize> Cluster<D> {
             let Some((lb, ub, capped)) = self.level_bounds(k, p) else {
                 continue;
             };
-            level.0 = k as u8;
+            level.dense = k as u8;
             if capped {
                 best = Some(match best {
                     Some((b_lb, b_ub, _)) => (b_lb.max(lb), b_ub, false),
@@ -484,7 +502,10 @@ impl<const D: usize> Cluster<D> {
             return best;
         }
         match (maps.sparse.as_ref().and_then(|s| s.bounds(p)), best) {
-            (Some((lb, ub, false)), _) => Some((lb, ub, false)),
+            (Some((lb, ub, false)), _) => {
+                level.sparse = true;
+                Some((lb, ub, false))
+            }
             (Some((lb, _, true)), Some((b_lb, b_ub, b_capped))) => {
                 Some((b_lb.max(lb), b_ub, b_capped))
             }
@@ -635,13 +656,19 @@ mod tests {
                                 );
                             }
                             for start in 0..=c.maps.levels.len() {
-                                let mut level = MapLevel(start as u8);
-                                assert_eq!(
-                                    c.map_bounds_from(&probe, d * slack, &mut level),
-                                    within,
-                                    "{D}D: read from level {start} within {}",
-                                    d * slack
-                                );
+                                for sparse in [false, true] {
+                                    let mut level = MapLevel {
+                                        dense: start as u8,
+                                        sparse,
+                                    };
+                                    assert_eq!(
+                                        c.map_bounds_from(&probe, d * slack, &mut level),
+                                        within,
+                                        "{D}D: read from level {start} (sparse first: \
+                                         {sparse}) within {}",
+                                        d * slack
+                                    );
+                                }
                             }
                         }
                     }
