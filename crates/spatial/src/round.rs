@@ -34,9 +34,36 @@ pub(crate) fn ceil(x: f64) -> f64 {
     }
 }
 
+/// A whole number `x` in `[0, 2^52)` as `usize`, through its bits: `x + 2^52` has `x` in the
+/// low bits of its mantissa. Two instructions, where `x as usize` (or through `i64`) adds
+/// the saturation of values out of range and NaN; the distance maps' reads, whose indices
+/// are whole numbers already tested against the map's side, convert one at every read.
+#[inline(always)]
+pub(crate) fn whole_to_usize(x: f64) -> usize {
+    const MAGIC: f64 = 4_503_599_627_370_496.0; // 2^52
+    debug_assert!(x >= 0.0 && x < MAGIC && x.fract() == 0.0, "{x}");
+    ((x + MAGIC).to_bits() - MAGIC.to_bits()) as usize
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn whole_numbers_convert_exactly() {
+        for x in [
+            0u64,
+            1,
+            2,
+            255,
+            65_535,
+            1 << 31,
+            (1 << 32) + 7,
+            (1 << 52) - 1,
+        ] {
+            assert_eq!(whole_to_usize(x as f64), x as usize, "{x}");
+        }
+    }
 
     #[test]
     fn floor_and_ceil_match_std() {

@@ -3,7 +3,7 @@
 
 use super::grid::Grid;
 use super::{CAPPED, Cells, DistanceMapError, PointMap, finite_max_norm, next_row};
-use crate::round::{ceil, floor};
+use crate::round::{ceil, floor, whole_to_usize};
 use std::fmt;
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -73,13 +73,12 @@ impl<const D: usize> DistanceMap<D> {
                 return None;
             }
             // `k + half` is a whole number in [0, side), and the index a whole number below
-            // the map's cells, under 2^53 (`grow`): exact in `f64`, converted once (through
-            // i64, one instruction and a check, where f64 -> usize is a longer sequence).
+            // the map's cells, under 2^52 (`grow`): exact in `f64`, converted once.
             idx += (k + half) * stride;
             stride *= self.side_f;
             centre[i] = (k + 0.5) * g.cell;
         }
-        Some((idx as i64 as usize, centre))
+        Some((whole_to_usize(idx), centre))
     }
 
     /// Adds every point of the closed box `[lo, hi]` at once: lowers each cell to the
@@ -232,10 +231,11 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
             .ceil();
         let side = 2.0 * cells;
         let total = side.powi(D as i32);
-        // Under 2^53 cells in all, so that a read's index is exact in `f64`.
+        // Under 2^52 cells in all, so that a read's index is exact in `f64` and converts by
+        // its bits (`whole_to_usize`).
         if !(side < f64::from(u32::MAX)
             && total < (isize::MAX as f64) / 2.0
-            && total < 2f64.powi(53))
+            && total < 2f64.powi(52))
         {
             return Err(DistanceMapError::TooLarge {
                 cells_per_axis: side,

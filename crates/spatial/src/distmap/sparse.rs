@@ -51,7 +51,7 @@
 
 use super::grid::Grid;
 use super::{CAPPED, Cells, DistanceMapError, PointMap};
-use crate::round::floor;
+use crate::round::{floor, whole_to_usize};
 use std::fmt;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicU8, AtomicU32, AtomicUsize, Ordering};
@@ -315,8 +315,8 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
             if !(k >= -half && k < half) {
                 return None;
             }
-            let j = k + half;
-            let j = j as i64 as usize;
+            // A whole number in [0, side), side < 2^32 (`grow`).
+            let j = whole_to_usize(k + half);
             bidx += (j >> self.shift) * stride;
             stride *= self.bside;
             cidx |= (j & self.mask) << (self.shift as usize * i);
