@@ -41,7 +41,7 @@ pub(crate) fn ceil(x: f64) -> f64 {
 #[inline(always)]
 pub(crate) fn whole_to_usize(x: f64) -> usize {
     const MAGIC: f64 = 4_503_599_627_370_496.0; // 2^52
-    debug_assert!(x >= 0.0 && x < MAGIC && x.fract() == 0.0, "{x}");
+    debug_assert!((0.0..MAGIC).contains(&x) && x.fract() == 0.0, "{x}");
     ((x + MAGIC).to_bits() - MAGIC.to_bits()) as usize
 }
 
