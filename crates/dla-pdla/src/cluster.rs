@@ -84,6 +84,18 @@ impl Default for MapLevel {
     }
 }
 
+impl MapLevel {
+    /// The same dense level, without the sparse map first: where a walker that knows
+    /// nothing of the cluster starts (any start gives the same answer; a start near the
+    /// level that answers saves reads).
+    pub(crate) fn dense_only(self) -> Self {
+        MapLevel {
+            sparse: false,
+            ..self
+        }
+    }
+}
+
 impl<const D: usize> Maps<D> {
     fn new(
         sparse: Option<SparseDistanceMap<D>>,
@@ -406,14 +418,18 @@ impl<const D: usize> Cluster<D> {
         // diagonal, so every dense level holds a bound below its `enough` there: the
         // coarsest-first read would descend through them to the same sparse answer.
         let sure = upper < maps.sure_sparse;
+        // The sparse map's answer at `p` once read (kept for the descent, which may end there).
+        let mut sparse = None;
         if sure || level.sparse {
-            if let Some(bounds) = maps.sparse.as_ref().and_then(|s| s.bounds(p))
-                && (sure || !bounds.2)
+            let bounds = maps.sparse.as_ref().and_then(|s| s.bounds(p));
+            if let Some(b) = bounds
+                && (sure || !b.2)
             {
-                level.sparse = !bounds.2;
-                return Some(bounds);
+                level.sparse = !b.2;
+                return Some(b);
             }
             level.sparse = false;
+            sparse = Some(bounds);
         }
         let top = maps
             .sure
@@ -434,7 +450,7 @@ impl<const D: usize> Cluster<D> {
                         if let Some((f, _)) = floor {
                             return Some((lb.max(f), ub, false));
                         }
-                        return self.descend(p, k, Some((lb, ub, false)), level);
+                        return self.descend(p, k, Some((lb, ub, false)), sparse, level);
                     }
                     Some((lb, ub, true)) => {
                         level.dense = k as u8;
@@ -449,9 +465,9 @@ impl<const D: usize> Cluster<D> {
             }
             // No level from `start` up holds `p`: read the finer ones as the coarsest-first
             // read does.
-            return self.descend(p, start, None, level);
+            return self.descend(p, start, None, sparse, level);
         }
-        self.descend(p, top + 1, None, level)
+        self.descend(p, top + 1, None, sparse, level)
     }
 
     /// Dense level `k`'s `(lower, upper, capped)` at `p` (a coarse level's upper bound widened
@@ -468,13 +484,15 @@ impl<const D: usize> Cluster<D> {
 
     /// The coarsest-first read of the dense levels below `from`, then the sparse map, with
     /// `best` the answer of level `from` when it is not capped and below its `enough` (see
-    /// [`map_bounds`](Self::map_bounds)); `level` becomes the finest dense level read.
+    /// [`map_bounds`](Self::map_bounds)) and `sparse` the sparse map's answer at `p` if it was
+    /// read already; `level` becomes the finest dense level read.
     #[inline(always)]
     fn descend(
         &self,
         p: &[f64; D],
         from: usize,
         mut best: Option<(f64, f64, bool)>,
+        sparse: Option<Option<(f64, f64, bool)>>,
         level: &mut MapLevel,
     ) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
@@ -501,7 +519,8 @@ impl<const D: usize> Cluster<D> {
         if !finer {
             return best;
         }
-        match (maps.sparse.as_ref().and_then(|s| s.bounds(p)), best) {
+        let sparse = sparse.unwrap_or_else(|| maps.sparse.as_ref().and_then(|s| s.bounds(p)));
+        match (sparse, best) {
             (Some((lb, ub, false)), _) => {
                 level.sparse = true;
                 Some((lb, ub, false))

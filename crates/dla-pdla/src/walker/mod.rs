@@ -188,7 +188,12 @@ where
             cluster.deposit_map_bounds(&self.p, state.upper)
         } else {
             state.counts.map_reads += 1;
-            cluster.map_bounds_from(&self.p, state.upper, &mut state.map_level)
+            let bounds = cluster.map_bounds_from(&self.p, state.upper, &mut state.map_level);
+            if state.fresh {
+                state.fresh = false;
+                state.fresh_level = state.map_level.dense_only();
+            }
+            bounds
         };
         if let Some((lb, ub, capped)) = bounds {
             // The map bounds the distance from above too: a walker with no answer yet (just
@@ -477,6 +482,14 @@ pub(crate) struct WalkState<const D: usize> {
     anchor: Option<[f64; D]>,
     /// The distance map level that answered the walker's last read, where the next starts.
     map_level: MapLevel,
+    /// Where the first read of a walker that knows nothing starts (just born or back from
+    /// the far field): the level the last such read ended at. Those walkers are all about
+    /// the birth distance from the cluster, and the coarsest level, the safe start, is
+    /// usually two levels above the one that answers them. The answer does not depend on the
+    /// start (`Cluster::map_bounds_from`).
+    fresh_level: MapLevel,
+    /// Whether the walker's next map read is its first since it knew nothing.
+    fresh: bool,
     /// The stored particle the walker's last move ended in contact with.
     touched: Option<[f64; D]>,
     /// Whether the near cache is used: `params.near_cache`, and the tree's answers are exact
@@ -513,6 +526,8 @@ impl<const D: usize> WalkState<D> {
             upper: f64::INFINITY,
             anchor: None,
             map_level: MapLevel::default(),
+            fresh_level: MapLevel::default(),
+            fresh: true,
             touched: None,
             near_on: params.near_cache && exact_within >= NEAR_RADIUS,
             exact_within,
@@ -571,7 +586,8 @@ impl<const D: usize> WalkState<D> {
     fn forget(&mut self) {
         self.upper = f64::INFINITY;
         self.anchor = None;
-        self.map_level = MapLevel::default();
+        self.map_level = self.fresh_level;
+        self.fresh = true;
         self.touched = None;
         self.on_wall = false;
         self.near.reset();
