@@ -81,9 +81,10 @@ core_lattice::declare_params! {
         /// Space dimension.
         dim: usize = 2 => { flag: "dim", unit: "", range: Range::Values(DIMENSIONS) },
         /// Particles in the final cluster, seed particle included (at most 2.5e9 in 4D and
-        /// 5D, the orthtree's 32-bit indices). Memory: about 11 bytes per particle in 2D and 15
-        /// in 3D at 1e7; the tree and distance map take about 25 in 4D at 1e5 and 300 in 5D at
-        /// 3e4 (mostly the map).
+        /// 5D, the orthtree's 32-bit indices). Memory: about 13 bytes per particle in 2D and 15
+        /// in 3D at 1e7, and 4.6 more for the parents a run that streams its positions records;
+        /// the tree and distance map take about 25 in 4D at 1e5 and 300 in 5D at 3e4 (mostly
+        /// the map).
         particles: u64 = 10_000 => {
             flag: "particles", unit: "particles",
             range: Range::Int { min: 1, max: Some(MAX_PARTICLES as i128) },
