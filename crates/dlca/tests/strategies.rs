@@ -199,11 +199,13 @@ fn initial_adjacent_particles_form_one_cluster() {
 
 #[test]
 fn power_of_two_periodic_lattices_match_all_pairs() {
-    // All-periodic power-of-two lattices take the lattice strategy's bit-field frame in 1D to 3D
-    // (4D and 5D use the plain occupancy lattice); sides of 1 and 2 are the edge cases of its
-    // field arithmetic.
-    let sizes: [&[u64]; 7] = [
+    // All-periodic power-of-two lattices take the lattice strategy's bit-field frames in 1D to
+    // 3D (4D and 5D use the plain occupancy lattice): the spread site index in 1D and where the
+    // first side is 1 024 or more, else the field-wise sum; sides of 1 and 2 are the edge cases
+    // of their field arithmetic.
+    let sizes: [&[u64]; 8] = [
         &[256],
+        &[1024, 2],
         // Large enough for clusters of more than 64 particles absorbing small ones (parts).
         &[64, 48],
         &[32, 16],

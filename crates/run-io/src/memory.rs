@@ -241,9 +241,26 @@ fn show_allocation(bytes: u64) -> String {
 /// # Errors
 /// The allocation failed, or its size overflows.
 pub fn try_vec<T: Clone>(len: usize, value: T, what: &str) -> Result<Vec<T>, AllocError> {
+    let mut v = try_vec_capacity(len, what)?;
+    v.resize(len, value);
+    Ok(v)
+}
+
+/// A vector of `len` zeros of an integer type (`T::default()`), or an [`AllocError`] naming `what`, whose pages
+/// the operating system supplies on first touch (`vec![0; len]` allocates zeroed memory): the
+/// elements a run never writes cost no memory. The allocation is first tried fallibly and
+/// released, so that memory that cannot be had is an error rather than an abort.
+///
+/// # Errors
+/// The allocation failed, or its size overflows.
+pub fn try_zeros<T: Clone + Default>(len: usize, what: &str) -> Result<Vec<T>, AllocError> {
+    drop(try_vec_capacity::<T>(len, what)?);
+    Ok(vec![T::default(); len])
+}
+
+fn try_vec_capacity<T>(len: usize, what: &str) -> Result<Vec<T>, AllocError> {
     let mut v = Vec::new();
     try_reserve(&mut v, len, what)?;
-    v.resize(len, value);
     Ok(v)
 }
 
@@ -321,5 +338,8 @@ mod tests {
         assert!(e.to_string().starts_with("cannot allocate "), "{e}");
         assert!(e.to_string().ends_with(" for the lattice"), "{e}");
         assert_eq!(try_vec(3, 7u8, "x").unwrap(), vec![7, 7, 7]);
+        let e = try_zeros::<u32>(usize::MAX / 2, "the labels").unwrap_err();
+        assert!(e.to_string().ends_with(" for the labels"), "{e}");
+        assert_eq!(try_zeros::<u32>(3, "x").unwrap(), vec![0, 0, 0]);
     }
 }

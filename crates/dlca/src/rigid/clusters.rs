@@ -14,9 +14,6 @@ use core_lattice::{Blocked, Direction, Lattice};
 use spatial::lattice::{ItemId, SiteSets};
 use std::sync::Arc;
 
-/// Marks an empty site.
-const EMPTY: u32 = u32::MAX;
-
 /// Clusters of at most this many particles never keep parts (see [`Part`]).
 const SMALL: u32 = 64;
 
@@ -128,11 +125,11 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     /// The lists of a single particle, shared by all single particles.
     single: Option<Lists<F::Entry>>,
     lattice: Lattice,
-    /// Which sites hold a particle, one bit a site: small enough to stay in cache where the
+    /// Which sites hold a particle, one bit a site by site index: small enough to stay in cache where the
     /// label array does not, and all a contact probe reads unless it finds a particle.
     occupied: Bits,
-    /// Label of the cluster on each occupied site (stale on empty sites).
-    cells: Vec<u32>,
+    /// Label of the cluster on each occupied site (stale on empty sites), by site index.
+    cells: Cells,
     /// Cluster owning each label.
     id_of: Vec<ItemId>,
     clusters: Vec<Cluster<D, F>>,
@@ -147,10 +144,42 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
 
 const DEAD: u32 = u32::MAX;
 
+/// The labels of the sites, by site index, allocated zeroed (a page never written costs no
+/// memory) and starting at a page boundary where the allocator allows it, so that the unused
+/// runs of a spread site index are whole pages.
+#[derive(Debug, Clone)]
+struct Cells {
+    v: Vec<u32>,
+    /// Index in `v` of site index 0.
+    at: usize,
+}
+
+impl Cells {
+    /// Cells per 4 KiB page.
+    const PAGE: usize = 1024;
+
+    /// Room for `len` labels, allocated fallibly.
+    fn new(len: usize) -> Result<Self, run_io::memory::AllocError> {
+        let v: Vec<u32> = run_io::memory::try_zeros(len + Self::PAGE, "the occupancy lattice")?;
+        let page = 4 * Self::PAGE;
+        let at = (page - v.as_ptr() as usize % page) % page / 4;
+        Ok(Cells { v, at })
+    }
+    #[inline(always)]
+    fn get(&self) -> &[u32] {
+        &self.v[self.at..]
+    }
+    #[inline(always)]
+    fn get_mut(&mut self) -> &mut [u32] {
+        &mut self.v[self.at..]
+    }
+}
+
 impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     /// The store for the clusters of `sets` (ids kept), with their occupancy lattice, in frame
     /// `frame` over `geo` (the geometry of the sets' lattice).
-    /// The lattice's cells (4 bytes a site) are allocated fallibly.
+    /// The lattice's cells (4 bytes a site) are allocated fallibly; a cell never occupied costs
+    /// no memory (the spread index's unused cells among them).
     pub(super) fn new(
         sets: &SiteSets,
         geo: Geometry<D>,
@@ -158,12 +187,11 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     ) -> Result<Self, run_io::memory::AllocError> {
         let lattice = sets.lattice().clone();
         let n = sets.id_bound();
-        let cells =
-            run_io::memory::try_vec(lattice.volume() as usize, EMPTY, "the occupancy lattice")?;
+        let cells = Cells::new(geo.volume as usize)?;
         let mut r = Rigid {
             frame,
             single: None,
-            occupied: Bits::new(lattice.volume() as usize),
+            occupied: Bits::new(geo.volume as usize),
             cells,
             id_of: (0..n as ItemId).collect(),
             clusters: vec![Cluster::default(); n],
@@ -194,8 +222,9 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 .map(|&k| r.geo.relative(&origin, &coords(k)))
                 .collect();
             for &k in sites {
-                r.cells[k as usize] = id;
-                r.occupied.set(k as usize);
+                let i = r.geo.index_of(k);
+                r.cells.get_mut()[i] = id;
+                r.occupied.set(i);
             }
             r.position[id as usize] = r.live.len() as u32;
             r.live.push(id);
@@ -235,6 +264,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             clusters,
             ..
         } = self;
+        let cells = cells.get_mut();
         let c = &mut clusters[id as usize];
         let (axis, d) = (dir.axis(), dir.index());
         if !geo.periodic[axis] {
@@ -318,7 +348,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         let label = self.clusters[large as usize].label;
         let origin = self.clusters[small as usize].origin;
         for r in &self.cold[small as usize].sites {
-            self.cells[self.geo.site(&origin, r)] = label;
+            self.cells.get_mut()[self.geo.site(&origin, r)] = label;
         }
         if nf > ni {
             self.id_of[lf as usize] = into;
@@ -417,6 +447,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             ..
         } = self;
         let o = c.origin;
+        let cells = cells.get();
         let in_c = |r: &[i32; D]| {
             geo.any(&o, r)
                 .is_some_and(|k| occupied.get(k) && cells[k] == label)
@@ -480,7 +511,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         self.cold[id as usize]
             .sites
             .iter()
-            .map(|r| self.geo.site(&c.origin, r) as u64)
+            .map(|r| self.geo.lattice_site(&c.origin, r))
             .collect()
     }
 
@@ -493,12 +524,15 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             let label = self.clusters[id as usize].label;
             assert_eq!(self.id_of[label as usize], id, "label table");
             assert_eq!(self.len_of(id), self.cold[id as usize].sites.len());
-            for k in self.sites(id) {
+            let origin = self.clusters[id as usize].origin;
+            for r in &self.cold[id as usize].sites {
+                let i = self.geo.site(&origin, r);
                 assert!(
-                    self.occupied.get(k as usize),
-                    "site {k} of cluster {id} not marked"
+                    self.occupied.get(i),
+                    "site {r:?} of cluster {id} not marked"
                 );
-                assert_eq!(self.cells[k as usize], label, "occupancy of cluster {id}");
+                assert_eq!(self.cells.get()[i], label, "occupancy of cluster {id}");
+                assert_eq!(self.geo.index_of(self.geo.lattice_site(&origin, r)), i);
                 total += 1;
             }
             let mut fresh = self.clusters[id as usize].clone();
@@ -517,8 +551,8 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 assert_eq!((fresh.lo[a], fresh.hi[a]), (c.lo[a], c.hi[a]), "extent");
             }
         }
-        let filled = (0..self.cells.len())
-            .filter(|&k| self.occupied.get(k))
+        let filled = (0..self.geo.volume as usize)
+            .filter(|&i| self.occupied.get(i))
             .count();
         assert_eq!(filled, total, "occupancy holds stray labels");
     }

@@ -1,8 +1,9 @@
 //! How the face and probe lists of a rigid cluster store relative positions, and how an entry
-//! plus a cluster origin becomes a k-index: [`AnyFrame`] for every lattice, [`Pow2Frame`] for
-//! all-periodic lattices with power-of-two sides and at most 2^32 sites.
+//! plus a cluster origin becomes a site index: [`AnyFrame`] for every lattice, [`Pow2Frame`]
+//! for all-periodic lattices with power-of-two sides and at most 2^32 sites, [`SpreadFrame`]
+//! for those among them whose geometry has a spread site index.
 //!
-//! Invariant: for the same origin and relative position, every frame gives the same k-index
+//! Invariant: for the same origin and relative position, every frame gives the same site index
 //! (so the choice of frame never changes a trajectory).
 
 use super::geometry::Geometry;
@@ -24,9 +25,9 @@ pub(crate) trait Frame<const D: usize>: Debug + Clone {
     fn start(i: usize) -> Self::Entry;
     /// The list start stored in `e`.
     fn start_of(e: Self::Entry) -> usize;
-    /// k-index of a particle site.
+    /// Site index of a particle site.
     fn site(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> usize;
-    /// k-index of a probe site, or `None` beyond a wall.
+    /// Site index of a probe site, or `None` beyond a wall.
     fn probe(&self, geo: &Geometry<D>, o: Self::Origin, e: Self::Entry) -> Option<usize>;
 }
 
@@ -88,6 +89,9 @@ impl<const D: usize> Frame<D> for Pow2Frame {
     type Entry = u32;
     type Origin = u32;
     fn new(geo: &Geometry<D>) -> Option<Self> {
+        if geo.spread.is_some() {
+            return None;
+        }
         let fits = geo.size.iter().product::<i64>() <= 1 << 32;
         let pow2 = geo.size.iter().all(|&l| (l as u64).is_power_of_two());
         if !(fits && pow2 && geo.periodic.iter().all(|&p| p)) {
@@ -100,6 +104,53 @@ impl<const D: usize> Frame<D> for Pow2Frame {
             }
         }
         Some(Pow2Frame { high })
+    }
+    #[inline(always)]
+    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {
+        (0..D).map(|a| o[a] as u64 * geo.stride[a]).sum::<u64>() as u32
+    }
+    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> u32 {
+        geo.any(&[0; D], r).expect("periodic") as u32
+    }
+    fn start(i: usize) -> u32 {
+        u32::try_from(i).expect("lists shorter than 2^32")
+    }
+    #[inline(always)]
+    fn start_of(e: u32) -> usize {
+        e as usize
+    }
+    #[inline(always)]
+    fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
+        self.add(o, e) as usize
+    }
+    #[inline(always)]
+    fn probe(&self, _: &Geometry<D>, o: u32, e: u32) -> Option<usize> {
+        Some(self.add(o, e) as usize)
+    }
+}
+
+/// Periodic lattices whose sides are all powers of two, with a spread site index of at most 32
+/// bits (see [`Geometry`]'s module): an entry is the site index of the relative position
+/// reduced modulo the sides, and the site index of origin plus entry is their sum with the
+/// spare bits masked off. Two operations, whatever the dimension.
+#[derive(Debug, Clone)]
+pub(crate) struct SpreadFrame {
+    /// The fields of the spread index.
+    mask: u32,
+}
+
+impl SpreadFrame {
+    #[inline(always)]
+    fn add(&self, a: u32, b: u32) -> u32 {
+        a.wrapping_add(b) & self.mask
+    }
+}
+
+impl<const D: usize> Frame<D> for SpreadFrame {
+    type Entry = u32;
+    type Origin = u32;
+    fn new(geo: &Geometry<D>) -> Option<Self> {
+        geo.spread.map(|mask| SpreadFrame { mask })
     }
     #[inline(always)]
     fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {

@@ -1,9 +1,20 @@
-//! Lattice arithmetic of the rigid-cluster store in `D` dimensions: k-indices of positions
-//! relative to an origin (wrapped on periodic axes, bounds-checked on wall axes), an extended
-//! lattice one layer beyond each wall for marking neighbour sites, and a bitset over the sites.
+//! Lattice arithmetic of the rigid-cluster store in `D` dimensions: the store's indices of
+//! positions relative to an origin (wrapped on periodic axes, bounds-checked on wall axes), an
+//! extended lattice one layer beyond each wall for marking neighbour sites, and a bitset over
+//! the sites.
+//!
+//! The store indexes its per-site arrays by a *site index* that is the lattice's k-index, except
+//! on all-periodic lattices with power-of-two sides: there each axis's field of the index has a
+//! spare bit above it that is always zero on a site (the *spread* index). Origin plus relative
+//! position is then one addition and one mask, whatever the dimension: the carry out of a field
+//! lands in its spare bit and the mask drops it (see [`SpreadFrame`](super::frame::SpreadFrame)).
+//! The arrays are up to `2^(D-1)` times longer than the lattice and the indices with a spare bit
+//! set are never touched; the store uses the spread index only where those come in whole pages
+//! ([`Geometry::spread_costs_no_memory`]), so that it costs no memory.
 //!
 //! Invariant: the [`Geometry`] describes exactly the lattice it was built from (same sides,
-//! strides and boundaries).
+//! strides and boundaries), and the site index is a one-to-one map of its sites into
+//! `[0, volume)` that preserves their order.
 
 use core_lattice::{Boundary, Lattice};
 
@@ -11,8 +22,15 @@ use core_lattice::{Boundary, Lattice};
 #[derive(Debug, Clone)]
 pub(crate) struct Geometry<const D: usize> {
     pub(super) size: [i64; D],
+    /// Strides of the site index.
     pub(super) stride: [u64; D],
+    /// Strides of the lattice's k-index.
+    lattice_stride: [u64; D],
     pub(super) periodic: [bool; D],
+    /// Length of the arrays indexed by site index.
+    pub(super) volume: u64,
+    /// On a spread index (see the module documentation), the mask of the axes' fields.
+    pub(super) spread: Option<u32>,
     /// Extended lattice for marking neighbour sites: one extra layer beyond each wall.
     ext_stride: [u64; D],
     pub(super) ext_volume: u64,
@@ -24,21 +42,70 @@ impl<const D: usize> Geometry<D> {
         let mut g = Geometry {
             size: [0; D],
             stride: [0; D],
+            lattice_stride: [0; D],
             periodic: [false; D],
+            volume: lattice.volume(),
+            spread: None,
             ext_stride: [0; D],
             ext_volume: 1,
         };
         for a in 0..D {
             g.size[a] = lattice.size(a) as i64;
-            g.stride[a] = lattice.stride(a);
+            g.lattice_stride[a] = lattice.stride(a);
             g.periodic[a] = lattice.boundary(a) == Boundary::Periodic;
             g.ext_stride[a] = g.ext_volume;
             g.ext_volume *= lattice.size(a) + if g.periodic[a] { 0 } else { 2 };
         }
+        g.stride = g.lattice_stride;
         g
     }
 
-    /// k-index of a particle (a site known to be on the lattice) at `r` relative to `o`.
+    /// The geometry with a spread site index (see the module documentation), if the lattice is
+    /// periodic with power-of-two sides and the index fits 32 bits.
+    pub(super) fn spread(lattice: &Lattice) -> Option<Self> {
+        let mut g = Self::new(lattice);
+        // Each field `bits` wide plus a spare bit, the last field without one.
+        let bits: [u32; D] = std::array::from_fn(|a| lattice.size(a).trailing_zeros());
+        let width = bits.iter().sum::<u32>() + D as u32 - 1;
+        let pow2 = (0..D).all(|a| (lattice.size(a)).is_power_of_two());
+        if !(pow2 && g.periodic.iter().all(|&p| p) && width <= 32) {
+            return None;
+        }
+        let (mut shift, mut mask) = (0, 0u64);
+        for a in 0..D {
+            g.stride[a] = 1 << shift;
+            mask |= (lattice.size(a) - 1) << shift;
+            shift += bits[a] + 1;
+        }
+        g.volume = mask + 1;
+        g.spread = Some(mask as u32);
+        Some(g)
+    }
+
+    /// Whether the unused indices of a spread site index come in runs of whole 4 KiB pages of
+    /// 4-byte cells (one axis, or a first axis of at least 1 024 sites), so that a page-aligned
+    /// label array costs no more memory than the lattice's.
+    pub(super) fn spread_costs_no_memory(&self) -> bool {
+        D == 1 || self.size[0] >= 1024
+    }
+
+    /// The site index of the site with lattice k-index `k`.
+    pub(super) fn index_of(&self, k: u64) -> usize {
+        let mut i = 0;
+        for a in 0..D {
+            let x = (k / self.lattice_stride[a]) % self.size[a] as u64;
+            i += x * self.stride[a];
+        }
+        i as usize
+    }
+
+    /// Lattice k-index of a particle at `r` relative to `o`.
+    pub(super) fn lattice_site(&self, o: &[i64; D], r: &[i32; D]) -> u64 {
+        let x = self.absolute(o, r);
+        (0..D).map(|a| x[a] as u64 * self.lattice_stride[a]).sum()
+    }
+
+    /// Site index of a particle (a site known to be on the lattice) at `r` relative to `o`.
     #[inline(always)]
     pub(super) fn site(&self, o: &[i64; D], r: &[i32; D]) -> usize {
         let mut k = 0u64;
@@ -56,7 +123,7 @@ impl<const D: usize> Geometry<D> {
         k as usize
     }
 
-    /// k-index of the site at `r` relative to `o` (`r` at most one step beyond a particle's
+    /// Site index of the site at `r` relative to `o` (`r` at most one step beyond a particle's
     /// relative coordinates), or `None` beyond a wall.
     #[inline(always)]
     pub(super) fn probe(&self, o: &[i64; D], r: &[i32; D]) -> Option<usize> {

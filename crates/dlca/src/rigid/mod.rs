@@ -44,7 +44,7 @@ mod tests;
 
 use clusters::{MAX_SIDE, Rigid};
 use core_lattice::{Blocked, Direction};
-use frame::{AnyFrame, Frame, Pow2Frame};
+use frame::{AnyFrame, Frame, Pow2Frame, SpreadFrame};
 use geometry::Geometry;
 use spatial::lattice::{ItemId, SiteSets};
 
@@ -62,13 +62,14 @@ pub(crate) enum RigidError {
     Alloc(#[from] run_io::memory::AllocError),
 }
 
-/// Defines [`RigidStore`] with one pair of variants (general frame, power-of-two frame) per
-/// dimension listed, its constructor's dimension dispatch, and the `each!` delegation. Adding a
-/// dimension is one line in the invocation below.
+/// Defines [`RigidStore`] with three variants (general frame, power-of-two frame, spread
+/// frame) per dimension listed, its constructor's dimension dispatch, and the `each!`
+/// delegation. Adding a dimension is one line in the invocation below.
 macro_rules! rigid_store {
-    ($($dim:literal => $any:ident, $pow2:ident;)+) => {
-        /// [`Rigid`] for the dimension of the lattice, with the power-of-two frame where it
-        /// applies, else the general one.
+    ($($dim:literal => $any:ident, $pow2:ident, $spread:ident;)+) => {
+        /// [`Rigid`] for the dimension of the lattice: with the spread frame where it applies
+        /// and costs no memory, else the power-of-two frame where that applies, else the
+        /// general one.
         #[derive(Debug, Clone)]
         pub(crate) enum RigidStore {
             $(
@@ -76,6 +77,8 @@ macro_rules! rigid_store {
                 $any(Rigid<$dim, AnyFrame>),
                 #[doc = concat!("All-periodic power-of-two lattice in ", stringify!($dim), "D.")]
                 $pow2(Rigid<$dim, Pow2Frame>),
+                #[doc = concat!("All-periodic power-of-two lattice in ", stringify!($dim), "D, spread site index.")]
+                $spread(Rigid<$dim, SpreadFrame>),
             )+
         }
 
@@ -86,6 +89,7 @@ macro_rules! rigid_store {
                     $(
                         RigidStore::$any($r) => $e,
                         RigidStore::$pow2($r) => $e,
+                        RigidStore::$spread($r) => $e,
                     )+
                 }
             };
@@ -101,6 +105,12 @@ macro_rules! rigid_store {
                 match l.dim() {
                     $(
                         $dim => {
+                            let spread = Geometry::<$dim>::spread(l)
+                                .filter(Geometry::spread_costs_no_memory);
+                            if let Some(geo) = spread {
+                                let frame = SpreadFrame::new(&geo).expect("a spread index");
+                                return Ok(RigidStore::$spread(Rigid::new(sets, geo, frame)?));
+                            }
                             let geo = Geometry::<$dim>::new(l);
                             Ok(match Pow2Frame::new(&geo) {
                                 Some(frame) => RigidStore::$pow2(Rigid::new(sets, geo, frame)?),
@@ -116,9 +126,9 @@ macro_rules! rigid_store {
 }
 
 rigid_store! {
-    1 => D1, P1;
-    2 => D2, P2;
-    3 => D3, P3;
+    1 => D1, P1, S1;
+    2 => D2, P2, S2;
+    3 => D3, P3, S3;
 }
 
 impl RigidStore {

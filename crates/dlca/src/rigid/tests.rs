@@ -1,7 +1,7 @@
 //! Unit tests of the rigid-cluster kernels: frame arithmetic and the dimension dispatch. The
 //! store's trajectories are checked against all-pairs in `tests/strategies.rs`.
 
-use super::frame::{AnyFrame, Frame, Pow2Frame};
+use super::frame::{AnyFrame, Frame, Pow2Frame, SpreadFrame};
 use super::geometry::Geometry;
 use super::{RigidError, RigidStore};
 use core_lattice::{Boundary, Lattice};
@@ -9,17 +9,41 @@ use spatial::lattice::SiteSets;
 
 /// From every origin, every relative position a particle can have (`[0, L)` per axis) and every
 /// one a probe can have (one step further either way): the power-of-two frame's field-wise sum
-/// gives the k-index the general frame and the full modular reduction give.
+/// gives the site index the general frame and the full modular reduction give, with the plain
+/// site index (the k-index) and with the spread one.
 fn frames_agree<const D: usize>(sizes: [u64; D]) {
     let lattice = Lattice::periodic(&sizes).unwrap();
     let geo = Geometry::<D>::new(&lattice);
     let pow2 = <Pow2Frame as Frame<D>>::new(&geo).expect("periodic powers of two");
-    let any = <AnyFrame as Frame<D>>::new(&geo).expect("applies everywhere");
+    frames_agree_with(&lattice, &geo, pow2);
+    let spread = Geometry::<D>::spread(&lattice).expect("periodic powers of two");
+    assert!(<Pow2Frame as Frame<D>>::new(&spread).is_none());
+    let frame = <SpreadFrame as Frame<D>>::new(&spread).expect("a spread index");
+    frames_agree_with(&lattice, &spread, frame);
+    // The spread index is one-to-one, in order, below its volume, and converts both ways.
+    let mut last = None;
+    for k in 0..lattice.volume() {
+        let x = lattice.coords_array(k);
+        let o: [i64; D] = std::array::from_fn(|a| x[a] as i64);
+        let i = spread.site(&o, &[0; D]);
+        assert!(
+            last < Some(i) && (i as u64) < spread.volume,
+            "site {k}: index {i}"
+        );
+        assert_eq!(spread.index_of(k), i);
+        assert_eq!(spread.lattice_site(&o, &[0; D]), k);
+        last = Some(i);
+    }
+}
+
+fn frames_agree_with<const D: usize, F: Frame<D>>(lattice: &Lattice, geo: &Geometry<D>, pow2: F) {
+    let sizes = lattice.sizes();
+    let any = <AnyFrame as Frame<D>>::new(geo).expect("applies everywhere");
     let span: Vec<i64> = sizes.iter().map(|&l| l as i64 + 2).collect();
     for k in 0..lattice.volume() {
         let x = lattice.coords_array(k);
         let o: [i64; D] = std::array::from_fn(|a| x[a] as i64);
-        let (po, ao) = (pow2.origin(&geo, &o), any.origin(&geo, &o));
+        let (po, ao) = (pow2.origin(geo, &o), any.origin(geo, &o));
         for i in 0..span.iter().product::<i64>() {
             let mut rest = i;
             let r: [i32; D] = std::array::from_fn(|a| {
@@ -28,13 +52,13 @@ fn frames_agree<const D: usize>(sizes: [u64; D]) {
                 c as i32
             });
             let want = geo.any(&o, &r).expect("periodic");
-            let (pe, ae) = (pow2.entry(&geo, &r), any.entry(&geo, &r));
+            let (pe, ae) = (pow2.entry(geo, &r), any.entry(geo, &r));
             let what = format!("origin {o:?}, relative {r:?}");
-            assert_eq!(pow2.probe(&geo, po, pe), Some(want), "{what}");
-            assert_eq!(any.probe(&geo, ao, ae), Some(want), "{what}");
+            assert_eq!(pow2.probe(geo, po, pe), Some(want), "{what}");
+            assert_eq!(any.probe(geo, ao, ae), Some(want), "{what}");
             if (0..D).all(|a| r[a] >= 0 && i64::from(r[a]) < sizes[a] as i64) {
-                assert_eq!(pow2.site(&geo, po, pe), want, "{what}");
-                assert_eq!(any.site(&geo, ao, ae), want, "{what}");
+                assert_eq!(pow2.site(geo, po, pe), want, "{what}");
+                assert_eq!(any.site(geo, ao, ae), want, "{what}");
             }
         }
     }
@@ -59,7 +83,15 @@ fn store_for(sizes: &[u64], boundary: Boundary) -> Result<RigidStore, RigidError
 #[test]
 fn dispatch_picks_the_frame_and_refuses_other_dimensions_with_a_typed_error() {
     use Boundary::{Periodic, Wall};
-    assert!(matches!(store_for(&[16], Periodic), Ok(RigidStore::P1(_))));
+    assert!(matches!(store_for(&[16], Periodic), Ok(RigidStore::S1(_))));
+    assert!(matches!(
+        store_for(&[1024, 4], Periodic),
+        Ok(RigidStore::S2(_))
+    ));
+    assert!(matches!(
+        store_for(&[4, 1024], Periodic),
+        Ok(RigidStore::P2(_))
+    ));
     assert!(matches!(
         store_for(&[8, 4], Periodic),
         Ok(RigidStore::P2(_))
