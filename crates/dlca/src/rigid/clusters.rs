@@ -32,6 +32,39 @@ fn list<const D: usize, F: Frame<D>>(lists: &[F::Entry], i: usize) -> &[F::Entry
     &lists[F::start_of(lists[i])..F::start_of(lists[i + 1])]
 }
 
+/// Clear the occupancy bits of the sites `entries` at origin `o`. A function of its own (like
+/// [`cover`]) so that its loop keeps its few values in registers.
+#[inline(never)]
+fn vacate<const D: usize, F: Frame<D>>(
+    frame: &F,
+    geo: &Geometry<D>,
+    occupied: &mut Bits,
+    o: F::Origin,
+    entries: &[F::Entry],
+) {
+    for &e in entries {
+        occupied.clear(frame.site(geo, o, e));
+    }
+}
+
+/// Set the occupancy bits of the sites `entries` at origin `o` and give them label `label`.
+#[inline(never)]
+fn cover<const D: usize, F: Frame<D>>(
+    frame: &F,
+    geo: &Geometry<D>,
+    occupied: &mut Bits,
+    cells: &mut [u32],
+    label: u32,
+    o: F::Origin,
+    entries: &[F::Entry],
+) {
+    for &e in entries {
+        let k = frame.site(geo, o, e);
+        occupied.set(k);
+        cells[k] = label;
+    }
+}
+
 /// What a move of one rigid cluster in `D` dimensions reads, in one small record (its lists in
 /// the entry format of frame `F`). Early in a run most clusters are a few particles and a move
 /// costs little more than the cache misses on its data, so everything is one record away.
@@ -282,14 +315,10 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         let mut o = c.origin;
         let lists = &*c.lists;
         let fo = frame.origin(geo, &o);
-        for &e in list::<D, F>(lists, d ^ 1) {
-            occupied.clear(frame.site(geo, fo, e));
-        }
+        vacate(frame, geo, occupied, fo, list::<D, F>(lists, d ^ 1));
         for p in c.parts.as_slice() {
             let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
-            for &e in list::<D, F>(&p.lists, d ^ 1) {
-                occupied.clear(frame.site(geo, po, e));
-            }
+            vacate(frame, geo, occupied, po, list::<D, F>(&p.lists, d ^ 1));
         }
         o[axis] += if dir.is_positive() { 1 } else { -1 };
         if o[axis] >= geo.size[axis] {
@@ -300,19 +329,33 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         c.origin = o;
         let fo = frame.origin(geo, &o);
         // Cover the leading face (in the new frame).
-        for &e in list::<D, F>(lists, d) {
-            let k = frame.site(geo, fo, e);
-            debug_assert!(!occupied.get(k) || !c.parts.is_empty(), "clusters overlap");
-            occupied.set(k);
-            cells[k] = label;
-        }
+        debug_assert!(
+            !c.parts.is_empty()
+                || list::<D, F>(lists, d)
+                    .iter()
+                    .all(|&e| !occupied.get(frame.site(geo, fo, e))),
+            "clusters overlap"
+        );
+        cover(
+            frame,
+            geo,
+            occupied,
+            cells,
+            label,
+            fo,
+            list::<D, F>(lists, d),
+        );
         for p in c.parts.as_slice() {
             let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
-            for &e in list::<D, F>(&p.lists, d) {
-                let k = frame.site(geo, po, e);
-                occupied.set(k);
-                cells[k] = label;
-            }
+            cover(
+                frame,
+                geo,
+                occupied,
+                cells,
+                label,
+                po,
+                list::<D, F>(&p.lists, d),
+            );
         }
         // Look at the new neighbours only.
         let mut probe = |fo: F::Origin, lists: &[F::Entry]| {
