@@ -551,16 +551,27 @@ impl World {
     /// Hash of every live animat's id, species, position, age and hunger, in id order, as 16
     /// hex digits.
     pub fn state_hash(&self) -> String {
+        // The bytes go to the hasher a few kilobytes at a time: the same stream (and hash) as
+        // six 8-byte updates an animat, for a fraction of the calls.
         let mut h = StateHasher::new();
+        let mut buf = Vec::with_capacity(4096);
         for a in self.animats() {
-            h.u64(a.id)
-                .u64(a.species.code())
-                .i64(a.pos[0])
-                .i64(a.pos[1])
-                .u64(a.age.into())
-                .u64(a.hunger.into());
+            for v in [
+                a.id,
+                a.species.code(),
+                a.pos[0] as u64,
+                a.pos[1] as u64,
+                a.age.into(),
+                a.hunger.into(),
+            ] {
+                buf.extend_from_slice(&v.to_le_bytes());
+            }
+            if buf.len() > 4096 - 48 {
+                h.bytes(&buf);
+                buf.clear();
+            }
         }
-        h.finish_hex()
+        h.bytes(&buf).finish_hex()
     }
 
     /// Memory the world takes, estimated: the cell index's tiles (36 KiB for each 64 x 64
