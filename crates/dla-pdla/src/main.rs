@@ -40,6 +40,13 @@ struct Cli {
     #[arg(long, value_enum, default_value_t = PositionsFormat::None)]
     positions: PositionsFormat,
 
+    /// Record no parents. A run whose positions stream (the default, for its checkpoints)
+    /// records each particle's parent, the particle it stuck to: about 5 bytes a particle at
+    /// the peak (4.7 GiB at 1e9). Without them the positions files have no parent column and
+    /// there are no branch orders (branches.csv); the walk and the state hash are the same.
+    #[arg(long)]
+    no_parents: bool,
+
     /// Also write DIR/checkpoint.bin (DIR = --out) every N particles, and keep one at the end
     /// (so that --resume with a larger --particles grows the finished cluster further). A
     /// checkpoint is a few kilobytes: the positions stream to positions.npy, which it refers
@@ -120,10 +127,18 @@ fn check_memory(cli: &Cli, p: &Params) -> Result<(), String> {
             ""
         }
     );
+    let smaller = if p.connectivity {
+        format!(
+            "lower --particles, or add --no-parents ({} bytes a particle less)",
+            dla_pdla::params::CONNECTIVITY_BYTES_PER_PARTICLE
+        )
+    } else {
+        "lower --particles".to_string()
+    };
     run_io::memory::Limit::from_flag(cli.max_memory).check(
         p.peak_memory_bytes().saturating_add(png),
         &what,
-        "lower --particles",
+        &smaller,
     )
 }
 
@@ -150,7 +165,12 @@ where
     );
     if params.connectivity && !sim.params().connectivity {
         tracing::warn!(
-            "the checkpointed run recorded no parents (an earlier version, or --no-checkpoint): the outputs have none"
+            "the checkpointed run recorded no parents (an earlier version, --no-checkpoint or --no-parents): the outputs have none"
+        );
+    }
+    if !params.connectivity && sim.params().connectivity {
+        tracing::warn!(
+            "the checkpointed run records parents, and its particles carry them: the resumed run records them too"
         );
     }
     if sim.seed() != seed {
@@ -244,10 +264,10 @@ impl Model for Dla {
         // Flags that would be silently ignored are refused too.
         p.validate_given(|name| cli.params.given(name))
             .map_err(|e| e.to_string())?;
-        // Wherever the positions stream, each particle's parent goes with them: into the
-        // positions files, and to resume with.
+        // Wherever the positions stream, each particle's parent goes with them (unless
+        // --no-parents): into the positions files, and to resume with.
         let p = Params {
-            connectivity: streams_positions(cli),
+            connectivity: streams_positions(cli) && !cli.no_parents,
             ..p
         };
         if p.dim > 3 && matches!(cli.positions, PositionsFormat::Xyz | PositionsFormat::Vtk) {

@@ -82,9 +82,9 @@ core_lattice::declare_params! {
         dim: usize = 2 => { flag: "dim", unit: "", range: Range::Values(DIMENSIONS) },
         /// Particles in the final cluster, seed particle included (at most 2.5e9 in 4D and
         /// 5D, the orthtree's 32-bit indices). Memory: about 13 bytes per particle in 2D and 15
-        /// in 3D at 1e7, and 4.6 more for the parents a run that streams its positions records;
-        /// the tree and distance map take about 25 in 4D at 1e5 and 300 in 5D at 3e4 (mostly
-        /// the map).
+        /// in 3D at 1e7, and 4.6 more for the parents a run that streams its positions records
+        /// (the `dla` binary's --no-parents records none); the tree and distance map take about
+        /// 25 in 4D at 1e5 and 300 in 5D at 3e4 (mostly the map).
         particles: u64 = 10_000 => {
             flag: "particles", unit: "particles",
             range: Range::Int { min: 1, max: Some(MAX_PARTICLES as i128) },
@@ -471,7 +471,9 @@ pub const CHECKPOINT_RESERVE_BYTES: u64 = 16 << 20;
 /// Peak memory of a run, bytes per particle by dimension (2 to 5): an upper bound of the peak
 /// RSS per particle measured at 1e5 to 3e6 particles (docs/dla.md, "Memory", has the
 /// calibration table), tree, distance maps and walkers included; the positions stream to disk.
-pub const PEAK_BYTES_PER_PARTICLE: [u64; 4] = [13, 26, 40, 450];
+/// 2D's allows for its maps' part that grows with the cluster's area (`R^2`, faster than `N`):
+/// 12.9 bytes a particle at 1e8, about 13.4 extrapolated to 1e9.
+pub const PEAK_BYTES_PER_PARTICLE: [u64; 4] = [14, 26, 40, 450];
 
 /// What `connectivity` adds per particle at the peak: the orthtree's 4-byte tag (the arrival
 /// index) while the cluster grows, and at the end the branch analysis's 1-byte order beside

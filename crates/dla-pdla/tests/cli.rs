@@ -148,6 +148,52 @@ fn a_run_removes_temporaries_an_interrupted_write_left() {
 }
 
 /// The state hash in `DIR/run.json`.
+#[test]
+fn no_parents_records_none_and_grows_the_same_cluster() {
+    let run = |extra: &[&str]| {
+        let dir = tempfile::tempdir().unwrap();
+        let st = dla()
+            .args([
+                "--particles",
+                "800",
+                "--quiet",
+                "--positions",
+                "csv",
+                "--out",
+            ])
+            .arg(dir.path())
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(st.status.success());
+        let csv = std::fs::read_to_string(dir.path().join("positions.csv")).unwrap();
+        let header = csv.lines().next().unwrap().to_string();
+        let parents = dir.path().join("positions_parent.npy").exists();
+        let branches = dir.path().join("branches.csv").exists();
+        (state_hash(dir.path()), header, parents, branches)
+    };
+    let (hash, header, parents, branches) = run(&[]);
+    assert!(header.contains("parent") && parents && branches, "{header}");
+    let (bare_hash, header, parents, branches) = run(&["--no-parents"]);
+    assert_eq!(bare_hash, hash);
+    assert!(
+        !header.contains("parent") && !parents && !branches,
+        "{header}"
+    );
+    // A run refused for memory names the flag while it would help.
+    let out = dla()
+        .args(["--particles", "1e7", "--max-memory", "10M", "--out"])
+        .arg(tempfile::tempdir().unwrap().path())
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("add --no-parents (5 bytes a particle less)"),
+        "{e}"
+    );
+}
+
 fn state_hash(dir: &std::path::Path) -> String {
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();

@@ -175,9 +175,9 @@ fn a_deposit_estimate_counts_the_images() {
         }
         .peak_bytes_per_particle()
     };
-    assert_eq!(at(2, 0.0), 13);
-    assert_eq!(at(2, 64.0), 26 + DEPOSIT_BYTES_PER_PARTICLE);
-    assert_eq!(at(2, 1000.0), 14 + DEPOSIT_BYTES_PER_PARTICLE);
+    assert_eq!(at(2, 0.0), 14);
+    assert_eq!(at(2, 64.0), 28 + DEPOSIT_BYTES_PER_PARTICLE);
+    assert_eq!(at(2, 1000.0), 15 + DEPOSIT_BYTES_PER_PARTICLE);
     assert_eq!(at(3, 64.0), 104 + DEPOSIT_BYTES_PER_PARTICLE);
 }
 
