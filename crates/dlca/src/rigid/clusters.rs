@@ -2,20 +2,32 @@
 //! cluster as an origin plus relative sites with its face and probe lists, over an occupancy
 //! lattice of labels (see the parent module for the method).
 //!
+//! *Large* clusters (at least [`Rigid::large_at`] particles) write no labels when they move:
+//! their covering of a site is a bit in the occupancy lattice only, and what a cluster's probe
+//! finds there is told by the large clusters' own [`Members`] bits, asked before the label.
+//! At most `N / 32` clusters are large, and the label writes they skip were most of a late
+//! run's memory traffic (a 4-byte store into an array of 4 bytes a site, far beyond the L2).
+//!
 //! Invariants, checked by [`Rigid::check`]: the occupancy bits hold exactly the live clusters'
-//! particles, each occupied cell holds the label of the cluster owning it, `id_of` maps every
-//! live cluster's label back to its id, each cluster's lists equal a fresh computation from its
+//! particles, each occupied cell of a small cluster holds its label, each large cluster's
+//! members are exactly its particles and it is in `large`, `id_of` maps every live small
+//! cluster's label back to its id, each cluster's lists equal a fresh computation from its
 //! sites (unless it keeps parts, which then cover less than half of it), and the extent along
 //! every wall axis is exact.
 
 use super::frame::Frame;
 use super::geometry::{Bits, Geometry, step};
+use super::members::Members;
 use core_lattice::{Blocked, Direction, Lattice};
 use spatial::lattice::{ItemId, SiteSets};
 use std::sync::Arc;
 
-/// Clusters of at most this many particles never keep parts (see [`Part`]).
+/// Clusters of at most this many particles never keep parts (see [`Part`]), and never count as
+/// large.
 const SMALL: u32 = 64;
+
+/// At most about this many clusters are large: `large_at` is the particles over this.
+const MAX_LARGE: u64 = 32;
 
 /// Largest side length this store handles (relative coordinates are `i32` with a margin).
 pub(super) const MAX_SIDE: u64 = (i32::MAX as u64) / 2;
@@ -30,6 +42,21 @@ pub(super) type Lists<E> = Arc<[E]>;
 #[inline(always)]
 fn list<const D: usize, F: Frame<D>>(lists: &[F::Entry], i: usize) -> &[F::Entry] {
     &lists[F::start_of(lists[i])..F::start_of(lists[i + 1])]
+}
+
+/// The large cluster among `large` (with their records `clusters` and `cold`) whose members
+/// hold the site at coordinates `x`, if any.
+fn large_owner<const D: usize, F: Frame<D>>(
+    geo: &Geometry<D>,
+    large: &[ItemId],
+    clusters: &[Cluster<D, F>],
+    cold: &[Cold<D>],
+    x: &[i64; D],
+) -> Option<ItemId> {
+    large.iter().copied().find(|&b| {
+        let members = cold[b as usize].members.as_ref().expect("a large cluster");
+        members.contains(&geo.relative(&clusters[b as usize].origin, x))
+    })
 }
 
 /// Clear the occupancy bits of the sites `entries` at origin `o`. A function of its own (like
@@ -47,21 +74,31 @@ fn vacate<const D: usize, F: Frame<D>>(
     }
 }
 
-/// Set the occupancy bits of the sites `entries` at origin `o` and give them label `label`.
+/// Set the occupancy bits of the sites `entries` at origin `o` and give them label `label`, if
+/// there is one (a large cluster has none to write).
 #[inline(never)]
 fn cover<const D: usize, F: Frame<D>>(
     frame: &F,
     geo: &Geometry<D>,
     occupied: &mut Bits,
     cells: &mut [u32],
-    label: u32,
+    label: Option<u32>,
     o: F::Origin,
     entries: &[F::Entry],
 ) {
-    for &e in entries {
-        let k = frame.site(geo, o, e);
-        occupied.set(k);
-        cells[k] = label;
+    match label {
+        Some(label) => {
+            for &e in entries {
+                let k = frame.site(geo, o, e);
+                occupied.set(k);
+                cells[k] = label;
+            }
+        }
+        None => {
+            for &e in entries {
+                occupied.set(frame.site(geo, o, e));
+            }
+        }
     }
 }
 
@@ -147,6 +184,9 @@ struct Cold<const D: usize> {
     sites: Vec<[i32; D]>,
     /// Size when the sites were last sorted into memory order.
     sorted_len: usize,
+    /// The sites as bits, for a large cluster (boxed: nearly all clusters are small, and this
+    /// record is one of `N`).
+    members: Option<Box<Members<D>>>,
 }
 
 /// Clusters, the occupancy lattice and the scratch space of the `lattice` strategy, in `D`
@@ -165,6 +205,10 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     cells: Cells,
     /// Cluster owning each label.
     id_of: Vec<ItemId>,
+    /// Clusters of at least this many particles are large: `max(SMALL, N / MAX_LARGE)`.
+    large_at: u32,
+    /// The live large clusters.
+    large: Vec<ItemId>,
     clusters: Vec<Cluster<D, F>>,
     cold: Vec<Cold<D>>,
     pub(super) live: Vec<ItemId>,
@@ -227,6 +271,8 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             occupied: Bits::new(geo.volume as usize),
             cells,
             id_of: (0..n as ItemId).collect(),
+            large_at: 0,
+            large: Vec::new(),
             clusters: vec![Cluster::default(); n],
             cold: vec![Cold::default(); n],
             live: Vec::new(),
@@ -262,11 +308,29 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             r.position[id as usize] = r.live.len() as u32;
             r.live.push(id);
         }
+        let particles: u64 = r.clusters.iter().map(|c| u64::from(c.len)).sum();
+        r.large_at = SMALL.max(u32::try_from(particles.div_ceil(MAX_LARGE)).unwrap_or(u32::MAX));
+        for i in 0..r.live.len() {
+            let id = r.live[i];
+            if r.clusters[id as usize].len >= r.large_at {
+                let cold = &mut r.cold[id as usize];
+                cold.members = Some(Box::new(Members::build(&r.geo, &cold.sites)));
+                r.large.push(id);
+            }
+        }
         for i in 0..r.live.len() {
             let id = r.live[i];
             r.finish(id);
         }
         Ok(r)
+    }
+
+    /// The cluster holding occupied site `k`: the large cluster whose members hold it, else the
+    /// owner of its label (stale only under a large cluster, which writes none).
+    fn owner_of(&self, k: usize) -> ItemId {
+        let x = self.geo.coords_of(k);
+        large_owner(&self.geo, &self.large, &self.clusters, &self.cold, &x)
+            .unwrap_or_else(|| self.id_of[self.cells.get()[k] as usize])
     }
 
     #[inline]
@@ -288,13 +352,22 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         out: &mut Vec<ItemId>,
     ) -> Result<(), Blocked> {
         out.clear();
+        self.shift(id, dir)?;
+        self.probe(id, dir.index(), out);
+        out.sort_unstable();
+        Ok(())
+    }
+
+    /// The occupancy part of a move of cluster `id` by `dir`: vacate its trailing face, move
+    /// its origin, cover its leading face (with its label, unless it is large).
+    fn shift(&mut self, id: ItemId, dir: Direction) -> Result<(), Blocked> {
         let Rigid {
             geo,
             frame,
             occupied,
             cells,
-            id_of,
             clusters,
+            large_at,
             ..
         } = self;
         let cells = cells.get_mut();
@@ -310,7 +383,6 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 return Err(Blocked);
             }
         }
-        let label = c.label;
         // Vacate the trailing face (in the old frame); labels of empty sites are never read.
         let mut o = c.origin;
         let lists = &*c.lists;
@@ -336,6 +408,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                     .all(|&e| !occupied.get(frame.site(geo, fo, e))),
             "clusters overlap"
         );
+        let label = (c.len < *large_at).then_some(c.label);
         cover(
             frame,
             geo,
@@ -347,38 +420,45 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         );
         for p in c.parts.as_slice() {
             let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
-            cover(
-                frame,
-                geo,
-                occupied,
-                cells,
-                label,
-                po,
-                list::<D, F>(&p.lists, d),
-            );
+            let entries = list::<D, F>(&p.lists, d);
+            cover(frame, geo, occupied, cells, label, po, entries);
         }
-        // Look at the new neighbours only.
+        Ok(())
+    }
+
+    /// The clusters in contact with cluster `id` after its move in direction index `d`, into
+    /// `out`: it looks at its new neighbours only.
+    fn probe(&self, id: ItemId, d: usize, out: &mut Vec<ItemId>) {
+        let (geo, frame, occupied) = (&self.geo, &self.frame, &self.occupied);
+        let cells = self.cells.get();
+        let c = &self.clusters[id as usize];
+        let o = c.origin;
+        let label = c.label;
         let mut probe = |fo: F::Origin, lists: &[F::Entry]| {
             for &e in list::<D, F>(lists, 2 * D + d) {
                 if let Some(k) = frame.probe(geo, fo, e)
                     && occupied.get(k)
                 {
-                    let l = cells[k];
-                    if l != label {
-                        let other = id_of[l as usize];
-                        if !out.contains(&other) {
-                            out.push(other);
+                    // Without large clusters every occupied site's label is its owner's.
+                    let other = if self.large.is_empty() {
+                        let l = cells[k];
+                        if l == label {
+                            continue;
                         }
+                        self.id_of[l as usize]
+                    } else {
+                        self.owner_of(k)
+                    };
+                    if other != id && !out.contains(&other) {
+                        out.push(other);
                     }
                 }
             }
         };
-        probe(fo, lists);
+        probe(frame.origin(geo, &o), &c.lists);
         for p in c.parts.as_slice() {
             probe(frame.origin(geo, &geo.shifted(&o, &p.offset)), &p.lists);
         }
-        out.sort_unstable();
-        Ok(())
     }
 
     /// Merge cluster `from` into `into` (which keeps its id). Call [`Rigid::finish`] on `into`
@@ -386,12 +466,16 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     pub(super) fn merge(&mut self, into: ItemId, from: ItemId) {
         let (ni, nf) = (self.len_of(into), self.len_of(from));
         let lf = self.clusters[from as usize].label;
-        // Relabel the smaller part only.
-        let (small, large) = if nf <= ni { (from, into) } else { (into, from) };
-        let label = self.clusters[large as usize].label;
-        let origin = self.clusters[small as usize].origin;
-        for r in &self.cold[small as usize].sites {
-            self.cells.get_mut()[self.geo.site(&origin, r)] = label;
+        // Relabel the smaller part only, and only if the union is small (a large cluster's
+        // labels are never read).
+        let (small, big) = if nf <= ni { (from, into) } else { (into, from) };
+        let label = self.clusters[big as usize].label;
+        let union_is_large = (ni + nf) as u32 >= self.large_at;
+        if !union_is_large {
+            let origin = self.clusters[small as usize].origin;
+            for r in &self.cold[small as usize].sites {
+                self.cells.get_mut()[self.geo.site(&origin, r)] = label;
+            }
         }
         if nf > ni {
             self.id_of[lf as usize] = into;
@@ -426,12 +510,24 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 len: p.len,
             });
         }
-        self.cold[into as usize].sites.extend(
+        let cold = &mut self.cold[into as usize];
+        let before = cold.sites.len();
+        cold.sites.extend(
             other_cold
                 .sites
                 .iter()
                 .map(|r| geo.relative(&target.origin, &geo.absolute(&other.origin, r))),
         );
+        // The union's members (in the larger part's frame, which it keeps).
+        self.large.retain(|&b| b != into && b != from);
+        if union_is_large {
+            let Cold { sites, members, .. } = cold;
+            match members {
+                Some(m) => m.extend(geo, sites, &sites[before..]),
+                None => *members = Some(Box::new(Members::build(geo, sites.iter()))),
+            }
+            self.large.push(into);
+        }
         // Unlink `from`.
         let p = self.position[from as usize] as usize;
         self.live.swap_remove(p);
@@ -467,7 +563,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         c.parts.clear();
         c.lists = match &self.single {
             Some(single) if cold.sites.len() == 1 => single.clone(),
-            _ => self.build_lists(&mut c, &cold.sites),
+            _ => self.build_lists(&mut c, &cold.sites, cold.members.as_deref()),
         };
         if cold.sites.len() == 1 && self.single.is_none() {
             self.single = Some(c.lists.clone());
@@ -476,8 +572,14 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         self.cold[id as usize] = cold;
     }
 
-    /// The extent and the lists of `c`, whose particles are `sites`.
-    fn build_lists(&mut self, c: &mut Cluster<D, F>, sites: &[[i32; D]]) -> Lists<F::Entry> {
+    /// The extent and the lists of `c`, whose particles are `sites` (and `members`, for a large
+    /// cluster, whose labels are stale).
+    fn build_lists(
+        &mut self,
+        c: &mut Cluster<D, F>,
+        sites: &[[i32; D]],
+        members: Option<&Members<D>>,
+    ) -> Lists<F::Entry> {
         let label = c.label;
         let Rigid {
             geo,
@@ -487,13 +589,28 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             marks,
             hood,
             scratch,
+            large,
+            clusters,
+            cold,
             ..
         } = self;
         let o = c.origin;
         let cells = cells.get();
-        let in_c = |r: &[i32; D]| {
-            geo.any(&o, r)
-                .is_some_and(|k| occupied.get(k) && cells[k] == label)
+        // A small cluster's label on a site is stale where a large cluster covered it since.
+        let held =
+            |r: &[i32; D]| large_owner(geo, large, clusters, cold, &geo.absolute(&o, r)).is_some();
+        let in_c = |r: &[i32; D]| match members {
+            // Relative positions of particles lie in `[0, L)` on periodic axes.
+            Some(m) => m.contains(&std::array::from_fn(|a| {
+                if geo.periodic[a] {
+                    r[a].rem_euclid(geo.size[a] as i32)
+                } else {
+                    r[a]
+                }
+            })),
+            None => geo
+                .any(&o, r)
+                .is_some_and(|k| occupied.get(k) && cells[k] == label && !held(r)),
         };
         scratch.iter_mut().for_each(Vec::clear);
         hood.clear();
@@ -568,19 +685,30 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             assert_eq!(self.id_of[label as usize], id, "label table");
             assert_eq!(self.len_of(id), self.cold[id as usize].sites.len());
             let origin = self.clusters[id as usize].origin;
+            let large = self.clusters[id as usize].len >= self.large_at;
+            let members = self.cold[id as usize].members.as_deref();
+            assert_eq!(large, self.large.contains(&id), "large list");
+            assert_eq!(large, members.is_some(), "members of a large cluster only");
+            if let Some(m) = members {
+                assert_eq!(m.count(), self.len_of(id), "members of cluster {id}");
+            }
             for r in &self.cold[id as usize].sites {
                 let i = self.geo.site(&origin, r);
                 assert!(
                     self.occupied.get(i),
                     "site {r:?} of cluster {id} not marked"
                 );
-                assert_eq!(self.cells.get()[i], label, "occupancy of cluster {id}");
+                match members {
+                    Some(m) => assert!(m.contains(r), "site {r:?} not a member of {id}"),
+                    None => assert_eq!(self.cells.get()[i], label, "occupancy of cluster {id}"),
+                }
+                assert_eq!(self.owner_of(i), id, "owner of site {r:?}");
                 assert_eq!(self.geo.index_of(self.geo.lattice_site(&origin, r)), i);
                 total += 1;
             }
             let mut fresh = self.clusters[id as usize].clone();
-            let sites = self.cold[id as usize].sites.clone();
-            let lists = self.build_lists(&mut fresh, &sites);
+            let cold = self.cold[id as usize].clone();
+            let lists = self.build_lists(&mut fresh, &cold.sites, cold.members.as_deref());
             let c = &self.clusters[id as usize];
             if c.parts.is_empty() {
                 assert_eq!(&*lists, &*c.lists);

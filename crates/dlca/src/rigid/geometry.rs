@@ -99,6 +99,11 @@ impl<const D: usize> Geometry<D> {
         i as usize
     }
 
+    /// Coordinates of the site with site index `i`.
+    pub(super) fn coords_of(&self, i: usize) -> [i64; D] {
+        std::array::from_fn(|a| ((i as u64 / self.stride[a]) % self.size[a] as u64) as i64)
+    }
+
     /// Lattice k-index of a particle at `r` relative to `o`.
     pub(super) fn lattice_site(&self, o: &[i64; D], r: &[i32; D]) -> u64 {
         let x = self.absolute(o, r);
@@ -202,26 +207,26 @@ impl<const D: usize> Geometry<D> {
         x
     }
 
-    /// Relative coordinates of absolute coordinates `x` in the frame with origin `o`.
+    /// Relative coordinates of absolute coordinates `x` in the frame with origin `o`, both on
+    /// the lattice (in `[0, L)` on periodic axes).
     pub(super) fn relative(&self, o: &[i64; D], x: &[i64; D]) -> [i32; D] {
         let mut r = [0; D];
         for a in 0..D {
-            let d = x[a] - o[a];
-            r[a] = if self.periodic[a] {
-                d.rem_euclid(self.size[a])
-            } else {
-                d
-            } as i32;
+            let mut d = x[a] - o[a];
+            if self.periodic[a] && d < 0 {
+                d += self.size[a];
+            }
+            r[a] = d as i32;
         }
         r
     }
 
-    /// Absolute coordinates of the particle at `r` relative to `o`.
+    /// Absolute coordinates of the site at `r` relative to `o` (`o` on the lattice).
     pub(super) fn absolute(&self, o: &[i64; D], r: &[i32; D]) -> [i64; D] {
         let mut x = [0; D];
         for a in 0..D {
             x[a] = o[a] + i64::from(r[a]);
-            if self.periodic[a] {
+            if self.periodic[a] && !(0..self.size[a]).contains(&x[a]) {
                 x[a] = x[a].rem_euclid(self.size[a]);
             }
         }

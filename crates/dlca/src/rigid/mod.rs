@@ -39,6 +39,7 @@
 mod clusters;
 mod frame;
 mod geometry;
+mod members;
 #[cfg(test)]
 mod tests;
 
