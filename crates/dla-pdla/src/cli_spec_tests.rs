@@ -19,6 +19,7 @@ const NOT_PARAMS: &[&str] = &[
     "animate",
     "animate-every",
     "max-memory",
+    "no-parents",
 ];
 
 fn spec() -> CliSpec<'static> {

@@ -198,8 +198,8 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     /// The lists of a single particle, shared by all single particles.
     single: Option<Lists<F::Entry>>,
     lattice: Lattice,
-    /// Which sites hold a particle, one bit a site by site index: small enough to stay in cache where the
-    /// label array does not, and all a contact probe reads unless it finds a particle.
+    /// Which sites hold a particle, one bit a site by site index: small enough to stay in cache
+    /// where the label array does not, and all a contact probe reads unless it finds a particle.
     occupied: Bits,
     /// Label of the cluster on each occupied site (stale on empty sites), by site index.
     cells: Cells,
