@@ -1,7 +1,8 @@
 //! How the face and probe lists of a rigid cluster store relative positions, and how an entry
 //! plus a cluster origin becomes a site index: [`AnyFrame`] for every lattice, [`Pow2Frame`]
 //! for all-periodic lattices with power-of-two sides and at most 2^32 sites, [`SpreadFrame`]
-//! for those among them whose geometry has a spread site index.
+//! for those among them whose geometry has a spread site index (the two are one
+//! [`FieldFrame`] with different sums).
 //!
 //! Invariant: for the same origin and relative position, every frame gives the same site index
 //! (so the choice of frame never changes a trajectory).
@@ -67,28 +68,26 @@ impl<const D: usize> Frame<D> for AnyFrame {
     }
 }
 
-/// Periodic lattices whose sides are all powers of two with at most 2^32 sites: an entry is
-/// the k-index of the relative position reduced modulo the sides, and the k-index of a site is
-/// the sum of origin and entry computed field by field (each axis a bit field of the k-index)
-/// with the carry between fields suppressed (SIMD within a register): four operations,
-/// whatever the dimension.
+/// How a bit-field frame ([`FieldFrame`]) adds an origin and an entry, each a site index with
+/// one bit field per axis.
+pub(crate) trait FieldSum: Debug + Clone {
+    /// The sum for geometry `geo`, if it applies.
+    fn new<const D: usize>(geo: &Geometry<D>) -> Option<Self>;
+    /// The site index of origin `a` plus entry `b`.
+    fn add(&self, a: u32, b: u32) -> u32;
+}
+
+/// Periodic lattices whose sides are all powers of two, indexed by their k-index with at most
+/// 2^32 sites: the sum is computed field by field with the carry between fields suppressed
+/// (SIMD within a register), five operations whatever the dimension.
 #[derive(Debug, Clone)]
-pub(crate) struct Pow2Frame {
+pub(crate) struct Carryless {
     /// The top bit of every axis's field.
     high: u32,
 }
 
-impl Pow2Frame {
-    #[inline(always)]
-    fn add(&self, a: u32, b: u32) -> u32 {
-        ((a & !self.high).wrapping_add(b & !self.high)) ^ ((a ^ b) & self.high)
-    }
-}
-
-impl<const D: usize> Frame<D> for Pow2Frame {
-    type Entry = u32;
-    type Origin = u32;
-    fn new(geo: &Geometry<D>) -> Option<Self> {
+impl FieldSum for Carryless {
+    fn new<const D: usize>(geo: &Geometry<D>) -> Option<Self> {
         if geo.spread.is_some() {
             return None;
         }
@@ -103,54 +102,49 @@ impl<const D: usize> Frame<D> for Pow2Frame {
                 high |= ((geo.size[a] as u64 / 2) * geo.stride[a]) as u32;
             }
         }
-        Some(Pow2Frame { high })
+        Some(Carryless { high })
     }
     #[inline(always)]
-    fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {
-        (0..D).map(|a| o[a] as u64 * geo.stride[a]).sum::<u64>() as u32
-    }
-    fn entry(&self, geo: &Geometry<D>, r: &[i32; D]) -> u32 {
-        geo.any(&[0; D], r).expect("periodic") as u32
-    }
-    fn start(i: usize) -> u32 {
-        u32::try_from(i).expect("lists shorter than 2^32")
-    }
-    #[inline(always)]
-    fn start_of(e: u32) -> usize {
-        e as usize
-    }
-    #[inline(always)]
-    fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
-        self.add(o, e) as usize
-    }
-    #[inline(always)]
-    fn probe(&self, _: &Geometry<D>, o: u32, e: u32) -> Option<usize> {
-        Some(self.add(o, e) as usize)
+    fn add(&self, a: u32, b: u32) -> u32 {
+        ((a & !self.high).wrapping_add(b & !self.high)) ^ ((a ^ b) & self.high)
     }
 }
 
 /// Periodic lattices whose sides are all powers of two, with a spread site index of at most 32
-/// bits (see [`Geometry`]'s module): an entry is the site index of the relative position
-/// reduced modulo the sides, and the site index of origin plus entry is their sum with the
-/// spare bits masked off. Two operations, whatever the dimension.
+/// bits (see [`Geometry`]'s module): the sum is a plain addition with the spare bits masked
+/// off, two operations whatever the dimension.
 #[derive(Debug, Clone)]
-pub(crate) struct SpreadFrame {
+pub(crate) struct Spread {
     /// The fields of the spread index.
     mask: u32,
 }
 
-impl SpreadFrame {
+impl FieldSum for Spread {
+    fn new<const D: usize>(geo: &Geometry<D>) -> Option<Self> {
+        geo.spread.map(|mask| Spread { mask })
+    }
     #[inline(always)]
     fn add(&self, a: u32, b: u32) -> u32 {
         a.wrapping_add(b) & self.mask
     }
 }
 
-impl<const D: usize> Frame<D> for SpreadFrame {
+/// Periodic power-of-two lattices: an entry is the site index of the relative position reduced
+/// modulo the sides, and a site's index is origin plus entry by the [`FieldSum`] `S`.
+#[derive(Debug, Clone)]
+pub(crate) struct FieldFrame<S>(S);
+
+/// The field-wise sum over the k-index.
+pub(crate) type Pow2Frame = FieldFrame<Carryless>;
+
+/// The sum over a spread site index.
+pub(crate) type SpreadFrame = FieldFrame<Spread>;
+
+impl<const D: usize, S: FieldSum> Frame<D> for FieldFrame<S> {
     type Entry = u32;
     type Origin = u32;
     fn new(geo: &Geometry<D>) -> Option<Self> {
-        geo.spread.map(|mask| SpreadFrame { mask })
+        S::new(geo).map(FieldFrame)
     }
     #[inline(always)]
     fn origin(&self, geo: &Geometry<D>, o: &[i64; D]) -> u32 {
@@ -168,10 +162,10 @@ impl<const D: usize> Frame<D> for SpreadFrame {
     }
     #[inline(always)]
     fn site(&self, _: &Geometry<D>, o: u32, e: u32) -> usize {
-        self.add(o, e) as usize
+        self.0.add(o, e) as usize
     }
     #[inline(always)]
     fn probe(&self, _: &Geometry<D>, o: u32, e: u32) -> Option<usize> {
-        Some(self.add(o, e) as usize)
+        Some(self.0.add(o, e) as usize)
     }
 }
