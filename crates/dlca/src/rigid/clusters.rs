@@ -14,13 +14,19 @@
 //! cluster's label back to its id, each cluster's lists equal a fresh computation from its
 //! sites (unless it keeps parts, which then cover less than half of it), and the extent along
 //! every wall axis is exact.
+//!
+//! This file holds the records, construction, merges and checks; `moves` the moves and the
+//! contact search, `lists` the computation of a shape's face and probe lists.
 
 use super::frame::Frame;
-use super::geometry::{Bits, Geometry, step};
+use super::geometry::{Bits, Geometry};
 use super::members::Members;
-use core_lattice::{Blocked, Direction, Lattice};
+use core_lattice::Lattice;
 use spatial::lattice::{ItemId, SiteSets};
 use std::sync::Arc;
+
+mod lists;
+mod moves;
 
 /// Clusters of at most this many particles never keep parts (see [`Part`]), and never count as
 /// large.
@@ -42,64 +48,6 @@ pub(super) type Lists<E> = Arc<[E]>;
 #[inline(always)]
 fn list<const D: usize, F: Frame<D>>(lists: &[F::Entry], i: usize) -> &[F::Entry] {
     &lists[F::start_of(lists[i])..F::start_of(lists[i + 1])]
-}
-
-/// The large cluster among `large` (with their records `clusters` and `cold`) whose members
-/// hold the site at coordinates `x`, if any.
-fn large_owner<const D: usize, F: Frame<D>>(
-    geo: &Geometry<D>,
-    large: &[ItemId],
-    clusters: &[Cluster<D, F>],
-    cold: &[Cold<D>],
-    x: &[i64; D],
-) -> Option<ItemId> {
-    large.iter().copied().find(|&b| {
-        let members = cold[b as usize].members.as_ref().expect("a large cluster");
-        members.contains(&geo.relative(&clusters[b as usize].origin, x))
-    })
-}
-
-/// Clear the occupancy bits of the sites `entries` at origin `o`. A function of its own (like
-/// [`cover`]) so that its loop keeps its few values in registers.
-#[inline(never)]
-fn vacate<const D: usize, F: Frame<D>>(
-    frame: &F,
-    geo: &Geometry<D>,
-    occupied: &mut Bits,
-    o: F::Origin,
-    entries: &[F::Entry],
-) {
-    for &e in entries {
-        occupied.clear(frame.site(geo, o, e));
-    }
-}
-
-/// Set the occupancy bits of the sites `entries` at origin `o` and give them label `label`, if
-/// there is one (a large cluster has none to write).
-#[inline(never)]
-fn cover<const D: usize, F: Frame<D>>(
-    frame: &F,
-    geo: &Geometry<D>,
-    occupied: &mut Bits,
-    cells: &mut [u32],
-    label: Option<u32>,
-    o: F::Origin,
-    entries: &[F::Entry],
-) {
-    match label {
-        Some(label) => {
-            for &e in entries {
-                let k = frame.site(geo, o, e);
-                occupied.set(k);
-                cells[k] = label;
-            }
-        }
-        None => {
-            for &e in entries {
-                occupied.set(frame.site(geo, o, e));
-            }
-        }
-    }
 }
 
 /// What a move of one rigid cluster in `D` dimensions reads, in one small record (its lists in
@@ -325,14 +273,6 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         Ok(r)
     }
 
-    /// The cluster holding occupied site `k`: the large cluster whose members hold it, else the
-    /// owner of its label (stale only under a large cluster, which writes none).
-    fn owner_of(&self, k: usize) -> ItemId {
-        let x = self.geo.coords_of(k);
-        large_owner(&self.geo, &self.large, &self.clusters, &self.cold, &x)
-            .unwrap_or_else(|| self.id_of[self.cells.get()[k] as usize])
-    }
-
     #[inline]
     pub(super) fn len_of(&self, id: ItemId) -> usize {
         self.clusters[id as usize].len as usize
@@ -341,124 +281,6 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
     #[inline]
     pub(super) fn contains(&self, id: ItemId) -> bool {
         self.clusters.get(id as usize).is_some_and(|c| c.len != 0)
-    }
-
-    /// Move cluster `id` by `dir`: all or nothing (a wall blocks it). On success the clusters
-    /// now in contact with it are written to `out`, in increasing id.
-    pub(super) fn try_move(
-        &mut self,
-        id: ItemId,
-        dir: Direction,
-        out: &mut Vec<ItemId>,
-    ) -> Result<(), Blocked> {
-        out.clear();
-        self.shift(id, dir)?;
-        self.probe(id, dir.index(), out);
-        out.sort_unstable();
-        Ok(())
-    }
-
-    /// The occupancy part of a move of cluster `id` by `dir`: vacate its trailing face, move
-    /// its origin, cover its leading face (with its label, unless it is large).
-    fn shift(&mut self, id: ItemId, dir: Direction) -> Result<(), Blocked> {
-        let Rigid {
-            geo,
-            frame,
-            occupied,
-            cells,
-            clusters,
-            large_at,
-            ..
-        } = self;
-        let cells = cells.get_mut();
-        let c = &mut clusters[id as usize];
-        let (axis, d) = (dir.axis(), dir.index());
-        if !geo.periodic[axis] {
-            let blocked = if dir.is_positive() {
-                c.origin[axis] + i64::from(c.hi[axis]) + 1 >= geo.size[axis]
-            } else {
-                c.origin[axis] + i64::from(c.lo[axis]) <= 0
-            };
-            if blocked {
-                return Err(Blocked);
-            }
-        }
-        // Vacate the trailing face (in the old frame); labels of empty sites are never read.
-        let mut o = c.origin;
-        let lists = &*c.lists;
-        let fo = frame.origin(geo, &o);
-        vacate(frame, geo, occupied, fo, list::<D, F>(lists, d ^ 1));
-        for p in c.parts.as_slice() {
-            let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
-            vacate(frame, geo, occupied, po, list::<D, F>(&p.lists, d ^ 1));
-        }
-        o[axis] += if dir.is_positive() { 1 } else { -1 };
-        if o[axis] >= geo.size[axis] {
-            o[axis] -= geo.size[axis];
-        } else if o[axis] < 0 {
-            o[axis] += geo.size[axis];
-        }
-        c.origin = o;
-        let fo = frame.origin(geo, &o);
-        // Cover the leading face (in the new frame).
-        debug_assert!(
-            !c.parts.is_empty()
-                || list::<D, F>(lists, d)
-                    .iter()
-                    .all(|&e| !occupied.get(frame.site(geo, fo, e))),
-            "clusters overlap"
-        );
-        let label = (c.len < *large_at).then_some(c.label);
-        cover(
-            frame,
-            geo,
-            occupied,
-            cells,
-            label,
-            fo,
-            list::<D, F>(lists, d),
-        );
-        for p in c.parts.as_slice() {
-            let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
-            let entries = list::<D, F>(&p.lists, d);
-            cover(frame, geo, occupied, cells, label, po, entries);
-        }
-        Ok(())
-    }
-
-    /// The clusters in contact with cluster `id` after its move in direction index `d`, into
-    /// `out`: it looks at its new neighbours only.
-    fn probe(&self, id: ItemId, d: usize, out: &mut Vec<ItemId>) {
-        let (geo, frame, occupied) = (&self.geo, &self.frame, &self.occupied);
-        let cells = self.cells.get();
-        let c = &self.clusters[id as usize];
-        let o = c.origin;
-        let label = c.label;
-        let mut probe = |fo: F::Origin, lists: &[F::Entry]| {
-            for &e in list::<D, F>(lists, 2 * D + d) {
-                if let Some(k) = frame.probe(geo, fo, e)
-                    && occupied.get(k)
-                {
-                    // Without large clusters every occupied site's label is its owner's.
-                    let other = if self.large.is_empty() {
-                        let l = cells[k];
-                        if l == label {
-                            continue;
-                        }
-                        self.id_of[l as usize]
-                    } else {
-                        self.owner_of(k)
-                    };
-                    if other != id && !out.contains(&other) {
-                        out.push(other);
-                    }
-                }
-            }
-        };
-        probe(frame.origin(geo, &o), &c.lists);
-        for p in c.parts.as_slice() {
-            probe(frame.origin(geo, &geo.shifted(&o, &p.offset)), &p.lists);
-        }
     }
 
     /// Merge cluster `from` into `into` (which keeps its id). Call [`Rigid::finish`] on `into`
@@ -535,134 +357,6 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             self.position[moved as usize] = p as u32;
         }
         self.position[from as usize] = DEAD;
-    }
-
-    /// After merges into cluster `id`: recompute its extent and its face and probe lists from
-    /// its sites and the occupancy lattice (O(size)) if the parts merged in since the last time
-    /// hold as many particles as the lists cover; otherwise keep the parts (see [`Part`]).
-    pub(super) fn finish(&mut self, id: ItemId) {
-        let c = &self.clusters[id as usize];
-        let extra: u32 = c.parts.as_slice().iter().map(|p| p.len).sum();
-        // Small clusters are recomputed at once: cheap, and it spares their moves the parts'
-        // extra pointers.
-        if !c.parts.is_empty() && 2 * extra < c.len && c.len > SMALL {
-            return;
-        }
-        if self.marks.is_empty() {
-            self.marks = vec![0; self.geo.ext_volume.div_ceil(64) as usize];
-        }
-        let mut c = std::mem::take(&mut self.clusters[id as usize]);
-        let mut cold = std::mem::take(&mut self.cold[id as usize]);
-        // Large clusters are kept in memory order (re-sorted when they double), so their lists
-        // walk the occupancy lattice in order.
-        if cold.sites.len() >= 64 && cold.sites.len() >= 2 * cold.sorted_len {
-            let (geo, o) = (&self.geo, c.origin);
-            cold.sites.sort_by_cached_key(|r| geo.site(&o, r));
-            cold.sorted_len = cold.sites.len();
-        }
-        c.parts.clear();
-        c.lists = match &self.single {
-            Some(single) if cold.sites.len() == 1 => single.clone(),
-            _ => self.build_lists(&mut c, &cold.sites, cold.members.as_deref()),
-        };
-        if cold.sites.len() == 1 && self.single.is_none() {
-            self.single = Some(c.lists.clone());
-        }
-        self.clusters[id as usize] = c;
-        self.cold[id as usize] = cold;
-    }
-
-    /// The extent and the lists of `c`, whose particles are `sites` (and `members`, for a large
-    /// cluster, whose labels are stale).
-    fn build_lists(
-        &mut self,
-        c: &mut Cluster<D, F>,
-        sites: &[[i32; D]],
-        members: Option<&Members<D>>,
-    ) -> Lists<F::Entry> {
-        let label = c.label;
-        let Rigid {
-            geo,
-            frame,
-            occupied,
-            cells,
-            marks,
-            hood,
-            scratch,
-            large,
-            clusters,
-            cold,
-            ..
-        } = self;
-        let o = c.origin;
-        let cells = cells.get();
-        // A small cluster's label on a site is stale where a large cluster covered it since.
-        let held =
-            |r: &[i32; D]| large_owner(geo, large, clusters, cold, &geo.absolute(&o, r)).is_some();
-        let in_c = |r: &[i32; D]| match members {
-            // Relative positions of particles lie in `[0, L)` on periodic axes.
-            Some(m) => m.contains(&std::array::from_fn(|a| {
-                if geo.periodic[a] {
-                    r[a].rem_euclid(geo.size[a] as i32)
-                } else {
-                    r[a]
-                }
-            })),
-            None => geo
-                .any(&o, r)
-                .is_some_and(|k| occupied.get(k) && cells[k] == label && !held(r)),
-        };
-        scratch.iter_mut().for_each(Vec::clear);
-        hood.clear();
-        c.lo = [i32::MAX; D];
-        c.hi = [i32::MIN; D];
-        for s in sites {
-            for a in 0..D {
-                c.lo[a] = c.lo[a].min(s[a]);
-                c.hi[a] = c.hi[a].max(s[a]);
-            }
-            for d in 0..2 * D {
-                let q = step(s, d);
-                if in_c(&q) {
-                    continue;
-                }
-                scratch[d].push(*s);
-                // A neighbour site (possibly one step beyond a wall), each once.
-                let e = geo.ext(&o, &q).expect("one step from a particle");
-                let (w, b) = (e / 64, 1u64 << (e % 64));
-                if marks[w] & b == 0 {
-                    marks[w] |= b;
-                    hood.push((q, e));
-                }
-            }
-        }
-        for (q, _) in hood.iter() {
-            for d in 0..2 * D {
-                let n = step(q, d);
-                let near = in_c(&n)
-                    || geo
-                        .ext(&o, &n)
-                        .is_some_and(|e| marks[e / 64] & (1u64 << (e % 64)) != 0);
-                if !near {
-                    scratch[2 * D + d].push(*q);
-                }
-            }
-        }
-        for (_, e) in hood.iter() {
-            marks[e / 64] &= !(1u64 << (e % 64));
-        }
-        let head = 4 * D + 1;
-        let mut lists = Vec::with_capacity(head + scratch.iter().map(Vec::len).sum::<usize>());
-        lists.push(F::start(head));
-        let mut end = head;
-        for list in scratch.iter() {
-            end += list.len();
-            lists.push(F::start(end));
-        }
-        for list in scratch.iter() {
-            lists.extend(list.iter().map(|r| frame.entry(geo, r)));
-        }
-        lists.into()
     }
 
     /// Absolute k-indices of the particles of `id`.
