@@ -7,6 +7,10 @@
 //! finds there is told by the large clusters' own [`Members`] bits, asked before the label.
 //! At most `N / 32` clusters are large, and the label writes they skip were most of a late
 //! run's memory traffic (a 4-byte store into an array of 4 bytes a site, far beyond the L2).
+//! Where the lattice's rows along axis 0 are whole words of the occupancy bits, a large
+//! cluster's move flips its image a word at a time from its members' rows when that visits
+//! fewer words than its faces hold sites ([`RowMoves`]): a fractal cluster in 2D has a few
+//! face sites in each word its rows span, and the run ends with its largest clusters moving.
 //!
 //! Invariants, checked by [`Rigid::check`]: the occupancy bits hold exactly the live clusters'
 //! particles, each occupied cell of a small cluster holds its label, each large cluster's
@@ -141,7 +145,7 @@ struct Cold<const D: usize> {
 /// dimensions.
 #[derive(Debug, Clone)]
 pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
-    geo: Geometry<D>,
+    pub(super) geo: Geometry<D>,
     frame: F,
     /// The lists of a single particle, shared by all single particles.
     single: Option<Lists<F::Entry>>,
@@ -157,6 +161,8 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
     large_at: u32,
     /// The live large clusters.
     large: Vec<ItemId>,
+    /// When large clusters move by rows ([`RowMoves`]).
+    pub(super) row_moves: RowMoves,
     clusters: Vec<Cluster<D, F>>,
     cold: Vec<Cold<D>>,
     pub(super) live: Vec<ItemId>,
@@ -168,6 +174,21 @@ pub(crate) struct Rigid<const D: usize, F: Frame<D>> {
 }
 
 const DEAD: u32 = u32::MAX;
+
+/// How a large cluster's move updates the occupancy bits: by its faces, a site at a time, or by
+/// its members' rows, a word at a time ([`Members::xor_move`]). Both give the same bits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RowMoves {
+    /// By faces always (the lattice's rows are not whole words).
+    Never,
+    /// By rows where the words and rows to visit are at most half the face sites: a word costs
+    /// about what a site costs, and a row's set-up about a word; the margin keeps sparse
+    /// clusters with short rows (3D) on their faces.
+    WhenCheaper,
+    /// By rows always (for tests).
+    #[cfg(test)]
+    Always,
+}
 
 /// The labels of the sites, by site index, allocated zeroed (a page never written costs no
 /// memory) and starting at a page boundary where the allocator allows it, so that the unused
@@ -221,6 +242,11 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             id_of: (0..n as ItemId).collect(),
             large_at: 0,
             large: Vec::new(),
+            row_moves: if geo.word_rows() {
+                RowMoves::WhenCheaper
+            } else {
+                RowMoves::Never
+            },
             clusters: vec![Cluster::default(); n],
             cold: vec![Cold::default(); n],
             live: Vec::new(),
@@ -384,6 +410,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             assert_eq!(large, self.large.contains(&id), "large list");
             assert_eq!(large, members.is_some(), "members of a large cluster only");
             if let Some(m) = members {
+                m.check();
                 assert_eq!(m.count(), self.len_of(id), "members of cluster {id}");
             }
             for r in &self.cold[id as usize].sites {

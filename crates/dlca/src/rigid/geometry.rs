@@ -82,6 +82,13 @@ impl<const D: usize> Geometry<D> {
         Some(g)
     }
 
+    /// Whether each row along axis 0 is whole words of a [`Bits`] by site index: consecutive
+    /// sites along axis 0, a side a multiple of 64 and row starts on word boundaries (what
+    /// [`Members::xor_move`](super::members::Members::xor_move) needs).
+    pub(super) fn word_rows(&self) -> bool {
+        self.stride[0] == 1 && self.size[0] % 64 == 0 && (1..D).all(|a| self.stride[a] % 64 == 0)
+    }
+
     /// Whether the unused indices of a spread site index come in runs of whole 4 KiB pages of
     /// 4-byte cells (one axis, or a first axis of at least 1 024 sites), so that a page-aligned
     /// label array costs no more memory than the lattice's.
@@ -253,6 +260,9 @@ impl Bits {
     #[inline(always)]
     pub(super) fn clear(&mut self, k: usize) {
         self.0[k >> 6] &= !(1 << (k & 63));
+    }
+    pub(super) fn words_mut(&mut self) -> &mut [u64] {
+        &mut self.0
     }
 }
 

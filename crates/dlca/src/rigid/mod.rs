@@ -43,6 +43,8 @@ mod members;
 #[cfg(test)]
 mod tests;
 
+#[cfg(test)]
+use clusters::RowMoves;
 use clusters::{MAX_SIDE, Rigid};
 use core_lattice::{Blocked, Direction};
 use frame::{AnyFrame, Frame, Pow2Frame, SpreadFrame};
@@ -158,6 +160,15 @@ impl RigidStore {
     ) -> Result<usize, Blocked> {
         each!(self, r => r.try_move(id, dir, out))?;
         Ok(out.len())
+    }
+
+    /// Move large clusters by rows as `mode` says (the lattice's rows must be whole words).
+    #[cfg(test)]
+    pub(crate) fn set_row_moves(&mut self, mode: RowMoves) {
+        each!(self, r => {
+            assert!(r.geo.word_rows(), "rows that are not whole words");
+            r.row_moves = mode;
+        })
     }
 
     /// See [`Rigid::merge`].

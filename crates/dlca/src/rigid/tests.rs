@@ -120,3 +120,133 @@ fn dispatch_picks_the_frame_and_refuses_other_dimensions_with_a_typed_error() {
         RigidError::Side(long)
     );
 }
+
+/// Large clusters moved a word at a time ([`RowMoves::Always`]) and by their faces
+/// ([`RowMoves::Never`]) give the same store: the same moves blocked, the same contacts after
+/// every move, consistent occupancy bits, members and lists (the store's check) after every
+/// move, and the same particles at the end. On lattices whose rows are one word, several words
+/// and sixteen words (the spread index), with periodic and walled axes in 1 to 3 dimensions, so
+/// that images wrap around their rows and around the other axes.
+#[test]
+fn moves_by_rows_match_moves_by_faces() {
+    use super::RowMoves;
+    use Boundary::{Periodic as P, Wall as W};
+    use core_lattice::Direction;
+    use core_lattice::rng::{RngExt, stream};
+    let cases: [(&[u64], &[Boundary]); 7] = [
+        (&[512], &[P]),
+        (&[64, 32], &[P, P]),
+        (&[192, 24], &[P, W]),
+        (&[128, 24], &[W, P]),
+        (&[1024, 4], &[P, P]),
+        (&[64, 8, 8], &[P, P, W]),
+        (&[64, 8, 8], &[W, P, P]),
+    ];
+    for (case, &(sizes, boundary)) in cases.iter().enumerate() {
+        let lattice = Lattice::new(sizes, boundary).unwrap();
+        let mut rng = stream(45, case as u64);
+        // Two random connected clusters of 80 particles (large: at least 64), then single
+        // particles on sites of even coordinates; no two clusters touch.
+        let volume = lattice.volume();
+        let mut owner = vec![usize::MAX; volume as usize];
+        let free_for = |owner: &[usize], k: u64, c: usize| {
+            owner[k as usize] == usize::MAX
+                && lattice
+                    .neighbours(k)
+                    .all(|n| [usize::MAX, c].contains(&owner[n as usize]))
+        };
+        let mut clusters: Vec<Vec<u64>> = Vec::new();
+        while clusters.len() < 2 {
+            let c = clusters.len();
+            let seed = rng.random_range(0..volume);
+            if !free_for(&owner, seed, c) {
+                continue;
+            }
+            let mut sites = vec![seed];
+            owner[seed as usize] = c;
+            for _ in 0..100_000 {
+                if sites.len() == 80 {
+                    break;
+                }
+                let from = sites[rng.random_range(0..sites.len())];
+                let dir = Direction::from_index(rng.random_range(0..2 * sizes.len()));
+                if let Some(k) = lattice.neighbour(from, dir)
+                    && free_for(&owner, k, c)
+                {
+                    owner[k as usize] = c;
+                    sites.push(k);
+                }
+            }
+            clusters.push(sites);
+        }
+        for k in 0..volume {
+            let x = lattice.coords_array(k);
+            let c = clusters.len();
+            if x.iter().all(|&c| c % 2 == 0) && free_for(&owner, k, c) && rng.random_bool(0.5) {
+                owner[k as usize] = c;
+                clusters.push(vec![k]);
+            }
+        }
+        let placed: usize = clusters.iter().map(Vec::len).sum();
+        let mut sets = SiteSets::new(lattice.clone());
+        for c in clusters {
+            sets.push(c);
+        }
+        let mut stores = [
+            RigidStore::new(&sets).unwrap(),
+            RigidStore::new(&sets).unwrap(),
+        ];
+        stores[0].set_row_moves(RowMoves::Always);
+        stores[1].set_row_moves(RowMoves::Never);
+        let (mut out, mut other) = (Vec::new(), Vec::new());
+        let mut large_moves = 0;
+        for step in 0..3000 {
+            let live = stores[0].live();
+            if live.len() == 1 {
+                break;
+            }
+            // Half the moves are the largest cluster's.
+            let id = if rng.random_bool(0.5) {
+                *live.iter().max_by_key(|&&id| stores[0].len_of(id)).unwrap()
+            } else {
+                live[rng.random_range(0..live.len())]
+            };
+            let dir = Direction::from_index(rng.random_range(0..2 * sizes.len()));
+            large_moves += usize::from(stores[0].len_of(id) >= 64);
+            let a = stores[0].try_move(id, dir, &mut out);
+            let b = stores[1].try_move(id, dir, &mut other);
+            assert_eq!(a, b, "case {case} step {step}");
+            assert_eq!(out, other, "case {case} step {step}: contacts");
+            if !out.is_empty() {
+                let mut group = out.clone();
+                group.push(id);
+                group.sort_unstable();
+                for s in &mut stores {
+                    for &from in &group[1..] {
+                        s.merge(group[0], from);
+                    }
+                    s.finish(group[0]);
+                }
+            }
+            stores[0].check();
+        }
+        stores[1].check();
+        assert!(
+            large_moves > 500,
+            "case {case}: {large_moves} moves of large clusters of {placed} particles"
+        );
+        let [a, b] = &stores;
+        let sites = |s: &RigidStore| {
+            let sets = s.to_sets();
+            let mut v: Vec<Vec<u64>> = sets
+                .live()
+                .iter()
+                .map(|&id| sets.sites(id).to_vec())
+                .collect();
+            v.iter_mut().for_each(|c| c.sort_unstable());
+            v.sort();
+            v
+        };
+        assert_eq!(sites(a), sites(b), "case {case}");
+    }
+}

@@ -1,9 +1,9 @@
 //! A move of a rigid cluster ([`Rigid::try_move`]): the occupancy bits of its trailing face
-//! cleared and those of its leading face set (with its label, unless it is large), then its
-//! probes read, a probe that finds a particle telling its owner by the large clusters' members
-//! first and the label after.
+//! cleared and those of its leading face set (with its label, unless it is large; a large one
+//! may flip its image by rows instead), then its probes read, a probe that finds a particle
+//! telling its owner by the large clusters' members first and the label after.
 
-use super::{Cluster, Cold, Rigid, list};
+use super::{Cluster, Cold, Rigid, RowMoves, list};
 use crate::rigid::frame::Frame;
 use crate::rigid::geometry::{Bits, Geometry};
 use core_lattice::{Blocked, Direction};
@@ -100,7 +100,9 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             occupied,
             cells,
             clusters,
+            cold,
             large_at,
+            row_moves,
             ..
         } = self;
         let cells = cells.get_mut();
@@ -116,15 +118,8 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                 return Err(Blocked);
             }
         }
-        // Vacate the trailing face (in the old frame); labels of empty sites are never read.
-        let mut o = c.origin;
-        let lists = &*c.lists;
-        let fo = frame.origin(geo, &o);
-        vacate(frame, geo, occupied, fo, list::<D, F>(lists, d ^ 1));
-        for p in c.parts.as_slice() {
-            let po = frame.origin(geo, &geo.shifted(&o, &p.offset));
-            vacate(frame, geo, occupied, po, list::<D, F>(&p.lists, d ^ 1));
-        }
+        let old = c.origin;
+        let mut o = old;
         o[axis] += if dir.is_positive() { 1 } else { -1 };
         if o[axis] >= geo.size[axis] {
             o[axis] -= geo.size[axis];
@@ -132,6 +127,34 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             o[axis] += geo.size[axis];
         }
         c.origin = o;
+        let lists = &*c.lists;
+        let large = c.len >= *large_at;
+        // A large cluster's image moved a word at a time, where that visits fewer words.
+        if large && *row_moves != RowMoves::Never {
+            let members = cold[id as usize]
+                .members
+                .as_deref()
+                .expect("a large cluster");
+            let faces = |l: &[F::Entry]| list::<D, F>(l, d).len() + list::<D, F>(l, d ^ 1).len();
+            let parts = c.parts.as_slice().iter();
+            let sites = faces(lists) + parts.map(|p| faces(&p.lists)).sum::<usize>();
+            let by_rows = match row_moves {
+                RowMoves::WhenCheaper => 2 * (members.words() + members.rows()) <= sites,
+                _ => true,
+            };
+            if by_rows {
+                let words = occupied.words_mut();
+                members.xor_move(geo, words, &old, axis, dir.is_positive());
+                return Ok(());
+            }
+        }
+        // Vacate the trailing face (in the old frame); labels of empty sites are never read.
+        let fo = frame.origin(geo, &old);
+        vacate(frame, geo, occupied, fo, list::<D, F>(lists, d ^ 1));
+        for p in c.parts.as_slice() {
+            let po = frame.origin(geo, &geo.shifted(&old, &p.offset));
+            vacate(frame, geo, occupied, po, list::<D, F>(&p.lists, d ^ 1));
+        }
         let fo = frame.origin(geo, &o);
         // Cover the leading face (in the new frame).
         debug_assert!(
@@ -141,7 +164,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
                     .all(|&e| !occupied.get(frame.site(geo, fo, e))),
             "clusters overlap"
         );
-        let label = (c.len < *large_at).then_some(c.label);
+        let label = (!large).then_some(c.label);
         cover(
             frame,
             geo,
