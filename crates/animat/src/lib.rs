@@ -22,7 +22,6 @@
 pub mod bench;
 #[cfg(feature = "files")]
 pub mod checkpoint;
-mod hint;
 #[cfg(feature = "files")]
 pub mod output;
 pub mod params;

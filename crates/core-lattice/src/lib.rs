@@ -13,6 +13,7 @@
 //! - [`spec`]: descriptions of model parameters (name, flag, unit, range), one table per model
 //!   that the front ends are derived from or checked against.
 //! - [`cpu`]: the processor features the build was compiled for, checked at start.
+//! - [`hint`]: a cache prefetch hint.
 //!
 //! Feature `serde` (default) makes lattices, random streams and statistics serialisable, for
 //! checkpoints and manifests. Everything around a run is in the crates `run-io` (outputs,
@@ -41,6 +42,7 @@
 //! ```
 
 pub mod cpu;
+pub mod hint;
 pub mod lattice;
 pub mod rng;
 pub mod spec;

@@ -63,14 +63,14 @@ impl World {
                 let flushed = self.flush_seconds;
                 let t = Instant::now();
                 if let Some(p) = ahead {
-                    self.cells.near_lines(p, crate::hint::prefetch);
+                    self.cells.near_lines(p, core_lattice::hint::prefetch);
                 }
                 let act = self.decide_near(&a);
                 self.search_seconds += t.elapsed().as_secs_f64() - (self.flush_seconds - flushed);
                 act
             } else {
                 if let Some(p) = ahead {
-                    self.cells.near_lines(p, crate::hint::prefetch);
+                    self.cells.near_lines(p, core_lattice::hint::prefetch);
                 }
                 self.decide_near(&a)
             };

@@ -304,6 +304,23 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         self.clusters[id as usize].len as usize
     }
 
+    /// Start loading the record of cluster `id` (one cache line) into the cache.
+    #[inline]
+    pub(super) fn prefetch_record(&self, id: ItemId) {
+        if let Some(c) = self.clusters.get(id as usize) {
+            core_lattice::hint::prefetch(c);
+        }
+    }
+
+    /// Start loading the head of cluster `id`'s lists (the list starts and its first entries)
+    /// into the cache; reads its record.
+    #[inline]
+    pub(super) fn prefetch_lists(&self, id: ItemId) {
+        if let Some(e) = self.clusters.get(id as usize).and_then(|c| c.lists.first()) {
+            core_lattice::hint::prefetch(e);
+        }
+    }
+
     #[inline]
     pub(super) fn contains(&self, id: ItemId) -> bool {
         self.clusters.get(id as usize).is_some_and(|c| c.len != 0)

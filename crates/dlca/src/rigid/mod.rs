@@ -171,6 +171,18 @@ impl RigidStore {
         })
     }
 
+    /// See [`Rigid::prefetch_record`].
+    #[inline]
+    pub(crate) fn prefetch_record(&self, id: ItemId) {
+        each!(self, r => r.prefetch_record(id))
+    }
+
+    /// See [`Rigid::prefetch_lists`].
+    #[inline]
+    pub(crate) fn prefetch_lists(&self, id: ItemId) {
+        each!(self, r => r.prefetch_lists(id))
+    }
+
     /// See [`Rigid::merge`].
     pub(crate) fn merge(&mut self, into: ItemId, from: ItemId) {
         each!(self, r => r.merge(into, from))

@@ -77,6 +77,12 @@ use std::time::Instant;
 
 /// Random stream purposes of a DLCA run (see `core_lattice::rng::stream_id`).
 const STREAM_PLACEMENT: u32 = 1;
+
+/// How many turns ahead a sweep asks for a cluster's record ([`ClusterStore::prefetch_record`]).
+const RECORD_AHEAD: usize = 8;
+
+/// How many turns ahead a sweep asks for a cluster's lists ([`ClusterStore::prefetch_lists`]).
+const LISTS_AHEAD: usize = 3;
 const STREAM_DYNAMICS: u32 = 2;
 
 /// A DLCA run: the lattice, the clusters, the search, the random stream and the records.
@@ -359,7 +365,16 @@ impl Simulation {
         order.extend_from_slice(self.engine.live());
         order.sort_unstable();
         shuffle(&mut self.run.rng, &mut order);
-        for &id in &order {
+        for (i, &id) in order.iter().enumerate() {
+            // The turns' order is known: the clusters' records are asked for a few turns
+            // ahead and their lists (found from the record) a turn or two ahead, so that the
+            // cache misses of a turn's start overlap earlier turns.
+            if let Some(&next) = order.get(i + RECORD_AHEAD) {
+                self.engine.prefetch_record(next);
+            }
+            if let Some(&next) = order.get(i + LISTS_AHEAD) {
+                self.engine.prefetch_lists(next);
+            }
             if self.engine.contains(id) {
                 self.visit(id);
             }

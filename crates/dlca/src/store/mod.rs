@@ -123,6 +123,16 @@ impl ClusterStore for Engine {
 
     forward_clusters!(each);
 
+    #[inline]
+    fn prefetch_record(&self, id: ItemId) {
+        each!(self, s => s.prefetch_record(id))
+    }
+
+    #[inline]
+    fn prefetch_lists(&self, id: ItemId) {
+        each!(self, s => s.prefetch_lists(id))
+    }
+
     /// Merges, then installs all-pairs in place of a store that has stopped paying.
     fn merge(&mut self, survivor: ItemId, others: &[ItemId], notes: &mut Vec<String>) -> Merged {
         let merged = each!(self, s => s.merge(survivor, others, notes));

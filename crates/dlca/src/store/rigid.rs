@@ -35,6 +35,16 @@ impl RigidClusters {
 impl ClusterStore for RigidClusters {
     forward_clusters!(s => s.store);
 
+    #[inline]
+    fn prefetch_record(&self, id: ItemId) {
+        self.store.prefetch_record(id);
+    }
+
+    #[inline]
+    fn prefetch_lists(&self, id: ItemId) {
+        self.store.prefetch_lists(id);
+    }
+
     fn kind(&self) -> Search {
         Search::Lattice
     }

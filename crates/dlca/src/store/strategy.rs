@@ -41,6 +41,15 @@ pub(crate) trait ClusterStore {
     /// Number of particles of live cluster `id`.
     fn len_of(&self, id: ItemId) -> usize;
 
+    /// A hint that cluster `id` takes its turn a few turns from now: the store may start
+    /// loading its record into the cache. Changes nothing; by default does nothing.
+    fn prefetch_record(&self, _id: ItemId) {}
+
+    /// A hint that cluster `id` takes its turn within a turn or two: the store may start
+    /// loading what its move reads beyond the record (the record itself having been asked for
+    /// earlier). Changes nothing; by default does nothing.
+    fn prefetch_lists(&self, _id: ItemId) {}
+
     /// Move cluster `id` by `dir`, all or nothing (a wall blocks the whole cluster), and write
     /// the clusters then in contact with it to `contacts`, in increasing id. Returns the number
     /// of candidate clusters examined.

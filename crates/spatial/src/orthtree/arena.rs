@@ -36,7 +36,7 @@
 //! recorded on a loom cell, so the model-checked test `tests/loom_shared.rs` sees each read
 //! and write of the arenas and reports any that is not ordered by the protocol.
 //!
-//! This module and `animat`'s prefetch hint are the workspace's only unsafe operations (raw
+//! This module and `core-lattice`'s prefetch hint are the workspace's only unsafe operations (raw
 //! pointers, allocation); the orthtree's other modules only call the `unsafe fn`s above, each
 //! call in an `unsafe` block with its `// SAFETY:` note (`#[allow(unsafe_code)]` on those
 //! modules). A growable buffer that readers index while a writer appends is exactly what `Vec`

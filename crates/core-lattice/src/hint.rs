@@ -1,5 +1,7 @@
-//! A cache prefetch hint: one of the workspace's two places of `unsafe` code (the other is
-//! the orthtree's arena in `spatial`; `unsafe_code` is denied everywhere else). Stable Rust has no
+//! A cache prefetch hint, for models that know which memory a later step reads (the animats'
+//! next turns' cells, DLCA's next clusters' records): one of the workspace's two places of
+//! `unsafe` code (the other is the orthtree's arena in `spatial`; `unsafe_code` is denied
+//! everywhere else). Stable Rust has no
 //! safe non-blocking prefetch: `_mm_prefetch` is a
 //! `#[target_feature]` function and `std::hint::prefetch_read` is unstable.
 
