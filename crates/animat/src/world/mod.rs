@@ -205,6 +205,10 @@ pub struct World {
     /// During a step: where each animat of `ranks` takes its turn (`inv[k]` is the index in
     /// `recs` of the animat of rank `k`).
     inv: Vec<u32>,
+    /// During a step, when the ids alive at its start are dense enough: the rank of id
+    /// `ids[0] + i` at index `i` ([`NO_RANK`] for an id not listed), so that finding a prey's
+    /// record is two reads and not a binary search over `ids`; empty otherwise.
+    rank_of: Vec<u32>,
     /// Reused buffers: the records and flags of the previous order while a step gathers them.
     spare_recs: Vec<Rec>,
     spare_flags: Vec<u8>,
@@ -279,6 +283,7 @@ impl World {
             ranks: Vec::new(),
             ids: Vec::new(),
             inv: Vec::new(),
+            rank_of: Vec::new(),
             spare_recs: Vec::new(),
             spare_flags: Vec::new(),
             born_at: 0,

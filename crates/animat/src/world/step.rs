@@ -16,6 +16,9 @@ use std::time::Instant;
 /// How many turns ahead a turn's cells are prefetched.
 const PREFETCH_TURNS: usize = 8;
 
+/// A `rank_of` entry for an id not alive at the step's start.
+const NO_RANK: u32 = u32::MAX;
+
 impl World {
     /// One step: every animat alive at its start acts once, in a fresh uniformly random order
     /// (ids sorted, then shuffled with the order stream); an animat eaten earlier in the step
@@ -35,6 +38,7 @@ impl World {
         shuffle(&mut self.order_rng, &mut order);
         self.gather(&mut order);
         self.order = order;
+        self.index_ranks();
         self.born_at = n;
         self.first_born = self.next_id;
         for j in 0..n {
@@ -145,16 +149,40 @@ impl World {
         }
     }
 
+    /// At the start of a step: `rank_of` over the ids alive, where they span at most twice
+    /// as many ids as there are animats (a table of at most 8 bytes an animat, written in
+    /// order); else empty.
+    fn index_ranks(&mut self) {
+        self.rank_of.clear();
+        let (Some(&lo), Some(&hi)) = (self.ids.first(), self.ids.last()) else {
+            return;
+        };
+        let span = (hi - lo) as usize + 1;
+        if span > 2 * self.ids.len() + 16 {
+            return;
+        }
+        self.rank_of.resize(span, NO_RANK);
+        for (k, &id) in self.ids.iter().enumerate() {
+            self.rank_of[(id - lo) as usize] = k as u32;
+        }
+    }
+
     /// During a step: the record of the live animat `id` (alive at the step's start or born
     /// in it).
     pub(super) fn record_of(&self, id: u64) -> usize {
         if id >= self.first_born {
             return self.born_at + (id - self.first_born) as usize;
         }
-        let k = self
-            .ids
-            .binary_search(&id)
-            .expect("a live animat is listed");
+        let k = if self.rank_of.is_empty() {
+            self.ids
+                .binary_search(&id)
+                .expect("a live animat is listed")
+        } else {
+            let k = self.rank_of[(id - self.ids[0]) as usize];
+            assert!(k != NO_RANK, "a live animat is listed");
+            debug_assert_eq!(self.ids.binary_search(&id), Ok(k as usize));
+            k as usize
+        };
         self.inv[k] as usize
     }
 
