@@ -206,7 +206,7 @@ pub struct World {
     /// `recs` of the animat of rank `k`).
     inv: Vec<u32>,
     /// During a step, when the ids alive at its start are dense enough: the rank of id
-    /// `ids[0] + i` at index `i` ([`NO_RANK`] for an id not listed), so that finding a prey's
+    /// `ids[0] + i` at index `i` (`u32::MAX` for an id not listed), so that finding a prey's
     /// record is two reads and not a binary search over `ids`; empty otherwise.
     rank_of: Vec<u32>,
     /// Reused buffers: the records and flags of the previous order while a step gathers them.

@@ -8,9 +8,10 @@
 //! At most `N / 32` clusters are large, and the label writes they skip were most of a late
 //! run's memory traffic (a 4-byte store into an array of 4 bytes a site, far beyond the L2).
 //! Where the lattice's rows along axis 0 are whole words of the occupancy bits, a large
-//! cluster's move flips its image a word at a time from its members' rows when that visits
-//! fewer words than its faces hold sites ([`RowMoves`]): a fractal cluster in 2D has a few
-//! face sites in each word its rows span, and the run ends with its largest clusters moving.
+//! cluster's move flips its image a word at a time from its members' rows when that visits at
+//! most half as many words and rows as its faces hold sites ([`RowMoves`]): a fractal cluster
+//! in 2D has a few face sites in each word its rows span, and the run ends with its largest
+//! clusters moving.
 //!
 //! Invariants, checked by [`Rigid::check`]: the occupancy bits hold exactly the live clusters'
 //! particles, each occupied cell of a small cluster holds its label, each large cluster's

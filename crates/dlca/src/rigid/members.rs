@@ -13,11 +13,11 @@
 use super::geometry::Geometry;
 
 /// Relative positions as bits over the box `lo .. lo + side`, in rows along axis 0 that each
-/// start a word: position `r` is bit `r[0] - lo[0]` after the zero word of row `sum over a >= 1 of (r[a] - lo[a])
-/// * row_stride[a]`. On a periodic axis of side `L` a relative position in `[L/2, L)` is taken
-/// as the one `L` lower, so that a cluster with particles on both sides of its origin has a box
-/// of its own extent, not `L`. Each row keeps the range of its words that hold bits, so that
-/// [`Members::xor_move`] reads those only.
+/// start a word: position `r` is bit `r[0] - lo[0]` after the zero word of row
+/// `sum over a >= 1 of (r[a] - lo[a]) * row_stride[a]`. On a periodic axis of side `L` a
+/// relative position in `[L/2, L)` is taken as the one `L` lower, so that a cluster with
+/// particles on both sides of its origin has a box of its own extent, not `L`. Each row keeps
+/// the range of its words that hold bits, so that [`Members::xor_move`] reads those only.
 #[derive(Debug, Clone)]
 pub(super) struct Members<const D: usize> {
     lo: [i32; D],
@@ -185,9 +185,9 @@ impl<const D: usize> Members<D> {
     /// Move the cluster's particles in `occupied` (one bit a site by site index of `geo`) from
     /// origin `origin` one step along `axis` (up if `up`): each lattice word that changes is
     /// flipped once, by the exclusive or of the old and the new image there, worked out from
-    /// the members' rows and shifted into the lattice row's alignment. Needs rows along axis 0 that start a word of `occupied`
-    /// ([`Geometry::word_rows`]). Exclusive or is linear, so this holds where images wrap onto
-    /// themselves around a periodic axis too.
+    /// the members' rows and shifted into the lattice row's alignment. Needs rows along axis 0
+    /// that start a word of `occupied` ([`Geometry::word_rows`]). Exclusive or is linear, so
+    /// this holds where images wrap onto themselves around a periodic axis too.
     pub(super) fn xor_move(
         &self,
         geo: &Geometry<D>,

@@ -129,7 +129,8 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
         c.origin = o;
         let lists = &*c.lists;
         let large = c.len >= *large_at;
-        // A large cluster's image moved a word at a time, where that visits fewer words.
+        // A large cluster's image moved a word at a time, where that visits at most half as
+        // many words and rows as its faces hold sites (see `RowMoves`).
         if large && *row_moves != RowMoves::Never {
             let members = cold[id as usize]
                 .members
