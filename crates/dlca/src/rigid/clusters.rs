@@ -243,7 +243,7 @@ impl<const D: usize, F: Frame<D>> Rigid<D, F> {
             id_of: (0..n as ItemId).collect(),
             large_at: 0,
             large: Vec::new(),
-            row_moves: if geo.word_rows() {
+            row_moves: if geo.bit_rows() {
                 RowMoves::WhenCheaper
             } else {
                 RowMoves::Never

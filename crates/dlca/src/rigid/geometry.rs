@@ -83,10 +83,17 @@ impl<const D: usize> Geometry<D> {
     }
 
     /// Whether each row along axis 0 is whole words of a [`Bits`] by site index: consecutive
-    /// sites along axis 0, a side a multiple of 64 and row starts on word boundaries (what
-    /// [`Members::xor_move`](super::members::Members::xor_move) needs).
+    /// sites along axis 0, a side a multiple of 64 and row starts on word boundaries (where
+    /// [`Members::xor_move`](super::members::Members::xor_move) writes whole words).
     pub(super) fn word_rows(&self) -> bool {
         self.stride[0] == 1 && self.size[0] % 64 == 0 && (1..D).all(|a| self.stride[a] % 64 == 0)
+    }
+
+    /// Whether consecutive sites along axis 0 have consecutive site indices and the first side
+    /// is at least 64: what a move by rows needs, at any bit position
+    /// ([`Members::xor_move`](super::members::Members::xor_move)).
+    pub(super) fn bit_rows(&self) -> bool {
+        self.stride[0] == 1 && self.size[0] >= 64
     }
 
     /// Whether the unused indices of a spread site index come in runs of whole 4 KiB pages of

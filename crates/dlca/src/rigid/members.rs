@@ -185,9 +185,10 @@ impl<const D: usize> Members<D> {
     /// Move the cluster's particles in `occupied` (one bit a site by site index of `geo`) from
     /// origin `origin` one step along `axis` (up if `up`): each lattice word that changes is
     /// flipped once, by the exclusive or of the old and the new image there, worked out from
-    /// the members' rows and shifted into the lattice row's alignment. Needs rows along axis 0
-    /// that start a word of `occupied` ([`Geometry::word_rows`]). Exclusive or is linear, so
-    /// this holds where images wrap onto themselves around a periodic axis too.
+    /// the members' rows and shifted into the lattice row's alignment (a word at a time where
+    /// the rows are whole words, [`Geometry::word_rows`]). Needs consecutive site indices along
+    /// axis 0 and a first side of at least 64 ([`Geometry::bit_rows`]). Exclusive or is linear,
+    /// so this holds where images wrap onto themselves around a periodic axis too.
     pub(super) fn xor_move(
         &self,
         geo: &Geometry<D>,
@@ -197,11 +198,10 @@ impl<const D: usize> Members<D> {
         up: bool,
     ) {
         let row_len = geo.size[0];
-        let lattice_words = (row_len / 64) as usize;
-        // The lattice position of the start of the box's word 0 (each row's zero word), as a
-        // word and a shift: box word `j` lands in lattice words `q0 + j` and `q0 + j + 1`.
+        // The lattice position of the start of the box's word 0 (each row's zero word): box
+        // word `j` starts at `x0 + 64 j` (modulo the row).
         let x0 = (origin[0] + i64::from(self.lo[0]) - 64).rem_euclid(row_len) as usize;
-        let (q0, t) = (x0 / 64, (x0 % 64) as u32);
+        let emit = Emitter::new(geo, x0);
         // Absolute coordinates along axes 1 and up of the current row, at `origin`.
         let start: [i64; D] = std::array::from_fn(|a| {
             if a == 0 {
@@ -211,7 +211,7 @@ impl<const D: usize> Members<D> {
             }
         });
         let base_of =
-            |y: &[i64; D]| (1..D).map(|a| y[a] as u64 * geo.stride[a]).sum::<u64>() as usize / 64;
+            |y: &[i64; D]| (1..D).map(|a| y[a] as u64 * geo.stride[a]).sum::<u64>() as usize;
         let step: i64 = if up { 1 } else { -1 };
         let rw = self.row_words;
         let words = |row: usize, lo: u32, hi: u32| {
@@ -236,7 +236,6 @@ impl<const D: usize> Members<D> {
                 }
             }
             let base = base_of(&y);
-            let lattice_row = &mut occupied[base..base + lattice_words];
             if axis == 0 {
                 if lo > hi {
                     continue;
@@ -245,10 +244,10 @@ impl<const D: usize> Members<D> {
                 let m = words(row, lo, hi);
                 if up {
                     let d = m.windows(2).map(|p| p[1] ^ ((p[1] << 1) | (p[0] >> 63)));
-                    xor_words(lattice_row, q0 + lo as usize, d, t);
+                    emit.xor(occupied, base, lo as usize, d);
                 } else {
                     let d = m.windows(2).map(|p| p[0] ^ ((p[0] >> 1) | (p[1] << 63)));
-                    xor_words(lattice_row, q0 + lo as usize - 1, d, t);
+                    emit.xor(occupied, base, lo as usize - 1, d);
                 }
                 continue;
             }
@@ -266,23 +265,95 @@ impl<const D: usize> Members<D> {
             let own = |row: usize, lo: u32, hi: u32| words(row, lo, hi)[1..].iter().copied();
             match (lo <= hi, prev) {
                 (false, None) => {}
-                (true, None) => xor_words(lattice_row, q0 + lo as usize, own(row, lo, hi), t),
-                (false, Some((p, (l, h)))) => {
-                    xor_words(lattice_row, q0 + l as usize, own(p, l, h), t)
-                }
+                (true, None) => emit.xor(occupied, base, lo as usize, own(row, lo, hi)),
+                (false, Some((p, (l, h)))) => emit.xor(occupied, base, l as usize, own(p, l, h)),
                 (true, Some((p, (l, h)))) => {
                     let (ul, uh) = (lo.min(l), hi.max(h));
                     let d = own(row, ul, uh).zip(own(p, ul, uh)).map(|(a, b)| a ^ b);
-                    xor_words(lattice_row, q0 + ul as usize, d, t);
+                    emit.xor(occupied, base, ul as usize, d);
                 }
             }
             let ahead = i64::from(at[axis]) + step;
             if lo <= hi && !(0..i64::from(self.side[axis])).contains(&ahead) {
                 let mut z = y;
                 z[axis] = (z[axis] + step).rem_euclid(geo.size[axis]);
-                let base = base_of(&z);
-                let lattice_row = &mut occupied[base..base + lattice_words];
-                xor_words(lattice_row, q0 + lo as usize, own(row, lo, hi), t);
+                emit.xor(occupied, base_of(&z), lo as usize, own(row, lo, hi));
+            }
+        }
+    }
+}
+
+/// Where a move by rows flips the bits of a lattice row: by whole words where the rows are
+/// whole words ([`Geometry::word_rows`]), else bit by bit from any position.
+enum Emitter {
+    /// Box word `j` lands in lattice words `q0 + j` and `q0 + j + 1` of the row (`words` a
+    /// row), shifted up by `t` bits.
+    Words { q0: usize, t: u32, words: usize },
+    /// Box word `j` starts at lattice position `x0 + 64 j` of a row of `len` sites.
+    Bits { x0: usize, len: usize },
+}
+
+impl Emitter {
+    fn new<const D: usize>(geo: &Geometry<D>, x0: usize) -> Self {
+        let len = geo.size[0] as usize;
+        if geo.word_rows() {
+            Emitter::Words {
+                q0: x0 / 64,
+                t: (x0 % 64) as u32,
+                words: len / 64,
+            }
+        } else {
+            Emitter::Bits { x0, len }
+        }
+    }
+
+    /// Flip in `occupied` the row starting at site index `base` by `words`, box words
+    /// `j, j + 1, ...` of a row (wrapping around the lattice row).
+    #[inline(always)]
+    fn xor(&self, occupied: &mut [u64], base: usize, j: usize, words: impl Iterator<Item = u64>) {
+        match *self {
+            Emitter::Words { q0, t, words: n } => {
+                let row = &mut occupied[base / 64..base / 64 + n];
+                xor_words(row, q0 + j, words, t);
+            }
+            Emitter::Bits { x0, len } => xor_bits(occupied, base, len, (x0 + 64 * j) % len, words),
+        }
+    }
+}
+
+/// Flip in `occupied` the bits of the lattice row of `len` sites (at least 64) starting at bit
+/// `base`, from position `x` on (wrapping around the row), by the bits of `words`.
+fn xor_bits(
+    occupied: &mut [u64],
+    base: usize,
+    len: usize,
+    mut x: usize,
+    words: impl Iterator<Item = u64>,
+) {
+    for w in words {
+        if w == 0 {
+            x += 64;
+            while x >= len {
+                x -= len;
+            }
+            continue;
+        }
+        // The word's 64 bits, in at most two runs (split where the row wraps).
+        let mut v = w;
+        let mut left = 64;
+        while left > 0 {
+            let run = left.min(len - x);
+            let bits = if run == 64 { v } else { v & ((1 << run) - 1) };
+            let (i, s) = ((base + x) / 64, (base + x) % 64);
+            occupied[i] ^= bits << s;
+            if s + run > 64 {
+                occupied[i + 1] ^= bits >> (64 - s);
+            }
+            v = if run == 64 { 0 } else { v >> run };
+            left -= run;
+            x += run;
+            if x == len {
+                x = 0;
             }
         }
     }

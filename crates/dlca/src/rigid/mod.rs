@@ -162,11 +162,11 @@ impl RigidStore {
         Ok(out.len())
     }
 
-    /// Move large clusters by rows as `mode` says (the lattice's rows must be whole words).
+    /// Move large clusters by rows as `mode` says (the lattice's first side must be at least 64).
     #[cfg(test)]
     pub(crate) fn set_row_moves(&mut self, mode: RowMoves) {
         each!(self, r => {
-            assert!(r.geo.word_rows(), "rows that are not whole words");
+            assert!(r.geo.bit_rows(), "rows too short to move by");
             r.row_moves = mode;
         })
     }

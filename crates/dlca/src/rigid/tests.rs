@@ -125,15 +125,16 @@ fn dispatch_picks_the_frame_and_refuses_other_dimensions_with_a_typed_error() {
 /// ([`RowMoves::Never`]) give the same store: the same moves blocked, the same contacts after
 /// every move, consistent occupancy bits, members and lists (the store's check) after every
 /// move, and the same particles at the end. On lattices whose rows are one word, several words
-/// and sixteen words (the spread index), with periodic and walled axes in 1 to 3 dimensions, so
-/// that images wrap around their rows and around the other axes.
+/// and sixteen words (the spread index), and whose rows start anywhere in a word (first sides
+/// that are not multiples of 64), with periodic and walled axes in 1 to 3 dimensions, so that
+/// images wrap around their rows and around the other axes.
 #[test]
 fn moves_by_rows_match_moves_by_faces() {
     use super::RowMoves;
     use Boundary::{Periodic as P, Wall as W};
     use core_lattice::Direction;
     use core_lattice::rng::{RngExt, stream};
-    let cases: [(&[u64], &[Boundary]); 7] = [
+    let cases: [(&[u64], &[Boundary]); 12] = [
         (&[512], &[P]),
         (&[64, 32], &[P, P]),
         (&[192, 24], &[P, W]),
@@ -141,6 +142,12 @@ fn moves_by_rows_match_moves_by_faces() {
         (&[1024, 4], &[P, P]),
         (&[64, 8, 8], &[P, P, W]),
         (&[64, 8, 8], &[W, P, P]),
+        // Rows at any bit position: first sides that are not multiples of 64.
+        (&[300], &[P]),
+        (&[100, 30], &[P, P]),
+        (&[70, 24], &[W, P]),
+        (&[130, 20], &[P, W]),
+        (&[96, 8, 8], &[P, W, P]),
     ];
     for (case, &(sizes, boundary)) in cases.iter().enumerate() {
         let lattice = Lattice::new(sizes, boundary).unwrap();
