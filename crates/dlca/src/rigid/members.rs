@@ -286,8 +286,8 @@ impl<const D: usize> Members<D> {
 /// Where a move by rows flips the bits of a lattice row: by whole words where the rows are
 /// whole words ([`Geometry::word_rows`]), else bit by bit from any position.
 enum Emitter {
-    /// Box word `j` lands in lattice words `q0 + j` and `q0 + j + 1` of the row (`words` a
-    /// row), shifted up by `t` bits.
+    /// Box word `j` lands in lattice words `q0 + j` and `q0 + j + 1` of the row (of `words`
+    /// words), shifted up by `t` bits.
     Words { q0: usize, t: u32, words: usize },
     /// Box word `j` starts at lattice position `x0 + 64 j` of a row of `len` sites.
     Bits { x0: usize, len: usize },
