@@ -77,13 +77,13 @@ use std::time::Instant;
 
 /// Random stream purposes of a DLCA run (see `core_lattice::rng::stream_id`).
 const STREAM_PLACEMENT: u32 = 1;
+const STREAM_DYNAMICS: u32 = 2;
 
 /// How many turns ahead a sweep asks for a cluster's record ([`ClusterStore::prefetch_record`]).
 const RECORD_AHEAD: usize = 8;
 
 /// How many turns ahead a sweep asks for a cluster's lists ([`ClusterStore::prefetch_lists`]).
 const LISTS_AHEAD: usize = 3;
-const STREAM_DYNAMICS: u32 = 2;
 
 /// A DLCA run: the lattice, the clusters, the search, the random stream and the records.
 ///
