@@ -210,8 +210,8 @@ impl<const D: usize> Members<D> {
                 (origin[a] + i64::from(self.lo[a])).rem_euclid(geo.size[a])
             }
         });
-        let base_of =
-            |y: &[i64; D]| (1..D).map(|a| y[a] as u64 * geo.stride[a]).sum::<u64>() as usize;
+        // The site index of a row's first site (`y[0]` is 0).
+        let base_of = |y: &[i64; D]| geo.site(y, &[0; D]);
         let step: i64 = if up { 1 } else { -1 };
         let rw = self.row_words;
         let words = |row: usize, lo: u32, hi: u32| {
