@@ -134,15 +134,22 @@ impl<const D: usize> NearCache<D> {
         if room <= 0.0 {
             return None;
         }
-        // First the smallest squared distance alone (lane-wise minima: no index to carry,
-        // so the loop is a handful of vector instructions per block), then, only if the cache
-        // can answer, the first particle at exactly that value (ties to the lowest index).
+        // One pass: lane-wise minima and, per lane, the first block holding that lane's
+        // minimum (selected without branches, so the loop stays a handful of vector
+        // instructions per block). The answer's particle is the first at the smallest value
+        // (ties to the lowest index): among the lanes at that value, the lowest block, then
+        // the lowest lane.
         let mut m = [f64::INFINITY; LANES];
+        let mut at = [0.0f64; LANES];
+        let mut b = 0.0f64;
         for block in &self.blocks {
             let d2 = block_dist_sq(p, block);
             for k in 0..LANES {
-                m[k] = if d2[k] < m[k] { d2[k] } else { m[k] };
+                let lower = d2[k] < m[k];
+                m[k] = if lower { d2[k] } else { m[k] };
+                at[k] = if lower { b } else { at[k] };
             }
+            b += 1.0;
         }
         let mut best = m[0];
         for &v in &m[1..] {
@@ -155,13 +162,15 @@ impl<const D: usize> NearCache<D> {
         {
             return None;
         }
-        for (b, block) in self.blocks.iter().enumerate() {
-            let d2 = block_dist_sq(p, block);
-            if let Some(k) = (0..LANES).find(|&k| d2[k] == best) {
-                return Some((d, self.get(b * LANES + k)));
-            }
+        // Each lane's index as a float (whole numbers far below 2^53: exact), the lanes not at
+        // the smallest value left at +inf, then one conversion of the smallest.
+        let mut first = f64::INFINITY;
+        for k in 0..LANES {
+            let index = at[k] * LANES as f64 + k as f64;
+            let index = if m[k] == best { index } else { f64::INFINITY };
+            first = if index < first { index } else { first };
         }
-        unreachable!("the minimum is one of the cached distances")
+        Some((d, self.get(first as usize)))
     }
 
     /// Whether the ball of radius `r` around `p` lies inside the cache's, so that
@@ -246,6 +255,12 @@ mod tests {
                 let exact = tree.nearest(&p).unwrap();
                 if let Some((d, x)) = near.nearest(&p) {
                     served += 1;
+                    // The first cached particle at the smallest squared distance.
+                    let first = (0..near.len())
+                        .map(|j| near.get(j))
+                        .min_by(|a, b| dist_sq(&p, a).total_cmp(&dist_sq(&p, b)))
+                        .unwrap();
+                    assert_eq!(x, first);
                     // The tree's exact value, bit for bit, and a stored point at it.
                     assert_eq!(d.to_bits(), exact.distance.to_bits());
                     assert_eq!(dist_sq(&p, &x).sqrt().to_bits(), d.to_bits());
@@ -281,6 +296,39 @@ mod tests {
     #[test]
     fn cache_answers_equal_the_tree_3d() {
         check::<3>(12);
+    }
+
+    /// Ties go to the first cached particle, whichever lane and block the others sit in.
+    #[test]
+    fn ties_go_to_the_first_cached_particle() {
+        let mut tree = Orthtree::<2>::with_leaf_side(8.0).unwrap();
+        // Twelve particles at distance exactly 1.25 from the origin (three blocks; the
+        // coordinates are exact in the tree's fixed point), then one farther.
+        let mut ring = Vec::new();
+        for (a, b) in [(0.75, 1.0), (1.0, 0.75), (1.25, 0.0)] {
+            for (sa, sb) in [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
+                let x = [sa * a, sb * b];
+                if !ring.contains(&x) {
+                    ring.push(x);
+                }
+            }
+        }
+        ring.push([-0.0, 1.25]);
+        ring.push([0.0, -1.25]);
+        ring.push([2.5, 2.5]);
+        for &x in &ring {
+            tree.insert(x).unwrap();
+        }
+        let mut near = NearCache::<2>::new();
+        near.rebuild(&tree, &[0.0, 0.0]);
+        assert_eq!(near.len(), ring.len());
+        let (d, x) = near.nearest(&[0.0, 0.0]).unwrap();
+        assert_eq!(d, 1.25);
+        let first = (0..near.len())
+            .map(|j| near.get(j))
+            .find(|y| dist_sq(&[0.0, 0.0], y) == 1.5625)
+            .unwrap();
+        assert_eq!(x, first);
     }
 
     #[test]
