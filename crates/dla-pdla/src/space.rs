@@ -28,7 +28,7 @@
 //! 4. check the orthtree's index limits against [`max_particles`](crate::params::max_particles).
 
 use crate::farfield::{
-    direction_3d, disk_direction, disk_point, return_to_circle, return_to_sphere_3d,
+    circle_direction, direction_3d, disk_point, return_to_circle, return_to_sphere_3d,
     return_to_sphere_nd,
 };
 use core_lattice::rng::{Rng, uniform01};
@@ -127,10 +127,10 @@ impl Space<2> for Dim<2> {
 
     const AXES: [&'static str; 2] = ["x", "y"];
 
-    /// The disk direction.
+    /// The circle direction ([`circle_direction`]: one draw, no rejection).
     #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 2] {
-        let (c, s) = disk_direction(rng);
+        let (c, s) = circle_direction(rng);
         [c, s]
     }
 
@@ -170,7 +170,7 @@ impl Space<3> for Dim<3> {
 
     const AXES: [&'static str; 3] = ["x", "y", "z"];
 
-    /// `z` uniform in `[-1, 1]` (Archimedes), then the azimuth from a disk direction.
+    /// `z` uniform in `[-1, 1]` (Archimedes), then the azimuth from a circle direction.
     #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 3] {
         direction_3d(rng)
