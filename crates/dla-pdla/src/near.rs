@@ -302,7 +302,7 @@ mod tests {
     #[test]
     fn ties_go_to_the_first_cached_particle() {
         let mut tree = Orthtree::<2>::with_leaf_side(8.0).unwrap();
-        // Twelve particles at distance exactly 1.25 from the origin (three blocks; the
+        // Twelve particles at distance exactly 1.25 from the origin (three blocks of four; the
         // coordinates are exact in the tree's fixed point), then one farther.
         let mut ring = Vec::new();
         for (a, b) in [(0.75, 1.0), (1.0, 0.75), (1.25, 0.0)] {
