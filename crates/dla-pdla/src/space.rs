@@ -127,7 +127,7 @@ impl Space<2> for Dim<2> {
 
     const AXES: [&'static str; 2] = ["x", "y"];
 
-    /// The circle direction ([`circle_direction`]: one draw, no rejection).
+    /// The circle direction (`circle_direction`: one draw, no rejection).
     #[inline(always)]
     fn direction<R: Rng + ?Sized>(rng: &mut R) -> [f64; 2] {
         let (c, s) = circle_direction(rng);
