@@ -71,7 +71,14 @@ impl<const D: usize> Cluster<D> {
                             .transpose()?,
                         Dim::<D>::MAP_LEVELS
                             .iter()
-                            .map(|&(cell, cap)| DistanceMap::new(cell, cap))
+                            .enumerate()
+                            .map(|(k, &(cell, cap))| {
+                                let map = DistanceMap::new(cell, cap)?;
+                                match Dim::<D>::MAP_SUB_BOXES.get(k) {
+                                    Some(&sub) if k > 0 && sub > 0 => map.with_sub_boxes(sub),
+                                    _ => Ok(map),
+                                }
+                            })
                             .collect::<Result<_, _>>()?,
                         params.leaf_side,
                     )
@@ -163,11 +170,16 @@ impl<const D: usize> Cluster<D> {
                 }
                 if let Some((fine, coarse)) = maps.levels.split_first_mut() {
                     insert_point(fine, &q, touched)?;
-                    // The coarser maps hold the boxes of the tree's leaves: lowered once, by
-                    // the first particle of a leaf, for every particle the leaf will hold.
+                    // The coarser maps hold the boxes of the tree's leaves (or the sub-boxes
+                    // of their cells that hold them): lowered once, by the first particle of
+                    // a leaf, for every particle the leaf will hold.
                     if new_leaf {
                         for map in coarse {
-                            map.insert_box(&lo, &hi)?;
+                            if map.sub_boxes() > 0 {
+                                map.insert_box_by_sub_box(&lo, &hi)?;
+                            } else {
+                                map.insert_box(&lo, &hi)?;
+                            }
                         }
                     }
                 }
@@ -222,7 +234,11 @@ impl<const D: usize> Cluster<D> {
             if new_leaf {
                 let (lo, hi) = self.leaf_box(q);
                 for map in coarse {
-                    map.insert_box_shared(&lo, &hi)?;
+                    if map.sub_boxes() > 0 {
+                        map.insert_box_by_sub_box_shared(&lo, &hi)?;
+                    } else {
+                        map.insert_box_shared(&lo, &hi)?;
+                    }
                 }
             }
         }

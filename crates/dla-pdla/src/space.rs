@@ -55,6 +55,14 @@ pub trait Space<const D: usize> {
     /// within the cap, so the cost of an insert grows like `(cap / cell)^D`.
     const MAP_LEVELS: &'static [(f64, f64)];
 
+    /// For each level of [`MAP_LEVELS`](Self::MAP_LEVELS) from the second on (the first is
+    /// lowered by every particle), how it is lowered: `0`, by the box of each new tree leaf;
+    /// `n`, by the sub-box of side `cell / n` of its cells that holds the new leaf, once per
+    /// sub-box ([`spatial::distmap::DistanceMap::insert_box_by_sub_box`]), when that side is
+    /// a whole number of leaf sides (otherwise by the leaf's box). Fewer, larger boxes: fewer
+    /// inserts, a bound looser by at most the sub-box's diagonal. Missing entries are `0`.
+    const MAP_SUB_BOXES: &'static [usize] = &[];
+
     /// A sparse fine map in front of [`MAP_LEVELS`](Self::MAP_LEVELS), as `(cell side, cap,
     /// block side in cells)` (diameters; see [`spatial::distmap::SparseDistanceMap`]), or
     /// `None`. Its bound lies within a small cell's diagonal of the distance, so walkers a few
@@ -115,6 +123,12 @@ impl Space<2> for Dim<2> {
         (256.0, 2048.0),
         (2048.0, 16384.0),
     ];
+
+    /// The two coarsest levels by sub-boxes of 32 and 256 diameters (8 a cell side): a new
+    /// leaf lowers them only when it is the first in such a box, and their bounds lose at
+    /// most an eighth of their cells' diagonal; the 64-diameter level keeps the leaves'
+    /// boxes (chosen by instruction counts, `docs/benchmarks.md`, "2D distance maps").
+    const MAP_SUB_BOXES: &'static [usize] = &[0, 0, 8, 8];
 
     /// Cells of 2 diameters capped at 8, in blocks of 16^2 cells (256 bytes, 32 diameters a
     /// side), allocated only near the cluster: about 2.4 bytes per particle. Walkers 3-8

@@ -22,13 +22,33 @@ where
     sim.run().unwrap();
     let cluster = sim.cluster();
     assert_eq!(cluster.maps().len(), Dim::<D>::MAP_LEVELS.len());
+    let pos = sim.positions().unwrap();
     if threads == 1 {
-        // The finest map holds every particle, the coarser ones the box of every leaf.
+        // The finest map holds every particle, the coarser ones the box of every leaf, or
+        // (2D's coarsest two) every sub-box of their cells that holds a leaf.
         assert_eq!(cluster.maps()[0].len(), n);
         let leaves = cluster.tree().leaf_count() as u64;
-        assert!(cluster.maps()[1..].iter().all(|m| m.len() == leaves));
+        let s = cluster.tree().leaf_side();
+        for m in &cluster.maps()[1..] {
+            let boxes = if m.sub_boxes() == 0 {
+                leaves
+            } else {
+                let side = m.cell_side() / m.sub_boxes() as f64;
+                let held: std::collections::HashSet<[i64; D]> = pos
+                    .iter()
+                    .map(|q| q.map(|x| (((x / s).floor() + 0.5) * s / side).floor() as i64))
+                    .collect();
+                assert!((held.len() as u64) < leaves);
+                held.len() as u64
+            };
+            assert_eq!(
+                m.len(),
+                boxes,
+                "{D}D: inserts into the map of {} cells",
+                m.cell_side()
+            );
+        }
     }
-    let pos = sim.positions().unwrap();
     // In 4D and 5D nearly all of a wide cube's volume lies in corners beyond the maps' reach
     // (which is at least their cap and cell beyond every particle).
     let r = sim.r_ext() + if D <= 3 { 80.0 } else { 10.0 };

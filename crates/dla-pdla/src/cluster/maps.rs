@@ -22,9 +22,10 @@ pub(super) struct Maps<const D: usize> {
     /// starts reading at that level.
     sure: Box<[f64]>,
     sure_sparse: f64,
-    /// What a coarse level's upper bound gains: those levels hold the boxes of the tree's
-    /// leaves, so the nearest particle may lie a leaf diagonal beyond the nearest box.
-    pub(super) leaf_diagonal: f64,
+    /// What a coarse level's upper bound gains (`box_diagonal[k]`, `k >= 1`): those levels
+    /// hold boxes (the tree's leaves, or the sub-boxes of their cells that hold them), so the
+    /// nearest particle may lie a box diagonal beyond the nearest box.
+    pub(super) box_diagonal: Box<[f64]>,
 }
 
 /// Where a walker's next map read starts ([`Cluster::map_bounds_from`]): the dense level its
@@ -75,6 +76,18 @@ impl<const D: usize> Maps<D> {
                 _ => reach(levels[k - 1].cap(), levels[k - 1].cell_side()),
             })
             .collect();
+        let box_diagonal = levels
+            .iter()
+            .map(|m| {
+                let sub = m.sub_boxes();
+                let side = if sub > 0 {
+                    leaf_side.max(m.cell_side() / sub as f64)
+                } else {
+                    leaf_side
+                };
+                side * (D as f64).sqrt() * (1.0 + 1e-12)
+            })
+            .collect();
         Maps {
             sure: levels
                 .iter()
@@ -86,7 +99,7 @@ impl<const D: usize> Maps<D> {
             sparse,
             levels,
             enough,
-            leaf_diagonal: leaf_side * (D as f64).sqrt() * (1.0 + 1e-12),
+            box_diagonal,
         }
     }
 }
@@ -216,13 +229,14 @@ impl<const D: usize> Cluster<D> {
     }
 
     /// Dense level `k`'s `(lower, upper, capped)` at `p` (a coarse level's upper bound widened
-    /// by a leaf diagonal: it holds the leaves' boxes), `None` where it does not hold `p`.
+    /// by a box diagonal: it holds boxes of particles, see `Maps::box_diagonal`), `None`
+    /// where it does not hold `p`.
     #[inline(always)]
     fn level_bounds(&self, k: usize, p: &[f64; D]) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
         let (lb, mut ub, capped) = maps.levels[k].bounds(p)?;
         if k > 0 {
-            ub += maps.leaf_diagonal;
+            ub += maps.box_diagonal[k];
         }
         Some((lb, ub, capped))
     }
@@ -393,7 +407,7 @@ mod tests {
         for (level, map) in c.maps.levels.iter().enumerate() {
             if let Some((lb, mut ub, capped)) = map.bounds(p) {
                 if level > 0 {
-                    ub += c.maps.leaf_diagonal;
+                    ub += c.maps.box_diagonal[level];
                 }
                 best = Some((lb, ub, capped));
                 if !capped {
@@ -406,6 +420,77 @@ mod tests {
             (None, Some(f)) => Some((f, f64::INFINITY, true)),
             (best, None) => best,
         }
+    }
+
+    /// Every coarse dense level's bounds against brute force on a cluster spread over
+    /// thousands of diameters (chains of touching particles from scattered seeds), so that
+    /// the 2D levels lowered by sub-boxes of 32 and 256 diameters hold many leaves per
+    /// sub-box and several sub-boxes per cell: where a level is not capped its lower bound
+    /// is at most the distance to the nearest particle and its upper bound (widened by the
+    /// level's box diagonal) at least that; capped, the lower bound still holds. The last
+    /// thousand particles lower the maps through `update_maps`, as PDLA does (a clone shares
+    /// them).
+    fn coarse_levels_hold<const D: usize>(seed: u64, spread: f64)
+    where
+        Dim<D>: Space<D>,
+    {
+        let mut rng = seed;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let params = Params {
+            dim: D,
+            ..Params::default()
+        };
+        let mut c = Cluster::<D>::new(&params).unwrap();
+        let mut pts: Vec<[f64; D]> = vec![c.insert([0.0; D]).unwrap()];
+        let mut shared = None;
+        for n in 1..3000 {
+            if n == 2000 {
+                c.reserve_maps(2.0 * spread).unwrap();
+                shared = Some(c.clone());
+            }
+            let p: [f64; D] = if n % 40 == 0 {
+                std::array::from_fn(|_| next() * spread)
+            } else {
+                let a = pts[pts.len() - 1 - (((next() + 1.0) * 4.0) as usize % pts.len())];
+                let u: [f64; D] = std::array::from_fn(|_| next());
+                let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
+                std::array::from_fn(|i| a[i] + u[i] / len)
+            };
+            pts.push(c.insert(p).unwrap());
+        }
+        assert!(
+            c.maps.levels.iter().skip(1).any(|m| m.sub_boxes() > 0) == (D == 2),
+            "the 2D coarse levels keep sub-boxes, the others leaf boxes"
+        );
+        for i in 0..1500 {
+            let reach = [spread, 4.0 * spread, 20.0 * spread][i % 3];
+            let probe: [f64; D] = std::array::from_fn(|_| next() * reach);
+            let d = pts
+                .iter()
+                .map(|q| spatial::orthtree::dist_sq(q, &probe).sqrt())
+                .fold(f64::INFINITY, f64::min);
+            for k in 1..c.maps.levels.len() {
+                if let Some((lb, ub, capped)) = c.level_bounds(k, &probe) {
+                    assert!(lb <= d, "{D}D level {k}: bound {lb} above the distance {d}");
+                    assert!(
+                        capped || ub >= d,
+                        "{D}D level {k}: upper bound {ub} below the distance {d}"
+                    );
+                }
+            }
+        }
+        drop(shared);
+    }
+
+    #[test]
+    fn coarse_levels_hold_on_a_wide_cluster() {
+        coarse_levels_hold::<2>(0x51_7cc1_b727, 3000.0);
+        coarse_levels_hold::<3>(0x2545_f491, 400.0);
     }
 
     #[test]

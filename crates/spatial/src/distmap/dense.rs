@@ -5,7 +5,7 @@ use super::grid::Grid;
 use super::{CAPPED, Cells, DistanceMapError, PointMap, finite_max_norm, next_row};
 use crate::round::{ceil, floor, whole_to_usize};
 use std::fmt;
-use std::sync::atomic::{AtomicU8, Ordering};
+use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
 
 /// The coarse distance map (see the [module docs](super)).
 pub struct DistanceMap<const D: usize> {
@@ -18,6 +18,12 @@ pub struct DistanceMap<const D: usize> {
     /// One byte per cell, axis 0 fastest. Atomic so that PDLA threads can share one map
     /// ([`DistanceMap::insert_shared`]); relaxed loads and stores are plain moves.
     pub(super) values: Vec<AtomicU8>,
+    /// Sub-boxes per axis of a cell for
+    /// [`insert_box_by_sub_box`](DistanceMap::insert_box_by_sub_box) (0: none kept).
+    sub: usize,
+    /// With `sub > 0`, one word per cell (indexed as `values`): bit `j` set once the cell's
+    /// sub-box `j` (`j = sum_i j_i sub^i`) has been inserted.
+    seen: Vec<AtomicU64>,
 }
 
 impl<const D: usize> Clone for DistanceMap<D> {
@@ -30,6 +36,12 @@ impl<const D: usize> Clone for DistanceMap<D> {
                 .values
                 .iter()
                 .map(|v| AtomicU8::new(v.load(Ordering::Relaxed)))
+                .collect(),
+            sub: self.sub,
+            seen: self
+                .seen
+                .iter()
+                .map(|v| AtomicU64::new(v.load(Ordering::Relaxed)))
                 .collect(),
         }
     }
@@ -55,7 +67,131 @@ impl<const D: usize> DistanceMap<D> {
             side: 0,
             side_f: 0.0,
             values: Vec::new(),
+            sub: 0,
+            seen: Vec::new(),
         })
+    }
+
+    /// The same map, keeping track of which of the `sub^D` equal sub-boxes of each cell
+    /// have been inserted by [`insert_box_by_sub_box`](Self::insert_box_by_sub_box) (8 bytes
+    /// more per cell). `sub^D` must not exceed 64, and the map must be empty.
+    pub fn with_sub_boxes(mut self, sub: usize) -> Result<Self, DistanceMapError> {
+        let fits = sub >= 1 && sub.checked_pow(D as u32).is_some_and(|n| n <= 64);
+        if !fits || self.side > 0 {
+            return Err(DistanceMapError::SubBoxes(sub));
+        }
+        self.sub = sub;
+        Ok(self)
+    }
+
+    /// Sub-boxes per axis of a cell kept by [`with_sub_boxes`](Self::with_sub_boxes) (0 when
+    /// not kept).
+    pub fn sub_boxes(&self) -> usize {
+        self.sub
+    }
+
+    /// Adds the box `[lo, hi]` as the sub-box of a cell ([`with_sub_boxes`](Self::with_sub_boxes))
+    /// that contains it, unless that sub-box was inserted before; `true` when the map was
+    /// lowered now. A caller that adds small boxes this way (DLA: the boxes of its tree's
+    /// leaves) inserts each sub-box once, whatever number of boxes it holds: the map stays a
+    /// lower bound, looser by at most a sub-box's diagonal. Sub-boxes are the closed boxes of
+    /// side `cell / sub` aligned on the cells (`[k c, (k + 1) c)` along each axis); a box that
+    /// does not lie inside one is inserted by itself, as [`insert_box`](Self::insert_box) does.
+    /// Fails like [`insert_box`](Self::insert_box), and with [`DistanceMapError::SubBoxes`]
+    /// on a map that keeps none.
+    pub fn insert_box_by_sub_box(
+        &mut self,
+        lo: &[f64; D],
+        hi: &[f64; D],
+    ) -> Result<bool, DistanceMapError> {
+        let Some((slo, shi)) = self.sub_box(lo, hi)? else {
+            self.insert_box(lo, hi)?;
+            return Ok(true);
+        };
+        let need =
+            finite_max_norm(&slo)?.max(finite_max_norm(&shi)?) + self.grid.cap + self.grid.cell;
+        if need >= self.reach() {
+            self.grow(need)?;
+        }
+        let (word, bit) = self.sub_bit(&slo);
+        let word = word.expect("the map covers the sub-box after growing");
+        let seen = self.seen[word].get_mut();
+        if *seen & bit != 0 {
+            return Ok(false);
+        }
+        *seen |= bit;
+        self.grid.points += 1;
+        self.lower_box_rows(&slo, &shi, Self::keep_nearer);
+        Ok(true)
+    }
+
+    /// [`insert_box_by_sub_box`](Self::insert_box_by_sub_box) through a shared reference, as
+    /// [`insert_box_shared`](Self::insert_box_shared) is to [`insert_box`](Self::insert_box):
+    /// the sub-box's bit is set with an atomic `fetch_or`, so that of several threads adding
+    /// boxes of one sub-box exactly one inserts it; no growth. Returns `(lowered now,
+    /// inside)`, `inside` as [`insert_box_shared`](Self::insert_box_shared) returns it; a
+    /// sub-box whose cell lies outside the map is inserted every time (its bit cannot be
+    /// kept).
+    pub fn insert_box_by_sub_box_shared(
+        &self,
+        lo: &[f64; D],
+        hi: &[f64; D],
+    ) -> Result<(bool, bool), DistanceMapError> {
+        let Some((slo, shi)) = self.sub_box(lo, hi)? else {
+            return Ok((true, self.insert_box_shared(lo, hi)?));
+        };
+        if let (Some(word), bit) = self.sub_bit(&slo)
+            && self.seen[word].fetch_or(bit, Ordering::Relaxed) & bit != 0
+        {
+            return Ok((false, true));
+        }
+        Ok((true, self.insert_box_shared(&slo, &shi)?))
+    }
+
+    /// The closed sub-box of a cell that holds the box `[lo, hi]` (found from its centre), as
+    /// `(lo, hi)`, or `None` when the box does not lie inside one.
+    #[allow(clippy::type_complexity)]
+    fn sub_box(
+        &self,
+        lo: &[f64; D],
+        hi: &[f64; D],
+    ) -> Result<Option<([f64; D], [f64; D])>, DistanceMapError> {
+        if self.sub == 0 {
+            return Err(DistanceMapError::SubBoxes(0));
+        }
+        finite_max_norm(lo)?;
+        finite_max_norm(hi)?;
+        let g = &self.grid;
+        let side = g.cell / self.sub as f64;
+        let mut slo = [0.0; D];
+        let mut shi = [0.0; D];
+        for i in 0..D {
+            let m = floor(0.5 * (lo[i] + hi[i]) / side);
+            slo[i] = m * side;
+            shi[i] = slo[i] + side;
+            if !(slo[i] <= lo[i] && hi[i] <= shi[i]) {
+                return Ok(None);
+            }
+        }
+        Ok(Some((slo, shi)))
+    }
+
+    /// The word of `seen` for the cell holding the sub-box with lower corner `slo` (`None`
+    /// outside the map) and the sub-box's bit.
+    fn sub_bit(&self, slo: &[f64; D]) -> (Option<usize>, u64) {
+        let side = self.grid.cell / self.sub as f64;
+        // The sub-box's centre, half its side from the boundaries of the cell's sub-boxes, so
+        // that rounding cannot place it in another.
+        let c: [f64; D] = std::array::from_fn(|i| slo[i] + 0.5 * side);
+        let mut j = 0usize;
+        let mut stride = 1usize;
+        for x in c {
+            let k = floor(x * self.grid.inv_cell);
+            let ji = floor((x - k * self.grid.cell) / side).clamp(0.0, (self.sub - 1) as f64);
+            j += ji as usize * stride;
+            stride *= self.sub;
+        }
+        (self.index(&c).map(|(i, _)| i), 1u64 << j)
     }
 
     /// The cell index of `p`, or `None` outside the map.
@@ -180,10 +316,34 @@ impl<const D: usize> DistanceMap<D> {
     }
 }
 
+impl<const D: usize> DistanceMap<D> {
+    /// Calls `copy(new, old)` for every cell of the map with its index `old` here and `new`
+    /// in a grown array of `side` cells per axis centred the same way (`half` its half side),
+    /// the old cells in its middle.
+    fn copy_rows(&self, side: usize, half: i64, mut copy: impl FnMut(usize, usize)) {
+        let off = (half - self.grid.half) as usize;
+        // Old rows (along axis 0) in order.
+        let rows = self.side.pow(D as u32 - 1);
+        for r in 0..rows {
+            let mut rem = r;
+            let mut base = off;
+            let mut stride = side;
+            for _ in 1..D {
+                base += (rem % self.side + off) * stride;
+                rem /= self.side;
+                stride *= side;
+            }
+            for j in 0..self.side {
+                copy(base + j, r * self.side + j);
+            }
+        }
+    }
+}
+
 impl<const D: usize> PointMap<D> for DistanceMap<D> {
     /// Heap bytes held (one byte per cell, counting the vector's capacity).
     fn memory_bytes(&self) -> usize {
-        self.values.capacity()
+        self.values.capacity() + self.seen.capacity() * size_of::<AtomicU64>()
     }
 
     fn value(&self, p: &[f64; D]) -> Option<u8> {
@@ -252,25 +412,23 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
             })?;
         values.extend((0..total as usize).map(|_| AtomicU8::new(CAPPED)));
         if self.side > 0 {
-            let off = (half - self.grid.half) as usize;
-            // Copy old rows (along axis 0) into the new array.
-            let rows = self.side.pow(D as u32 - 1);
-            for r in 0..rows {
-                let mut rem = r;
-                let mut base = off;
-                let mut stride = side;
-                for _ in 1..D {
-                    base += (rem % self.side + off) * stride;
-                    rem /= self.side;
-                    stride *= side;
-                }
-                for (new, old) in values[base..base + self.side]
-                    .iter_mut()
-                    .zip(&self.values[r * self.side..(r + 1) * self.side])
-                {
-                    *new.get_mut() = old.load(Ordering::Relaxed);
-                }
+            self.copy_rows(side, half, |new, old| {
+                *values[new].get_mut() = self.values[old].load(Ordering::Relaxed);
+            });
+        }
+        if self.sub > 0 {
+            let mut seen: Vec<AtomicU64> = Vec::new();
+            seen.try_reserve_exact(total as usize)
+                .map_err(|_| DistanceMapError::Alloc {
+                    bytes: total as u64 * 8,
+                })?;
+            seen.extend((0..total as usize).map(|_| AtomicU64::new(0)));
+            if self.side > 0 {
+                self.copy_rows(side, half, |new, old| {
+                    *seen[new].get_mut() = self.seen[old].load(Ordering::Relaxed);
+                });
             }
+            self.seen = seen;
         }
         self.values = values;
         self.grid.set_half(half);

@@ -93,6 +93,12 @@ pub enum DistanceMapError {
         /// Cells per axis that were needed.
         cells_per_axis: f64,
     },
+    /// Sub-boxes per axis that a map cannot keep: 0, more than 64 per cell in all, or asked
+    /// of a map that already holds cells.
+    #[error(
+        "{0} sub-boxes per axis cannot be kept; expected at least 1, at most 64 per cell, on an empty map"
+    )]
+    SubBoxes(usize),
     /// The system refused the memory of the map's cells.
     #[error("cannot allocate {bytes} bytes for the distance map")]
     Alloc {

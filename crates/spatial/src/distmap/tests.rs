@@ -424,3 +424,160 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
     sparse::<3>(2.0, 8.0, 6);
     sparse::<2>(2.0, 8.0, 7);
 }
+
+/// Boxes added by the sub-boxes that hold them ([`DistanceMap::insert_box_by_sub_box`]), as
+/// DLA adds its leaves' boxes to the coarse maps: each sub-box is inserted by its first box
+/// only, the map then holds the bytes of a map given those sub-boxes by `insert_box` (and a
+/// box across sub-boxes by itself), through growth in the middle; its bounds hold against
+/// brute force over points in the boxes, looser by at most a sub-box's diagonal; and two
+/// threads adding every box through the shared insert lower each sub-box exactly once, to
+/// the same bytes.
+fn check_sub_boxes<const D: usize>(cell: f64, cap: f64, sub: usize, leaf: f64, seed: u64) {
+    let mut next = uniform(seed);
+    let mut by_sub = DistanceMap::<D>::new(cell, cap)
+        .unwrap()
+        .with_sub_boxes(sub)
+        .unwrap();
+    let mut reference = DistanceMap::<D>::new(cell, cap).unwrap();
+    let side = cell / sub as f64;
+    let mut seen = std::collections::HashSet::new();
+    let mut boxes = Vec::new();
+    let mut pts = Vec::new();
+    for n in 0..400 {
+        // Spreading outwards, so that the map grows while it holds sub-boxes.
+        let r = 3.0 * leaf + n as f64 * cell / 40.0;
+        let p: [f64; D] = std::array::from_fn(|_| (2.0 * next() - 1.0) * r);
+        let lo = p.map(|x| (x / leaf).floor() * leaf);
+        let hi = lo.map(|x| x + leaf);
+        let key = lo.map(|x| ((x + 0.5 * leaf) / side).floor() as i64);
+        let first = seen.insert(key);
+        assert_eq!(by_sub.insert_box_by_sub_box(&lo, &hi).unwrap(), first);
+        if first {
+            let slo = key.map(|k| k as f64 * side);
+            reference.insert_box(&slo, &slo.map(|x| x + side)).unwrap();
+        }
+        boxes.push((lo, hi));
+        pts.push(p);
+        pts.push(hi.map(|x| x - 1e-9));
+    }
+    assert_eq!(bytes(&by_sub), bytes(&reference));
+    // A box across a sub-box boundary is inserted by itself, every time.
+    let mut lo = [0.25 * side; D];
+    lo[0] = side - 0.5 * leaf;
+    let hi = lo.map(|x| x + leaf);
+    for _ in 0..2 {
+        assert!(by_sub.insert_box_by_sub_box(&lo, &hi).unwrap());
+    }
+    reference.insert_box(&lo, &hi).unwrap();
+    assert_eq!(bytes(&by_sub), bytes(&reference));
+    pts.push(lo);
+    pts.push(hi);
+    let diag = side * (D as f64).sqrt();
+    for _ in 0..400 {
+        let r = 1.5 * (3.0 * leaf + 400.0 * cell / 40.0) + cap;
+        let p: [f64; D] = std::array::from_fn(|_| (2.0 * next() - 1.0) * r);
+        let d = brute(&pts, &p);
+        if let Some((lb, ub, _)) = by_sub.bounds(&p) {
+            assert!(lb <= d, "bound {lb} above the distance {d} at {p:?}");
+            assert!(
+                ub + diag >= d,
+                "upper bound {ub} + {diag} below {d} at {p:?}"
+            );
+        } else {
+            assert!(d > cap, "{p:?} outside the map but near");
+        }
+    }
+    // Shared: two threads, each adding every box; each sub-box lowered exactly once.
+    let mut shared = DistanceMap::<D>::new(cell, cap)
+        .unwrap()
+        .with_sub_boxes(sub)
+        .unwrap();
+    shared.reserve(by_sub.reach()).unwrap();
+    let lowered = std::sync::atomic::AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for t in 0..2 {
+            let (shared, boxes, lowered) = (&shared, &boxes, &lowered);
+            s.spawn(move || {
+                let order: Vec<_> = if t == 0 {
+                    boxes.iter().collect()
+                } else {
+                    boxes.iter().rev().collect()
+                };
+                for (lo, hi) in order {
+                    let (now, inside) = shared.insert_box_by_sub_box_shared(lo, hi).unwrap();
+                    assert!(inside);
+                    if now {
+                        lowered.fetch_add(1, Ordering::Relaxed);
+                    }
+                }
+            });
+        }
+    });
+    assert_eq!(lowered.load(Ordering::Relaxed), seen.len());
+    let mut exclusive = DistanceMap::<D>::new(cell, cap)
+        .unwrap()
+        .with_sub_boxes(sub)
+        .unwrap();
+    exclusive.reserve(by_sub.reach()).unwrap();
+    for (lo, hi) in &boxes {
+        exclusive.insert_box_by_sub_box(lo, hi).unwrap();
+    }
+    assert_eq!(bytes(&shared), bytes(&exclusive));
+}
+
+#[test]
+fn sub_boxes_are_inserted_once_and_keep_the_bound() {
+    // The 2D `dla` shapes (sub-boxes of 32 and 256 diameters, leaves of 4), odd ones, 3D.
+    check_sub_boxes::<2>(256.0, 2048.0, 8, 4.0, 1);
+    check_sub_boxes::<2>(2048.0, 16384.0, 8, 4.0, 2);
+    check_sub_boxes::<2>(64.0, 512.0, 4, 8.0, 3);
+    check_sub_boxes::<2>(24.0, 96.0, 3, 2.0, 4);
+    check_sub_boxes::<3>(32.0, 128.0, 4, 4.0, 5);
+    check_sub_boxes::<3>(16.0, 64.0, 2, 8.0, 6);
+}
+
+#[test]
+fn sub_boxes_are_refused_where_they_cannot_be_kept() {
+    let refused = |r: Result<DistanceMap<2>, DistanceMapError>| {
+        matches!(r.unwrap_err(), DistanceMapError::SubBoxes(_))
+    };
+    assert!(refused(
+        DistanceMap::<2>::new(8.0, 32.0).unwrap().with_sub_boxes(0)
+    ));
+    assert!(refused(
+        DistanceMap::<2>::new(8.0, 32.0).unwrap().with_sub_boxes(9)
+    ));
+    assert!(
+        DistanceMap::<2>::new(8.0, 32.0)
+            .unwrap()
+            .with_sub_boxes(8)
+            .is_ok()
+    );
+    assert!(
+        DistanceMap::<3>::new(8.0, 32.0)
+            .unwrap()
+            .with_sub_boxes(4)
+            .is_ok()
+    );
+    assert!(matches!(
+        DistanceMap::<3>::new(8.0, 32.0)
+            .unwrap()
+            .with_sub_boxes(5)
+            .unwrap_err(),
+        DistanceMapError::SubBoxes(5)
+    ));
+    let mut map = DistanceMap::<2>::new(8.0, 32.0).unwrap();
+    map.insert(&[0.0, 0.0]).unwrap();
+    assert!(refused(map.with_sub_boxes(2)));
+    // A map without sub-boxes refuses the sub-box inserts.
+    let mut plain = DistanceMap::<2>::new(8.0, 32.0).unwrap();
+    assert!(matches!(
+        plain.insert_box_by_sub_box(&[0.0; 2], &[1.0; 2]),
+        Err(DistanceMapError::SubBoxes(0))
+    ));
+    assert!(
+        plain
+            .insert_box_by_sub_box_shared(&[0.0; 2], &[1.0; 2])
+            .is_err()
+    );
+}
