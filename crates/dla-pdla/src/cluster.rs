@@ -175,11 +175,7 @@ impl<const D: usize> Cluster<D> {
                     // a leaf, for every particle the leaf will hold.
                     if new_leaf {
                         for map in coarse {
-                            if map.sub_boxes() > 0 {
-                                map.insert_box_by_sub_box(&lo, &hi)?;
-                            } else {
-                                map.insert_box(&lo, &hi)?;
-                            }
+                            insert_leaf_box(map, &lo, &hi)?;
                         }
                     }
                 }
@@ -234,11 +230,7 @@ impl<const D: usize> Cluster<D> {
             if new_leaf {
                 let (lo, hi) = self.leaf_box(q);
                 for map in coarse {
-                    if map.sub_boxes() > 0 {
-                        map.insert_box_by_sub_box_shared(&lo, &hi)?;
-                    } else {
-                        map.insert_box_shared(&lo, &hi)?;
-                    }
+                    insert_leaf_box_shared(map, &lo, &hi)?;
                 }
             }
         }
@@ -326,6 +318,35 @@ fn insert_point_shared<const D: usize>(
         Some(t) => map.insert_shared_beside(q, t)?,
         None => map.insert_shared(q)?,
     };
+    Ok(())
+}
+
+/// Lowers a coarse map by a new leaf's box `[lo, hi]`: by the sub-box holding it, once per
+/// sub-box, where the map keeps sub-boxes (`Space::MAP_SUB_BOXES`), else by the box itself.
+fn insert_leaf_box<const D: usize>(
+    map: &mut DistanceMap<D>,
+    lo: &[f64; D],
+    hi: &[f64; D],
+) -> Result<(), DistanceMapError> {
+    if map.sub_boxes() > 0 {
+        map.insert_box_by_sub_box(lo, hi)?;
+    } else {
+        map.insert_box(lo, hi)?;
+    }
+    Ok(())
+}
+
+/// [`insert_leaf_box`] through a shared reference, while other threads read and insert (PDLA).
+fn insert_leaf_box_shared<const D: usize>(
+    map: &DistanceMap<D>,
+    lo: &[f64; D],
+    hi: &[f64; D],
+) -> Result<(), DistanceMapError> {
+    if map.sub_boxes() > 0 {
+        map.insert_box_by_sub_box_shared(lo, hi)?;
+    } else {
+        map.insert_box_shared(lo, hi)?;
+    }
     Ok(())
 }
 

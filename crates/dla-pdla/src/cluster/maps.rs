@@ -299,6 +299,39 @@ mod tests {
     use crate::params::Params;
     use crate::space::{Dim, Space};
 
+    /// Uniform numbers in `[-1, 1)` from a xorshift generator seeded with `seed` (non-zero).
+    fn signed_uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut rng = seed;
+        move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
+    /// A cluster of the default parameters in `D` dimensions holding one particle at the
+    /// origin, and the stored positions.
+    fn seeded_cluster<const D: usize>() -> (Cluster<D>, Vec<[f64; D]>)
+    where
+        Dim<D>: Space<D>,
+    {
+        let params = Params {
+            dim: D,
+            ..Params::default()
+        };
+        let mut c = Cluster::<D>::new(&params).unwrap();
+        let first = c.insert([0.0; D]).unwrap();
+        (c, vec![first])
+    }
+
+    /// A point one diameter from `a` in a random direction from `next` (as DLA's chains grow).
+    fn touching<const D: usize>(a: &[f64; D], next: &mut impl FnMut() -> f64) -> [f64; D] {
+        let u: [f64; D] = std::array::from_fn(|_| next());
+        let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
+        std::array::from_fn(|i| a[i] + u[i] / len)
+    }
+
     /// The maps' bounds against brute force over random clusters (chains of touching
     /// particles from the origin, as DLA grows them, plus scattered ones) and random probes,
     /// in 2D to 5D: the lower bound never exceeds the exact distance to the nearest stored
@@ -309,19 +342,8 @@ mod tests {
     where
         Dim<D>: Space<D>,
     {
-        let mut rng = seed;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        let params = Params {
-            dim: D,
-            ..Params::default()
-        };
-        let mut c = Cluster::<D>::new(&params).unwrap();
-        let mut pts: Vec<[f64; D]> = vec![c.insert([0.0; D]).unwrap()];
+        let mut next = signed_uniform(seed);
+        let (mut c, mut pts) = seeded_cluster::<D>();
         let mut keep = None;
         for n in 1..400 {
             if n == 250 {
@@ -333,9 +355,7 @@ mod tests {
                 std::array::from_fn(|_| next() * 25.0)
             } else {
                 let a = pts[((next() + 1.0) * 0.5 * pts.len() as f64) as usize % pts.len()];
-                let u: [f64; D] = std::array::from_fn(|_| next());
-                let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
-                std::array::from_fn(|i| a[i] + u[i] / len)
+                touching(&a, &mut next)
             };
             pts.push(c.insert(p).unwrap());
             if n % 50 == 49 {
@@ -434,19 +454,8 @@ mod tests {
     where
         Dim<D>: Space<D>,
     {
-        let mut rng = seed;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
-            (rng >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
-        let params = Params {
-            dim: D,
-            ..Params::default()
-        };
-        let mut c = Cluster::<D>::new(&params).unwrap();
-        let mut pts: Vec<[f64; D]> = vec![c.insert([0.0; D]).unwrap()];
+        let mut next = signed_uniform(seed);
+        let (mut c, mut pts) = seeded_cluster::<D>();
         let mut shared = None;
         for n in 1..3000 {
             if n == 2000 {
@@ -457,9 +466,7 @@ mod tests {
                 std::array::from_fn(|_| next() * spread)
             } else {
                 let a = pts[pts.len() - 1 - (((next() + 1.0) * 4.0) as usize % pts.len())];
-                let u: [f64; D] = std::array::from_fn(|_| next());
-                let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
-                std::array::from_fn(|i| a[i] + u[i] / len)
+                touching(&a, &mut next)
             };
             pts.push(c.insert(p).unwrap());
         }
