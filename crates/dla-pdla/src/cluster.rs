@@ -22,8 +22,8 @@ use std::sync::Arc;
 
 mod maps;
 mod window;
-pub(crate) use maps::MapLevel;
 use maps::Maps;
+pub(crate) use maps::{MapBall, MapLevel};
 use window::Window;
 
 /// The cluster: its orthtree and, when `params.distance_map` is on, the distance maps.

@@ -295,6 +295,76 @@ pub fn return_to_sphere_nd<const D: usize, R: Rng + ?Sized>(
     }
 }
 
+/// 2D: where Brownian motion from `p`, inside the disk of radius `big_r` around `c`
+/// (`|p - c| < big_r`), first leaves it. The harmonic measure of the disk seen from `p` is the
+/// image of the uniform one seen from its centre under the disk automorphism that takes the
+/// centre to `p` (conformal invariance): with `z = (p - c) / big_r` and `w` a uniform point of
+/// the unit circle ([`circle_direction`]), the exit point is `c + big_r (w + z) / (1 + conj(z) w)`.
+#[inline(always)]
+pub(crate) fn exit_disk<R: Rng + ?Sized>(
+    p: &[f64; 2],
+    c: &[f64; 2],
+    big_r: f64,
+    rng: &mut R,
+) -> [f64; 2] {
+    let (wx, wy) = circle_direction(rng);
+    let inv = 1.0 / big_r;
+    let (zx, zy) = ((p[0] - c[0]) * inv, (p[1] - c[1]) * inv);
+    // (w + z) / (1 + conj(z) w), as (w + z) conj(den) / |den|^2.
+    let (nx, ny) = (wx + zx, wy + zy);
+    let (dx, dy) = (1.0 + zx * wx + zy * wy, zx * wy - zy * wx);
+    let k = big_r / (dx * dx + dy * dy);
+    [
+        c[0] + k * (nx * dx + ny * dy),
+        c[1] + k * (ny * dx - nx * dy),
+    ]
+}
+
+/// 3D: where Brownian motion from `p`, inside the ball of radius `big_r` around `c`
+/// (`r = |p - c| < big_r`), first leaves it. The exit density on the sphere is proportional to
+/// `|y - p|^-3` (the interior Poisson kernel), so the distance `s = |y - p|` has `1 / s`
+/// uniform between `1 / (R + r)` and `1 / (R - r)` (as for [`return_cosine_3d`]); written with
+/// `a = R - r`, `b = R + r`, `t = a + 2 r xi` (`xi` uniform), the cosine `u` of the exit point's
+/// angle from `p - c` has `1 - u = a^2 (1 - xi)(b + t) / (R t^2)` and
+/// `1 + u = b^2 xi (t + a) / (R t^2)`, free of cancellation and of any division by `r` (at
+/// `r = 0`, `u = 2 xi - 1`, uniform); the azimuth is uniform ([`circle_direction`]), about a
+/// frame built without square roots (Duff et al., "Building an orthonormal basis, revisited",
+/// 2017).
+#[inline(always)]
+pub(crate) fn exit_ball_3d<R: Rng + ?Sized>(
+    p: &[f64; 3],
+    c: &[f64; 3],
+    big_r: f64,
+    rng: &mut R,
+) -> [f64; 3] {
+    let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+    let r = norm(&d);
+    let xi = uniform01(rng);
+    let (a, b) = (big_r - r, big_r + r);
+    let t = a + 2.0 * r * xi;
+    let k = 1.0 / (big_r * t * t);
+    let one_minus_u = a * a * (1.0 - xi) * (b + t) * k;
+    let one_plus_u = b * b * xi * (t + a) * k;
+    let u = if one_minus_u < one_plus_u {
+        1.0 - one_minus_u
+    } else {
+        one_plus_u - 1.0
+    };
+    let sin_t = (one_minus_u * one_plus_u).max(0.0).sqrt();
+    let e = if r > 0.0 {
+        scale(d, 1.0 / r)
+    } else {
+        [0.0, 0.0, 1.0]
+    };
+    let sign = 1.0f64.copysign(e[2]);
+    let g = -1.0 / (sign + e[2]);
+    let h = e[0] * e[1] * g;
+    let v1 = [1.0 + sign * e[0] * e[0] * g, sign * h, -sign * e[0]];
+    let v2 = [h, sign + e[1] * e[1] * g, -e[1]];
+    let (ca, sa) = circle_direction(rng);
+    std::array::from_fn(|i| c[i] + big_r * (u * e[i] + sin_t * (ca * v1[i] + sa * v2[i])))
+}
+
 /// Euclidean norm.
 #[inline]
 pub fn norm<const D: usize>(p: &[f64; D]) -> f64 {
@@ -396,5 +466,92 @@ mod tests {
             .sum();
         // 1 023 degrees of freedom: mean 1 023, standard deviation 45; 5.5 of them above.
         assert!(chi2 < 1023.0 + 5.5 * 45.2, "chi-square {chi2}");
+    }
+
+    /// Harmonic functions keep their value in expectation at the exit point (the exit law is
+    /// the harmonic measure): means over many exits against the value at the start.
+    #[test]
+    fn exits_keep_harmonic_functions_in_mean() {
+        let mut rng = core_lattice::stream(11, 0);
+        let n = 2_000_000;
+        // 2D: the disk of radius 3 about c, from points at 0, 0.5 and 0.97 of the radius.
+        let c = [10.25, -3.5];
+        for f in [0.0, 0.5, 0.97] {
+            let p = [c[0] + 3.0 * f * 0.6, c[1] + 3.0 * f * 0.8];
+            let a = [c[0] + 4.0, c[1] + 1.0];
+            let h = |y: &[f64; 2]| {
+                [
+                    y[0],
+                    y[1],
+                    (y[0] - c[0]).powi(2) - (y[1] - c[1]).powi(2),
+                    ((y[0] - a[0]).powi(2) + (y[1] - a[1]).powi(2)).ln(),
+                ]
+            };
+            let mut sum = [0.0; 4];
+            let mut sq = [0.0; 4];
+            for _ in 0..n {
+                let y = exit_disk(&p, &c, 3.0, &mut rng);
+                let r = ((y[0] - c[0]).powi(2) + (y[1] - c[1]).powi(2)).sqrt();
+                assert!((r - 3.0).abs() < 1e-12, "off the circle: {r}");
+                for (k, v) in h(&y).iter().enumerate() {
+                    sum[k] += v;
+                    sq[k] += v * v;
+                }
+            }
+            let want = h(&p);
+            for k in 0..4 {
+                let mean = sum[k] / n as f64;
+                let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
+                assert!(
+                    (mean - want[k]).abs() < 5.0 * sd + 1e-12,
+                    "2D f {f} h{k}: {mean} against {} (sd {sd})",
+                    want[k]
+                );
+            }
+        }
+        // 3D: the ball of radius 2 about c.
+        let c = [-1.0, 4.5, 0.25];
+        for f in [0.0, 0.3, 0.9, 0.995] {
+            let dir = [0.36, -0.48, 0.8];
+            let p = [
+                c[0] + 2.0 * f * dir[0],
+                c[1] + 2.0 * f * dir[1],
+                c[2] + 2.0 * f * dir[2],
+            ];
+            let a = [c[0] - 1.0, c[1] + 2.5, c[2] + 0.5];
+            let h = |y: &[f64; 3]| {
+                let (x, yy, z) = (y[0] - c[0], y[1] - c[1], y[2] - c[2]);
+                [
+                    x,
+                    yy,
+                    z,
+                    x * yy,
+                    x * x - z * z,
+                    1.0 / ((y[0] - a[0]).powi(2) + (y[1] - a[1]).powi(2) + (y[2] - a[2]).powi(2))
+                        .sqrt(),
+                ]
+            };
+            let mut sum = [0.0; 6];
+            let mut sq = [0.0; 6];
+            for _ in 0..n {
+                let y = exit_ball_3d(&p, &c, 2.0, &mut rng);
+                let r = norm(&[y[0] - c[0], y[1] - c[1], y[2] - c[2]]);
+                assert!((r - 2.0).abs() < 1e-12, "off the sphere: {r}");
+                for (k, v) in h(&y).iter().enumerate() {
+                    sum[k] += v;
+                    sq[k] += v * v;
+                }
+            }
+            let want = h(&p);
+            for k in 0..6 {
+                let mean = sum[k] / n as f64;
+                let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
+                assert!(
+                    (mean - want[k]).abs() < 5.0 * sd + 1e-12,
+                    "3D f {f} h{k}: {mean} against {} (sd {sd})",
+                    want[k]
+                );
+            }
+        }
     }
 }

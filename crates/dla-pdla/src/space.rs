@@ -28,8 +28,8 @@
 //! 4. check the orthtree's index limits against [`max_particles`](crate::params::max_particles).
 
 use crate::farfield::{
-    circle_direction, direction_3d, disk_point, return_to_circle, return_to_sphere_3d,
-    return_to_sphere_nd,
+    circle_direction, direction_3d, disk_point, exit_ball_3d, exit_disk, return_to_circle,
+    return_to_sphere_3d, return_to_sphere_nd,
 };
 use core_lattice::rng::{Rng, uniform01};
 
@@ -85,6 +85,20 @@ pub trait Space<const D: usize> {
     /// found: where Brownian motion from `p` first hits the sphere (harmonic measure), or a
     /// uniform point if it escapes to infinity.
     fn return_to_sphere<R: Rng + ?Sized>(p: &[f64; D], big_r: f64, rng: &mut R) -> [f64; D];
+
+    /// Where Brownian motion from `p`, inside the ball of radius `big_r` around `c`
+    /// (`|p - c| < big_r`), first leaves it (harmonic measure of the ball seen from `p`), or
+    /// `None` (nothing drawn) where this dimension has no sampler: then the walker jumps by
+    /// the ball of `p`'s own bound instead.
+    #[inline(always)]
+    fn exit_ball<R: Rng + ?Sized>(
+        _p: &[f64; D],
+        _c: &[f64; D],
+        _big_r: f64,
+        _rng: &mut R,
+    ) -> Option<[f64; D]> {
+        None
+    }
 
     /// A generous estimate of `R_ext` for a cluster of `n` particles, for sizing PDLA's shared
     /// distance maps up front. A cluster that outgrows it only loses the maps' help at its rim.
@@ -154,6 +168,17 @@ impl Space<2> for Dim<2> {
         return_to_circle(p, big_r, rng)
     }
 
+    /// [`exit_disk`].
+    #[inline(always)]
+    fn exit_ball<R: Rng + ?Sized>(
+        p: &[f64; 2],
+        c: &[f64; 2],
+        big_r: f64,
+        rng: &mut R,
+    ) -> Option<[f64; 2]> {
+        Some(exit_disk(p, c, big_r, rng))
+    }
+
     /// 1.3 times `0.85 n^(1/1.71)`: the off-lattice DLA dimension 1.71 with a prefactor fitted
     /// to grown clusters.
     #[inline]
@@ -194,6 +219,17 @@ impl Space<3> for Dim<3> {
     #[inline]
     fn return_to_sphere<R: Rng + ?Sized>(p: &[f64; 3], big_r: f64, rng: &mut R) -> [f64; 3] {
         return_to_sphere_3d(p, big_r, rng)
+    }
+
+    /// [`exit_ball_3d`].
+    #[inline(always)]
+    fn exit_ball<R: Rng + ?Sized>(
+        p: &[f64; 3],
+        c: &[f64; 3],
+        big_r: f64,
+        rng: &mut R,
+    ) -> Option<[f64; 3]> {
+        Some(exit_ball_3d(p, c, big_r, rng))
     }
 
     /// 1.3 times `1.15 n^(1/2.5)`: the off-lattice DLA dimension 2.5 with a prefactor fitted

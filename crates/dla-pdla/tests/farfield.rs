@@ -345,3 +345,86 @@ fn ks_nd_directions_are_uniform_on_the_sphere() {
     check::<4>(51);
     check::<5>(52);
 }
+
+/// `Space::exit_ball` in 2D: the exit angle from a point at `x = r / R` inside the circle,
+/// measured from the point's own direction about the centre, follows the interior Poisson
+/// kernel `(1 - x^2) / (2 pi (1 - 2 x cos phi + x^2))`; every exit lies on the circle.
+#[test]
+fn ks_2d_ball_exit_matches_interior_harmonic_density() {
+    let n = 20_000;
+    let c = [37.0, -12.5];
+    for (k, &x) in [0.0f64, 0.3, 0.8, 0.99].iter().enumerate() {
+        let big_r = 6.0;
+        let mut rng = stream(45, k as u64);
+        let density = |phi: f64| (1.0 - x * x) / (2.0 * PI * (1.0 - 2.0 * x * phi.cos() + x * x));
+        let table = cdf_table(density, -PI, PI, 200_000);
+        let samples: Vec<f64> = (0..n)
+            .map(|i| {
+                let a = 0.37 * i as f64;
+                let p = [c[0] + x * big_r * a.cos(), c[1] + x * big_r * a.sin()];
+                let q = Dim::<2>::exit_ball(&p, &c, big_r, &mut rng).expect("a 2D sampler");
+                assert!(((q[0] - c[0]).hypot(q[1] - c[1]) - big_r).abs() < 1e-12);
+                let mut phi = (q[1] - c[1]).atan2(q[0] - c[0]) - a;
+                while phi > PI {
+                    phi -= 2.0 * PI;
+                }
+                while phi < -PI {
+                    phi += 2.0 * PI;
+                }
+                phi
+            })
+            .collect();
+        assert_ks_below_critical(samples, &table, x);
+    }
+}
+
+/// `Space::exit_ball` in 3D: the cosine of the exit point's angle from the start's direction
+/// about the centre follows the interior Poisson kernel, density proportional to
+/// `(r^2 + R^2 - 2 r R u)^(-3/2)`, and the azimuth about that direction is uniform (the
+/// component along a fixed perpendicular, over the sine, has the arcsine law of `cos` of a
+/// uniform angle).
+#[test]
+fn ks_3d_ball_exit_matches_interior_harmonic_measure() {
+    let n = 40_000;
+    let c = [-3.0, 8.25, 0.5];
+    // The arcsine law's CDF, 1/2 + asin(t) / pi, tabulated (its density is not integrable
+    // by the trapezoid rule at the ends).
+    let arcsine: Vec<(f64, f64)> = (0..=100_000)
+        .map(|i| {
+            let t = -1.0 + 2.0 * i as f64 / 100_000.0;
+            (t, 0.5 + t.asin() / PI)
+        })
+        .collect();
+    for (k, &x) in [0.0f64, 0.5, 0.9, 0.97].iter().enumerate() {
+        let big_r = 5.0;
+        let r = x * big_r;
+        let mut rng = stream(46, k as u64);
+        let table = cdf_table(
+            |u| (r * r + big_r * big_r - 2.0 * r * big_r * u).powf(-1.5),
+            -1.0,
+            1.0,
+            100_000,
+        );
+        let mut cosines = Vec::with_capacity(n);
+        let mut azimuths = Vec::with_capacity(n);
+        for i in 0..n {
+            let (th, ph) = (0.3 + (i % 7) as f64 * 0.4, i as f64 * 0.77);
+            let e = [th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()];
+            // A unit vector perpendicular to e.
+            let f = [-ph.sin(), ph.cos(), 0.0];
+            let p = [c[0] + r * e[0], c[1] + r * e[1], c[2] + r * e[2]];
+            let q = Dim::<3>::exit_ball(&p, &c, big_r, &mut rng).expect("a 3D sampler");
+            let d = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+            let dn = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            assert!((dn - big_r).abs() < 1e-12);
+            let u = (d[0] * e[0] + d[1] * e[1] + d[2] * e[2]) / dn;
+            let s = (1.0 - u * u).sqrt();
+            cosines.push(u);
+            if s > 1e-6 {
+                azimuths.push((d[0] * f[0] + d[1] * f[1] + d[2] * f[2]) / dn / s);
+            }
+        }
+        assert_ks_below_critical(cosines, &table, x);
+        assert_ks_below_critical(azimuths, &arcsine, x);
+    }
+}

@@ -3,7 +3,7 @@
 //! ([`MapLevel`]), every start giving the same bound ([`Cluster::map_bounds_from`]).
 
 use super::Cluster;
-use spatial::distmap::{DistanceMap, PointMap, SparseDistanceMap};
+use spatial::distmap::{DistanceMap, PointMap, Reading, SparseDistanceMap};
 
 /// The distance maps: the optional sparse fine level, then the dense levels, finest first.
 #[derive(Debug, Default)]
@@ -104,6 +104,51 @@ impl<const D: usize> Maps<D> {
     }
 }
 
+/// The empty ball behind a map read ([`Cluster::map_bounds_from`]): the last map read's
+/// lower bound, its cell's centre and the distance from that centre within which no particle
+/// lies (see [`Reading`]). When `lower` is the lower bound the read returned and that was
+/// not capped, the walker may leave this whole ball rather than the ball of its own bound.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct MapBall<const D: usize> {
+    pub(crate) lower: f64,
+    pub(crate) centre: [f64; D],
+    pub(crate) clear: f64,
+}
+
+impl<const D: usize> Default for MapBall<D> {
+    fn default() -> Self {
+        MapBall {
+            lower: f64::NAN,
+            centre: [0.0; D],
+            clear: f64::NAN,
+        }
+    }
+}
+
+impl<const D: usize> MapBall<D> {
+    /// Notes `r` unless it is capped and a read that is not was noted before (a capped finer
+    /// map leaves the coarser answer standing), and returns its bounds.
+    #[inline(always)]
+    fn note(&mut self, r: Reading<D>) -> (f64, f64, bool) {
+        if !r.capped || self.lower.is_nan() {
+            self.lower = r.lower;
+            self.centre = r.centre;
+            self.clear = r.clear;
+        }
+        (r.lower, r.upper, r.capped)
+    }
+
+    /// The radius about `centre` within which a walker centre stays more than a diameter
+    /// from every particle centre: `clear - 1`, less a margin for the rounding of a point
+    /// computed on that sphere (a few ulps of the larger of the centre's coordinates and the
+    /// radius).
+    #[inline(always)]
+    pub(crate) fn radius(&self) -> f64 {
+        let scale = self.centre.iter().fold(self.clear, |s, x| s.max(x.abs()));
+        self.clear - 1.0 - scale * 1e-15
+    }
+}
+
 impl<const D: usize> Cluster<D> {
     /// A lower bound of the distance from `p` to the nearest particle from the distance maps,
     /// and whether it is capped (`true`: every map holding `p` is capped there, and the
@@ -144,7 +189,7 @@ impl<const D: usize> Cluster<D> {
     /// reads for a walker near the cluster).
     #[inline(always)]
     pub fn map_bounds_within(&self, p: &[f64; D], upper: f64) -> Option<(f64, f64, bool)> {
-        self.map_bounds_from(p, upper, &mut MapLevel::default())
+        self.map_bounds_from(p, upper, &mut MapLevel::default(), &mut MapBall::default())
     }
 
     /// [`map_bounds_within`](Self::map_bounds_within), read from the dense level that
@@ -168,6 +213,7 @@ impl<const D: usize> Cluster<D> {
         p: &[f64; D],
         upper: f64,
         level: &mut MapLevel,
+        ball: &mut MapBall<D>,
     ) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
         // The sparse map first for a walker known to be within its cap less a cell's half
@@ -179,7 +225,7 @@ impl<const D: usize> Cluster<D> {
         // The sparse map's answer at `p` once read (kept for the descent, which may end there).
         let mut sparse = None;
         if sure || level.sparse {
-            let bounds = maps.sparse.as_ref().and_then(|s| s.bounds(p));
+            let bounds = self.sparse_bounds(p, ball);
             if let Some(b) = bounds
                 && (sure || !b.2)
             {
@@ -199,7 +245,7 @@ impl<const D: usize> Cluster<D> {
             // Climb from `start` while the levels are capped, keeping the last capped read.
             let mut floor = None;
             for k in start..=top {
-                match self.level_bounds(k, p) {
+                match self.level_bounds(k, p, ball) {
                     Some((lb, ub, false)) => {
                         level.dense = k as u8;
                         if lb >= maps.enough[k] {
@@ -208,7 +254,7 @@ impl<const D: usize> Cluster<D> {
                         if let Some((f, _)) = floor {
                             return Some((lb.max(f), ub, false));
                         }
-                        return self.descend(p, k, Some((lb, ub, false)), sparse, level);
+                        return self.descend(p, k, Some((lb, ub, false)), sparse, level, ball);
                     }
                     Some((lb, ub, true)) => {
                         level.dense = k as u8;
@@ -223,18 +269,30 @@ impl<const D: usize> Cluster<D> {
             }
             // No level from `start` up holds `p`: read the finer ones as the coarsest-first
             // read does.
-            return self.descend(p, start, None, sparse, level);
+            return self.descend(p, start, None, sparse, level, ball);
         }
-        self.descend(p, top + 1, None, sparse, level)
+        self.descend(p, top + 1, None, sparse, level, ball)
+    }
+
+    /// The sparse map's `(lower, upper, capped)` at `p`, noted in `ball`; `None` without one or
+    /// where it has no answer.
+    #[inline(always)]
+    fn sparse_bounds(&self, p: &[f64; D], ball: &mut MapBall<D>) -> Option<(f64, f64, bool)> {
+        Some(ball.note(self.maps.sparse.as_ref()?.reading(p)?))
     }
 
     /// Dense level `k`'s `(lower, upper, capped)` at `p` (a coarse level's upper bound widened
     /// by a box diagonal: it holds boxes of particles, see `Maps::box_diagonal`), `None`
     /// where it does not hold `p`.
     #[inline(always)]
-    fn level_bounds(&self, k: usize, p: &[f64; D]) -> Option<(f64, f64, bool)> {
+    fn level_bounds(
+        &self,
+        k: usize,
+        p: &[f64; D],
+        ball: &mut MapBall<D>,
+    ) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
-        let (lb, mut ub, capped) = maps.levels[k].bounds(p)?;
+        let (lb, mut ub, capped) = ball.note(maps.levels[k].reading(p)?);
         if k > 0 {
             ub += maps.box_diagonal[k];
         }
@@ -253,11 +311,12 @@ impl<const D: usize> Cluster<D> {
         mut best: Option<(f64, f64, bool)>,
         sparse: Option<Option<(f64, f64, bool)>>,
         level: &mut MapLevel,
+        ball: &mut MapBall<D>,
     ) -> Option<(f64, f64, bool)> {
         let maps = &*self.maps;
         let mut finer = true;
         for k in (0..from.min(maps.levels.len())).rev() {
-            let Some((lb, ub, capped)) = self.level_bounds(k, p) else {
+            let Some((lb, ub, capped)) = self.level_bounds(k, p, ball) else {
                 continue;
             };
             level.dense = k as u8;
@@ -278,7 +337,7 @@ impl<const D: usize> Cluster<D> {
         if !finer {
             return best;
         }
-        let sparse = sparse.unwrap_or_else(|| maps.sparse.as_ref().and_then(|s| s.bounds(p)));
+        let sparse = sparse.unwrap_or_else(|| self.sparse_bounds(p, ball));
         match (sparse, best) {
             (Some((lb, ub, false)), _) => {
                 level.sparse = true;
@@ -391,13 +450,15 @@ mod tests {
                                         dense: start as u8,
                                         sparse,
                                     };
+                                    let mut ball = MapBall::default();
                                     assert_eq!(
-                                        c.map_bounds_from(&probe, d * slack, &mut level),
+                                        c.map_bounds_from(&probe, d * slack, &mut level, &mut ball),
                                         within,
                                         "{D}D: read from level {start} (sparse first: \
                                          {sparse}) within {}",
                                         d * slack
                                     );
+                                    ball_holds(&ball, &probe, &pts, within);
                                 }
                             }
                         }
@@ -409,6 +470,44 @@ mod tests {
             }
         }
         drop(keep);
+    }
+
+    /// The ball a read noted: empty (no particle nearer its centre than `clear`), holding the
+    /// probe `p` no farther from its centre than `clear - lower`, and, when it gave the read's
+    /// answer `bounds`, that answer's lower bound; the radius a walker leaves it at keeps
+    /// every walker centre inside at least a diameter from every particle.
+    fn ball_holds<const D: usize>(
+        ball: &MapBall<D>,
+        p: &[f64; D],
+        pts: &[[f64; D]],
+        bounds: Option<(f64, f64, bool)>,
+    ) {
+        let Some((lb, _, _)) = bounds else {
+            return;
+        };
+        assert!(
+            !ball.lower.is_nan(),
+            "{D}D: a read that answered noted no ball"
+        );
+        let from_centre = pts
+            .iter()
+            .map(|q| spatial::orthtree::dist_sq(q, &ball.centre).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            ball.clear <= from_centre,
+            "{D}D: clear {} beyond the nearest particle at {from_centre}",
+            ball.clear
+        );
+        let e = spatial::orthtree::dist_sq(p, &ball.centre).sqrt();
+        assert!(
+            e <= ball.clear - ball.lower + 1e-9,
+            "{D}D: the probe lies {e} from the centre, beyond {}",
+            ball.clear - ball.lower
+        );
+        assert!(ball.radius() <= from_centre - 1.0);
+        if ball.lower == lb && lb > 1.0 {
+            assert!(e < ball.radius(), "{D}D: a jumping walker outside its ball");
+        }
     }
 
     /// The maps read finest first, the finest that is not capped answering (a capped sparse
@@ -482,7 +581,7 @@ mod tests {
                 .map(|q| spatial::orthtree::dist_sq(q, &probe).sqrt())
                 .fold(f64::INFINITY, f64::min);
             for k in 1..c.maps.levels.len() {
-                if let Some((lb, ub, capped)) = c.level_bounds(k, &probe) {
+                if let Some((lb, ub, capped)) = c.level_bounds(k, &probe, &mut MapBall::default()) {
                     assert!(lb <= d, "{D}D level {k}: bound {lb} above the distance {d}");
                     assert!(
                         capped || ub >= d,

@@ -370,7 +370,7 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
     /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and the
     /// stored byte.
     #[inline(always)]
-    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
+    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8, [f64; D])> {
         let (idx, z) = self.index(p)?;
         let v = self.values[idx].load(Ordering::Relaxed);
         let mut e2 = 0.0;
@@ -378,7 +378,7 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
             let e = p[i] - z[i];
             e2 += e * e;
         }
-        Some((f64::from(v) * self.grid.quantum, e2.sqrt(), v))
+        Some((f64::from(v) * self.grid.quantum, e2.sqrt(), v, z))
     }
 
     /// Enlarges the map so that it covers `|x_i| < need` (by at least a quarter of its half

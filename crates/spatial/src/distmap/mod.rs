@@ -62,6 +62,24 @@ use grid::{Grid, RowTables};
 use sealed::Cells;
 pub use sparse::{SparseDistanceMap, UNKNOWN};
 
+/// One read of a map at a position `p` ([`PointMap::reading`]): the bounds of
+/// [`PointMap::bounds`] and the empty ball they come from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reading<const D: usize> {
+    /// A lower bound of the distance from `p` to the nearest point: `clear - |p - centre|`
+    /// (shrunk for rounding).
+    pub lower: f64,
+    /// An upper bound of that distance (`+inf` for a capped cell).
+    pub upper: f64,
+    /// Whether the cell is capped (at least `cap` from every point).
+    pub capped: bool,
+    /// The centre of the cell holding `p`.
+    pub centre: [f64; D],
+    /// A lower bound of the distance from `centre` to the nearest point (`cap` and above for a
+    /// capped cell), shrunk for rounding as `lower` is: no point lies within it of the centre.
+    pub clear: f64,
+}
+
 /// Largest stored value: the cell is at least `cap` from every point.
 const CAPPED: u8 = u8::MAX;
 
@@ -153,7 +171,7 @@ pub trait PointMap<const D: usize>: Cells<D> {
     /// negative (no information).
     #[inline]
     fn lower_bound(&self, p: &[f64; D]) -> Option<(f64, bool)> {
-        let (m, e, v) = self.read(p)?;
+        let (m, e, v, _) = self.read(p)?;
         Some((lower_from(m, e), v == CAPPED))
     }
 
@@ -165,14 +183,27 @@ pub trait PointMap<const D: usize>: Cells<D> {
     /// add the boxes' diagonal for one to the points in them.
     #[inline(always)]
     fn bounds(&self, p: &[f64; D]) -> Option<(f64, f64, bool)> {
-        let (m, e, v) = self.read(p)?;
+        self.reading(p).map(|r| (r.lower, r.upper, r.capped))
+    }
+
+    /// [`bounds`](Self::bounds) with what they come from: the cell's centre and a lower bound
+    /// of its distance to the nearest point (see [`Reading`]).
+    #[inline(always)]
+    fn reading(&self, p: &[f64; D]) -> Option<Reading<D>> {
+        let (m, e, v, centre) = self.read(p)?;
         let capped = v == CAPPED;
         let upper = if capped {
             f64::INFINITY
         } else {
             (m + self.grid().quantum + e) * (1.0 + SHRINK) + 1e-12
         };
-        Some((lower_from(m, e), upper, capped))
+        Some(Reading {
+            lower: lower_from(m, e),
+            upper,
+            capped,
+            centre,
+            clear: m * (1.0 - SHRINK) - 1e-12,
+        })
     }
 
     /// Adds the point `q`: lowers every cell whose centre lies within `cap` of it, growing the
@@ -226,7 +257,7 @@ mod sealed {
 
         /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and
         /// its distance byte; `None` where the map has no answer.
-        fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)>;
+        fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8, [f64; D])>;
 
         /// Enlarges the map to cover `|x_i| < need` (by at least a quarter), keeping what
         /// it holds.

@@ -277,7 +277,7 @@ impl<const D: usize> PointMap<D> for SparseDistanceMap<D> {
 
     /// The distance byte of the cell holding `p` (255 in an absent block), for tests.
     fn value(&self, p: &[f64; D]) -> Option<u8> {
-        self.read(p).map(|(_, _, v)| v)
+        self.read(p).map(|(_, _, v, _)| v)
     }
 
     /// As [`PointMap::reserve`], and reserves chunk slots for every block of the table, so
@@ -303,7 +303,8 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
     /// The cell holding `p`: its stored distance `m` from the centre, `|p - centre|` and its
     /// distance byte `v`; `None` outside the table or in an [`UNKNOWN`] block.
     #[inline(always)]
-    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8)> {
+    fn read(&self, p: &[f64; D]) -> Option<(f64, f64, u8, [f64; D])> {
+        let mut centre = [0.0; D];
         let mut bidx = 0usize;
         let mut cidx = 0usize;
         let mut stride = 1usize;
@@ -320,7 +321,8 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
             bidx += (j >> self.shift) * stride;
             stride *= self.bside;
             cidx |= (j & self.mask) << (self.shift as usize * i);
-            let e = p[i] - (k + 0.5) * self.grid.cell;
+            centre[i] = (k + 0.5) * self.grid.cell;
+            let e = p[i] - centre[i];
             e2 += e * e;
         }
         let v = match self.table[bidx].load(Ordering::Acquire) {
@@ -328,7 +330,7 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
             UNKNOWN => return None,
             entry => CAPPED - self.block(entry)[cidx].load(Ordering::Relaxed),
         };
-        Some((f64::from(v) * self.grid.quantum, e2.sqrt(), v))
+        Some((f64::from(v) * self.grid.quantum, e2.sqrt(), v, centre))
     }
 
     /// Enlarges the table to cover `|x_i| < need` (by at least a quarter), copying the old
