@@ -1,7 +1,9 @@
 //! Exact far-field return of a walker outside the birth sphere (`--far-field return`; see
 //! `docs/dla.md`): the samplers of the harmonic measure in 2D, 3D and `d >= 4` dimensions,
-//! which [`Space::return_to_sphere`](crate::space::Space::return_to_sphere) dispatches to, and
-//! the vector helpers they share.
+//! which [`Space::return_to_sphere`](crate::space::Space::return_to_sphere) dispatches to; the
+//! samplers of the interior harmonic measure by which a walker leaves a map cell's empty ball
+//! in 2D and 3D ([`Space::exit_ball`](crate::space::Space::exit_ball)); and the vector helpers
+//! they share.
 //!
 //! A Brownian walker at radius `r > R` outside a sphere of radius `R` centred on the origin
 //! either hits the sphere (always in 2D, where Brownian motion is recurrent; with probability
@@ -299,14 +301,10 @@ pub fn return_to_sphere_nd<const D: usize, R: Rng + ?Sized>(
 /// (`|p - c| < big_r`), first leaves it. The harmonic measure of the disk seen from `p` is the
 /// image of the uniform one seen from its centre under the disk automorphism that takes the
 /// centre to `p` (conformal invariance): with `z = (p - c) / big_r` and `w` a uniform point of
-/// the unit circle ([`circle_direction`]), the exit point is `c + big_r (w + z) / (1 + conj(z) w)`.
+/// the unit circle (the walk's direction draw), the exit point is
+/// `c + big_r (w + z) / (1 + conj(z) w)`.
 #[inline(always)]
-pub(crate) fn exit_disk<R: Rng + ?Sized>(
-    p: &[f64; 2],
-    c: &[f64; 2],
-    big_r: f64,
-    rng: &mut R,
-) -> [f64; 2] {
+pub fn exit_disk<R: Rng + ?Sized>(p: &[f64; 2], c: &[f64; 2], big_r: f64, rng: &mut R) -> [f64; 2] {
     let (wx, wy) = circle_direction(rng);
     let inv = 1.0 / big_r;
     let (zx, zy) = ((p[0] - c[0]) * inv, (p[1] - c[1]) * inv);
@@ -327,11 +325,11 @@ pub(crate) fn exit_disk<R: Rng + ?Sized>(
 /// `a = R - r`, `b = R + r`, `t = a + 2 r xi` (`xi` uniform), the cosine `u` of the exit point's
 /// angle from `p - c` has `1 - u = a^2 (1 - xi)(b + t) / (R t^2)` and
 /// `1 + u = b^2 xi (t + a) / (R t^2)`, free of cancellation and of any division by `r` (at
-/// `r = 0`, `u = 2 xi - 1`, uniform); the azimuth is uniform ([`circle_direction`]), about a
+/// `r = 0`, `u = 2 xi - 1`, uniform); the azimuth is uniform (the walk's direction draw), about a
 /// frame built without square roots (Duff et al., "Building an orthonormal basis, revisited",
 /// 2017).
 #[inline(always)]
-pub(crate) fn exit_ball_3d<R: Rng + ?Sized>(
+pub fn exit_ball_3d<R: Rng + ?Sized>(
     p: &[f64; 3],
     c: &[f64; 3],
     big_r: f64,

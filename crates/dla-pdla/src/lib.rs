@@ -10,7 +10,7 @@
 //!
 //! | module | owns |
 //! |---|---|
-//! | [`farfield`] | the exact far-field return samplers |
+//! | [`farfield`] | the exact far-field return samplers and the ball-exit samplers of the walk |
 //! | [`space`] | everything dimension-specific ([`Dim`], [`Space`]) |
 //! | [`params`] | the run's parameters, their table ([`params::PARAMS`]) and validation |
 //! | [`error`] | [`SimError`] |

@@ -3,9 +3,9 @@
 //! (or jumping and dying) in the far field, jumping by a lower bound of its distance to the
 //! cluster (distance maps, then the orthtree's `vpdist` or the walker's near cache), or leaving
 //! the empty ball of the map cell that gave the bound at its harmonic measure's exit point, and
-//! taking `step_min` steps near it, until a step ends in exact contact and the walker sticks (always
-//! with `sticking_probability` 1; otherwise with that probability, the walker walking on from
-//! the contact point when it does not).
+//! taking `step_min` steps near it, until a step ends in exact contact and the walker sticks
+//! (always with `sticking_probability` 1; otherwise with that probability, the walker walking
+//! on from the contact point when it does not).
 //!
 //! Invariants: a move never brings the walker's centre closer than 1 to a particle stored
 //! when the move starts (jumps stay within a lower bound of the distance minus 1, or inside a
