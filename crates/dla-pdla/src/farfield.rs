@@ -2,8 +2,7 @@
 //! `docs/dla.md`): the samplers of the harmonic measure in 2D, 3D and `d >= 4` dimensions,
 //! which [`Space::return_to_sphere`](crate::space::Space::return_to_sphere) dispatches to; the
 //! samplers of the interior harmonic measure by which a walker leaves a map cell's empty ball
-//! in 2D and 3D ([`Space::exit_ball`](crate::space::Space::exit_ball)); and the vector helpers
-//! they share.
+//! ([`Space::exit_ball`](crate::space::Space::exit_ball)); and the vector helpers they share.
 //!
 //! A Brownian walker at radius `r > R` outside a sphere of radius `R` centred on the origin
 //! either hits the sphere (always in 2D, where Brownian motion is recurrent; with probability
@@ -363,6 +362,55 @@ pub fn exit_ball_3d<R: Rng + ?Sized>(
     std::array::from_fn(|i| c[i] + big_r * (u * e[i] + sin_t * (ca * v1[i] + sa * v2[i])))
 }
 
+/// `d >= 4` (`D` dimensions): where Brownian motion from `p`, inside the ball of radius
+/// `big_r` around `c` (`r = |p - c| < big_r`), first leaves it. The cosine `u` of the exit
+/// point's angle from `p - c` has density proportional to `(1 - u^2)^((D - 3)/2) s(u)^(-D)`,
+/// `s(u) = |y - p|`: drawn from the 3D law `s^-3` ([`exit_ball_3d`]'s inversion) and accepted
+/// with probability `q^((D - 3)/2)`, `q = (1 - u^2) R^2 / s^2`, which is at most 1 (its maximum,
+/// 1, is at `u = r / R`): von Neumann's rejection, exact, as [`return_cosine_nd`] does outside
+/// the sphere. The direction orthogonal to `p - c` is uniform ([`orthogonal_direction`]; any
+/// one at `r = 0`, where the law of `u` is the uniform direction's).
+pub fn exit_ball_nd<const D: usize, R: Rng + ?Sized>(
+    p: &[f64; D],
+    c: &[f64; D],
+    big_r: f64,
+    rng: &mut R,
+) -> [f64; D] {
+    const { assert!(D >= 4, "2D and 3D have their own samplers") };
+    let d: [f64; D] = std::array::from_fn(|i| p[i] - c[i]);
+    let r = norm(&d);
+    let (a, b) = (big_r - r, big_r + r);
+    let (u, sin_t) = loop {
+        let xi = uniform01(rng);
+        let t = a + 2.0 * r * xi;
+        let k = 1.0 / (big_r * t * t);
+        let one_minus_u = a * a * (1.0 - xi) * (b + t) * k;
+        let one_plus_u = b * b * xi * (t + a) * k;
+        let sin2 = (one_minus_u * one_plus_u).max(0.0);
+        // s = |y - p| = R (R - r)(R + r) / (R t) from the inversion: s = a b / t.
+        let s = a * b / t;
+        let q = (sin2 * (big_r / s) * (big_r / s)).min(1.0);
+        let v = uniform01(rng);
+        if v * v < q.powi(D as i32 - 3) {
+            let u = if one_minus_u < one_plus_u {
+                1.0 - one_minus_u
+            } else {
+                one_plus_u - 1.0
+            };
+            break (u, sin2.sqrt());
+        }
+    };
+    let e = if r > 0.0 {
+        scale(d, 1.0 / r)
+    } else {
+        let mut e = [0.0; D];
+        e[D - 1] = 1.0;
+        e
+    };
+    let w = orthogonal_direction(&e, rng);
+    std::array::from_fn(|i| c[i] + big_r * (u * e[i] + sin_t * w[i]))
+}
+
 /// Euclidean norm.
 #[inline]
 pub fn norm<const D: usize>(p: &[f64; D]) -> f64 {
@@ -547,6 +595,52 @@ mod tests {
                 assert!(
                     (mean - want[k]).abs() < 5.0 * sd + 1e-12,
                     "3D f {f} h{k}: {mean} against {} (sd {sd})",
+                    want[k]
+                );
+            }
+        }
+        exits_nd_keep_harmonic_functions::<4>(&mut rng);
+        exits_nd_keep_harmonic_functions::<5>(&mut rng);
+    }
+
+    /// [`exits_keep_harmonic_functions_in_mean`] in `D >= 4` dimensions: `x_0`, `x_0 x_1`,
+    /// `x_0^2 - x_{D-1}^2` about the centre and `|y - a|^(2 - D)` for `a` outside the ball.
+    fn exits_nd_keep_harmonic_functions<const D: usize>(rng: &mut impl Rng) {
+        let n = 1_000_000;
+        let c: [f64; D] = std::array::from_fn(|i| 0.5 * i as f64 - 1.0);
+        for f in [0.0, 0.4, 0.9, 0.99] {
+            let dir: [f64; D] = std::array::from_fn(|i| if i < 2 { 0.6 } else { 0.0 });
+            let dir = scale(dir, 1.0 / norm(&dir));
+            let p: [f64; D] = std::array::from_fn(|i| c[i] + 2.0 * f * dir[i]);
+            let a: [f64; D] = std::array::from_fn(|i| c[i] + if i == 1 { 2.5 } else { 0.5 });
+            let h = |y: &[f64; D]| {
+                let x: [f64; D] = std::array::from_fn(|i| y[i] - c[i]);
+                let ya: [f64; D] = std::array::from_fn(|i| y[i] - a[i]);
+                [
+                    x[0],
+                    x[0] * x[1],
+                    x[0] * x[0] - x[D - 1] * x[D - 1],
+                    norm(&ya).powi(2 - D as i32),
+                ]
+            };
+            let mut sum = [0.0; 4];
+            let mut sq = [0.0; 4];
+            for _ in 0..n {
+                let y = exit_ball_nd(&p, &c, 2.0, rng);
+                let r = norm(&std::array::from_fn::<f64, D, _>(|i| y[i] - c[i]));
+                assert!((r - 2.0).abs() < 1e-12, "{D}D: off the sphere: {r}");
+                for (k, v) in h(&y).iter().enumerate() {
+                    sum[k] += v;
+                    sq[k] += v * v;
+                }
+            }
+            let want = h(&p);
+            for k in 0..4 {
+                let mean = sum[k] / n as f64;
+                let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
+                assert!(
+                    (mean - want[k]).abs() < 5.0 * sd + 1e-12,
+                    "{D}D f {f} h{k}: {mean} against {} (sd {sd})",
                     want[k]
                 );
             }
