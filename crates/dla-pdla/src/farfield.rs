@@ -245,13 +245,7 @@ pub fn return_cosine_nd<const D: usize, R: Rng + ?Sized>(
         let q = sin2 * (r / s) * (r / s);
         let v = uniform01(rng);
         if v * v < q.powi(D as i32 - 3) {
-            // u from the smaller of its two factors, which holds its digits.
-            let u = if one_minus_u < one_plus_u {
-                1.0 - one_minus_u
-            } else {
-                one_plus_u - 1.0
-            };
-            return Some((u, sin2.sqrt()));
+            return Some((cosine_from_factors(one_minus_u, one_plus_u), sin2.sqrt()));
         }
     }
 }
@@ -293,6 +287,32 @@ pub fn return_to_sphere_nd<const D: usize, R: Rng + ?Sized>(
             let w = orthogonal_direction(&e, rng);
             std::array::from_fn(|i| big_r * (u * e[i] + sin_t * w[i]))
         }
+    }
+}
+
+/// The interior inversion of [`exit_ball_3d`] for one uniform `xi`, from a point `r` from the
+/// centre of a ball of radius `big_r`: `(1 - u, 1 + u, s)`, `u` the exit point's cosine and
+/// `s = a b / t` its distance from the point (`a = R - r`, `b = R + r`, `t = a + 2 r xi`).
+#[inline(always)]
+fn interior_factors(r: f64, big_r: f64, xi: f64) -> (f64, f64, f64) {
+    let (a, b) = (big_r - r, big_r + r);
+    let t = a + 2.0 * r * xi;
+    let k = 1.0 / (big_r * t * t);
+    (
+        a * a * (1.0 - xi) * (b + t) * k,
+        b * b * xi * (t + a) * k,
+        a * b / t,
+    )
+}
+
+/// The cosine `u` from its factors `1 - u` and `1 + u`, from the smaller one, which holds its
+/// digits.
+#[inline(always)]
+fn cosine_from_factors(one_minus_u: f64, one_plus_u: f64) -> f64 {
+    if one_minus_u < one_plus_u {
+        1.0 - one_minus_u
+    } else {
+        one_plus_u - 1.0
     }
 }
 
@@ -340,17 +360,8 @@ pub fn exit_ball_3d<R: Rng + ?Sized>(
 ) -> [f64; 3] {
     let d = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
     let r = norm(&d);
-    let xi = uniform01(rng);
-    let (a, b) = (big_r - r, big_r + r);
-    let t = a + 2.0 * r * xi;
-    let k = 1.0 / (big_r * t * t);
-    let one_minus_u = a * a * (1.0 - xi) * (b + t) * k;
-    let one_plus_u = b * b * xi * (t + a) * k;
-    let u = if one_minus_u < one_plus_u {
-        1.0 - one_minus_u
-    } else {
-        one_plus_u - 1.0
-    };
+    let (one_minus_u, one_plus_u, _) = interior_factors(r, big_r, uniform01(rng));
+    let u = cosine_from_factors(one_minus_u, one_plus_u);
     let sin_t = (one_minus_u * one_plus_u).max(0.0).sqrt();
     let e = if r > 0.0 {
         scale(d, 1.0 / r)
@@ -383,25 +394,13 @@ pub fn exit_ball_nd<const D: usize, R: Rng + ?Sized>(
     const { assert!(D >= 4, "2D and 3D have their own samplers") };
     let d: [f64; D] = std::array::from_fn(|i| p[i] - c[i]);
     let r = norm(&d);
-    let (a, b) = (big_r - r, big_r + r);
     let (u, sin_t) = loop {
-        let xi = uniform01(rng);
-        let t = a + 2.0 * r * xi;
-        let k = 1.0 / (big_r * t * t);
-        let one_minus_u = a * a * (1.0 - xi) * (b + t) * k;
-        let one_plus_u = b * b * xi * (t + a) * k;
+        let (one_minus_u, one_plus_u, s) = interior_factors(r, big_r, uniform01(rng));
         let sin2 = (one_minus_u * one_plus_u).max(0.0);
-        // s = |y - p| = R (R - r)(R + r) / (R t) from the inversion: s = a b / t.
-        let s = a * b / t;
         let q = (sin2 * (big_r / s) * (big_r / s)).min(1.0);
         let v = uniform01(rng);
         if v * v < q.powi(D as i32 - 3) {
-            let u = if one_minus_u < one_plus_u {
-                1.0 - one_minus_u
-            } else {
-                one_plus_u - 1.0
-            };
-            break (u, sin2.sqrt());
+            break (cosine_from_factors(one_minus_u, one_plus_u), sin2.sqrt());
         }
     };
     let e = if r > 0.0 {
@@ -564,27 +563,16 @@ mod tests {
                     ((y[0] - a[0]).powi(2) + (y[1] - a[1]).powi(2)).ln(),
                 ]
             };
-            let mut sum = [0.0; 4];
-            let mut sq = [0.0; 4];
-            for _ in 0..n {
-                let y = exit_disk(&p, &c, 3.0, &mut rng);
-                let r = ((y[0] - c[0]).powi(2) + (y[1] - c[1]).powi(2)).sqrt();
-                assert!((r - 3.0).abs() < 1e-12, "off the circle: {r}");
-                for (k, v) in h(&y).iter().enumerate() {
-                    sum[k] += v;
-                    sq[k] += v * v;
-                }
-            }
-            let want = h(&p);
-            for k in 0..4 {
-                let mean = sum[k] / n as f64;
-                let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
-                assert!(
-                    (mean - want[k]).abs() < 5.0 * sd + 1e-12,
-                    "2D f {f} h{k}: {mean} against {} (sd {sd})",
-                    want[k]
-                );
-            }
+            let label = format!("2D f {f}");
+            assert_means_kept(
+                &label,
+                n,
+                &p,
+                &c,
+                3.0,
+                || exit_disk(&p, &c, 3.0, &mut rng),
+                h,
+            );
         }
         // 3D: the ball of radius 2 about c.
         let c = [-1.0, 4.5, 0.25];
@@ -608,27 +596,16 @@ mod tests {
                         .sqrt(),
                 ]
             };
-            let mut sum = [0.0; 6];
-            let mut sq = [0.0; 6];
-            for _ in 0..n {
-                let y = exit_ball_3d(&p, &c, 2.0, &mut rng);
-                let r = norm(&[y[0] - c[0], y[1] - c[1], y[2] - c[2]]);
-                assert!((r - 2.0).abs() < 1e-12, "off the sphere: {r}");
-                for (k, v) in h(&y).iter().enumerate() {
-                    sum[k] += v;
-                    sq[k] += v * v;
-                }
-            }
-            let want = h(&p);
-            for k in 0..6 {
-                let mean = sum[k] / n as f64;
-                let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
-                assert!(
-                    (mean - want[k]).abs() < 5.0 * sd + 1e-12,
-                    "3D f {f} h{k}: {mean} against {} (sd {sd})",
-                    want[k]
-                );
-            }
+            let label = format!("3D f {f}");
+            assert_means_kept(
+                &label,
+                n,
+                &p,
+                &c,
+                2.0,
+                || exit_ball_3d(&p, &c, 2.0, &mut rng),
+                h,
+            );
         }
         exits_nd_keep_harmonic_functions::<4>(&mut rng);
         exits_nd_keep_harmonic_functions::<5>(&mut rng);
@@ -654,27 +631,43 @@ mod tests {
                     norm(&ya).powi(2 - D as i32),
                 ]
             };
-            let mut sum = [0.0; 4];
-            let mut sq = [0.0; 4];
-            for _ in 0..n {
-                let y = exit_ball_nd(&p, &c, 2.0, rng);
-                let r = norm(&std::array::from_fn::<f64, D, _>(|i| y[i] - c[i]));
-                assert!((r - 2.0).abs() < 1e-12, "{D}D: off the sphere: {r}");
-                for (k, v) in h(&y).iter().enumerate() {
-                    sum[k] += v;
-                    sq[k] += v * v;
-                }
+            let label = format!("{D}D f {f}");
+            assert_means_kept(&label, n, &p, &c, 2.0, || exit_ball_nd(&p, &c, 2.0, rng), h);
+        }
+    }
+
+    /// Draws `n` exits with `exit` from `p` inside the ball of radius `big_r` about `c`: each
+    /// lies on the sphere, and each function of `h` (harmonic in the ball) keeps its value at
+    /// `p` in the mean, within five standard errors.
+    fn assert_means_kept<const D: usize, const K: usize>(
+        label: &str,
+        n: usize,
+        p: &[f64; D],
+        c: &[f64; D],
+        big_r: f64,
+        mut exit: impl FnMut() -> [f64; D],
+        h: impl Fn(&[f64; D]) -> [f64; K],
+    ) {
+        let mut sum = [0.0; K];
+        let mut sq = [0.0; K];
+        for _ in 0..n {
+            let y = exit();
+            let r = norm(&std::array::from_fn::<f64, D, _>(|i| y[i] - c[i]));
+            assert!((r - big_r).abs() < 1e-12, "{label}: off the sphere: {r}");
+            for (k, v) in h(&y).iter().enumerate() {
+                sum[k] += v;
+                sq[k] += v * v;
             }
-            let want = h(&p);
-            for k in 0..4 {
-                let mean = sum[k] / n as f64;
-                let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
-                assert!(
-                    (mean - want[k]).abs() < 5.0 * sd + 1e-12,
-                    "{D}D f {f} h{k}: {mean} against {} (sd {sd})",
-                    want[k]
-                );
-            }
+        }
+        let want = h(p);
+        for k in 0..K {
+            let mean = sum[k] / n as f64;
+            let sd = ((sq[k] / n as f64 - mean * mean) / n as f64).sqrt();
+            assert!(
+                (mean - want[k]).abs() < 5.0 * sd + 1e-12,
+                "{label} h{k}: {mean} against {} (sd {sd})",
+                want[k]
+            );
         }
     }
 }

@@ -48,6 +48,17 @@ fn ks(mut samples: Vec<f64>, table: &[(f64, f64)]) -> f64 {
     d
 }
 
+/// The angle `phi` turned by whole turns into `[-pi, pi]`.
+fn within_half_turn(mut phi: f64) -> f64 {
+    while phi > PI {
+        phi -= 2.0 * PI;
+    }
+    while phi < -PI {
+        phi += 2.0 * PI;
+    }
+    phi
+}
+
 /// Critical KS distance at significance 1e-3: 1.95 / sqrt(n).
 fn critical(n: usize) -> f64 {
     1.95 / (n as f64).sqrt()
@@ -78,14 +89,7 @@ fn ks_2d_return_angle_matches_harmonic_density() {
                 let p = [x * big_r * a.cos(), x * big_r * a.sin()];
                 let q = Dim::<2>::return_to_sphere(&p, big_r, &mut rng);
                 assert!(((q[0].hypot(q[1])) - big_r).abs() < 1e-9);
-                let mut phi = q[1].atan2(q[0]) - a;
-                while phi > PI {
-                    phi -= 2.0 * PI;
-                }
-                while phi < -PI {
-                    phi += 2.0 * PI;
-                }
-                phi
+                within_half_turn(q[1].atan2(q[0]) - a)
             })
             .collect();
         assert_ks_below_critical(samples, &table, x);
@@ -364,14 +368,7 @@ fn ks_2d_ball_exit_matches_interior_harmonic_density() {
                 let p = [c[0] + x * big_r * a.cos(), c[1] + x * big_r * a.sin()];
                 let q = Dim::<2>::exit_ball(&p, &c, big_r, &mut rng).expect("a 2D sampler");
                 assert!(((q[0] - c[0]).hypot(q[1] - c[1]) - big_r).abs() < 1e-12);
-                let mut phi = (q[1] - c[1]).atan2(q[0] - c[0]) - a;
-                while phi > PI {
-                    phi -= 2.0 * PI;
-                }
-                while phi < -PI {
-                    phi += 2.0 * PI;
-                }
-                phi
+                within_half_turn((q[1] - c[1]).atan2(q[0] - c[0]) - a)
             })
             .collect();
         assert_ks_below_critical(samples, &table, x);
