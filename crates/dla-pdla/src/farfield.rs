@@ -321,19 +321,20 @@ fn cosine_from_factors(one_minus_u: f64, one_plus_u: f64) -> f64 {
 /// image of the uniform one seen from its centre under the disk automorphism that takes the
 /// centre to `p` (conformal invariance): with `z = (p - c) / big_r` and `w` a uniform point of
 /// the unit circle (the walk's direction draw), the exit point is
-/// `c + big_r (w + z) / (1 + conj(z) w)`.
+/// `c + big_r (w + z) / (1 + conj(z) w)`, computed as
+/// `c + big_r (big_r w + q) / (big_r + conj(q) w)` with `q = p - c` (the same quotient with
+/// numerator and denominator times `big_r`), which leaves no division by `big_r` on the walk's
+/// dependency chain.
 #[inline(always)]
 pub fn exit_disk<R: Rng + ?Sized>(p: &[f64; 2], c: &[f64; 2], big_r: f64, rng: &mut R) -> [f64; 2] {
     let (wx, wy) = circle_direction(rng);
-    let inv = 1.0 / big_r;
-    let (zx, zy) = ((p[0] - c[0]) * inv, (p[1] - c[1]) * inv);
-    // (w + z) / (1 + conj(z) w), as (w + z) conj(den) / (|w + z| |den|): the two moduli are
-    // equal, and dividing by their product rather than by |den|^2 keeps the point on the
-    // circle to an ulp or two even where both are small (a walker near the ball's edge
-    // leaving near its nearest point), where the quotient's own modulus would carry their
-    // relative rounding errors.
-    let (nx, ny) = (wx + zx, wy + zy);
-    let (dx, dy) = (1.0 + zx * wx + zy * wy, zx * wy - zy * wx);
+    let (qx, qy) = (p[0] - c[0], p[1] - c[1]);
+    // num / den as num conj(den) / (|num| |den|): the two moduli are equal (`|w| = 1`), and
+    // dividing by their product rather than by |den|^2 keeps the point on the circle to an ulp
+    // or two even where both are small (a walker near the ball's edge leaving near its nearest
+    // point), where the quotient's own modulus would carry their relative rounding errors.
+    let (nx, ny) = (big_r * wx + qx, big_r * wy + qy);
+    let (dx, dy) = (big_r + qx * wx + qy * wy, qx * wy - qy * wx);
     let k = big_r / ((nx * nx + ny * ny) * (dx * dx + dy * dy)).sqrt();
     [
         c[0] + k * (nx * dx + ny * dy),
