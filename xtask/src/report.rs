@@ -129,14 +129,35 @@ pub fn utc_now() -> String {
     run_io::provenance::utc_minutes(SystemTime::now())
 }
 
-/// The build: `aggsim 0.1.0 at commit <hash>` (the commit when built from a git checkout).
+/// The build: `aggsim 0.1.0 at commit <hash>`. The commands that report it build the binaries
+/// they measure from the checkout, so the commit is the checkout's when they run (`git
+/// rev-parse HEAD`), with a note when tracked files differ from it; xtask's own build may be
+/// older (its binary run directly, without `cargo xtask`). Outside a checkout, the commit xtask
+/// was built at, if any.
 pub fn build_id() -> String {
+    let version = env!("CARGO_PKG_VERSION");
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(crate::workspace_root())
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    if let Some(commit) = git(&["rev-parse", "HEAD"]).filter(|c| !c.is_empty()) {
+        let dirty =
+            git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
+        let note = if dirty {
+            " with uncommitted changes"
+        } else {
+            ""
+        };
+        return format!("aggsim {version} at commit {commit}{note}");
+    }
     match run_io::provenance::GIT_COMMIT {
-        Some(c) => format!("aggsim {} at commit {c}", env!("CARGO_PKG_VERSION")),
-        None => format!(
-            "aggsim {} (not built from a git checkout)",
-            env!("CARGO_PKG_VERSION")
-        ),
+        Some(c) => format!("aggsim {version} at commit {c}"),
+        None => format!("aggsim {version} (not built from a git checkout)"),
     }
 }
 
@@ -231,6 +252,28 @@ impl Doc {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn build_id_names_the_checkouts_commit() {
+        let head = std::process::Command::new("git")
+            .args(["rev-parse", "HEAD"])
+            .current_dir(crate::workspace_root())
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+        let id = build_id();
+        assert!(
+            id.starts_with(&format!("aggsim {} ", env!("CARGO_PKG_VERSION"))),
+            "{id}"
+        );
+        match head {
+            // The commit the checkout is at now, not the one xtask was compiled at.
+            Some(head) => assert!(id.contains(&format!("at commit {head}")), "{id} vs {head}"),
+            // An exported tree: whatever the build recorded.
+            None => assert!(id.contains("commit") || id.contains("not built"), "{id}"),
+        }
+    }
 
     #[test]
     fn formats_error_bars() {
