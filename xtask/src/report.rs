@@ -136,15 +136,6 @@ pub fn utc_now() -> String {
 /// was built at, if any.
 pub fn build_id() -> String {
     let version = env!("CARGO_PKG_VERSION");
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .args(args)
-            .current_dir(crate::workspace_root())
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
     if let Some(commit) = git(&["rev-parse", "HEAD"]).filter(|c| !c.is_empty()) {
         let dirty =
             git(&["status", "--porcelain", "--untracked-files=no"]).is_some_and(|s| !s.is_empty());
@@ -159,6 +150,17 @@ pub fn build_id() -> String {
         Some(c) => format!("aggsim {version} at commit {c}"),
         None => format!("aggsim {version} (not built from a git checkout)"),
     }
+}
+
+/// What `git args` prints in the workspace, trimmed; `None` without git or a checkout.
+fn git(args: &[&str]) -> Option<String> {
+    std::process::Command::new("git")
+        .args(args)
+        .current_dir(crate::workspace_root())
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
 }
 
 /// One line describing the machine: CPU model (vendor, family, model, caches, whether
@@ -255,13 +257,7 @@ mod tests {
 
     #[test]
     fn build_id_names_the_checkouts_commit() {
-        let head = std::process::Command::new("git")
-            .args(["rev-parse", "HEAD"])
-            .current_dir(crate::workspace_root())
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+        let head = git(&["rev-parse", "HEAD"]);
         let id = build_id();
         assert!(
             id.starts_with(&format!("aggsim {} ", env!("CARGO_PKG_VERSION"))),
