@@ -94,6 +94,11 @@ impl World {
     }
 
     /// The position of the nearest adjacent animat of `kind` (ties: lower id).
+    ///
+    /// This and the other queries the rules ask are inlined into the decision: each is asked
+    /// from a few places at most, and inlined they keep the near cache and the tally in
+    /// registers instead of passing them through memory on every call.
+    #[inline(always)]
     pub(super) fn nearest_adjacent(
         &self,
         a: &Animat,
@@ -127,6 +132,7 @@ impl World {
         self.grid.get(id).map(|(p, _)| p)
     }
 
+    #[inline(always)]
     pub(super) fn adjacent(
         &self,
         a: &Animat,
@@ -151,6 +157,7 @@ impl World {
     }
 
     /// Position of the nearest animat of `kind` within vision (ties: lower id).
+    #[inline(always)]
     pub(super) fn nearest_seen(
         &self,
         a: &Animat,
@@ -206,6 +213,7 @@ impl World {
         self.overcrowded_in(a, &mut self.near(a), &mut Tally::default())
     }
 
+    #[inline(always)]
     pub(super) fn overcrowded_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
         t.count += 1;
         let n = self.params.crowd_max as usize + 1;
@@ -255,6 +263,7 @@ impl World {
         self.enough_prey_in(a, &mut self.near(a), &mut Tally::default())
     }
 
+    #[inline(always)]
     pub(super) fn enough_prey_in(&self, a: &Animat, near: &mut Near<'_>, t: &mut Tally) -> bool {
         t.count += 1;
         let n = self.params.prey_needed as usize;

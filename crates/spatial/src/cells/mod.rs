@@ -528,15 +528,13 @@ impl CellIndex {
     /// around `p` (cells `x - 2 ..= x + 5` of rows `y - 2 ..= y + 2`), for a prefetch hint:
     /// the caller can ask the CPU to start loading them without waiting (this crate has no
     /// `unsafe` code of its own for it). Only the lines in `p`'s own tile are given
-    /// (`near_corners`); the rest are rare and load on use. A line may be given twice.
-    #[inline]
+    /// ([`near_line_offsets`]); the rest are rare and load on use. A line may be given twice.
+    #[inline(always)]
     pub fn near_lines(&self, p: [i64; 2], mut touch: impl FnMut(&u8)) {
-        let (key, _) = split(p);
-        if let Some(t) = self.slot(key) {
+        if let Some(t) = self.slot([p[0] >> SHIFT, p[1] >> SHIFT]) {
             let kinds = &self.tiles[t as usize].kinds;
-            // One line per 8 x 8 block of cells.
-            for [x, y] in near_corners(p) {
-                touch(&kinds[offset(x, y)]);
+            for o in near_line_offsets(p) {
+                touch(&kinds[o]);
             }
         }
     }
@@ -564,26 +562,26 @@ impl CellIndex {
     }
 }
 
-/// The corners of the part of `x - 2 ..= x + 5`, `y - 2 ..= y + 2` around `p = [x, y]` that
-/// lies in `p`'s tile. That part spans at most 2 x 2 blocks of 8 x 8 cells (it is 8 x 5 cells),
-/// so its corners touch every block, hence every cache line of kind bytes, that it covers.
-#[inline]
-fn near_corners(p: [i64; 2]) -> [[i64; 2]; 4] {
-    // The tile's cells are `k << SHIFT ..= (k << SHIFT) + TILE - 1` on each axis, with
-    // `k = v >> SHIFT` (no overflow: `k << SHIFT <= v`).
-    let clamp = |c: i64, v: i64| {
-        let lo = (v >> SHIFT) << SHIFT;
-        c.clamp(lo, lo + (TILE - 1))
-    };
-    let (x0, x1) = (
-        clamp(p[0].saturating_sub(2), p[0]),
-        clamp(p[0].saturating_add(5), p[0]),
-    );
-    let (y0, y1) = (
-        clamp(p[1].saturating_sub(2), p[1]),
-        clamp(p[1].saturating_add(2), p[1]),
-    );
-    [[x0, y0], [x1, y0], [x0, y1], [x1, y1]]
+/// The offsets, in `p`'s tile's kind bytes, of the first byte of each cache line that the
+/// part of `x - 2 ..= x + 5`, `y - 2 ..= y + 2` around `p = [x, y]` lying in that tile touches.
+/// That part spans at most 2 x 2 blocks of 8 x 8 cells (it is 8 x 5 cells), and each block
+/// is one line; the part's corners, in the tile's own coordinates, name them. Worked on the
+/// coordinates within the tile, so that no sum can overflow.
+#[inline(always)]
+fn near_line_offsets(p: [i64; 2]) -> [usize; 4] {
+    let (lx, ly) = ((p[0] & (TILE - 1)) as usize, (p[1] & (TILE - 1)) as usize);
+    let last = (TILE - 1) as usize;
+    let (bx0, bx1) = (lx.saturating_sub(2) >> 3, (lx + 5).min(last) >> 3);
+    let (by0, by1) = (ly.saturating_sub(2) >> 3, (ly + 2).min(last) >> 3);
+    // Block rows and columns are below 8, so the offsets stay below CELLS; the mask lets the
+    // compiler see it.
+    let line = |by: usize, bx: usize| ((by << 3 | bx) << 6) & (CELLS - 64);
+    [
+        line(by0, bx0),
+        line(by0, bx1),
+        line(by1, bx0),
+        line(by1, bx1),
+    ]
 }
 
 /// The rectangle and kinds of a [`CellIndex::scan_rect`].

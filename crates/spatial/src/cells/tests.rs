@@ -10,9 +10,8 @@ fn kind_byte(second: bool) -> u8 {
 #[test]
 fn prefetched_lines_cover_the_rows_lines_in_the_tile() {
     // Every 8-byte row word `Window::rows` reads around p, where it lies in p's tile, is
-    // in one of the lines of the four corners, and no corner lies outside the rows or
-    // the tile; also at the limits of i64, where the rows cannot be formed.
-    let line = |c: [i64; 2]| ((c[0] >> SHIFT, c[1] >> SHIFT), offset(c[0], c[1]) / 64);
+    // in one of the prefetched lines, and every prefetched line holds a cell of the rows
+    // in the tile; also at the limits of i64, where the rows cannot be formed.
     let mut pts = vec![
         [i64::MIN, i64::MIN],
         [i64::MAX, i64::MAX],
@@ -26,24 +25,28 @@ fn prefetched_lines_cover_the_rows_lines_in_the_tile() {
         }
     }
     for p in pts {
-        let corners = near_corners(p);
-        let lines: Vec<_> = corners.iter().map(|&c| line(c)).collect();
-        for c in corners {
-            assert_eq!(c[0] >> SHIFT, p[0] >> SHIFT, "{p:?} {c:?}");
-            assert_eq!(c[1] >> SHIFT, p[1] >> SHIFT, "{p:?} {c:?}");
-            assert!(c[0] >= p[0].saturating_sub(2) && c[0] <= p[0].saturating_add(5));
-            assert!(c[1] >= p[1].saturating_sub(2) && c[1] <= p[1].saturating_add(2));
-        }
-        if p[0].checked_sub(2).is_none() || p[0].checked_add(5).is_none() {
-            continue;
-        }
-        for dy in -2..=2 {
-            for dx in -2..=5 {
-                let c = [p[0] + dx, p[1] + dy];
-                if c[0] >> SHIFT == p[0] >> SHIFT && c[1] >> SHIFT == p[1] >> SHIFT {
-                    assert!(lines.contains(&line(c)), "{p:?}: cell {c:?} not prefetched");
+        let lines = near_line_offsets(p);
+        // The cells of the rows in p's tile, by the offset of their line.
+        let mut cells = Vec::new();
+        for dy in -2..=2i64 {
+            for dx in -2..=5i64 {
+                let (Some(x), Some(y)) = (p[0].checked_add(dx), p[1].checked_add(dy)) else {
+                    continue;
+                };
+                if x >> SHIFT == p[0] >> SHIFT && y >> SHIFT == p[1] >> SHIFT {
+                    cells.push(offset(x, y) & !63);
                 }
             }
+        }
+        for o in lines {
+            assert_eq!(o % 64, 0, "{p:?}: {o} is not a line's start");
+            assert!(
+                cells.contains(&o),
+                "{p:?}: line {o} holds no cell of the rows"
+            );
+        }
+        for c in cells {
+            assert!(lines.contains(&c), "{p:?}: line {c} not prefetched");
         }
     }
 }
