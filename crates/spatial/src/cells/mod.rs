@@ -67,7 +67,6 @@ pub const KIND_MASK: u8 = 3;
 
 #[derive(Debug, Clone)]
 struct Tile {
-    kinds: Box<[u8; CELLS]>,
     ids: Box<[u64; CELLS]>,
     count: u32,
     /// Occupied cells of each 8 x 8 block, by kind (index `kind - 1`); boxed, so that the
@@ -120,6 +119,9 @@ pub struct CellIndex {
     /// Every tile's slot by tile coordinates.
     map: FxHashMap<[i64; 2], u32>,
     tiles: Vec<Tile>,
+    /// The cell bytes of every tile, by slot (parallel to `tiles`), in one allocation: the
+    /// bytes that every query reads lie together instead of between the tiles' ids.
+    kinds: Vec<[u8; CELLS]>,
     free: Vec<u32>,
     /// Dense directory of the tiles in the rectangle of tile coordinates `[dx0, dx0 + dw) x
     /// [dy0, dy0 + dh)`: slot + 1, or 0 for no tile. Complete for its rectangle (a lookup
@@ -223,7 +225,7 @@ impl CellIndex {
     pub fn kind(&self, p: [i64; 2]) -> u8 {
         let (key, off) = split(p);
         match self.slot(key) {
-            Some(t) => self.tiles[t as usize].kinds[off] & KIND_MASK,
+            Some(t) => self.kinds[t as usize][off] & KIND_MASK,
             None => FREE,
         }
     }
@@ -264,7 +266,7 @@ impl CellIndex {
             let b = self.bucket(id) << 2;
             let (key, off) = split(p);
             if let Some(t) = self.slot(key) {
-                let k = &mut self.tiles[t as usize].kinds[off];
+                let k = &mut self.kinds[t as usize][off];
                 *k = (*k & KIND_MASK) | b;
             }
         }
@@ -288,11 +290,8 @@ impl CellIndex {
                 let t = match self.free.pop() {
                     Some(t) => t,
                     None => {
+                        self.kinds.push([FREE; CELLS]);
                         self.tiles.push(Tile {
-                            kinds: vec![FREE; CELLS]
-                                .into_boxed_slice()
-                                .try_into()
-                                .expect("CELLS bytes"),
                             ids: vec![0u64; CELLS]
                                 .into_boxed_slice()
                                 .try_into()
@@ -309,8 +308,9 @@ impl CellIndex {
             }
         };
         let tile = &mut self.tiles[t as usize];
-        debug_assert_eq!(tile.kinds[off], FREE, "cell {p:?} already occupied");
-        tile.kinds[off] = k | b;
+        let kinds = &mut self.kinds[t as usize];
+        debug_assert_eq!(kinds[off], FREE, "cell {p:?} already occupied");
+        kinds[off] = k | b;
         tile.ids[off] = id;
         tile.count += 1;
         tile.enter(k, off);
@@ -325,10 +325,11 @@ impl CellIndex {
             return;
         };
         let tile = &mut self.tiles[t as usize];
-        debug_assert_ne!(tile.kinds[off], FREE);
-        let k = tile.kinds[off];
+        let kinds = &mut self.kinds[t as usize];
+        debug_assert_ne!(kinds[off], FREE);
+        let k = kinds[off];
         tile.leave(k, off);
-        tile.kinds[off] = FREE;
+        kinds[off] = FREE;
         tile.count -= 1;
         if tile.count == 0 {
             self.map.remove(&key);
@@ -347,14 +348,15 @@ impl CellIndex {
         if kf == kt {
             if let Some(t) = self.slot(kf) {
                 let tile = &mut self.tiles[t as usize];
-                let k = tile.kinds[of];
+                let kinds = &mut self.kinds[t as usize];
+                let k = kinds[of];
                 if of >> 6 != ot >> 6 {
                     tile.leave(k, of);
                     tile.enter(k, ot);
                 }
-                tile.kinds[ot] = k;
+                kinds[ot] = k;
                 tile.ids[ot] = tile.ids[of];
-                tile.kinds[of] = FREE;
+                kinds[of] = FREE;
                 return;
             }
         }
@@ -389,8 +391,8 @@ impl CellIndex {
         let fetch = |tx: i64, ty: i64| -> (&[u8; CELLS], &[u64; CELLS]) {
             match self.slot([tx, ty]) {
                 Some(t) => {
-                    let t = &self.tiles[t as usize];
-                    (&t.kinds, &t.ids)
+                    let t = t as usize;
+                    (&self.kinds[t], &*self.tiles[t].ids)
                 }
                 None => (&EMPTY_KINDS, &EMPTY_IDS),
             }
@@ -471,6 +473,7 @@ impl CellIndex {
         f: &mut impl FnMut(i64, i64, u8) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
         let tile = &self.tiles[t as usize];
+        let kinds = &self.kinds[t as usize];
         // `key` is some cell's coordinates shifted right, so shifting back cannot overflow,
         // nor can adding TILE - 1; the rectangle meets the tile, so the local bounds lie in
         // 0..TILE.
@@ -503,11 +506,8 @@ impl CellIndex {
             let cmask = (u64::MAX >> (8 * (7 - c1))) & (u64::MAX << (8 * c0)) & LOW;
             for ly in ly0.max(by)..=ly1.min(by + 7) {
                 let o = (b << 6) | ((ly & 7) << 3);
-                let w = u64::from_le_bytes(
-                    tile.kinds[o..o + 8]
-                        .try_into()
-                        .expect("a block row is 8 bytes"),
-                );
+                let w =
+                    u64::from_le_bytes(kinds[o..o + 8].try_into().expect("a block row is 8 bytes"));
                 let sel = match r.kinds & KIND_MASK {
                     1 => w,
                     2 => w >> 1,
@@ -532,7 +532,7 @@ impl CellIndex {
     #[inline(always)]
     pub fn near_lines(&self, p: [i64; 2], mut touch: impl FnMut(&u8)) {
         if let Some(t) = self.slot([p[0] >> SHIFT, p[1] >> SHIFT]) {
-            let kinds = &self.tiles[t as usize].kinds;
+            let kinds = &self.kinds[t as usize];
             for o in near_line_offsets(p) {
                 touch(&kinds[o]);
             }
@@ -545,7 +545,8 @@ impl CellIndex {
         let slots = self.tiles.capacity() * size_of::<Tile>()
             + (self.dir.capacity() + self.free.capacity()) * size_of::<u32>()
             + self.map.capacity() * (size_of::<[i64; 2]>() + size_of::<u32>() + 1);
-        self.tiles.len() as u64 * TILE_BYTES + slots as u64
+        let spare_kinds = (self.kinds.capacity() - self.kinds.len()) * CELLS;
+        self.tiles.len() as u64 * TILE_BYTES + (slots + spare_kinds) as u64
     }
 
     /// Occupied cells (O(tiles in use); for consistency checks).

@@ -102,7 +102,7 @@ fn scan_rect_visits_exactly_the_occupied_cells_of_the_kinds_in_the_rectangle() {
         let _ = c.scan_rect([x0, x0 + w], [y0, y0 + h], kinds, |x, y, b| {
             assert_eq!(
                 b,
-                c.tiles[c.slot([x >> SHIFT, y >> SHIFT]).unwrap() as usize].kinds[offset(x, y)]
+                c.kinds[c.slot([x >> SHIFT, y >> SHIFT]).unwrap() as usize][offset(x, y)]
             );
             seen.push([x, y]);
             ControlFlow::Continue(())
