@@ -67,7 +67,6 @@ pub const KIND_MASK: u8 = 3;
 
 #[derive(Debug, Clone)]
 struct Tile {
-    ids: Box<[u64; CELLS]>,
     count: u32,
     /// Occupied cells of each 8 x 8 block, by kind (index `kind - 1`); boxed, so that the
     /// tile records that every query reads stay small.
@@ -122,6 +121,8 @@ pub struct CellIndex {
     /// The cell bytes of every tile, by slot (parallel to `tiles`), in one allocation: the
     /// bytes that every query reads lie together instead of between the tiles' ids.
     kinds: Vec<[u8; CELLS]>,
+    /// The ids on the cells of every tile, by slot, also in one allocation.
+    ids: Vec<[u64; CELLS]>,
     free: Vec<u32>,
     /// Dense directory of the tiles in the rectangle of tile coordinates `[dx0, dx0 + dw) x
     /// [dy0, dy0 + dh)`: slot + 1, or 0 for no tile. Complete for its rectangle (a lookup
@@ -290,12 +291,8 @@ impl CellIndex {
                 let t = match self.free.pop() {
                     Some(t) => t,
                     None => {
-                        self.kinds.push([FREE; CELLS]);
+                        self.push_tile_arrays();
                         self.tiles.push(Tile {
-                            ids: vec![0u64; CELLS]
-                                .into_boxed_slice()
-                                .try_into()
-                                .expect("CELLS ids"),
                             count: 0,
                             block_counts: Box::new([[0; BLOCKS]; 2]),
                             block_masks: [0; 2],
@@ -311,9 +308,23 @@ impl CellIndex {
         let kinds = &mut self.kinds[t as usize];
         debug_assert_eq!(kinds[off], FREE, "cell {p:?} already occupied");
         kinds[off] = k | b;
-        tile.ids[off] = id;
+        self.ids[t as usize][off] = id;
         tile.count += 1;
         tile.enter(k, off);
+    }
+
+    /// Adds a new slot's cell bytes (all [`FREE`]) and ids. The two vectors grow by a quarter
+    /// at a time, not double: they hold most of the index's memory, so doubling could ask
+    /// for nearly twice what a large run uses in one allocation (growing a large allocation
+    /// remaps its pages rather than copying them, so the smaller steps cost little).
+    fn push_tile_arrays(&mut self) {
+        if self.ids.len() == self.ids.capacity() {
+            let more = (self.ids.len() / 4).max(16);
+            self.kinds.reserve_exact(more);
+            self.ids.reserve_exact(more);
+        }
+        self.kinds.push([FREE; CELLS]);
+        self.ids.push([0; CELLS]);
     }
 
     /// Frees cell `p` (which must be occupied).
@@ -355,7 +366,8 @@ impl CellIndex {
                     tile.enter(k, ot);
                 }
                 kinds[ot] = k;
-                tile.ids[ot] = tile.ids[of];
+                let ids = &mut self.ids[t as usize];
+                ids[ot] = ids[of];
                 kinds[of] = FREE;
                 return;
             }
@@ -370,8 +382,7 @@ impl CellIndex {
     #[inline]
     pub fn id(&self, p: [i64; 2]) -> u64 {
         let (key, off) = split(p);
-        self.slot(key)
-            .map_or(0, |t| self.tiles[t as usize].ids[off])
+        self.slot(key).map_or(0, |t| self.ids[t as usize][off])
     }
 
     /// A window of half-side `k <= WINDOW_MAX` around `p`, or `None` when `p` is too close to
@@ -392,7 +403,7 @@ impl CellIndex {
             match self.slot([tx, ty]) {
                 Some(t) => {
                     let t = t as usize;
-                    (&self.kinds[t], &*self.tiles[t].ids)
+                    (&self.kinds[t], &self.ids[t])
                 }
                 None => (&EMPTY_KINDS, &EMPTY_IDS),
             }
@@ -545,8 +556,7 @@ impl CellIndex {
         let slots = self.tiles.capacity() * size_of::<Tile>()
             + (self.dir.capacity() + self.free.capacity()) * size_of::<u32>()
             + self.map.capacity() * (size_of::<[i64; 2]>() + size_of::<u32>() + 1);
-        let spare_kinds = (self.kinds.capacity() - self.kinds.len()) * CELLS;
-        self.tiles.len() as u64 * TILE_BYTES + (slots + spare_kinds) as u64
+        self.tiles.len() as u64 * TILE_BYTES + slots as u64
     }
 
     /// Occupied cells (O(tiles in use); for consistency checks).
