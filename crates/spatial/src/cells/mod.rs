@@ -315,8 +315,9 @@ impl CellIndex {
 
     /// Adds a new slot's cell bytes (all [`FREE`]) and ids. The two vectors grow by a quarter
     /// at a time, not double: they hold most of the index's memory, so doubling could ask
-    /// for nearly twice what a large run uses in one allocation (growing a large allocation
-    /// remaps its pages rather than copying them, so the smaller steps cost little).
+    /// for nearly twice what a large run uses in one allocation. The smaller steps cost little:
+    /// the system allocator (glibc's) grows a large allocation by remapping its pages, not by
+    /// copying them.
     fn push_tile_arrays(&mut self) {
         if self.ids.len() == self.ids.capacity() {
             let more = (self.ids.len() / 4).max(16);
@@ -539,7 +540,7 @@ impl CellIndex {
     /// around `p` (cells `x - 2 ..= x + 5` of rows `y - 2 ..= y + 2`), for a prefetch hint:
     /// the caller can ask the CPU to start loading them without waiting (this crate has no
     /// `unsafe` code of its own for it). Only the lines in `p`'s own tile are given
-    /// ([`near_line_offsets`]); the rest are rare and load on use. A line may be given twice.
+    /// (`near_line_offsets`); the rest are rare and load on use. A line may be given twice.
     #[inline(always)]
     pub fn near_lines(&self, p: [i64; 2], mut touch: impl FnMut(&u8)) {
         if let Some(t) = self.slot([p[0] >> SHIFT, p[1] >> SHIFT]) {
