@@ -69,7 +69,7 @@ pub const KIND_MASK: u8 = 3;
 struct Tile {
     count: u32,
     /// Occupied cells of each 8 x 8 block, by kind (index `kind - 1`); boxed, so that the
-    /// tile records that every query reads stay small.
+    /// tile records that the wide queries scan for their block masks stay small.
     block_counts: Box<[[u8; BLOCKS]; 2]>,
     /// Bit `b` set when block `b` holds an item of the kind (same index).
     block_masks: [u64; 2],
