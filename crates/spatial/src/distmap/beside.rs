@@ -21,6 +21,10 @@ pub struct Beside<const D: usize> {
     w: [f64; D],
     /// A bound of `|c_0 - m_0|` over the cells an insert visits.
     slack: f64,
+    /// The boundary along axis 0 as a linear function of a row's offset `off` (in cells,
+    /// centres at whole numbers): `at - off * slope`, when `|w_0| > 1e-3` (see `clip_at`).
+    at: f64,
+    slope: f64,
 }
 
 impl<const D: usize> Beside<D> {
@@ -31,29 +35,26 @@ impl<const D: usize> Beside<D> {
     pub(super) fn new(q: &[f64; D], p: &[f64; D], cap: f64, cell: f64) -> Option<Self> {
         let w: [f64; D] = std::array::from_fn(|i| p[i] - q[i]);
         let w2: f64 = w.iter().map(|x| x * x).sum();
+        let mid: [f64; D] = std::array::from_fn(|i| 0.5 * (p[i] + q[i]));
+        let inv_cell = 1.0 / cell;
         (0.25..=4.0).contains(&w2).then(|| Beside {
-            mid: std::array::from_fn(|i| 0.5 * (p[i] + q[i])),
+            mid,
             w,
             slack: cap + 2.0 * cell + 2.0,
+            at: (mid[0] + Self::MARGIN / w[0]) * inv_cell - 0.5,
+            slope: inv_cell / w[0],
         })
     }
 
     /// Narrows the cell range `a..=b` along axis 0 of the row at cell indices `k[1..]` to the
     /// half-space (an empty range when none of it is inside).
     #[inline(always)]
-    pub(super) fn clip(
-        &self,
-        k: &[i64; D],
-        cell: f64,
-        inv_cell: f64,
-        a: i64,
-        b: i64,
-    ) -> (i64, i64) {
+    pub(super) fn clip(&self, k: &[i64; D], cell: f64, a: i64, b: i64) -> (i64, i64) {
         let mut off = 0.0;
         for (i, &k) in k.iter().enumerate().skip(1) {
             off += self.term(i, k, cell);
         }
-        self.clip_at(off, inv_cell, a, b)
+        self.clip_at(off, a, b)
     }
 
     /// The term of axis `i >= 1` in the offset of the rows at cell index `k` along it: what
@@ -66,18 +67,20 @@ impl<const D: usize> Beside<D> {
     /// [`clip`](Self::clip) given the row's offset `off`, the sum of its [`term`](Self::term)s
     /// over axes `1..D` in order.
     #[inline(always)]
-    pub(super) fn clip_at(&self, off: f64, inv_cell: f64, a: i64, b: i64) -> (i64, i64) {
-        // Keep the cells with (c_0 - m_0) w_0 < r; a cell on the boundary is kept.
-        let r = Self::MARGIN - off;
+    pub(super) fn clip_at(&self, off: f64, a: i64, b: i64) -> (i64, i64) {
+        // Keep the cells with (c_0 - m_0) w_0 < MARGIN - off; a cell on the boundary is kept.
         let w0 = self.w[0];
         if w0.abs() > 1e-3 {
-            let x = (self.mid[0] + r / w0) * inv_cell - 0.5;
+            // `(m_0 + (MARGIN - off) / w_0) / c - 1/2`, expanded so that a row costs a
+            // multiplication, not a division: it differs from that by a few ulps of the cell
+            // index, far inside `MARGIN`, so every cell it drops is still strictly nearer `p`.
+            let x = self.at - off * self.slope;
             if w0 > 0.0 {
                 (a, b.min(floor(x) as i64))
             } else {
                 (a.max(ceil(x) as i64), b)
             }
-        } else if r + 1e-3 * self.slack > 0.0 {
+        } else if Self::MARGIN - off + 1e-3 * self.slack > 0.0 {
             (a, b)
         } else {
             (a, a - 1)

@@ -188,7 +188,7 @@ impl Grid {
         let a = (a as i64).max(lo0);
         let b = (b as i64).min(hi0);
         match side {
-            Some(side) => side.clip(k, self.cell, self.inv_cell, a, b),
+            Some(side) => side.clip(k, self.cell, a, b),
             None => (a, b),
         }
     }
@@ -262,10 +262,8 @@ impl<const D: usize> RowTables<D> {
 
     /// [`Grid::clip_row`] of the row at cell indices `k[1..]` (the cells from `lo`).
     #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn clip_row(
         &self,
-        g: &Grid,
         (a, b): (f64, f64),
         lo0: i64,
         hi0: i64,
@@ -281,7 +279,7 @@ impl<const D: usize> RowTables<D> {
                 for i in 1..D {
                     off += self.off[i][(k[i] - lo[i]) as usize];
                 }
-                side.clip_at(off, g.inv_cell, a, b)
+                side.clip_at(off, a, b)
             }
             None => (a, b),
         }

@@ -327,7 +327,7 @@ mod sealed {
                 loop {
                     let (s, j2) = t.row_offset(&k, &lo);
                     if let Some(range) = g.row_range(q[0], s, t0, j2) {
-                        let (a, b) = t.clip_row(g, range, lo[0], hi[0], &k, &lo, side);
+                        let (a, b) = t.clip_row(range, lo[0], hi[0], &k, &lo, side);
                         if a <= b {
                             self.lower_row(q, s, &k, (a, b), &mut lower, &mut cache);
                         }
