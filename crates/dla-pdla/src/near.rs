@@ -25,7 +25,7 @@
 //!   next move ([`NearCache::added`]), so the cache misses at most what the tree gained during
 //!   one move, as the walk itself does (the re-check at sticking covers both).
 
-use spatial::orthtree::{Orthtree, dist_sq};
+use spatial::orthtree::{Orthtree, RangeSink, dist_sq};
 
 /// Radius of the ball a cache holds, in diameters, tuned by instruction counts
 /// (`docs/benchmarks.md`): a smaller ball is rebuilt too often, a larger one costs more to
@@ -58,6 +58,8 @@ pub(crate) struct NearCache<const D: usize> {
     /// the last block hold `+inf` coordinates, which are never nearest.
     blocks: Vec<[[f64; LANES]; D]>,
     len: usize,
+    /// The rebuild's scratch space, kept for its capacity.
+    found: Found<D>,
 }
 
 impl<const D: usize> NearCache<D> {
@@ -67,6 +69,10 @@ impl<const D: usize> NearCache<D> {
             centre: [0.0; D],
             blocks: Vec::new(),
             len: 0,
+            found: Found {
+                points: Vec::new(),
+                len: 0,
+            },
         }
     }
 
@@ -86,7 +92,12 @@ impl<const D: usize> NearCache<D> {
     pub(crate) fn rebuild(&mut self, tree: &Orthtree<D>, p: &[f64; D]) {
         self.blocks.clear();
         self.len = 0;
-        tree.for_each_within(p, NEAR_RADIUS, |x| self.push(&x));
+        self.found.len = 0;
+        tree.range_into(p, NEAR_RADIUS, &mut self.found);
+        for j in 0..self.found.len {
+            let x = self.found.points[j];
+            self.push(&x);
+        }
         self.centre = *p;
         self.live = true;
     }
@@ -197,6 +208,30 @@ impl<const D: usize> NearCache<D> {
                 }
             }
         }
+    }
+}
+
+/// What a rebuild's range query found: every point it offers is written after the last one
+/// inside and kept by counting it, without a branch per point (see `RangeSink`), so the first
+/// `len` are the particles `Orthtree::for_each_within` lists, in its order.
+#[derive(Debug, Clone)]
+struct Found<const D: usize> {
+    points: Vec<[f64; D]>,
+    len: usize,
+}
+
+impl<const D: usize> RangeSink<D> for Found<D> {
+    #[inline(always)]
+    fn reserve(&mut self, n: usize) {
+        if self.points.len() < self.len + n {
+            self.points.resize(self.len + n, [0.0; D]);
+        }
+    }
+
+    #[inline(always)]
+    fn offer(&mut self, x: [f64; D], inside: bool) {
+        self.points[self.len] = x;
+        self.len += usize::from(inside);
     }
 }
 

@@ -14,7 +14,39 @@
 //! - `v > d (2 kappa - 1) / (2 kappa + 1)`.
 
 use proptest::prelude::*;
-use spatial::orthtree::Orthtree;
+use spatial::orthtree::{Orthtree, RangeSink};
+
+/// Every offer of a range query, with whether it came within the room last reserved.
+struct Offers<const D: usize> {
+    all: Vec<([f64; D], bool)>,
+    room: usize,
+    unreserved: usize,
+}
+
+impl<const D: usize> Default for Offers<D> {
+    fn default() -> Self {
+        Offers {
+            all: Vec::new(),
+            room: 0,
+            unreserved: 0,
+        }
+    }
+}
+
+impl<const D: usize> RangeSink<D> for Offers<D> {
+    fn reserve(&mut self, n: usize) {
+        self.room = n;
+    }
+
+    fn offer(&mut self, x: [f64; D], inside: bool) {
+        if self.room == 0 {
+            self.unreserved += 1;
+        } else {
+            self.room -= 1;
+        }
+        self.all.push((x, inside));
+    }
+}
 
 /// Reference squared distance.
 fn d2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
@@ -206,6 +238,16 @@ fn check<const D: usize>(
                 .filter(|x| d2(q, x) <= r * r)
                 .copied()
                 .collect();
+            // The sink form offers the same points as inside, in the same order, and every
+            // other point of the leaves it scans as outside; `reserve` comes first each time.
+            let mut offers = Offers::default();
+            tree.range_into(q, r, &mut offers);
+            prop_assert_eq!(offers.unreserved, 0, "an offer beyond the room reserved");
+            let inside: Vec<[f64; D]> = offers.all.iter().filter(|o| o.1).map(|o| o.0).collect();
+            prop_assert_eq!(&inside, &got, "range_into {} around {:?}", r, q);
+            for (x, _) in offers.all.iter().filter(|o| !o.1) {
+                prop_assert!(d2(q, x) > r * r, "{:?} offered as outside {}", x, r);
+            }
             got.sort_by(key);
             want.sort_by(key);
             prop_assert_eq!(got, want, "range {} around {:?}", r, q);

@@ -68,7 +68,7 @@
 //! | [`insert`](Orthtree::insert) | O(h + points in the leaf) (a leaf's block is copied when it grows) |
 //! | [`nearest`](Orthtree::nearest), [`nearest_distance`](Orthtree::nearest_distance) | branch and bound: O(h) plus the nodes whose box is closer than the answer |
 //! | [`vpdist`](Orthtree::vpdist) | O(h) nodes times a constant depending on `kappa` and `D` only (the variable-precision paper, Listing 1) |
-//! | [`for_each_within`](Orthtree::for_each_within) | O(h + nodes meeting the ball + points reported) |
+//! | [`for_each_within`](Orthtree::for_each_within), [`range_into`](Orthtree::range_into) | O(h + nodes meeting the ball + the points of their leaves) |
 //! | [`iter`](Orthtree::iter) | O(N + nodes) |
 //!
 //! Queries take `&self` and never allocate (except [`iter`](Orthtree::iter), which keeps an
@@ -184,7 +184,7 @@ use std::sync::{Mutex, MutexGuard};
 use sync::{AtomicU32, AtomicU64, AtomicUsize, Ordering};
 
 pub use iter::Points;
-pub use query::{Neighbour, VpEstimate, dist_sq};
+pub use query::{Neighbour, RangeSink, VpEstimate, dist_sq};
 
 /// The orthtree's default leaf side `s`, in particle diameters: the side of the leaf cells
 /// (the last level of the tree, where the variable-precision paper, section 3.3, keeps its chunks

@@ -34,6 +34,7 @@ macro_rules! child_centre {
 mod cover;
 mod leaf;
 mod range;
+pub use range::RangeSink;
 
 /// Relative shrink applied to far-node lower bounds `|p - c| - r`, so that rounding in the
 /// distance to the centre can never push the bound above a point's computed distance. `2^-44`

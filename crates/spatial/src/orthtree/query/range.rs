@@ -3,13 +3,48 @@
 use super::super::{EMPTY, Orthtree, decode};
 use super::box_dist_sq;
 
+/// Where [`Orthtree::range_into`] puts what it finds. The query offers every point of each
+/// leaf that meets the ball, with whether it lies inside, so that a sink can keep the points
+/// without a branch per point (whether a point of a leaf lies inside is close to a coin toss,
+/// and a mispredicted branch costs more than the few stores it would skip).
+pub trait RangeSink<const D: usize> {
+    /// Room for `n` more offers: the points of the next leaf.
+    fn reserve(&mut self, n: usize);
+    /// A stored point (as the tree decodes it) and whether its squared distance from the
+    /// query position, summed axis by axis, is at most the squared radius.
+    fn offer(&mut self, x: [f64; D], inside: bool);
+}
+
+/// The sink of [`Orthtree::for_each_within`]: the closure, for the points inside.
+struct Calls<F>(F);
+
+impl<const D: usize, F: FnMut([f64; D])> RangeSink<D> for Calls<F> {
+    #[inline(always)]
+    fn reserve(&mut self, _: usize) {}
+
+    #[inline(always)]
+    fn offer(&mut self, x: [f64; D], inside: bool) {
+        if inside {
+            (self.0)(x);
+        }
+    }
+}
+
 impl<const D: usize> Orthtree<D> {
     /// Calls `f` with the stored position of every point at distance `<= r` from `p` (inclusive,
     /// comparing squared distances summed axis by axis, as
     /// [`nearest_distance`](Self::nearest_distance) does). Order unspecified. Nothing is called if
     /// `r` is negative or NaN. Used by DLA to find the first contact along a step (the
     /// variable-precision paper, section 3.2, Fig. 6).
-    pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, mut f: F) {
+    pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, f: F) {
+        self.range_into(p, r, &mut Calls(f));
+    }
+
+    /// The range query of [`for_each_within`](Self::for_each_within), handing `sink` every
+    /// point of the leaves that meet the ball with whether it lies inside (see [`RangeSink`]):
+    /// the points offered as inside are exactly those `for_each_within` lists, in the same
+    /// order.
+    pub fn range_into<S: RangeSink<D>>(&self, p: &[f64; D], r: f64, sink: &mut S) {
         if self.root == EMPTY || r.is_nan() || r < 0.0 {
             return;
         }
@@ -22,9 +57,9 @@ impl<const D: usize> Orthtree<D> {
             // their levels.
             unsafe {
                 if level == 0 {
-                    tree.range_leaf(p, r_sq, node, c, half, &mut f);
+                    tree.range_leaf(p, r_sq, node, c, half, sink);
                 } else {
-                    tree.range_node(p, r_sq, node, level, c, half, &mut f);
+                    tree.range_node(p, r_sq, node, level, c, half, sink);
                 }
             }
         };
@@ -38,7 +73,7 @@ impl<const D: usize> Orthtree<D> {
     ///
     /// `node` is a reached node of level `level`, as for [`visit`](Self::visit).
     #[allow(clippy::too_many_arguments)]
-    unsafe fn range_node<F: FnMut([f64; D])>(
+    unsafe fn range_node<S: RangeSink<D>>(
         &self,
         p: &[f64; D],
         r_sq: f64,
@@ -46,7 +81,7 @@ impl<const D: usize> Orthtree<D> {
         level: u32,
         c: [f64; D],
         half: f64,
-        f: &mut F,
+        sink: &mut S,
     ) {
         let q = half * 0.5;
         // Per axis, the squared distance from p to the lower and the upper half of the node,
@@ -77,9 +112,9 @@ impl<const D: usize> Orthtree<D> {
             // if `level == 1`, else a reached node of level `level - 1`.
             unsafe {
                 if level == 1 {
-                    self.range_leaf(p, r_sq, child, cc, q, f);
+                    self.range_leaf(p, r_sq, child, cc, q, sink);
                 } else {
-                    self.range_node(p, r_sq, child, level - 1, cc, q, f);
+                    self.range_node(p, r_sq, child, level - 1, cc, q, sink);
                 }
             }
         }
@@ -91,18 +126,20 @@ impl<const D: usize> Orthtree<D> {
     ///
     /// `leaf` is a reached leaf, as for [`visit_leaf`](Self::visit_leaf).
     #[inline]
-    unsafe fn range_leaf<F: FnMut([f64; D])>(
+    unsafe fn range_leaf<S: RangeSink<D>>(
         &self,
         p: &[f64; D],
         r_sq: f64,
         leaf: u32,
         c: [f64; D],
         half: f64,
-        f: &mut F,
+        sink: &mut S,
     ) {
         let origin = c.map(|x| x - half);
         // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
-        for code in unsafe { self.leaf_points(leaf) } {
+        let codes = unsafe { self.leaf_points(leaf) };
+        sink.reserve(codes.len());
+        for code in codes {
             let mut x = [0.0; D];
             let mut d2 = 0.0;
             for i in 0..D {
@@ -110,9 +147,7 @@ impl<const D: usize> Orthtree<D> {
                 let e = p[i] - x[i];
                 d2 += e * e;
             }
-            if d2 <= r_sq {
-                f(x);
-            }
+            sink.offer(x, d2 <= r_sq);
         }
     }
 }
