@@ -35,14 +35,16 @@ impl<const D: usize> Beside<D> {
     pub(super) fn new(q: &[f64; D], p: &[f64; D], cap: f64, cell: f64) -> Option<Self> {
         let w: [f64; D] = std::array::from_fn(|i| p[i] - q[i]);
         let w2: f64 = w.iter().map(|x| x * x).sum();
-        let mid: [f64; D] = std::array::from_fn(|i| 0.5 * (p[i] + q[i]));
-        let inv_cell = 1.0 / cell;
-        (0.25..=4.0).contains(&w2).then(|| Beside {
-            mid,
-            w,
-            slack: cap + 2.0 * cell + 2.0,
-            at: (mid[0] + Self::MARGIN / w[0]) * inv_cell - 0.5,
-            slope: inv_cell / w[0],
+        (0.25..=4.0).contains(&w2).then(|| {
+            let mid: [f64; D] = std::array::from_fn(|i| 0.5 * (p[i] + q[i]));
+            let inv_cell = 1.0 / cell;
+            Beside {
+                mid,
+                w,
+                slack: cap + 2.0 * cell + 2.0,
+                at: (mid[0] + Self::MARGIN / w[0]) * inv_cell - 0.5,
+                slope: inv_cell / w[0],
+            }
         })
     }
 
