@@ -69,10 +69,7 @@ impl<const D: usize> NearCache<D> {
             centre: [0.0; D],
             blocks: Vec::new(),
             len: 0,
-            found: Found {
-                points: Vec::new(),
-                len: 0,
-            },
+            found: Found::default(),
         }
     }
 
@@ -214,7 +211,7 @@ impl<const D: usize> NearCache<D> {
 /// What a rebuild's range query found: every point it offers is written after the last one
 /// inside and kept by counting it, without a branch per point (see `RangeSink`), so the first
 /// `len` are the particles `Orthtree::for_each_within` lists, in its order.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 struct Found<const D: usize> {
     points: Vec<[f64; D]>,
     len: usize,
