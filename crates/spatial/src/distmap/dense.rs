@@ -264,13 +264,7 @@ impl<const D: usize> DistanceMap<D> {
     /// The offset in `values` of the first cell (`k_0 = -half`) of the row at `k[1..]`.
     #[inline(always)]
     fn row_base(&self, k: &[i64; D]) -> usize {
-        let mut base = 0usize;
-        let mut stride = self.side;
-        for i in 1..D {
-            base += (k[i] + self.grid.half) as usize * stride;
-            stride *= self.side;
-        }
-        base
+        (1..D).map(|i| self.row_key(i, k[i]) as usize).sum()
     }
 
     /// Calls `lower(cell, w)` for every cell of the map whose centre lies within `cap` of the
@@ -456,19 +450,26 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
 
     type RowCache<'a> = ();
 
-    /// Lowers the row's cells in `values`, contiguous along axis 0.
+    /// The row's offset in `values` along axis `i`: `(k + half) side^i`.
+    #[inline(always)]
+    fn row_key(&self, i: usize, k: i64) -> u64 {
+        ((k + self.grid.half) as usize * self.side.pow(i as u32)) as u64
+    }
+
+    /// Lowers the row's cells in `values`, contiguous along axis 0; the row's key is the
+    /// offset of its first cell (`k_0 = -half`).
     #[inline(always)]
     fn lower_row(
         &self,
         q: &[f64; D],
         s: f64,
-        k: &[i64; D],
+        key: u64,
         (a, b): (i64, i64),
         lower: &mut impl FnMut(&AtomicU8, u8),
         _: &mut (),
     ) {
         let g = &self.grid;
-        let base = self.row_base(k);
+        let base = key as usize;
         let row = &self.values[base + (a + g.half) as usize..=base + (b + g.half) as usize];
         let x0 = (a as f64 + 0.5) * g.cell - q[0];
         for (j, v) in row.iter().enumerate() {

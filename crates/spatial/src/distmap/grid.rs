@@ -11,7 +11,12 @@ const WIDTHS_MAX: f64 = 4096.0;
 
 /// Most cells per axis over which an insert tabulates its rows' offsets ([`RowTables`]); an
 /// insert spanning more computes every row in full.
-const TABLE_ROWS: usize = 24;
+const TABLE_ROWS: usize = 12;
+
+/// Most entries of the table of widths ([`Grid::widths`]) for which an insert tabulates its
+/// rows' ranges along axis 0 ([`RowTables`]). With [`TABLE_ROWS`], enough for a cap of up to
+/// 5.5 cells (the tables stay small: an insert sets them to zero before filling them).
+const TABLE_SPANS: usize = 32;
 
 /// The cells of a map of side `cell` capped at `cap`, how far the map reaches, its points,
 /// and the tables its inserts read (see [`Grid::new`]).
@@ -198,12 +203,20 @@ impl Grid {
 /// that axis instead of once per row: the squared distance from the point to the cells'
 /// centres along the axis and its whole-cell lower bound ([`Grid::row_offset`] sums these over
 /// the axes, in the same order, so a row gets the same values bit for bit), and the axis's
-/// term of the half-space offset of an insert beside a touched point ([`Beside::clip`]). A
-/// row then costs a few table reads and additions.
+/// term of the half-space offset of an insert beside a touched point ([`Beside::clip`]) and its
+/// term of the map's key of the row; and
+/// for each entry `j2` of the table of widths, the range along axis 0 a row with that lower
+/// bound covers ([`Grid::row_range`] and [`Grid::clip_row`]'s clamp to the box, the same
+/// integers). A row then costs a few table reads and additions, with no rounding of its own
+/// (the point's ball has far fewer distinct `j2` than rows).
 pub(super) struct RowTables<const D: usize> {
     e2: [[f64; TABLE_ROWS]; D],
     j2: [[usize; TABLE_ROWS]; D],
     off: [[f64; TABLE_ROWS]; D],
+    key: [[u64; TABLE_ROWS]; D],
+    spans: [(i64, i64); TABLE_SPANS],
+    /// Entries of `spans` filled: rows with a larger `j2` hold no cell within the cap.
+    nspans: usize,
 }
 
 impl<const D: usize> RowTables<D> {
@@ -214,31 +227,48 @@ impl<const D: usize> RowTables<D> {
             e2: [[0.0; TABLE_ROWS]; D],
             j2: [[0; TABLE_ROWS]; D],
             off: [[0.0; TABLE_ROWS]; D],
+            key: [[0; TABLE_ROWS]; D],
+            spans: [(0, 0); TABLE_SPANS],
+            nspans: 0,
         }
     }
 
-    /// Fills the tables for an insert of `q` over the cells `lo..=hi` (`kq` from
-    /// [`Grid::row_origin`]); `false` (tables unusable) when an axis spans more than
-    /// [`TABLE_ROWS`] cells.
+    /// Fills the tables for an insert of `q` over the cells `lo..=hi` (`t0` and `kq` from
+    /// [`Grid::row_origin`], `key` the map's term of a row's key per axis and cell index);
+    /// `false` (tables unusable) when an axis spans more than
+    /// [`TABLE_ROWS`] cells or the map has no table of widths, or a table longer than
+    /// [`TABLE_SPANS`].
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn fill(
         &mut self,
         g: &Grid,
         q: &[f64; D],
         lo: &[i64; D],
         hi: &[i64; D],
-        kq: &[i64; D],
+        (t0, kq): (f64, &[i64; D]),
         side: Option<&Beside<D>>,
+        key: impl Fn(usize, i64) -> u64,
     ) -> bool {
-        if (1..D).any(|i| hi[i] - lo[i] >= TABLE_ROWS as i64) {
+        let n = g.widths.len();
+        if n == 0 || n > TABLE_SPANS || (1..D).any(|i| hi[i] - lo[i] >= TABLE_ROWS as i64) {
             return false;
         }
+        for (span, &h) in self.spans.iter_mut().zip(g.widths.iter()) {
+            // `Grid::row_range`, then `Grid::clip_row`'s clamp.
+            *span = (
+                (ceil(t0 - h) as i64).max(lo[0]),
+                (floor(t0 + h) as i64).min(hi[0]),
+            );
+        }
+        self.nspans = n;
         for i in 1..D {
             for (m, k) in (lo[i]..=hi[i]).enumerate() {
                 let e = q[i] - (k as f64 + 0.5) * g.cell;
                 self.e2[i][m] = e * e;
                 let j = if k <= kq[i] { kq[i] - k } else { k - kq[i] - 1 };
                 self.j2[i][m] = (j * j) as usize;
+                self.key[i][m] = key(i, k);
                 if let Some(side) = side {
                     self.off[i][m] = side.term(i, k, g.cell);
                 }
@@ -247,33 +277,38 @@ impl<const D: usize> RowTables<D> {
         true
     }
 
-    /// [`Grid::row_offset`] of the row at cell indices `k[1..]` (the cells from `lo`).
+    /// [`Grid::row_offset`] of the row at cell indices `k[1..]` (the cells from `lo`), and the
+    /// map's key of the row.
     #[inline(always)]
-    pub(super) fn row_offset(&self, k: &[i64; D], lo: &[i64; D]) -> (f64, usize) {
+    pub(super) fn row_offset(&self, k: &[i64; D], lo: &[i64; D]) -> (f64, usize, u64) {
         let mut s = 0.0;
         let mut j2 = 0usize;
+        let mut key = 0u64;
         for i in 1..D {
             let m = (k[i] - lo[i]) as usize;
             s += self.e2[i][m];
             j2 += self.j2[i][m];
+            key += self.key[i][m];
         }
-        (s, j2)
+        (s, j2, key)
     }
 
-    /// [`Grid::clip_row`] of the row at cell indices `k[1..]` (the cells from `lo`).
+    /// The cells `a..=b` along axis 0 of the row at cell indices `k[1..]` (the cells from
+    /// `lo`) with offset lower bound `j2` ([`row_offset`](Self::row_offset)): [`Grid::row_range`]
+    /// and [`Grid::clip_row`] from the tables; `None` when no cell of the row is within the cap.
     #[inline(always)]
-    pub(super) fn clip_row(
+    pub(super) fn row_span(
         &self,
-        (a, b): (f64, f64),
-        lo0: i64,
-        hi0: i64,
+        j2: usize,
         k: &[i64; D],
         lo: &[i64; D],
         side: Option<&Beside<D>>,
-    ) -> (i64, i64) {
-        let a = (a as i64).max(lo0);
-        let b = (b as i64).min(hi0);
-        match side {
+    ) -> Option<(i64, i64)> {
+        if j2 >= self.nspans {
+            return None;
+        }
+        let (a, b) = self.spans[j2];
+        Some(match side {
             Some(side) => {
                 let mut off = 0.0;
                 for i in 1..D {
@@ -282,6 +317,6 @@ impl<const D: usize> RowTables<D> {
                 side.clip_at(off, a, b)
             }
             None => (a, b),
-        }
+        })
     }
 }

@@ -269,15 +269,20 @@ mod sealed {
         where
             Self: 'a;
 
-        /// Calls `lower(cell, w)` for the cells `a..=b` (along axis 0) of the row at cell
-        /// indices `k[1..]`, at squared distance `s` from `q` along the other axes, with `w`
-        /// the value the map stores for the cell's quantised distance to `q`, whenever `w`
-        /// could improve on the stored value.
+        /// The term of axis `i` (`1..D`) at cell index `k` in the key of a row: the row at cell
+        /// indices `k[1..]` is the sum of its axes' terms, where the map finds its cells
+        /// (`lower_row`). A sum, so that an insert tabulates the terms once per axis.
+        fn row_key(&self, i: usize, k: i64) -> u64;
+
+        /// Calls `lower(cell, w)` for the cells `a..=b` (along axis 0) of the row with key
+        /// `key` (see [`row_key`](Self::row_key)), at squared distance `s` from `q` along the
+        /// other axes, with `w` the value the map stores for the cell's quantised distance to
+        /// `q`, whenever `w` could improve on the stored value.
         fn lower_row<'a>(
             &'a self,
             q: &[f64; D],
             s: f64,
-            k: &[i64; D],
+            key: u64,
             ab: (i64, i64),
             lower: &mut impl FnMut(&AtomicU8, u8),
             cache: &mut Self::RowCache<'a>,
@@ -323,13 +328,13 @@ mod sealed {
             let mut cache = Self::RowCache::default();
             // In 2D a row is one cell index along axis 1: nothing to share between rows.
             let mut t = RowTables::new();
-            if D >= 3 && t.fill(g, q, &lo, &hi, &kq, side) {
+            let key = |i, k| self.row_key(i, k);
+            if D >= 3 && t.fill(g, q, &lo, &hi, (t0, &kq), side, key) {
                 loop {
-                    let (s, j2) = t.row_offset(&k, &lo);
-                    if let Some(range) = g.row_range(q[0], s, t0, j2) {
-                        let (a, b) = t.clip_row(range, lo[0], hi[0], &k, &lo, side);
+                    let (s, j2, key) = t.row_offset(&k, &lo);
+                    if let Some((a, b)) = t.row_span(j2, &k, &lo, side) {
                         if a <= b {
-                            self.lower_row(q, s, &k, (a, b), &mut lower, &mut cache);
+                            self.lower_row(q, s, key, (a, b), &mut lower, &mut cache);
                         }
                     }
                     if !next_row(&mut k, &lo, &hi) {
@@ -342,7 +347,8 @@ mod sealed {
                 if let Some(range) = g.row_range(q[0], s, t0, j2) {
                     let (a, b) = g.clip_row(range, lo[0], hi[0], &k, side);
                     if a <= b {
-                        self.lower_row(q, s, &k, (a, b), &mut lower, &mut cache);
+                        let key = (1..D).map(|i| self.row_key(i, k[i])).sum();
+                        self.lower_row(q, s, key, (a, b), &mut lower, &mut cache);
                     }
                 }
                 if !next_row(&mut k, &lo, &hi) {

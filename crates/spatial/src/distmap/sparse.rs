@@ -60,6 +60,9 @@ use std::sync::atomic::{AtomicU8, AtomicU32, AtomicUsize, Ordering};
 const ABSENT: u32 = 0;
 /// Table entry of a block that could not be allocated: no information.
 pub const UNKNOWN: u32 = u32::MAX;
+/// Bits of a row's key ([`Cells::row_key`]) that hold its cells' offset within a block
+/// (blocks hold at most 2^20 cells); the block row is above them.
+const CELL_BITS: u32 = 20;
 /// Bytes of a slab chunk (at least one block).
 const CHUNK_BYTES: usize = 1 << 16;
 
@@ -126,7 +129,7 @@ impl<const D: usize> SparseDistanceMap<D> {
     pub fn new(cell: f64, cap: f64, block_side: usize) -> Result<Self, DistanceMapError> {
         let mut grid = Grid::new(cell, cap)?;
         let block_cells = block_side.checked_pow(D as u32).unwrap_or(usize::MAX);
-        if !block_side.is_power_of_two() || block_cells > 1 << 20 {
+        if !block_side.is_power_of_two() || block_cells > 1 << CELL_BITS {
             return Err(DistanceMapError::TooLarge {
                 cells_per_axis: block_side as f64,
             });
@@ -399,6 +402,16 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
 
     type RowCache<'a> = Recent<'a>;
 
+    /// The row's block row in the table (above [`CELL_BITS`]) and its cells' offset within a
+    /// block (below), along axis `i`.
+    #[inline(always)]
+    fn row_key(&self, i: usize, k: i64) -> u64 {
+        let u = (k + self.grid.half) as usize;
+        let brow = (u >> self.shift) * self.bside.pow(i as u32);
+        let crow = (u & self.mask) << (self.shift as usize * i);
+        ((brow as u64) << CELL_BITS) + crow as u64
+    }
+
     /// Raises the row's cells to their nearness `s`, block by block, allocating a block at its
     /// first cell within the cap.
     #[inline(always)]
@@ -406,23 +419,14 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
         &'a self,
         q: &[f64; D],
         s: f64,
-        k: &[i64; D],
+        key: u64,
         (a, b): (i64, i64),
         lower: &mut impl FnMut(&AtomicU8, u8),
         recent: &mut Recent<'a>,
     ) {
         let half = self.grid.half;
-        let shift = self.shift as usize;
-        // The row's block row in the table and its cells' offset within a block.
-        let mut brow = 0usize;
-        let mut crow = 0usize;
-        let mut stride = self.bside;
-        for i in 1..D {
-            let u = (k[i] + half) as usize;
-            brow += (u >> shift) * stride;
-            stride *= self.bside;
-            crow |= (u & self.mask) << (shift * i);
-        }
+        let brow = (key >> CELL_BITS) as usize;
+        let crow = (key & ((1 << CELL_BITS) - 1)) as usize;
         let last = (b + half) as usize;
         let mut u = (a + half) as usize;
         while u <= last {

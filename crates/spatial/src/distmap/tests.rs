@@ -244,9 +244,9 @@ fn uniform(seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
-/// The rows' ranges from the table of widths cover every cell the exactly solved ranges
-/// cover, and the extra cells they visit are never lowered: the same bytes either way,
-/// in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
+/// The rows' ranges from the table of widths (in 3D, tabulated per insert with the rows'
+/// offsets and keys) cover every cell the exactly solved ranges cover, and the extra cells
+/// they visit are never lowered: the same bytes either way, in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
 /// centres among random ones.
 #[test]
 fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
@@ -281,6 +281,8 @@ fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
     same::<3>(8.0, 32.0, 5);
     same::<3>(32.0, 128.0, 6);
     same::<3>(2.5, 11.0, 7);
+    // Wider than the rows' tables (13 cells per axis): rows from the table of widths alone.
+    same::<3>(1.0, 6.5, 8);
 }
 
 #[test]
