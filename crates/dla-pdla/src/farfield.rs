@@ -335,7 +335,10 @@ pub fn exit_disk<R: Rng + ?Sized>(p: &[f64; 2], c: &[f64; 2], big_r: f64, rng: &
     // point), where the quotient's own modulus would carry their relative rounding errors.
     let (nx, ny) = (big_r * wx + qx, big_r * wy + qy);
     let (dx, dy) = (big_r + qx * wx + qy * wy, qx * wy - qy * wx);
-    let k = big_r / ((nx * nx + ny * ny) * (dx * dx + dy * dy)).sqrt();
+    let moduli2 = (nx * nx + ny * ny) * (dx * dx + dy * dy);
+    // big_r / sqrt(moduli2) as (big_r / moduli2) sqrt(moduli2): the division and the square
+    // root run side by side instead of one after the other on the walk's dependency chain.
+    let k = big_r / moduli2 * moduli2.sqrt();
     [
         c[0] + k * (nx * dx + ny * dy),
         c[1] + k * (ny * dx - nx * dy),
