@@ -23,7 +23,6 @@ pub use counts::WalkCounts;
 
 use crate::cluster::{Cluster, MapBall, MapLevel};
 use crate::contact::{contact, first_contact_with, wall_contact};
-use crate::farfield::norm;
 use crate::near::{NEAR_RADIUS, NearCache, REBUILD_UPPER};
 use crate::params::{FarField, Params};
 use crate::space::{Dim, Space};
@@ -125,11 +124,20 @@ where
             }
             return self.near_move::<true, true, R>(state, cluster, r_ext, params, rng);
         }
-        let r = norm(&self.p);
         // Far field. The margin keeps a walker just returned to the birth sphere (whose norm
         // may round to slightly above r_b) in the near field, which is valid everywhere;
         // without it a walker at r_b (1 + 1e-16) would be "returned" to itself forever.
-        if r > r_b * FAR_FIELD_MARGIN {
+        // The norm's square root is taken only for a walker whose squared norm comes within
+        // a relative 1e-12 of the margin's square (far above their rounding), so the test is
+        // the one on the norm itself, and a move in the near field does not wait for a root.
+        let r_far = r_b * FAR_FIELD_MARGIN;
+        let r2: f64 = self.p.iter().map(|x| x * x).sum();
+        let r = if r2 > r_far * r_far * (1.0 - 1e-12) {
+            r2.sqrt()
+        } else {
+            0.0
+        };
+        if r > r_far {
             state.counts.far_field += 1;
             state.forget();
             if VARIANT && let Motion::Ballistic = state.motion {
