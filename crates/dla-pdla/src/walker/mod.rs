@@ -229,10 +229,14 @@ where
                 // bound, which is `|p - z|` smaller, so the move is as exact and longer: a
                 // quarter to a third fewer moves a particle (`docs/dla.md`).
                 if !DEPOSIT && (!VARIANT || state.motion == Motion::Diffusive) && ball.lower == lb {
-                    if let Some(y) = Dim::<D>::exit_ball(&self.p, &ball.centre, ball.radius(), rng)
-                    {
-                        let moved = dist_sq(&y, &self.p).sqrt();
+                    let big_r = ball.radius();
+                    if let Some(y) = Dim::<D>::exit_ball(&self.p, &ball.centre, big_r, rng) {
                         self.p = y;
+                        // The walker moved at most the radius plus its distance from the
+                        // centre, which is at most `clear - lower` (see `Reading`): a bound
+                        // known before the exit point, so the next move does not wait for
+                        // the square root of the distance moved.
+                        let moved = big_r + (ball.clear - ball.lower);
                         state.upper += moved * (1.0 + 1e-9) + 1e-9;
                         return None;
                     }
