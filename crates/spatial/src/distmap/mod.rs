@@ -35,7 +35,10 @@
 //!   `c = 8`; the rows are contiguous in memory). A row's range comes from a table of
 //!   widths indexed by its distance from the point in whole cells, integer arithmetic with no
 //!   square root per row; it visits a few cells more than the exact range, which the
-//!   per-cell test rejects.
+//!   per-cell test rejects. In 3D and above an insert first tabulates, per axis, what its rows
+//!   need (offsets, distances, the map's address terms) and, per entry of the widths table,
+//!   the range itself, so that each of its rows (64 for a cap of 4 cells) costs a few table
+//!   reads.
 //! - Growth: when a point comes within `cap + c` of the map's edge (max-norm), the map grows by a
 //!   quarter (at least to cover the point) and the old cells are copied; no cell of the new rim
 //!   can be within `cap` of a point inserted before, so the copy is exact. Amortised O(1) per
