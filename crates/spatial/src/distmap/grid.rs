@@ -203,12 +203,11 @@ impl Grid {
 /// that axis instead of once per row: the squared distance from the point to the cells'
 /// centres along the axis and its whole-cell lower bound ([`Grid::row_offset`] sums these over
 /// the axes, in the same order, so a row gets the same values bit for bit), and the axis's
-/// term of the half-space offset of an insert beside a touched point ([`Beside::clip`]) and its
-/// term of the map's key of the row; and
-/// for each entry `j2` of the table of widths, the range along axis 0 a row with that lower
-/// bound covers ([`Grid::row_range`] and [`Grid::clip_row`]'s clamp to the box, the same
-/// integers). A row then costs a few table reads and additions, with no rounding of its own
-/// (the point's ball has far fewer distinct `j2` than rows).
+/// term of the half-space offset of an insert beside a touched point ([`Beside::clip`]) and of
+/// the map's key of the row; and for each entry `j2` of the table of widths, the range along
+/// axis 0 a row with that lower bound covers ([`Grid::row_range`] and [`Grid::clip_row`]'s
+/// clamp to the box, the same integers). A row then costs a few table reads and additions,
+/// with no rounding of its own (the point's ball has far fewer distinct `j2` than rows).
 pub(super) struct RowTables<const D: usize> {
     e2: [[f64; TABLE_ROWS]; D],
     j2: [[usize; TABLE_ROWS]; D],
@@ -235,9 +234,8 @@ impl<const D: usize> RowTables<D> {
 
     /// Fills the tables for an insert of `q` over the cells `lo..=hi` (`t0` and `kq` from
     /// [`Grid::row_origin`], `key` the map's term of a row's key per axis and cell index);
-    /// `false` (tables unusable) when an axis spans more than
-    /// [`TABLE_ROWS`] cells or the map has no table of widths, or a table longer than
-    /// [`TABLE_SPANS`].
+    /// `false` (tables unusable) when an axis spans more than [`TABLE_ROWS`] cells or the map's
+    /// table of widths is empty or longer than [`TABLE_SPANS`].
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub(super) fn fill(
