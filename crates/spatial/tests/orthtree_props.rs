@@ -17,20 +17,11 @@ use proptest::prelude::*;
 use spatial::orthtree::{Orthtree, RangeSink};
 
 /// Every offer of a range query, with whether it came within the room last reserved.
+#[derive(Default)]
 struct Offers<const D: usize> {
     all: Vec<([f64; D], bool)>,
     room: usize,
     unreserved: usize,
-}
-
-impl<const D: usize> Default for Offers<D> {
-    fn default() -> Self {
-        Offers {
-            all: Vec::new(),
-            room: 0,
-            unreserved: 0,
-        }
-    }
 }
 
 impl<const D: usize> RangeSink<D> for Offers<D> {

@@ -246,8 +246,8 @@ fn uniform(seed: u64) -> impl FnMut() -> f64 {
 
 /// The rows' ranges from the table of widths (in 3D, tabulated per insert with the rows'
 /// offsets and keys) cover every cell the exactly solved ranges cover, and the extra cells
-/// they visit are never lowered: the same bytes either way, in 2D and 3D, for the `dla` maps' shapes and odd ones, with points at cell corners and
-/// centres among random ones.
+/// they visit are never lowered: the same bytes either way, in 2D and 3D, for the `dla` maps'
+/// shapes and odd ones, with points at cell corners and centres among random ones.
 #[test]
 fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
     fn same<const D: usize>(cell: f64, cap: f64, seed: u64) {
