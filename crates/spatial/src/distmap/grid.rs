@@ -275,6 +275,48 @@ impl<const D: usize> RowTables<D> {
         true
     }
 
+    /// Calls `row(s, key, (a, b))` for every row of a 3D insert over the cells `lo..=hi` that
+    /// holds a cell within the cap (in the half-space `side` if given), in the odometer's
+    /// order (axis 1 fastest), with the values [`row_offset`](Self::row_offset) and
+    /// [`row_span`](Self::row_span) give it. As two nested loops, the outer axis's terms are
+    /// read once per plane of rows; in 3D a row's sums have two terms, so adding the outer
+    /// one second is the odometer's sum bit for bit.
+    #[inline(always)]
+    pub(super) fn each_row_3d(
+        &self,
+        lo: &[i64; D],
+        hi: &[i64; D],
+        side: Option<&Beside<D>>,
+        mut row: impl FnMut(f64, u64, (i64, i64)),
+    ) {
+        debug_assert_eq!(D, 3);
+        // `fill` checked both spans against the tables; the `min`s let the compiler see it.
+        let n1 = ((hi[1] - lo[1] + 1) as usize).min(TABLE_ROWS);
+        let n2 = ((hi[2] - lo[2] + 1) as usize).min(TABLE_ROWS);
+        let nspans = self.nspans.min(TABLE_SPANS);
+        for m2 in 0..n2 {
+            let j2_out = self.j2[2][m2];
+            if j2_out >= nspans {
+                continue;
+            }
+            let (e2_out, key_out, off_out) = (self.e2[2][m2], self.key[2][m2], self.off[2][m2]);
+            for m1 in 0..n1 {
+                let j2 = self.j2[1][m1] + j2_out;
+                if j2 >= nspans {
+                    continue;
+                }
+                let (a, b) = self.spans[j2];
+                let (a, b) = match side {
+                    Some(side) => side.clip_at(self.off[1][m1] + off_out, a, b),
+                    None => (a, b),
+                };
+                if a <= b {
+                    row(self.e2[1][m1] + e2_out, self.key[1][m1] + key_out, (a, b));
+                }
+            }
+        }
+    }
+
     /// [`Grid::row_offset`] of the row at cell indices `k[1..]` (the cells from `lo`), and the
     /// map's key of the row.
     #[inline(always)]

@@ -333,6 +333,12 @@ mod sealed {
             let mut t = RowTables::new();
             let key = |i, k| self.row_key(i, k);
             if D >= 3 && t.fill(g, q, &lo, &hi, (t0, &kq), side, key) {
+                if D == 3 {
+                    t.each_row_3d(&lo, &hi, side, |s, key, ab| {
+                        self.lower_row(q, s, key, ab, &mut lower, &mut cache)
+                    });
+                    return;
+                }
                 loop {
                     let (s, j2, key) = t.row_offset(&k, &lo);
                     if let Some((a, b)) = t.row_span(j2, &k, &lo, side) {
