@@ -208,9 +208,9 @@ impl<const D: usize> NearCache<D> {
     }
 }
 
-/// What a rebuild's range query found: every point it offers is written after the last one
-/// inside and kept by counting it, without a branch per point (see `RangeSink`), so the first
-/// `len` are the particles `Orthtree::for_each_within` lists, in its order.
+/// What a rebuild's range query found: each leaf's points kept where the query wrote them (see
+/// `RangeSink`), so the first `len` are the particles `Orthtree::for_each_within` lists, in
+/// its order.
 #[derive(Debug, Clone, Default)]
 struct Found<const D: usize> {
     points: Vec<[f64; D]>,
@@ -219,16 +219,16 @@ struct Found<const D: usize> {
 
 impl<const D: usize> RangeSink<D> for Found<D> {
     #[inline(always)]
-    fn reserve(&mut self, n: usize) {
+    fn room(&mut self, n: usize) -> &mut [[f64; D]] {
         if self.points.len() < self.len + n {
             self.points.resize(self.len + n, [0.0; D]);
         }
+        &mut self.points[self.len..]
     }
 
     #[inline(always)]
-    fn offer(&mut self, x: [f64; D], inside: bool) {
-        self.points[self.len] = x;
-        self.len += usize::from(inside);
+    fn keep(&mut self, kept: usize) {
+        self.len += kept;
     }
 }
 

@@ -16,26 +16,28 @@
 use proptest::prelude::*;
 use spatial::orthtree::{Orthtree, RangeSink};
 
-/// Every offer of a range query, with whether it came within the room last reserved.
+/// What a range query kept, leaf by leaf, and whether it ever kept more than the room it
+/// asked for.
 #[derive(Default)]
-struct Offers<const D: usize> {
-    all: Vec<([f64; D], bool)>,
+struct Kept<const D: usize> {
+    points: Vec<[f64; D]>,
+    slots: Vec<[f64; D]>,
     room: usize,
-    unreserved: usize,
+    overflow: bool,
 }
 
-impl<const D: usize> RangeSink<D> for Offers<D> {
-    fn reserve(&mut self, n: usize) {
+impl<const D: usize> RangeSink<D> for Kept<D> {
+    fn room(&mut self, n: usize) -> &mut [[f64; D]] {
         self.room = n;
+        // Slots the query must overwrite: NaN would show as a kept point never written.
+        self.slots = vec![[f64::NAN; D]; n];
+        &mut self.slots
     }
 
-    fn offer(&mut self, x: [f64; D], inside: bool) {
-        if self.room == 0 {
-            self.unreserved += 1;
-        } else {
-            self.room -= 1;
-        }
-        self.all.push((x, inside));
+    fn keep(&mut self, kept: usize) {
+        self.overflow |= kept > self.room;
+        self.points
+            .extend_from_slice(&self.slots[..kept.min(self.room)]);
     }
 }
 
@@ -229,16 +231,12 @@ fn check<const D: usize>(
                 .filter(|x| d2(q, x) <= r * r)
                 .copied()
                 .collect();
-            // The sink form offers the same points as inside, in the same order, and every
-            // other point of the leaves it scans as outside; `reserve` comes first each time.
-            let mut offers = Offers::default();
-            tree.range_into(q, r, &mut offers);
-            prop_assert_eq!(offers.unreserved, 0, "an offer beyond the room reserved");
-            let inside: Vec<[f64; D]> = offers.all.iter().filter(|o| o.1).map(|o| o.0).collect();
-            prop_assert_eq!(&inside, &got, "range_into {} around {:?}", r, q);
-            for (x, _) in offers.all.iter().filter(|o| !o.1) {
-                prop_assert!(d2(q, x) > r * r, "{:?} offered as outside {}", x, r);
-            }
+            // The sink form keeps the same points, in the same order, within the room it
+            // asked for.
+            let mut kept = Kept::default();
+            tree.range_into(q, r, &mut kept);
+            prop_assert!(!kept.overflow, "kept more points than the room asked for");
+            prop_assert_eq!(&kept.points, &got, "range_into {} around {:?}", r, q);
             got.sort_by(key);
             want.sort_by(key);
             prop_assert_eq!(got, want, "range {} around {:?}", r, q);

@@ -3,29 +3,40 @@
 use super::super::{EMPTY, Orthtree, decode};
 use super::box_dist_sq;
 
-/// Where [`Orthtree::range_into`] puts what it finds. The query offers every point of each
-/// leaf that meets the ball, with whether it lies inside, so that a sink can keep the points
-/// without a branch per point (whether a point of a leaf lies inside is close to a coin toss,
-/// and a mispredicted branch costs more than the few stores it would skip).
+/// Where [`Orthtree::range_into`] puts what it finds, a leaf at a time: the query asks the
+/// sink for room for the leaf's points, writes each point it scans after the last one found
+/// inside (a point outside is overwritten by the next), then tells the sink how many it kept.
+/// So the points are kept without a branch per point (whether a point of a leaf lies inside is
+/// close to a coin toss, and a mispredicted branch costs more than the store it would skip),
+/// and the scan keeps its count in a register.
 pub trait RangeSink<const D: usize> {
-    /// Room for `n` more offers: the points of the next leaf.
-    fn reserve(&mut self, n: usize);
-    /// A stored point (as the tree decodes it) and whether its squared distance from the
-    /// query position, summed axis by axis, is at most the squared radius.
-    fn offer(&mut self, x: [f64; D], inside: bool);
+    /// Room for the `n` points of the next leaf: at least `n` slots.
+    fn room(&mut self, n: usize) -> &mut [[f64; D]];
+    /// The first `kept` slots of the last [`room`](Self::room) hold the leaf's points inside
+    /// the ball (as the tree decodes them, their squared distance from the query position
+    /// summed axis by axis at most the squared radius), in the leaf's order.
+    fn keep(&mut self, kept: usize);
 }
 
-/// The sink of [`Orthtree::for_each_within`]: the closure, for the points inside.
-struct Calls<F>(F);
+/// The sink of [`Orthtree::for_each_within`]: the closure, called for the points kept.
+struct Calls<const D: usize, F> {
+    f: F,
+    slots: Vec<[f64; D]>,
+}
 
-impl<const D: usize, F: FnMut([f64; D])> RangeSink<D> for Calls<F> {
+impl<const D: usize, F: FnMut([f64; D])> RangeSink<D> for Calls<D, F> {
     #[inline(always)]
-    fn reserve(&mut self, _: usize) {}
+    fn room(&mut self, n: usize) -> &mut [[f64; D]] {
+        if self.slots.len() < n {
+            self.slots.resize(n, [0.0; D]);
+        }
+        &mut self.slots
+    }
 
     #[inline(always)]
-    fn offer(&mut self, x: [f64; D], inside: bool) {
-        if inside {
-            (self.0)(x);
+    fn keep(&mut self, kept: usize) {
+        for &x in &self.slots[..kept] {
+            (self.f)(x);
         }
     }
 }
@@ -37,13 +48,19 @@ impl<const D: usize> Orthtree<D> {
     /// `r` is negative or NaN. Used by DLA to find the first contact along a step (the
     /// variable-precision paper, section 3.2, Fig. 6).
     pub fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, f: F) {
-        self.range_into(p, r, &mut Calls(f));
+        self.range_into(
+            p,
+            r,
+            &mut Calls {
+                f,
+                slots: Vec::new(),
+            },
+        );
     }
 
-    /// The range query of [`for_each_within`](Self::for_each_within), handing `sink` every
-    /// point of the leaves that meet the ball with whether it lies inside (see [`RangeSink`]):
-    /// the points offered as inside are exactly those `for_each_within` lists, in the same
-    /// order.
+    /// The range query of [`for_each_within`](Self::for_each_within), handing `sink` the
+    /// points of each leaf that meets the ball (see [`RangeSink`]): the points kept are exactly
+    /// those `for_each_within` lists, in the same order.
     pub fn range_into<S: RangeSink<D>>(&self, p: &[f64; D], r: f64, sink: &mut S) {
         if self.root == EMPTY || r.is_nan() || r < 0.0 {
             return;
@@ -138,7 +155,8 @@ impl<const D: usize> Orthtree<D> {
         let origin = c.map(|x| x - half);
         // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
         let codes = unsafe { self.leaf_points(leaf) };
-        sink.reserve(codes.len());
+        let slots = &mut sink.room(codes.len())[..codes.len()];
+        let mut kept = 0;
         for code in codes {
             let mut x = [0.0; D];
             let mut d2 = 0.0;
@@ -147,7 +165,12 @@ impl<const D: usize> Orthtree<D> {
                 let e = p[i] - x[i];
                 d2 += e * e;
             }
-            sink.offer(x, d2 <= r_sq);
+            debug_assert!(kept < slots.len());
+            // SAFETY: `kept` is at most the number of points scanned before this one, so below
+            // `codes.len()`, which is `slots.len()`.
+            unsafe { *slots.get_unchecked_mut(kept) = x };
+            kept += usize::from(d2 <= r_sq);
         }
+        sink.keep(kept);
     }
 }
