@@ -103,9 +103,39 @@ impl<const D: usize> Orthtree<D> {
     /// Whether the arenas hold what an insert into the leaf of length `leaf_len` may append:
     /// a path of `root_level` nodes, one leaf, and a new block.
     fn has_room(&self, w: &Writer, leaf_len: u32) -> bool {
+        self.has_room_for(w, LeafPool::push_needs(leaf_len))
+    }
+
+    /// [`has_room`](Self::has_room) for a push that appends at most `slots` point slots.
+    fn has_room_for(&self, w: &Writer, slots: u64) -> bool {
         (w.nodes + self.root_level as usize) * Self::FANOUT <= self.children.capacity()
             && w.leaves < self.leaves.capacity()
-            && w.pool.len + LeafPool::push_needs(leaf_len) as usize <= self.slots.capacity()
+            && w.pool.len as u64 + slots <= self.slots.capacity() as u64
+    }
+
+    /// An exclusive insert that needs neither a new root nor more room: places the point and
+    /// returns `true` when the root holds leaf cell `k` and both the index limits and the
+    /// arenas admit an insert into the longest leaf there could be (so into this one, whatever
+    /// its length); else changes nothing and returns `false`, and the insert first finds its
+    /// leaf's length, checks the limits for it and grows what it needs. In a growing cluster
+    /// nearly every insert takes this path, which descends the tree once.
+    fn place_if_room(&mut self, k: &[i64; D], code: [u32; D], tag: u32) -> bool {
+        if self.root == EMPTY || !self.root_contains(k) {
+            return false;
+        }
+        let mut w = self.writer();
+        let slots = LeafPool::push_needs_within(w.longest_leaf);
+        let fits = w.longest_leaf < u32::MAX
+            && w.nodes as u64 + 128 <= self.index_limit
+            && (w.leaves as u64) < self.index_limit
+            && w.pool.len as u64 + slots <= self.index_limit
+            && self.has_room_for(&w, slots);
+        if fits {
+            // SAFETY: `w` is this tree's writer; `&mut self` excludes readers, so the old
+            // block may be freed at once (`None`).
+            unsafe { self.place(&mut w, k, code, tag, None) };
+        }
+        fits
     }
 
     /// Initialises internal node `w.nodes` with empty child slots (not yet linked).
@@ -248,6 +278,7 @@ impl<const D: usize> Orthtree<D> {
                     w.pool
                         .push(&self.slots, tags, Leaf { start: 0, len: 0 }, code, retire)
                 };
+                w.longest_leaf = w.longest_leaf.max(1);
                 let l = w.leaves;
                 // SAFETY: leaf record l is beyond every published leaf: no reader reaches it
                 // until the `Release` store below links the path.
@@ -279,6 +310,7 @@ impl<const D: usize> Orthtree<D> {
                 // changes it), `w` is this tree's writer and `retire` follows the readers (the
                 // caller's contract).
                 let rec = unsafe { w.pool.push(&self.slots, tags, leaf, code, retire) };
+                w.longest_leaf = w.longest_leaf.max(leaf.len.saturating_add(1));
                 record.store(rec.pack(), Ordering::Release);
                 return;
             }
@@ -310,12 +342,12 @@ impl<const D: usize> Orthtree<D> {
     /// ([`keep_tags`](Self::keep_tags)) and ignored otherwise.
     pub fn insert_tagged(&mut self, p: [f64; D], tag: u32) -> Result<[f64; D], OrthtreeError> {
         let (k, code) = self.locate(&p)?;
-        // Capacity checks before any change, so that an error leaves the tree as it was.
-        let leaf_len = self.existing_leaf_len(&k);
-        self.check_limits(&self.writer(), leaf_len)?;
-        self.cover(&p, &k)?;
-        self.reserve_for_insert(leaf_len)?;
-        {
+        if !self.place_if_room(&k, code, tag) {
+            // Capacity checks before any change, so that an error leaves the tree as it was.
+            let leaf_len = self.existing_leaf_len(&k);
+            self.check_limits(&self.writer(), leaf_len)?;
+            self.cover(&p, &k)?;
+            self.reserve_for_insert(leaf_len)?;
             let mut w = self.writer();
             // SAFETY: `w` is this tree's writer; `&mut self` excludes readers, so the old
             // block may be freed at once (`None`).

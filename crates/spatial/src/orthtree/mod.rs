@@ -315,6 +315,9 @@ struct Writer {
     leaves: usize,
     /// The point pool's allocator.
     pool: LeafPool,
+    /// At least the length of every leaf (the longest leaf a push made): bounds what any
+    /// insert may append to the pool without finding its leaf first.
+    longest_leaf: u32,
     /// Shared inserts since the epoch was last advanced.
     since_epoch: u32,
     /// The smallest epoch the readers had announced when last asked, and the tree's epoch
@@ -515,6 +518,7 @@ impl<const D: usize> Orthtree<D> {
                     nodes: 0,
                     leaves: 0,
                     pool: LeafPool::new(),
+                    longest_leaf: 0,
                     since_epoch: 0,
                     readers_known: 0,
                     readers_asked_at: 0,

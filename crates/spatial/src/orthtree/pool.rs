@@ -98,6 +98,12 @@ impl LeafPool {
         }
     }
 
+    /// Upper bound of [`push_needs`](Self::push_needs) over every leaf length up to `len`: the
+    /// block a leaf of `len + 1` points takes (classes grow with their lengths).
+    pub(super) fn push_needs_within(len: u32) -> u64 {
+        class_of(len.saturating_add(1)).1
+    }
+
     /// Grows `slots` (exclusive access) so that a push into a leaf of length `leaf_len` fits.
     /// Grows the tags too when the tree has them, to the slots' capacity.
     pub(super) fn reserve<const D: usize>(

@@ -208,6 +208,37 @@ fn duplicates_and_huge_leaves() {
     assert!(s.point_slots - s.free_slots <= 3000 * 5 / 4, "{s:?}");
 }
 
+/// An insert that neither grows the root nor the arenas places its point without looking up
+/// its leaf's length first: it checks room for a push into the longest leaf the writer has
+/// seen. That bound must hold for every leaf, through growth, big leaves and compaction.
+#[test]
+fn the_writers_longest_leaf_bounds_every_leaf() {
+    let mut rng = Rng::new(5);
+    let mut t = Orthtree::<2>::with_leaf_side(1.0).unwrap();
+    for i in 0..20_000 {
+        // Mostly a spread cloud, with runs into a few crowded cells (long leaves).
+        let p = if i % 7 == 0 {
+            [0.25 + (i % 3) as f64, 0.5]
+        } else {
+            [rng.uniform() * 300.0, rng.uniform() * 300.0]
+        };
+        t.insert(p).unwrap();
+        if i % 997 == 0 {
+            let longest = t.writer().longest_leaf;
+            let leaves = t.leaf_count() as u32;
+            let max = (0..leaves)
+                // SAFETY: leaf records below the count are initialised; nothing writes now.
+                .map(|l| unsafe { t.leaf(l) }.len)
+                .max()
+                .unwrap_or(0);
+            assert!(longest >= max, "longest {longest} below a leaf of {max}");
+            assert!(LeafPool::push_needs_within(longest) >= LeafPool::push_needs(max));
+        }
+    }
+    assert_eq!(t.len(), 20_000);
+    assert_eq!(t.iter().count(), 20_000);
+}
+
 #[test]
 fn works_in_one_four_and_eight_dimensions() {
     fn check<const D: usize>(seed: u64) {
