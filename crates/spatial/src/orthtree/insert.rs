@@ -113,6 +113,19 @@ impl<const D: usize> Orthtree<D> {
             && w.pool.len as u64 + slots <= self.slots.capacity() as u64
     }
 
+    /// Whether the index limits ([`check_limits`](Self::check_limits)) and the arenas
+    /// ([`has_room`](Self::has_room)) admit a push into the longest leaf there could be, and
+    /// so into any leaf: a sufficient condition for an insert under a root that holds its
+    /// cell, checked without finding its leaf.
+    fn fits_any_leaf(&self, w: &Writer) -> bool {
+        let slots = LeafPool::push_needs_within(w.longest_leaf);
+        w.longest_leaf < u32::MAX
+            && w.nodes as u64 + 128 <= self.index_limit
+            && (w.leaves as u64) < self.index_limit
+            && w.pool.len as u64 + slots <= self.index_limit
+            && self.has_room_for(w, slots)
+    }
+
     /// An exclusive insert that needs neither a new root nor more room: places the point and
     /// returns `true` when the root holds leaf cell `k` and both the index limits and the
     /// arenas admit an insert into the longest leaf there could be (so into this one, whatever
@@ -124,12 +137,7 @@ impl<const D: usize> Orthtree<D> {
             return false;
         }
         let mut w = self.writer();
-        let slots = LeafPool::push_needs_within(w.longest_leaf);
-        let fits = w.longest_leaf < u32::MAX
-            && w.nodes as u64 + 128 <= self.index_limit
-            && (w.leaves as u64) < self.index_limit
-            && w.pool.len as u64 + slots <= self.index_limit
-            && self.has_room_for(&w, slots);
+        let fits = self.fits_any_leaf(&w);
         if fits {
             // SAFETY: `w` is this tree's writer; `&mut self` excludes readers, so the old
             // block may be freed at once (`None`).
@@ -247,7 +255,7 @@ impl<const D: usize> Orthtree<D> {
     /// first empty slot of the path and links them with one `Release` store, so a concurrent
     /// reader sees either the tree before the insert or after it, and every node it reaches
     /// holds a point. Old blocks are retired at epoch `retire` if given (readers may scan
-    /// them), else freed.
+    /// them), else freed. Returns whether the leaf is new.
     ///
     /// # Safety
     ///
@@ -260,7 +268,7 @@ impl<const D: usize> Orthtree<D> {
         code: [u32; D],
         tag: u32,
         retire: Option<u64>,
-    ) {
+    ) -> bool {
         let tags = self.tags.as_ref().map(|t| (t, tag));
         let mut node = self.root;
         let mut level = self.root_level;
@@ -298,7 +306,7 @@ impl<const D: usize> Orthtree<D> {
                 }
                 // SAFETY: as for the load of this slot above.
                 unsafe { self.children.get(slot) }.store(below, Ordering::Release);
-                return;
+                return true;
             }
             if level == 1 {
                 // SAFETY: a non-empty slot of a level-1 node holds an initialised leaf record
@@ -312,7 +320,7 @@ impl<const D: usize> Orthtree<D> {
                 let rec = unsafe { w.pool.push(&self.slots, tags, leaf, code, retire) };
                 w.longest_leaf = w.longest_leaf.max(leaf.len.saturating_add(1));
                 record.store(rec.pack(), Ordering::Release);
-                return;
+                return false;
             }
             node = child;
             level -= 1;
@@ -428,10 +436,14 @@ impl<const D: usize> Orthtree<D> {
             return Err(OrthtreeError::NeedsExclusive);
         }
         let mut w = self.writer();
-        let leaf_len = self.existing_leaf_len(&k);
-        self.check_limits(&w, leaf_len)?;
-        if !self.has_room(&w, leaf_len) {
-            return Err(OrthtreeError::NeedsExclusive);
+        // As `place_if_room`: room for a push into the longest leaf is room for this one,
+        // without a first descent to find its length; else the exact checks.
+        if !self.fits_any_leaf(&w) {
+            let leaf_len = self.existing_leaf_len(&k);
+            self.check_limits(&w, leaf_len)?;
+            if !self.has_room(&w, leaf_len) {
+                return Err(OrthtreeError::NeedsExclusive);
+            }
         }
         let epoch = self.shared.epoch.load(Ordering::Relaxed);
         if w.pool.oldest_retired() >= Some(w.readers_known) && epoch > w.readers_asked_at {
@@ -446,7 +458,7 @@ impl<const D: usize> Orthtree<D> {
         unsafe { w.pool.reclaim(&self.slots, known) };
         // SAFETY: `w` is this tree's writer, locked, and old blocks are retired at the current
         // epoch, as readers may be scanning them.
-        unsafe { self.place(&mut w, &k, code, tag, Some(epoch)) };
+        let new_leaf = unsafe { self.place(&mut w, &k, code, tag, Some(epoch)) };
         self.shared.len.fetch_add(1, Ordering::Relaxed);
         w.since_epoch += 1;
         if w.since_epoch >= EPOCH_INSERTS {
@@ -454,7 +466,7 @@ impl<const D: usize> Orthtree<D> {
             // Release: a reader that reads the new value sees every record stored before it.
             self.shared.epoch.fetch_add(1, Ordering::AcqRel);
         }
-        Ok((self.decoded(&k, &code), leaf_len == 0))
+        Ok((self.decoded(&k, &code), new_leaf))
     }
 
     /// The reclamation epoch a reader announces (see [`insert_shared`](Self::insert_shared)).

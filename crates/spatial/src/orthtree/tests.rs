@@ -239,6 +239,38 @@ fn the_writers_longest_leaf_bounds_every_leaf() {
     assert_eq!(t.iter().count(), 20_000);
 }
 
+/// A shared insert reports a new leaf exactly when it made one (the fast path no longer looks
+/// the leaf up first), and places the point as an exclusive insert does.
+#[test]
+fn shared_inserts_report_their_new_leaves() {
+    let mut rng = Rng::new(9);
+    let mut t = Orthtree::<2>::with_leaf_side(4.0).unwrap();
+    let mut u = t.clone();
+    t.insert([0.0, 0.0]).unwrap();
+    u.insert([0.0, 0.0]).unwrap();
+    t.prepare_shared(3000, 300.0).unwrap();
+    let mut new_leaves = 0;
+    for i in 0..3000 {
+        let p = if i % 3 == 0 {
+            [1.0, 1.0 + (i % 5) as f64]
+        } else {
+            [rng.uniform() * 400.0 - 200.0, rng.uniform() * 400.0 - 200.0]
+        };
+        let leaves = t.leaf_count();
+        // SAFETY: no thread reads the tree, so every epoch is safe to reclaim.
+        let (at, new_leaf) = unsafe { t.insert_shared(p, || u64::MAX) }.unwrap();
+        assert_eq!(new_leaf, t.leaf_count() > leaves);
+        new_leaves += usize::from(new_leaf);
+        assert_eq!(at, u.insert(p).unwrap());
+    }
+    assert!(
+        new_leaves > 100 && new_leaves < 2000,
+        "{new_leaves} new leaves"
+    );
+    assert_eq!(t.leaf_count(), u.leaf_count());
+    assert_eq!(t.len(), u.len());
+}
+
 #[test]
 fn works_in_one_four_and_eight_dimensions() {
     fn check<const D: usize>(seed: u64) {
