@@ -230,6 +230,8 @@ impl<const D: usize> RangeSink<D> for Found<D> {
     fn keep(&mut self, kept: usize) {
         self.len += kept;
     }
+
+    const WHOLE_LEAF: bool = true;
 }
 
 /// Squared distances from `p` to the particles of a block, each summed axis by axis from 0,

@@ -6,33 +6,41 @@ use super::box_dist_sq;
 /// Points a leaf scan handles at once.
 const LANES: usize = 4;
 
-/// Where [`Orthtree::range_into`] puts what it finds, a leaf at a time: the query asks the
-/// sink for room for the leaf's points, writes each point it scans after the last one found
-/// inside (a point outside is overwritten by the next), then tells the sink how many it kept.
-/// So the points are kept without a branch per point (whether a point of a leaf lies inside is
-/// close to a coin toss, and a mispredicted branch costs more than the store it would skip),
-/// and the scan keeps its count in a register.
+/// Where [`Orthtree::range_into`] puts what it finds, a leaf (or a piece of one) at a time: the
+/// query asks the sink for room, writes each point it scans after the last one found inside
+/// (a point outside is overwritten by the next), then tells the sink how many it kept. So the
+/// points are kept without a branch per point (whether a point of a leaf lies inside is close
+/// to a coin toss, and a mispredicted branch costs more than the store it would skip), and the
+/// scan keeps its count in a register.
 pub trait RangeSink<const D: usize> {
-    /// Room for the `n` points of the next leaf: at least `n` slots.
+    /// Room for up to `n` points, the rest of the leaf being scanned: a non-empty slice; the
+    /// query scans as many of the leaf's points as it has slots (all `n` if it has that many),
+    /// then asks again for the rest.
     fn room(&mut self, n: usize) -> &mut [[f64; D]];
-    /// The first `kept` slots of the last [`room`](Self::room) hold the leaf's points inside
-    /// the ball (as the tree decodes them, their squared distance from the query position
-    /// summed axis by axis at most the squared radius), in the leaf's order.
+    /// The first `kept` slots of the last [`room`](Self::room) hold the points just scanned
+    /// that lie inside the ball (as the tree decodes them, their squared distance from the
+    /// query position summed axis by axis at most the squared radius), in the leaf's order.
     fn keep(&mut self, kept: usize);
+
+    /// Whether [`room`](Self::room) always lends at least the `n` slots asked for, so that a
+    /// leaf is scanned in one piece (a little less work per leaf).
+    const WHOLE_LEAF: bool = false;
 }
 
-/// The sink of [`Orthtree::for_each_within`]: the closure, called for the points kept.
+/// Slots of [`for_each_within`](Orthtree::for_each_within)'s sink: a leaf with more points is
+/// scanned in pieces of this many.
+const CALL_SLOTS: usize = 16;
+
+/// The sink of [`Orthtree::for_each_within`]: the closure, called for the points kept, from a
+/// few slots on the stack (the query allocates nothing).
 struct Calls<const D: usize, F> {
     f: F,
-    slots: Vec<[f64; D]>,
+    slots: [[f64; D]; CALL_SLOTS],
 }
 
 impl<const D: usize, F: FnMut([f64; D])> RangeSink<D> for Calls<D, F> {
     #[inline(always)]
-    fn room(&mut self, n: usize) -> &mut [[f64; D]] {
-        if self.slots.len() < n {
-            self.slots.resize(n, [0.0; D]);
-        }
+    fn room(&mut self, _: usize) -> &mut [[f64; D]] {
         &mut self.slots
     }
 
@@ -56,7 +64,7 @@ impl<const D: usize> Orthtree<D> {
             r,
             &mut Calls {
                 f,
-                slots: Vec::new(),
+                slots: [[0.0; D]; CALL_SLOTS],
             },
         );
     }
@@ -157,8 +165,36 @@ impl<const D: usize> Orthtree<D> {
     ) {
         let origin = c.map(|x| x - half);
         // SAFETY: a reached leaf (the caller's contract); the slice lives for this call only.
-        let codes = unsafe { self.leaf_points(leaf) };
-        let slots = &mut sink.room(codes.len())[..codes.len()];
+        let mut codes = unsafe { self.leaf_points(leaf) };
+        if S::WHOLE_LEAF {
+            let slots = &mut sink.room(codes.len())[..codes.len()];
+            let kept = self.scan_leaf(p, r_sq, &origin, codes, slots);
+            sink.keep(kept);
+            return;
+        }
+        while !codes.is_empty() {
+            let room = sink.room(codes.len());
+            assert!(!room.is_empty(), "a range sink lent no room");
+            let (now, rest) = codes.split_at(room.len().min(codes.len()));
+            codes = rest;
+            let kept = self.scan_leaf(p, r_sq, &origin, now, &mut room[..now.len()]);
+            sink.keep(kept);
+        }
+    }
+
+    /// Decodes the points `codes` of a leaf whose lower corner is `origin`, writes each into
+    /// `slots` after the last one within the squared radius `r_sq` of `p`, and returns how
+    /// many those are (`slots` and `codes` have the same length).
+    #[inline(always)]
+    fn scan_leaf(
+        &self,
+        p: &[f64; D],
+        r_sq: f64,
+        origin: &[f64; D],
+        codes: &[[u32; D]],
+        slots: &mut [[f64; D]],
+    ) -> usize {
+        assert_eq!(codes.len(), slots.len());
         let mut kept = 0;
         // Four points at a time, axis by axis (the vectorizer's shape), then the rest; each
         // point's squared distance is summed over the axes in order either way.
@@ -194,6 +230,6 @@ impl<const D: usize> Orthtree<D> {
             unsafe { *slots.get_unchecked_mut(kept) = x };
             kept += usize::from(d2 <= r_sq);
         }
-        sink.keep(kept);
+        kept
     }
 }
