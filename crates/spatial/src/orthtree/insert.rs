@@ -84,17 +84,27 @@ impl<const D: usize> Orthtree<D> {
     }
 
     /// The index-limit checks of an insert into the leaf of length `leaf_len`, before any
-    /// change. 128 nodes: the most one insert can add (root growth and a path down to a leaf).
+    /// change.
     fn check_limits(&self, w: &Writer, leaf_len: u32) -> Result<(), OrthtreeError> {
+        // A leaf as long as a `u32` counts cannot take another point.
+        let slots = if leaf_len == u32::MAX {
+            u64::MAX
+        } else {
+            LeafPool::push_needs(leaf_len)
+        };
+        self.check_limits_for(w, slots)
+    }
+
+    /// [`check_limits`](Self::check_limits) for a push that appends at most `slots` point
+    /// slots. 128 nodes: the most one insert can add (root growth and a path down to a leaf).
+    fn check_limits_for(&self, w: &Writer, slots: u64) -> Result<(), OrthtreeError> {
         if w.nodes as u64 + 128 > self.index_limit {
             return Err(OrthtreeError::CapacityExceeded("nodes"));
         }
         if w.leaves as u64 + 1 > self.index_limit {
             return Err(OrthtreeError::CapacityExceeded("leaves"));
         }
-        if leaf_len == u32::MAX
-            || w.pool.len as u64 + LeafPool::push_needs(leaf_len) > self.index_limit
-        {
+        if (w.pool.len as u64).saturating_add(slots) > self.index_limit {
             return Err(OrthtreeError::CapacityExceeded("point slots"));
         }
         Ok(())
@@ -113,17 +123,15 @@ impl<const D: usize> Orthtree<D> {
             && w.pool.len as u64 + slots <= self.slots.capacity() as u64
     }
 
-    /// Whether the index limits ([`check_limits`](Self::check_limits)) and the arenas
-    /// ([`has_room`](Self::has_room)) admit a push into the longest leaf there could be, and
+    /// Whether the index limits and the arenas admit a push into the longest leaf there could
+    /// be ([`check_limits`](Self::check_limits) and [`has_room`](Self::has_room) for it), and
     /// so into any leaf: a sufficient condition for an insert under a root that holds its
     /// cell, checked without finding its leaf.
     fn fits_any_leaf(&self, w: &Writer) -> bool {
-        let slots = LeafPool::push_needs_within(w.longest_leaf);
-        w.longest_leaf < u32::MAX
-            && w.nodes as u64 + 128 <= self.index_limit
-            && (w.leaves as u64) < self.index_limit
-            && w.pool.len as u64 + slots <= self.index_limit
-            && self.has_room_for(w, slots)
+        w.longest_leaf < u32::MAX && {
+            let slots = LeafPool::push_needs_within(w.longest_leaf);
+            self.check_limits_for(w, slots).is_ok() && self.has_room_for(w, slots)
+        }
     }
 
     /// An exclusive insert that needs neither a new root nor more room: places the point and
