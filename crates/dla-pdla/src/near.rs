@@ -91,10 +91,20 @@ impl<const D: usize> NearCache<D> {
         self.len = 0;
         self.found.len = 0;
         tree.range_into(p, NEAR_RADIUS, &mut self.found);
-        for j in 0..self.found.len {
-            let x = self.found.points[j];
-            self.push(&x);
+        // Transposed into blocks a whole block at a time (a point's store needs no test of
+        // whether its block exists yet); the last block's lanes past the points stay +inf.
+        let found = &self.found.points[..self.found.len];
+        let chunks = found.chunks_exact(LANES);
+        let rest = chunks.remainder();
+        self.blocks.extend(
+            chunks.map(|chunk| std::array::from_fn(|i| std::array::from_fn(|k| chunk[k][i]))),
+        );
+        if !rest.is_empty() {
+            self.blocks.push(std::array::from_fn(|i| {
+                std::array::from_fn(|k| rest.get(k).map_or(f64::INFINITY, |x| x[i]))
+            }));
         }
+        self.len = found.len();
         self.centre = *p;
         self.live = true;
     }
