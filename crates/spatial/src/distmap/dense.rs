@@ -472,10 +472,13 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
         let base = key as usize;
         let row = &self.values[base + (a + g.half) as usize..=base + (b + g.half) as usize];
         let x0 = (a as f64 + 0.5) * g.cell - q[0];
-        for (j, v) in row.iter().enumerate() {
-            // Rows are far shorter than 2^31 cells; i32 converts in one instruction.
-            let x = x0 + f64::from(j as i32) * g.cell;
+        // The cell's index along the row, counted in a float (whole numbers: exact), so no
+        // cell waits for an integer's conversion.
+        let mut j = 0.0;
+        for v in row {
+            let x = x0 + j * g.cell;
             self.lower_cell(v, x * x + s, lower);
+            j += 1.0;
         }
     }
 }
