@@ -147,6 +147,7 @@ impl<const D: usize> NearCache<D> {
 
     /// The exact nearest distance from `p` to the stored particles and a particle at that
     /// distance, if the cache can prove it (see the module documentation); `None` otherwise.
+    #[inline(always)]
     pub(crate) fn nearest(&self, p: &[f64; D]) -> Option<(f64, [f64; D])> {
         let room = self.room(p)?;
         if room <= 0.0 {
