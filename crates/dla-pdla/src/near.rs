@@ -202,6 +202,7 @@ impl<const D: usize> NearCache<D> {
     /// Calls `f` with every cached particle at distance `<= r` from `p`, with the inclusion
     /// test of `Orthtree::for_each_within` (squared distance summed axis by axis against
     /// `r * r`). Lists every stored particle in that ball when [`covers`](Self::covers).
+    #[inline(always)]
     pub(crate) fn for_each_within<F: FnMut([f64; D])>(&self, p: &[f64; D], r: f64, mut f: F) {
         if !self.live {
             return;
