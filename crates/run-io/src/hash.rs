@@ -40,6 +40,19 @@ impl StateHasher {
     pub fn f64(&mut self, v: f64) -> &mut Self {
         self.u64(v.to_bits())
     }
+    /// Feed up to eight `f64`s as [`f64`](Self::f64) feeds them one after the other, in one
+    /// update of the hasher (what a model's point costs when it is hashed as it is stored).
+    ///
+    /// # Panics
+    ///
+    /// If `vs` holds more than eight values.
+    pub fn f64s(&mut self, vs: &[f64]) -> &mut Self {
+        let mut buf = [0u8; 64];
+        for (chunk, v) in buf.chunks_exact_mut(8).zip(vs) {
+            chunk.copy_from_slice(&v.to_bits().to_le_bytes());
+        }
+        self.bytes(&buf[..8 * vs.len()])
+    }
     /// The hash so far.
     pub fn finish(&self) -> u64 {
         self.0.digest()
@@ -72,6 +85,12 @@ mod tests {
         assert_eq!(a.finish_hex().len(), 16);
         // Pinned: the empty input hash of XXH3-64 (reference value from the xxHash suite).
         assert_eq!(StateHasher::new().finish(), 0x2D06800538D394C2);
+        let xs = [1.5, -0.0, f64::MAX, 3e-310, 7.0];
+        let mut one_by_one = StateHasher::new();
+        for x in xs {
+            one_by_one.f64(x);
+        }
+        assert_eq!(StateHasher::new().f64s(&xs).finish(), one_by_one.finish());
         assert_ne!(
             StateHasher::new().f64(0.0).finish(),
             StateHasher::new().f64(-0.0).finish()

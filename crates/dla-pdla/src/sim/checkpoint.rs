@@ -301,9 +301,7 @@ where
                 snap.n
             )));
         }
-        for x in p {
-            hasher.f64(x);
-        }
+        hasher.f64s(&p);
     }
     if hasher.finish_hex() != snap.state_hash {
         return Err(bad_log(format!(

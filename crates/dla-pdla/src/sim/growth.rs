@@ -234,9 +234,7 @@ impl<const D: usize> Growth<D> {
             .r_ext
             .max(if self.deposit { q[D - 1] } else { norm(&q) });
         self.gyration.push(&q);
-        for x in q {
-            self.hasher.f64(x);
-        }
+        self.hasher.f64s(&q);
         if let Some(v) = &mut self.positions {
             v.push(q);
         }
