@@ -40,8 +40,9 @@ impl StateHasher {
     pub fn f64(&mut self, v: f64) -> &mut Self {
         self.u64(v.to_bits())
     }
-    /// Feed up to eight `f64`s as [`f64`](Self::f64) feeds them one after the other, in one
-    /// update of the hasher (what a model's point costs when it is hashed as it is stored).
+    /// Feed up to eight `f64`s as [`f64`](Self::f64) feeds them one after the other (the same
+    /// hash), in one update of the hasher: one call for a point's coordinates instead of one
+    /// per coordinate.
     ///
     /// # Panics
     ///
@@ -95,5 +96,11 @@ mod tests {
             StateHasher::new().f64(0.0).finish(),
             StateHasher::new().f64(-0.0).finish()
         );
+    }
+
+    #[test]
+    #[should_panic]
+    fn more_than_eight_values_at_once_are_refused() {
+        StateHasher::new().f64s(&[0.0; 9]);
     }
 }
