@@ -88,7 +88,6 @@ impl<const D: usize> NearCache<D> {
     /// on `p`.
     pub(crate) fn rebuild(&mut self, tree: &Orthtree<D>, p: &[f64; D]) {
         self.blocks.clear();
-        self.len = 0;
         self.found.len = 0;
         tree.range_into(p, NEAR_RADIUS, &mut self.found);
         // Transposed into blocks a whole block at a time (a point's store needs no test of
