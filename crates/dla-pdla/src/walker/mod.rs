@@ -133,12 +133,10 @@ where
         // the one on the norm itself, and a move in the near field does not wait for a root.
         let r_far = r_b * FAR_FIELD_MARGIN;
         let r2: f64 = self.p.iter().map(|x| x * x).sum();
-        let r = if r2 > r_far * r_far * (1.0 - 1e-12) {
-            r2.sqrt()
-        } else {
-            0.0
-        };
-        if r > r_far {
+        if r2 > r_far * r_far * (1.0 - 1e-12)
+            && let r = r2.sqrt()
+            && r > r_far
+        {
             state.counts.far_field += 1;
             state.forget();
             if VARIANT && let Motion::Ballistic = state.motion {
