@@ -28,8 +28,8 @@
 use spatial::orthtree::{Orthtree, RangeSink, dist_sq};
 
 /// Radius of the ball a cache holds, in diameters, tuned by instruction counts
-/// (`docs/benchmarks.md`): a smaller ball is rebuilt too often, a larger one costs more to
-/// build and to scan at every move than the tree queries it saves.
+/// (`docs/dla.md`, "The near cache"; `docs/tuning.md`): a smaller ball is rebuilt too often,
+/// a larger one costs more to build and to scan at every move than the tree queries it saves.
 pub const NEAR_RADIUS: f64 = 5.0;
 
 /// A cache is (re)built at the walker's position when its nearest distance is known to be

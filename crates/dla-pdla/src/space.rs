@@ -198,7 +198,7 @@ impl Space<3> for Dim<3> {
     /// side): about 270 cells visited per insert, and about 6 bytes per particle at 1e6 (the
     /// cap's neighbourhood of a 3D cluster fills much of its ball). A cap of 6 saves less in
     /// inserts than its walkers lose; four bits per cell (half the memory) lose more in
-    /// moves than they save (`docs/benchmarks.md`, "3D DLA").
+    /// moves than they save (`docs/tuning.md`, "3D DLA").
     const SPARSE_LEVEL: Option<(f64, f64, usize)> = Some((2.0, 8.0, 8));
 
     /// Half a diameter: the sparse map's bound lies within a 2-diameter cell's diagonal of the
