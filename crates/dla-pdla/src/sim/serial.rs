@@ -51,14 +51,15 @@ impl<const D: usize> Serial<D> {
         Dim<D>: Space<D>,
     {
         self.walk.reset();
-        let w = Walker::launch(
-            growth.r_ext + params.birth_gap,
-            &mut self.walk,
-            &mut self.rng,
-        );
+        let r_b = growth.r_ext + params.birth_gap;
+        // Each branch makes its own walker: a plain walk is born as `launch` would bear it (no
+        // substrate, no ballistic start), inline, so that its position is never written
+        // through a pointer and stays in registers (see `walker::detached`).
         if self.walk.variant() {
+            let w = Walker::launch(r_b, &mut self.walk, &mut self.rng);
             self.walk_one::<true>(w, params, cluster, growth)
         } else {
+            let w = Walker::born(r_b, &mut self.rng);
             self.walk_one::<false>(w, params, cluster, growth)
         }
     }
@@ -83,7 +84,11 @@ impl<const D: usize> Serial<D> {
                 &mut self.rng,
             ) {
                 let p = if self.walk.refuse {
-                    match w.settle(p, &mut self.walk, cluster, params, &mut self.rng) {
+                    // Settled through a copy, so that `w`'s own address is never taken.
+                    let mut moved = w;
+                    let settled = moved.settle(p, &mut self.walk, cluster, params, &mut self.rng);
+                    w = moved;
+                    match settled {
                         Some(p) => p,
                         None => continue,
                     }

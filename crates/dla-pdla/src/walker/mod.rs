@@ -146,7 +146,9 @@ where
                 return None;
             }
             match params.far_field {
-                FarField::Return => self.p = Dim::<D>::return_to_sphere(&self.p, r_b, rng),
+                FarField::Return => {
+                    self.p = Dim::<D>::return_to_sphere(&detached(&self.p), r_b, rng)
+                }
                 FarField::Jump => {
                     if r > params.death_ratio * r_b {
                         *self = Walker::born(r_b, rng);
@@ -267,7 +269,8 @@ where
             }
             None => {
                 state.counts.tree_queries += 1;
-                match tree.vpdist_bounded_nearest(&self.p, params.precision, state.upper(&self.p)) {
+                let at = detached(&self.p);
+                match tree.vpdist_bounded_nearest(&at, params.precision, state.upper(&self.p)) {
                     Some(answer) => {
                         state.counts.tree_nodes += u64::from(answer.0.nodes);
                         answer
@@ -320,7 +323,7 @@ where
             (best.0 <= params.step_min).then_some(best)
         } else {
             state.counts.contact_tree += 1;
-            first_contact_with::<D, false>(tree, &self.p, &u, params.step_min)
+            first_contact_with::<D, false>(tree, &detached(&self.p), &u, params.step_min)
         };
         if DEPOSIT
             && let Some(tw) = wall_contact::<false>(self.p[D - 1], u[D - 1], params.step_min)
@@ -462,6 +465,18 @@ where
             self.p[i] += len * u[i];
         }
     }
+}
+
+/// A copy of the walker's position `p` for a call that is not inlined (tree queries, contact
+/// searches, the near cache's rebuild, the far-field return), so that the callee takes the
+/// copy's address and not the position's. A position whose address escapes lives on the
+/// stack, and every move then stores it and loads it back on the walk's chain of dependent
+/// operations; otherwise it stays in registers from one move to the next. `black_box` keeps
+/// the compiler from handing the callee the position's own slot instead of the copy. Only
+/// speed depends on it: the copy holds the same numbers.
+#[inline(always)]
+pub(crate) fn detached<const D: usize>(p: &[f64; D]) -> [f64; D] {
+    std::hint::black_box(*p)
 }
 
 /// A uniformly random unit vector: [`Space::direction`] of [`Dim<D>`].

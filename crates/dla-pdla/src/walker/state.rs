@@ -228,7 +228,7 @@ impl<const D: usize> WalkState<D> {
         }
         if self.upper(p) <= REBUILD_UPPER {
             self.counts.near_rebuilds += 1;
-            self.near.rebuild(tree, p);
+            self.near.rebuild(tree, &super::detached(p));
             return self.near.nearest(p);
         }
         None
