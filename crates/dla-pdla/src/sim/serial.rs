@@ -52,14 +52,14 @@ impl<const D: usize> Serial<D> {
     {
         self.walk.reset();
         let r_b = growth.r_ext + params.birth_gap;
-        // Each branch makes its own walker: a plain walk is born as `launch` would bear it (no
-        // substrate, no ballistic start), inline, so that its position is never written
-        // through a pointer and stays in registers (see `walker::detached`).
+        // Each branch launches its own walker, so that the plain walk's position is never
+        // written through a pointer the variant walk shares and stays in registers (see
+        // `walker::detached`).
         if self.walk.variant() {
             let w = Walker::launch(r_b, &mut self.walk, &mut self.rng);
             self.walk_one::<true>(w, params, cluster, growth)
         } else {
-            let w = Walker::born(r_b, &mut self.rng);
+            let w = Walker::launch(r_b, &mut self.walk, &mut self.rng);
             self.walk_one::<false>(w, params, cluster, growth)
         }
     }

@@ -58,6 +58,7 @@ where
     /// sphere of radius `r_b` ([`born`](Self::born)), or on a substrate's launch plane at
     /// height `r_b`, or, ballistic in radial growth, entering the birth sphere along its own
     /// straight line ([`ballistic_start`]).
+    #[inline(always)]
     pub(crate) fn launch<R: Rng + ?Sized>(r_b: f64, state: &mut WalkState<D>, rng: &mut R) -> Self {
         if let Some(s) = state.substrate {
             return Walker {
@@ -270,7 +271,7 @@ where
             None => {
                 state.counts.tree_queries += 1;
                 let at = detached(&self.p);
-                match tree.vpdist_bounded_nearest(&at, params.precision, state.upper(&self.p)) {
+                match tree.vpdist_bounded_nearest(&at, params.precision, state.upper(&at)) {
                     Some(answer) => {
                         state.counts.tree_nodes += u64::from(answer.0.nodes);
                         answer
