@@ -17,7 +17,7 @@ use crate::cluster::Cluster;
 use crate::error::SimError;
 use crate::params::Params;
 use crate::space::{Dim, Space};
-use crate::walker::{WalkCounts, WalkState, Walker};
+use crate::walker::{WalkCounts, WalkState, Walker, detached};
 use core_lattice::rng::{Rng, stream, stream_id};
 use spatial::orthtree::{OrthtreeError, dist_sq};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -356,10 +356,12 @@ where
     /// `false` to stop. Runs before every move, so the common case (nothing new) is one load;
     /// `stop` and `halt` are read when something was published, at every walker's birth and
     /// under the lock at sticking: a thread that misses them finishes its walker and stops
-    /// there.
+    /// there. The rare call gets a copy of `p`, so that the walker's position stays in
+    /// registers ([`detached`]).
     #[inline(always)]
     fn sync(&self, me: &mut Thread<D>, p: &[f64; D]) -> bool {
-        self.published.count.load(Ordering::Acquire) == me.applied || self.catch_up(me, p)
+        self.published.count.load(Ordering::Acquire) == me.applied
+            || self.catch_up(me, &detached(p))
     }
 
     /// Whether the run goes on: neither stopped by a thread nor halted from outside.
@@ -439,7 +441,11 @@ where
                     if !me.walk.refuse {
                         break p;
                     }
-                    if let Some(p) = w.settle(p, &mut me.walk, self.cluster, params, rng) {
+                    // Settled through a copy, so that `w`'s own address is never taken.
+                    let mut moved = w;
+                    let settled = moved.settle(p, &mut me.walk, self.cluster, params, rng);
+                    w = moved;
+                    if let Some(p) = settled {
                         break p;
                     }
                 }
