@@ -441,11 +441,7 @@ where
                     if !me.walk.refuse {
                         break p;
                     }
-                    // Settled through a copy, so that `w`'s own address is never taken.
-                    let mut moved = w;
-                    let settled = moved.settle(p, &mut me.walk, self.cluster, params, rng);
-                    w = moved;
-                    if let Some(p) = settled {
+                    if let Some(p) = w.settle_detached(p, &mut me.walk, self.cluster, params, rng) {
                         break p;
                     }
                 }

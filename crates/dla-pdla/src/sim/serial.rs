@@ -84,11 +84,7 @@ impl<const D: usize> Serial<D> {
                 &mut self.rng,
             ) {
                 let p = if self.walk.refuse {
-                    // Settled through a copy, so that `w`'s own address is never taken.
-                    let mut moved = w;
-                    let settled = moved.settle(p, &mut self.walk, cluster, params, &mut self.rng);
-                    w = moved;
-                    match settled {
+                    match w.settle_detached(p, &mut self.walk, cluster, params, &mut self.rng) {
                         Some(p) => p,
                         None => continue,
                     }

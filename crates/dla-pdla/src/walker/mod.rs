@@ -370,6 +370,24 @@ where
         }
     }
 
+    /// [`settle`](Self::settle) through a copy of the walker, written back: the walk loops
+    /// call this, so that their walker's own address is never taken and its position stays
+    /// in registers from one move to the next (see [`detached`]).
+    #[inline(always)]
+    pub(crate) fn settle_detached<R: Rng + ?Sized>(
+        &mut self,
+        q: [f64; D],
+        state: &mut WalkState<D>,
+        cluster: &Cluster<D>,
+        params: &Params,
+        rng: &mut R,
+    ) -> Option<[f64; D]> {
+        let mut moved = *self;
+        let settled = moved.settle(q, state, cluster, params, rng);
+        *self = moved;
+        settled
+    }
+
     /// What becomes of a walker whose last move ([`advance`](Self::advance)) ended in contact
     /// at `q`, when contacts may be refused (`params.sticking_probability < 1`, `state`'s
     /// `refuse`): the sticking position, or `None` when the walker walks on. The callers ask
