@@ -5,6 +5,7 @@
 use super::beside::Beside;
 use super::{CAPPED, DistanceMapError, SHRINK};
 use crate::round::{ceil, floor};
+use std::sync::atomic::AtomicU8;
 
 /// Largest `(cap / cell)^2` for which a map tabulates its row widths.
 const WIDTHS_MAX: f64 = 4096.0;
@@ -17,6 +18,28 @@ const TABLE_ROWS: usize = 12;
 /// rows' ranges along axis 0 ([`RowTables`]). With [`TABLE_ROWS`], enough for a cap of up to
 /// 5.5 cells (the tables stay small: an insert sets them to zero before filling them).
 const TABLE_SPANS: usize = 32;
+
+/// Cells along a row that a 2D insert computes at once ([`Grid::window_row`]): a point's
+/// cells within the cap along a row fit whenever the cap is at most 5.5 cells (both 2D maps
+/// have 4).
+pub(super) const WINDOW: usize = 12;
+
+/// Merges the 16 bytes `w` into the row `row` of a map held exclusively, byte by byte with
+/// `keep` (the dense map's minimum, the sparse map's maximum): through plain copies, so that
+/// the compiler does it as one vector load, operation and store.
+#[inline(always)]
+pub(super) fn merge_row(row: &mut [AtomicU8; 16], w: [u8; 16], keep: impl Fn(u8, u8) -> u8) {
+    let mut cur = [0u8; 16];
+    for (c, v) in cur.iter_mut().zip(row.iter_mut()) {
+        *c = *v.get_mut();
+    }
+    for (c, w) in cur.iter_mut().zip(w) {
+        *c = keep(*c, w);
+    }
+    for (v, c) in row.iter_mut().zip(cur) {
+        *v.get_mut() = c;
+    }
+}
 
 /// The cells of a map of side `cell` capped at `cap`, how far the map reaches, its points,
 /// and the tables its inserts read (see [`Grid::new`]).
@@ -81,6 +104,50 @@ impl Grid {
             below,
             widths,
         })
+    }
+
+    /// The offset along axis 0 from `q_0` of the centre of cell `k + n`, given
+    /// `kc = k + 1/2`: `(kc + n) c - q_0`, the sum exact (whole numbers and halves), so that
+    /// every insert computes a cell's offset to the same bits, whichever cell its row or
+    /// window starts at.
+    #[inline(always)]
+    pub(super) fn offset(&self, kc: f64, n: f64, q0: f64) -> f64 {
+        (kc + n) * self.cell - q0
+    }
+
+    /// The squared offsets along a row ([`offset`](Self::offset)) of the [`WINDOW`] cells
+    /// from cell `k` (`kc = k + 1/2`) on: the same for every row of an insert
+    /// ([`window_row`](Self::window_row)).
+    #[inline(always)]
+    pub(super) fn window_offsets(&self, kc: f64, q0: f64) -> [f64; WINDOW] {
+        std::array::from_fn(|n| {
+            let x = self.offset(kc, f64::from(n as i32), q0);
+            x * x
+        })
+    }
+
+    /// The distance bytes `min(255, floor(|c - q| / u))` of the [`WINDOW`] cells at squared
+    /// offsets `x2` ([`window_offsets`](Self::window_offsets)) along a row at squared
+    /// distance `s` from `q` along the other axes, and 255 (capped) in the four lanes after
+    /// them: a 16-byte row that an exclusive 2D insert merges into the map's
+    /// ([`Cells::lower_window`]). Each lane is the value [`Cells::lower_row`] stores for its
+    /// cell, computed without a test so that the lanes run in vector registers: a cell
+    /// beyond the cap comes out capped, and a cell already nearer another point keeps its
+    /// value when merged.
+    ///
+    /// [`Cells::lower_window`]: super::sealed::Cells::lower_window
+    /// [`Cells::lower_row`]: super::sealed::Cells::lower_row
+    #[inline(always)]
+    pub(super) fn window_row(&self, x2: &[f64; WINDOW], s: f64) -> [u8; 16] {
+        let mut w = [CAPPED; 16];
+        for (w, x2) in w.iter_mut().zip(x2) {
+            let d = ((x2 + s).sqrt() * self.inv_quantum).min(f64::from(CAPPED));
+            // `floor(d)` (a whole number in [0, 255]) plus 2^52 is exact and holds it in the
+            // mantissa's low byte: a conversion without the saturating cast's tests, which
+            // keeps the lanes in vector registers.
+            *w = (d.floor() + 4_503_599_627_370_496.0).to_bits() as u8;
+        }
+        w
     }
 
     /// Sets the half side in cells (`half` and `half_f`).

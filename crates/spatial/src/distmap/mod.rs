@@ -218,7 +218,8 @@ pub trait PointMap<const D: usize>: Cells<D> {
 
     /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
     /// the same map, visiting only the cells nearer `q` than `p` (about half), since no other
-    /// cell can be lowered by `q`.
+    /// cell can be lowered by `q`. A 2D map whose cap spans at most 5.5 cells goes by whole
+    /// rows of the ball's box instead, branch-free, which costs less than finding that half.
     fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
         self.insert_with(q, Some(p))
     }
@@ -290,6 +291,18 @@ mod sealed {
             lower: &mut impl FnMut(&AtomicU8, u8),
             cache: &mut Self::RowCache<'a>,
         );
+
+        /// An exclusive insert of `q` in 2D by whole rows of [`WINDOW`](grid::WINDOW) cells
+        /// ([`Grid::window_row`]) from the first column of the ball's box: every cell of the
+        /// box gets the value [`lower_row`](Self::lower_row) would store, branch-free and a
+        /// row at a time, where the rows of [`lower_rows`](Self::lower_rows) spend most of
+        /// their work on finding the few cells of the ball's half beside the touched point.
+        /// The map ends exactly as those rows leave it: a cell they skip keeps its value
+        /// either way. `false` when the map does not go this way (the caller then goes by
+        /// rows); maps other than the 2D ones never do.
+        fn lower_window(&mut self, _q: &[f64; D]) -> bool {
+            false
+        }
 
         /// The `lower` of an exclusive insert: stores `w` if it is nearer than the cell's
         /// value (plain loads and stores, which relaxed atomics compile to).
@@ -374,14 +387,17 @@ mod sealed {
             touched: Option<&[f64; D]>,
         ) -> Result<(), DistanceMapError> {
             let g = self.grid();
-            let side = touched.and_then(|p| Beside::new(q, p, g.cap, g.cell));
             let need = finite_max_norm(q)? + g.cap + g.cell;
             if need >= g.reach() {
                 self.grow(need)?;
             }
             self.make_room();
             self.grid_mut().points += 1;
-            self.lower_rows(q, side.as_ref(), Self::keep_nearer);
+            if !self.lower_window(q) {
+                let g = self.grid();
+                let side = touched.and_then(|p| Beside::new(q, p, g.cap, g.cell));
+                self.lower_rows(q, side.as_ref(), Self::keep_nearer);
+            }
             Ok(())
         }
 

@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::grid::Grid;
+use super::grid::{Grid, WINDOW, merge_row};
 use super::{CAPPED, Cells, DistanceMapError, PointMap};
 use crate::round::{floor, whole_to_usize};
 use std::fmt;
@@ -216,7 +216,8 @@ impl<const D: usize> SparseDistanceMap<D> {
         recent: &mut Recent<'a>,
     ) {
         let at = brow + (u >> self.shift);
-        let x0 = ((u as i64 - self.grid.half) as f64 + 0.5) * self.grid.cell - q[0];
+        let kc = (u as i64 - self.grid.half) as f64 + 0.5;
+        let x0 = self.grid.offset(kc, 0.0, q[0]);
         let block = if recent.at[0] == at {
             recent.block[0]
         } else if recent.at[1] == at {
@@ -231,7 +232,7 @@ impl<const D: usize> SparseDistanceMap<D> {
         };
         let row = &block[crow | (u & self.mask)..=crow | (end & self.mask)];
         for (n, v) in row.iter().enumerate() {
-            let x = x0 + f64::from(n as i32) * self.grid.cell;
+            let x = self.grid.offset(kc, f64::from(n as i32), q[0]);
             let d2 = x * x + s;
             if d2 < self.grid.below[usize::from(v.load(Ordering::Relaxed))] {
                 let d = d2.sqrt() * self.grid.inv_quantum;
@@ -240,6 +241,31 @@ impl<const D: usize> SparseDistanceMap<D> {
                 }
             }
         }
+    }
+
+    /// Raises the 16 cells of the block row at in-block offset `crow` of the block at table
+    /// index `at` to the nearness `near` where it is higher (exclusive access: plain bytes),
+    /// allocating the block if it is absent and some nearness is above zero.
+    #[inline(always)]
+    fn raise_row(&mut self, at: usize, crow: usize, near: [u8; 16]) {
+        let slot = &self.table[at];
+        let entry = match slot.load(Ordering::Relaxed) {
+            ABSENT if near.iter().all(|&n| n == 0) => return,
+            ABSENT => self.allocate(slot),
+            entry => entry,
+        };
+        if entry == UNKNOWN {
+            return;
+        }
+        let n = entry as usize - 1;
+        let first = (n & ((1 << self.chunk_shift) - 1)) * self.block_cells + crow;
+        let chunk = self.chunks[n >> self.chunk_shift]
+            .get_mut()
+            .expect("a block is published after its chunk is created");
+        let row: &mut [AtomicU8; 16] = (&mut chunk[first..first + 16])
+            .try_into()
+            .expect("a block row holds 16 cells");
+        merge_row(row, near, u8::max);
     }
 
     /// The block at table index `at` for a segment of `len + 1` cells starting `x0` from `q`
@@ -398,6 +424,44 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
     fn make_room(&mut self) {
         let per_axis = (2.0 * self.grid.cap * self.grid.inv_cell) as usize / (self.mask + 1) + 2;
         self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
+    }
+
+    /// Row by row of the ball's box: [`Grid::window_row`] as nearness, placed at the box's
+    /// first column in the 32 cells of two consecutive block rows and merged into the blocks
+    /// 16 bytes at a time by a byte maximum ([`raise_row`](Self::raise_row)). Needs blocks of
+    /// 16 cells a side (a block row is then 16 bytes, and a row of the box spans at most two).
+    fn lower_window(&mut self, q: &[f64; D]) -> bool {
+        if D != 2 || self.mask != 15 {
+            return false;
+        }
+        let g = &self.grid;
+        let Some((lo, hi)) = g.cells_near(q, q) else {
+            return true;
+        };
+        if hi[0] - lo[0] >= WINDOW as i64 {
+            return false;
+        }
+        let x2 = g.window_offsets(lo[0] as f64 + 0.5, q[0]);
+        let start = (lo[0] + g.half) as usize;
+        let end = (hi[0] + g.half) as usize;
+        let off = start & 15;
+        for k in lo[1]..=hi[1] {
+            let e = q[1] - (k as f64 + 0.5) * self.grid.cell;
+            let w = self.grid.window_row(&x2, e * e);
+            let mut near = [0u8; 32];
+            for (n, w) in near[off..off + 16].iter_mut().zip(w) {
+                *n = CAPPED - w;
+            }
+            let key = self.row_key(1, k);
+            let at = ((key >> CELL_BITS) as usize) + (start >> 4);
+            let crow = (key & ((1 << CELL_BITS) - 1)) as usize;
+            let (first, second) = near.split_at(16);
+            self.raise_row(at, crow, first.try_into().expect("16 bytes"));
+            if end >> 4 != start >> 4 {
+                self.raise_row(at + 1, crow, second.try_into().expect("16 bytes"));
+            }
+        }
+        true
     }
 
     type RowCache<'a> = Recent<'a>;

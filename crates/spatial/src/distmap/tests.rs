@@ -340,34 +340,35 @@ fn bad_parameters_and_points_are_refused() {
     assert!(map.is_empty());
 }
 
+/// A random aggregate: each point one diameter from an earlier one (some along an axis,
+/// where the half-space's normal has a zero component; every fifth closer, between 0.3 and
+/// 1, as DLA's noise reduction stores them), with the earlier one.
+fn aggregate<const D: usize>(n: usize, seed: u64) -> Vec<([f64; D], Option<[f64; D]>)> {
+    let mut next = uniform(seed);
+    let mut pts: Vec<([f64; D], Option<[f64; D]>)> = vec![([0.3; D], None)];
+    while pts.len() < n {
+        let p = pts[(next() * pts.len() as f64) as usize % pts.len()].0;
+        let u: [f64; D] = if pts.len() % 7 == 0 {
+            std::array::from_fn(|i| if i == pts.len() % D { -1.0 } else { 0.0 })
+        } else {
+            let u: [f64; D] = std::array::from_fn(|_| next() - 0.5);
+            let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
+            u.map(|x| x / len)
+        };
+        let f = if pts.len() % 5 == 0 {
+            0.3 + 0.7 * next()
+        } else {
+            1.0
+        };
+        pts.push((std::array::from_fn(|i| p[i] + f * u[i]), Some(p)));
+    }
+    pts
+}
+
 /// A point inserted beside the point it touches (visiting only the cells nearer it) leaves the
 /// dense and the sparse maps exactly as a full insert does: every byte and every block.
 #[test]
 fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
-    /// A random aggregate: each point one diameter from an earlier one (some along an axis,
-    /// where the half-space's normal has a zero component; every fifth closer, between 0.3 and
-    /// 1, as DLA's noise reduction stores them), with the earlier one.
-    fn aggregate<const D: usize>(n: usize, seed: u64) -> Vec<([f64; D], Option<[f64; D]>)> {
-        let mut next = uniform(seed);
-        let mut pts: Vec<([f64; D], Option<[f64; D]>)> = vec![([0.3; D], None)];
-        while pts.len() < n {
-            let p = pts[(next() * pts.len() as f64) as usize % pts.len()].0;
-            let u: [f64; D] = if pts.len() % 7 == 0 {
-                std::array::from_fn(|i| if i == pts.len() % D { -1.0 } else { 0.0 })
-            } else {
-                let u: [f64; D] = std::array::from_fn(|_| next() - 0.5);
-                let len = u.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-9);
-                u.map(|x| x / len)
-            };
-            let f = if pts.len() % 5 == 0 {
-                0.3 + 0.7 * next()
-            } else {
-                1.0
-            };
-            pts.push((std::array::from_fn(|i| p[i] + f * u[i]), Some(p)));
-        }
-        pts
-    }
     fn dense<const D: usize>(cell: f64, cap: f64, seed: u64) {
         let pts = aggregate::<D>(700, seed);
         let mut full = DistanceMap::<D>::new(cell, cap).unwrap();
@@ -425,6 +426,94 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
     dense::<4>(8.0, 32.0, 5);
     sparse::<3>(2.0, 8.0, 6);
     sparse::<2>(2.0, 8.0, 7);
+}
+
+/// Exclusive 2D inserts go by whole window rows where a row of the ball's box spans at most
+/// [`grid::WINDOW`] cells (the sparse map's with blocks of 16 cells a side), and by rows
+/// otherwise; shared inserts always go by rows. Both leave every byte, and every block of a
+/// sparse map, the same, with and without the touched point: for the `dla` maps' shapes, odd
+/// ones, a cap one cell too wide for the window, points at cell corners and centres, and
+/// points near the map's edge (where a dense row's 16 bytes would run past its end).
+#[test]
+fn window_inserts_give_the_row_inserts_bytes() {
+    fn points(cell: f64, cap: f64, seed: u64) -> Vec<([f64; 2], Option<[f64; 2]>)> {
+        let mut pts = aggregate::<2>(500, seed);
+        let mut next = uniform(seed + 100);
+        let span = 6.0 * cap;
+        pts.extend((0..300).map(|_| ([(next() - 0.5) * span, (next() - 0.5) * span], None)));
+        for k in -3..3 {
+            pts.push(([k as f64 * cell, (k + 1) as f64 * cell], None));
+            pts.push((
+                std::array::from_fn(|i| (k as f64 + 0.5 + i as f64) * cell),
+                None,
+            ));
+        }
+        pts
+    }
+    fn dense(cell: f64, cap: f64, seed: u64) {
+        let pts = points(cell, cap, seed);
+        let mut window = DistanceMap::<2>::new(cell, cap).unwrap();
+        for (q, p) in &pts {
+            match p {
+                Some(p) => window.insert_beside(q, p).unwrap(),
+                None => window.insert(q).unwrap(),
+            }
+        }
+        let mut rows = DistanceMap::<2>::new(cell, cap).unwrap();
+        rows.reserve(window.reach()).unwrap();
+        for (q, p) in &pts {
+            let inside = match p {
+                Some(p) => rows.insert_shared_beside(q, p).unwrap(),
+                None => rows.insert_shared(q).unwrap(),
+            };
+            assert!(inside);
+        }
+        assert_eq!(window.side, rows.side);
+        let lowered = bytes(&window).iter().filter(|&&v| v < CAPPED).count();
+        assert!(lowered > 100, "{lowered} cells lowered");
+        assert!(bytes(&window) == bytes(&rows), "cell {cell}, cap {cap}");
+    }
+    fn sparse(cell: f64, cap: f64, block: usize, seed: u64) {
+        let pts = points(cell, cap, seed);
+        let mut window = SparseDistanceMap::<2>::new(cell, cap, block).unwrap();
+        for (q, p) in &pts {
+            match p {
+                Some(p) => window.insert_beside(q, p).unwrap(),
+                None => window.insert(q).unwrap(),
+            }
+        }
+        let mut rows = SparseDistanceMap::<2>::new(cell, cap, block).unwrap();
+        rows.reserve(window.reach()).unwrap();
+        for (q, p) in &pts {
+            let inside = match p {
+                Some(p) => rows.insert_shared_beside(q, p).unwrap(),
+                None => rows.insert_shared(q).unwrap(),
+            };
+            assert!(inside);
+        }
+        assert_eq!(window.blocks(), rows.blocks());
+        let reach = window.reach();
+        let per_axis = (2.0 * reach / cell).round() as usize;
+        let mut lowered = 0;
+        for idx in 0..per_axis * per_axis {
+            let c = [idx % per_axis, idx / per_axis].map(|k| -reach + (k as f64 + 0.5) * cell);
+            let v = window.value(&c);
+            assert_eq!(v, rows.value(&c), "at {c:?}");
+            lowered += usize::from(v.is_some_and(|v| v < CAPPED));
+        }
+        assert!(lowered > 100, "{lowered} cells lowered");
+    }
+    // The `dla` shapes: the first dense level and the sparse map.
+    dense(16.0, 64.0, 1);
+    sparse(2.0, 8.0, 16, 2);
+    // Other caps within the window (up to 5.5 cells), and 6.5 cells (by rows).
+    dense(3.0, 10.5, 3);
+    dense(1.0, 5.5, 4);
+    dense(1.0, 6.5, 5);
+    sparse(1.5, 7.0, 16, 6);
+    sparse(1.0, 5.5, 16, 7);
+    // Blocks of 8 cells a side: by rows.
+    sparse(2.0, 8.0, 8, 8);
 }
 
 /// Boxes added by the sub-boxes that hold them ([`DistanceMap::insert_box_by_sub_box`]), as
