@@ -19,17 +19,21 @@ const TABLE_ROWS: usize = 12;
 /// 5.5 cells (the tables stay small: an insert sets them to zero before filling them).
 const TABLE_SPANS: usize = 32;
 
-/// Cells along a row that a 2D insert computes at once ([`Grid::window_row`]): a point's
-/// cells within the cap along a row fit whenever the cap is at most 5.5 cells (both 2D maps
-/// have 4).
+/// Cells along a row that an exclusive 2D or 3D insert computes at once
+/// ([`Grid::window_row`]): a point's cells within the cap along a row fit whenever the cap is
+/// at most 5.5 cells (`dla`'s sparse maps and first dense levels have 4).
 pub(super) const WINDOW: usize = 12;
 
-/// Merges the 16 bytes `w` into the row `row` of a map held exclusively, byte by byte with
+/// Merges the bytes `w` into the row `row` of a map held exclusively, byte by byte with
 /// `keep` (the dense map's minimum, the sparse map's maximum): through plain copies, so that
 /// the compiler does it as one vector load, operation and store.
 #[inline(always)]
-pub(super) fn merge_row(row: &mut [AtomicU8; 16], w: [u8; 16], keep: impl Fn(u8, u8) -> u8) {
-    let mut cur = [0u8; 16];
+pub(super) fn merge_row<const N: usize>(
+    row: &mut [AtomicU8; N],
+    w: [u8; N],
+    keep: impl Fn(u8, u8) -> u8,
+) {
+    let mut cur = [0u8; N];
     for (c, v) in cur.iter_mut().zip(row.iter_mut()) {
         *c = *v.get_mut();
     }
@@ -67,6 +71,10 @@ pub struct Grid {
     /// misses a cell). Empty when `(cap / cell)^2` exceeds [`WIDTHS_MAX`]; rows then solve
     /// for their range exactly.
     pub(super) widths: Box<[f64]>,
+    /// `cap^2 (1 + 1e-9)`: a row of cells at a squared distance of at least this from a point
+    /// along the other axes has no cell within the cap, even after rounding (an exclusive
+    /// window insert skips it, see [`window_row`](Self::window_row)).
+    pub(super) window_skip: f64,
 }
 
 impl Grid {
@@ -103,6 +111,7 @@ impl Grid {
             points: 0,
             below,
             widths,
+            window_skip: cap * cap * (1.0 + 1e-9),
         })
     }
 
@@ -115,25 +124,30 @@ impl Grid {
         (kc + n) * self.cell - q0
     }
 
-    /// The squared offsets along a row ([`offset`](Self::offset)) of the [`WINDOW`] cells
-    /// from cell `k` (`kc = k + 1/2`) on: the same for every row of an insert
+    /// The squared offsets along a row ([`offset`](Self::offset)) of the first `cells` of
+    /// the [`WINDOW`] cells from cell `k` (`kc = k + 1/2`) on, and infinity after them (their
+    /// cells come out capped): the same for every row of an insert
     /// ([`window_row`](Self::window_row)).
     #[inline(always)]
-    pub(super) fn window_offsets(&self, kc: f64, q0: f64) -> [f64; WINDOW] {
+    pub(super) fn window_offsets(&self, kc: f64, q0: f64, cells: i64) -> [f64; WINDOW] {
         std::array::from_fn(|n| {
             let x = self.offset(kc, f64::from(n as i32), q0);
-            x * x
+            if (n as i64) < cells {
+                x * x
+            } else {
+                f64::INFINITY
+            }
         })
     }
 
     /// The distance bytes `min(255, floor(|c - q| / u))` of the [`WINDOW`] cells at squared
     /// offsets `x2` ([`window_offsets`](Self::window_offsets)) along a row at squared
-    /// distance `s` from `q` along the other axes, and 255 (capped) in the four lanes after
-    /// them: a 16-byte row that an exclusive 2D insert merges into the map's
-    /// ([`Cells::lower_window`]). Each lane is the value [`Cells::lower_row`] stores for its
-    /// cell, computed without a test so that the lanes run in vector registers: a cell
-    /// beyond the cap comes out capped, and a cell already nearer another point keeps its
-    /// value when merged.
+    /// distance `s` from `q` along the other axes (255, capped, at an infinite offset), and
+    /// 255 in the four lanes after them: a 16-byte row that an exclusive 2D or 3D insert
+    /// merges into the map's ([`Cells::lower_window`]). Each lane is the value
+    /// [`Cells::lower_row`] stores for its cell, computed without a test so that the lanes
+    /// run in vector registers: a cell beyond the cap comes out capped, and a cell already
+    /// nearer another point keeps its value when merged.
     ///
     /// [`Cells::lower_window`]: super::sealed::Cells::lower_window
     /// [`Cells::lower_row`]: super::sealed::Cells::lower_row
@@ -264,6 +278,58 @@ impl Grid {
             None => (a, b),
         }
     }
+}
+
+/// Calls `f(map, s, key)` for the rows of an exclusive window insert of `q` into `map` in 2D
+/// or 3D ([`Grid::window_row`]): the rows of the box `lo..=hi` of cells of side `cell` with a
+/// cell within the cap, each given by its squared offset `s` from `q` along axes 1 and 2
+/// (below `skip`, the map's [`Grid::window_skip`]) and its key, the sum of `key(map, i, k_i)`
+/// over those axes; axis 1 fastest. In 3D both are sums of per-axis terms tabulated once.
+/// `false` (and no call) in 4D and more, or if the box is wider than [`WINDOW`] cells along
+/// some axis.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn window_rows<M, const D: usize>(
+    map: &mut M,
+    q: &[f64; D],
+    (lo, hi): (&[i64; D], &[i64; D]),
+    cell: f64,
+    skip: f64,
+    key: impl Fn(&M, usize, i64) -> u64,
+    mut f: impl FnMut(&mut M, f64, u64),
+) -> bool {
+    if !(D == 2 || D == 3) || (0..D).any(|i| hi[i] - lo[i] >= WINDOW as i64) {
+        return false;
+    }
+    // As `RowTables` and `Grid::row_offset`: a row's squared offset is then the same sum, to
+    // the bits.
+    let e2 = |i: usize, k: i64| {
+        let e = q[i] - (k as f64 + 0.5) * cell;
+        e * e
+    };
+    if D == 2 {
+        // Every row of a 2D box has a cell within the cap.
+        for k in lo[1]..=hi[1] {
+            let key = key(map, 1, k);
+            f(map, e2(1, k), key);
+        }
+        return true;
+    }
+    let mut t1 = [(0.0, 0); WINDOW];
+    for (t, k) in t1.iter_mut().zip(lo[1]..=hi[1]) {
+        *t = (e2(1, k), key(map, 1, k));
+    }
+    let n1 = (hi[1] - lo[1]) as usize + 1;
+    for k2 in lo[2]..=hi[2] {
+        let (s2, key2) = (e2(2, k2), key(map, 2, k2));
+        for &(s1, key1) in &t1[..n1] {
+            let s = s1 + s2;
+            if s < skip {
+                f(map, s, key1 + key2);
+            }
+        }
+    }
+    true
 }
 
 /// What the rows of one insert need from each axis `1..D`, tabulated once per cell index along

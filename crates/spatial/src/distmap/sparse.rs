@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::grid::{Grid, WINDOW, merge_row};
+use super::grid::{Grid, merge_row, window_rows};
 use super::{CAPPED, Cells, DistanceMapError, PointMap};
 use crate::round::{floor, whole_to_usize};
 use std::fmt;
@@ -243,11 +243,47 @@ impl<const D: usize> SparseDistanceMap<D> {
         }
     }
 
-    /// Raises the 16 cells of the block row at in-block offset `crow` of the block at table
+    /// [`Cells::lower_window`] with blocks of `B` cells a side (`B = mask + 1`).
+    #[inline(always)]
+    fn lower_window_in<const B: usize>(&mut self, q: &[f64; D]) -> bool {
+        let g = &self.grid;
+        let Some((lo, hi)) = g.cells_near(q, q) else {
+            return true;
+        };
+        let x2 = g.window_offsets(lo[0] as f64 + 0.5, q[0], hi[0] - lo[0] + 1);
+        let start = (lo[0] + g.half) as usize;
+        let off = start % B;
+        // Block rows spanned by the box's rows: at most 2 of 16 cells, 3 of 8.
+        let blocks = (off + (hi[0] - lo[0]) as usize) / B + 1;
+        let (cell, skip) = (g.cell, g.window_skip);
+        let mut near = [0u8; 32];
+        window_rows(
+            self,
+            q,
+            (&lo, &hi),
+            cell,
+            skip,
+            |m, i, k| m.row_key(i, k),
+            |m, s, key| {
+                let w = m.grid.window_row(&x2, s);
+                for (n, w) in near[off..off + 16].iter_mut().zip(w) {
+                    *n = CAPPED - w;
+                }
+                let at = ((key >> CELL_BITS) as usize) + start / B;
+                let crow = (key & ((1 << CELL_BITS) - 1)) as usize;
+                for j in 0..blocks {
+                    let near: [u8; B] = near[j * B..(j + 1) * B].try_into().expect("B bytes");
+                    m.raise_row(at + j, crow, near);
+                }
+            },
+        )
+    }
+
+    /// Raises the `B` cells of the block row at in-block offset `crow` of the block at table
     /// index `at` to the nearness `near` where it is higher (exclusive access: plain bytes),
     /// allocating the block if it is absent and some nearness is above zero.
     #[inline(always)]
-    fn raise_row(&mut self, at: usize, crow: usize, near: [u8; 16]) {
+    fn raise_row<const B: usize>(&mut self, at: usize, crow: usize, near: [u8; B]) {
         let slot = &self.table[at];
         let entry = match slot.load(Ordering::Relaxed) {
             ABSENT if near.iter().all(|&n| n == 0) => return,
@@ -262,9 +298,9 @@ impl<const D: usize> SparseDistanceMap<D> {
         let chunk = self.chunks[n >> self.chunk_shift]
             .get_mut()
             .expect("a block is published after its chunk is created");
-        let row: &mut [AtomicU8; 16] = (&mut chunk[first..first + 16])
+        let row: &mut [AtomicU8; B] = (&mut chunk[first..first + B])
             .try_into()
-            .expect("a block row holds 16 cells");
+            .expect("a block row holds B cells");
         merge_row(row, near, u8::max);
     }
 
@@ -426,42 +462,16 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
         self.ensure_slots(self.blocks() + per_axis.pow(D as u32));
     }
 
-    /// Row by row of the ball's box: [`Grid::window_row`] as nearness, placed at the box's
-    /// first column in the 32 cells of two consecutive block rows and merged into the blocks
-    /// 16 bytes at a time by a byte maximum ([`raise_row`](Self::raise_row)). Needs blocks of
-    /// 16 cells a side (a block row is then 16 bytes, and a row of the box spans at most two).
+    /// Row by row of the ball's box (in 2D and 3D): [`Grid::window_row`] as nearness, placed
+    /// at the box's first column in the cells of consecutive block rows and merged into the
+    /// blocks a block row at a time by a byte maximum ([`raise_row`](Self::raise_row)). Needs
+    /// blocks of 8 or 16 cells a side (a row of the box then spans at most three or two).
     fn lower_window(&mut self, q: &[f64; D]) -> bool {
-        if D != 2 || self.mask != 15 {
-            return false;
+        match (D, self.mask + 1) {
+            (2 | 3, 8) => self.lower_window_in::<8>(q),
+            (2 | 3, 16) => self.lower_window_in::<16>(q),
+            _ => false,
         }
-        let g = &self.grid;
-        let Some((lo, hi)) = g.cells_near(q, q) else {
-            return true;
-        };
-        if hi[0] - lo[0] >= WINDOW as i64 {
-            return false;
-        }
-        let x2 = g.window_offsets(lo[0] as f64 + 0.5, q[0]);
-        let start = (lo[0] + g.half) as usize;
-        let end = (hi[0] + g.half) as usize;
-        let off = start & 15;
-        for k in lo[1]..=hi[1] {
-            let e = q[1] - (k as f64 + 0.5) * self.grid.cell;
-            let w = self.grid.window_row(&x2, e * e);
-            let mut near = [0u8; 32];
-            for (n, w) in near[off..off + 16].iter_mut().zip(w) {
-                *n = CAPPED - w;
-            }
-            let key = self.row_key(1, k);
-            let at = ((key >> CELL_BITS) as usize) + (start >> 4);
-            let crow = (key & ((1 << CELL_BITS) - 1)) as usize;
-            let (first, second) = near.split_at(16);
-            self.raise_row(at, crow, first.try_into().expect("16 bytes"));
-            if end >> 4 != start >> 4 {
-                self.raise_row(at + 1, crow, second.try_into().expect("16 bytes"));
-            }
-        }
-        true
     }
 
     type RowCache<'a> = Recent<'a>;

@@ -428,21 +428,21 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
     sparse::<2>(2.0, 8.0, 7);
 }
 
-/// Exclusive 2D inserts go by whole window rows where a row of the ball's box spans at most
-/// [`grid::WINDOW`] cells (the sparse map's with blocks of 16 cells a side), and by rows
-/// otherwise; shared inserts always go by rows. Both leave every byte, and every block of a
-/// sparse map, the same, with and without the touched point: for the `dla` maps' shapes, odd
-/// ones, a cap one cell too wide for the window, points at cell corners and centres, and
+/// Exclusive 2D and 3D inserts go by whole window rows where the ball's box spans at most
+/// [`grid::WINDOW`] cells a side (the sparse map's with blocks of 8 or 16 cells a side), and
+/// by rows otherwise; shared inserts always go by rows. Both leave every byte, and every block
+/// of a sparse map, the same, with and without the touched point: for the `dla` maps' shapes,
+/// odd ones, a cap one cell too wide for the window, points at cell corners and centres, and
 /// points near the map's edge (where a dense row's 16 bytes would run past its end).
 #[test]
 fn window_inserts_give_the_row_inserts_bytes() {
-    fn points(cell: f64, cap: f64, seed: u64) -> Vec<([f64; 2], Option<[f64; 2]>)> {
-        let mut pts = aggregate::<2>(500, seed);
+    fn points<const D: usize>(cell: f64, cap: f64, seed: u64) -> Vec<([f64; D], Option<[f64; D]>)> {
+        let mut pts = aggregate::<D>(400, seed);
         let mut next = uniform(seed + 100);
         let span = 6.0 * cap;
-        pts.extend((0..300).map(|_| ([(next() - 0.5) * span, (next() - 0.5) * span], None)));
+        pts.extend((0..200).map(|_| (std::array::from_fn(|_| (next() - 0.5) * span), None)));
         for k in -3..3 {
-            pts.push(([k as f64 * cell, (k + 1) as f64 * cell], None));
+            pts.push((std::array::from_fn(|i| (k + i as i64) as f64 * cell), None));
             pts.push((
                 std::array::from_fn(|i| (k as f64 + 0.5 + i as f64) * cell),
                 None,
@@ -450,70 +450,73 @@ fn window_inserts_give_the_row_inserts_bytes() {
         }
         pts
     }
-    fn dense(cell: f64, cap: f64, seed: u64) {
-        let pts = points(cell, cap, seed);
-        let mut window = DistanceMap::<2>::new(cell, cap).unwrap();
-        for (q, p) in &pts {
+    /// Inserts `pts` into `window` (exclusively) and into `rows` (shared, reserved to the
+    /// first one's reach).
+    fn fill<M: PointMap<D>, const D: usize>(
+        window: &mut M,
+        rows: &mut M,
+        pts: &[([f64; D], Option<[f64; D]>)],
+    ) {
+        for (q, p) in pts {
             match p {
                 Some(p) => window.insert_beside(q, p).unwrap(),
                 None => window.insert(q).unwrap(),
             }
         }
-        let mut rows = DistanceMap::<2>::new(cell, cap).unwrap();
         rows.reserve(window.reach()).unwrap();
-        for (q, p) in &pts {
+        for (q, p) in pts {
             let inside = match p {
                 Some(p) => rows.insert_shared_beside(q, p).unwrap(),
                 None => rows.insert_shared(q).unwrap(),
             };
             assert!(inside);
         }
+    }
+    fn dense<const D: usize>(cell: f64, cap: f64, seed: u64) {
+        let mut window = DistanceMap::<D>::new(cell, cap).unwrap();
+        let mut rows = DistanceMap::<D>::new(cell, cap).unwrap();
+        fill(&mut window, &mut rows, &points::<D>(cell, cap, seed));
         assert_eq!(window.side, rows.side);
         let lowered = bytes(&window).iter().filter(|&&v| v < CAPPED).count();
         assert!(lowered > 100, "{lowered} cells lowered");
         assert!(bytes(&window) == bytes(&rows), "cell {cell}, cap {cap}");
     }
-    fn sparse(cell: f64, cap: f64, block: usize, seed: u64) {
-        let pts = points(cell, cap, seed);
-        let mut window = SparseDistanceMap::<2>::new(cell, cap, block).unwrap();
-        for (q, p) in &pts {
-            match p {
-                Some(p) => window.insert_beside(q, p).unwrap(),
-                None => window.insert(q).unwrap(),
-            }
-        }
-        let mut rows = SparseDistanceMap::<2>::new(cell, cap, block).unwrap();
-        rows.reserve(window.reach()).unwrap();
-        for (q, p) in &pts {
-            let inside = match p {
-                Some(p) => rows.insert_shared_beside(q, p).unwrap(),
-                None => rows.insert_shared(q).unwrap(),
-            };
-            assert!(inside);
-        }
+    fn sparse<const D: usize>(cell: f64, cap: f64, block: usize, seed: u64) {
+        let mut window = SparseDistanceMap::<D>::new(cell, cap, block).unwrap();
+        let mut rows = SparseDistanceMap::<D>::new(cell, cap, block).unwrap();
+        fill(&mut window, &mut rows, &points::<D>(cell, cap, seed));
         assert_eq!(window.blocks(), rows.blocks());
         let reach = window.reach();
         let per_axis = (2.0 * reach / cell).round() as usize;
         let mut lowered = 0;
-        for idx in 0..per_axis * per_axis {
-            let c = [idx % per_axis, idx / per_axis].map(|k| -reach + (k as f64 + 0.5) * cell);
+        for idx in 0..per_axis.pow(D as u32) {
+            let mut rem = idx;
+            let c: [f64; D] = std::array::from_fn(|_| {
+                let k = rem % per_axis;
+                rem /= per_axis;
+                -reach + (k as f64 + 0.5) * cell
+            });
             let v = window.value(&c);
             assert_eq!(v, rows.value(&c), "at {c:?}");
             lowered += usize::from(v.is_some_and(|v| v < CAPPED));
         }
         assert!(lowered > 100, "{lowered} cells lowered");
     }
-    // The `dla` shapes: the first dense level and the sparse map.
-    dense(16.0, 64.0, 1);
-    sparse(2.0, 8.0, 16, 2);
+    // The `dla` shapes: the first dense level and the sparse map, in 2D and 3D.
+    dense::<2>(16.0, 64.0, 1);
+    sparse::<2>(2.0, 8.0, 16, 2);
+    dense::<3>(8.0, 32.0, 3);
+    sparse::<3>(2.0, 8.0, 8, 4);
     // Other caps within the window (up to 5.5 cells), and 6.5 cells (by rows).
-    dense(3.0, 10.5, 3);
-    dense(1.0, 5.5, 4);
-    dense(1.0, 6.5, 5);
-    sparse(1.5, 7.0, 16, 6);
-    sparse(1.0, 5.5, 16, 7);
-    // Blocks of 8 cells a side: by rows.
-    sparse(2.0, 8.0, 8, 8);
+    dense::<2>(3.0, 10.5, 5);
+    dense::<2>(1.0, 5.5, 6);
+    dense::<2>(1.0, 6.5, 7);
+    dense::<3>(2.5, 11.0, 8);
+    sparse::<2>(1.5, 7.0, 16, 9);
+    sparse::<2>(1.0, 5.5, 16, 10);
+    sparse::<3>(1.0, 5.5, 8, 11);
+    // Blocks of 4 cells a side: by rows.
+    sparse::<2>(2.0, 8.0, 4, 12);
 }
 
 /// Boxes added by the sub-boxes that hold them ([`DistanceMap::insert_box_by_sub_box`]), as
