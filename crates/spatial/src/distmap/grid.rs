@@ -308,7 +308,7 @@ pub(super) fn window_rows<M, const D: usize>(
         e * e
     };
     if D == 2 {
-        // Every row of a 2D box has a cell within the cap.
+        // A 2D box's rows all come within about a cell of the cap: none is worth a test.
         for k in lo[1]..=hi[1] {
             let key = key(map, 1, k);
             f(map, e2(1, k), key);

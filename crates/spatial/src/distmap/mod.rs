@@ -218,9 +218,9 @@ pub trait PointMap<const D: usize>: Cells<D> {
 
     /// [`insert`](Self::insert) of a point `q` that touches the point `p` inserted before it:
     /// the same map, visiting only the cells nearer `q` than `p` (about half), since no other
-    /// cell can be lowered by `q`. A 2D or 3D map whose cap spans at most 5.5 cells goes by
-    /// whole rows of the ball's box instead, branch-free, which costs less than finding that
-    /// half.
+    /// cell can be lowered by `q`. A 2D or 3D map whose cap spans at most 5.5 cells (a sparse
+    /// map's blocks 8 or 16 cells a side) goes by whole rows of the ball's box instead,
+    /// branch-free, which costs less than finding that half.
     fn insert_beside(&mut self, q: &[f64; D], p: &[f64; D]) -> Result<(), DistanceMapError> {
         self.insert_with(q, Some(p))
     }
@@ -295,13 +295,13 @@ mod sealed {
 
         /// An exclusive insert of `q` in 2D or 3D by whole rows of
         /// [`WINDOW`](super::grid::WINDOW) cells ([`Grid::window_row`]) from the first column
-        /// of the ball's box
-        /// ([`window_rows`](super::grid::window_rows)): every cell of the box gets the value
-        /// [`lower_row`](Self::lower_row) would store, branch-free and a row at a time, where
-        /// the rows of [`lower_rows`](Self::lower_rows) spend most of their work on finding
-        /// the few cells of the ball's half beside the touched point. The map ends exactly as
-        /// those rows leave it: a cell they skip keeps its value either way. `false` when the
-        /// map does not go this way (the caller then goes by rows).
+        /// of the ball's box ([`window_rows`](super::grid::window_rows)): every cell of the
+        /// box gets the value [`lower_row`](Self::lower_row) would store, branch-free and a
+        /// row at a time, where the rows of [`lower_rows`](Self::lower_rows) spend most of
+        /// their work on finding the few cells of the ball's half beside the touched point.
+        /// The map ends exactly as those rows leave it: a cell they skip keeps its value
+        /// either way. `false` when the map does not go this way (the caller then goes by
+        /// rows).
         fn lower_window(&mut self, _q: &[f64; D]) -> bool {
             false
         }
