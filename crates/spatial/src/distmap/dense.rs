@@ -454,6 +454,9 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
     /// end of the row.
     fn lower_window(&mut self, q: &[f64; D]) -> bool {
         let g = &self.grid;
+        if !g.window_inserts {
+            return false;
+        }
         let Some((lo, hi)) = g.cells_near(q, q) else {
             return true;
         };

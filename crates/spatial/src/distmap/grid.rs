@@ -75,6 +75,9 @@ pub struct Grid {
     /// along the other axes has no cell within the cap, even after rounding (an exclusive
     /// window insert skips it, see [`window_row`](Self::window_row)).
     pub(super) window_skip: f64,
+    /// Whether exclusive inserts may go by window rows (`Cells::lower_window`); always, but
+    /// for the tests of the rows' inserts.
+    pub(super) window_inserts: bool,
 }
 
 impl Grid {
@@ -112,6 +115,7 @@ impl Grid {
             below,
             widths,
             window_skip: cap * cap * (1.0 + 1e-9),
+            window_inserts: true,
         })
     }
 

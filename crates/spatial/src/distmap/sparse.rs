@@ -247,6 +247,9 @@ impl<const D: usize> SparseDistanceMap<D> {
     #[inline(always)]
     fn lower_window_in<const B: usize>(&mut self, q: &[f64; D]) -> bool {
         let g = &self.grid;
+        if !g.window_inserts {
+            return false;
+        }
         let Some((lo, hi)) = g.cells_near(q, q) else {
             return true;
         };

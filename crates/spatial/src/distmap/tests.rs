@@ -263,6 +263,7 @@ fn tabulated_row_ranges_give_the_exact_ranges_bytes() {
         }
         let mut table = DistanceMap::<D>::new(cell, cap).unwrap();
         assert!(!table.grid.widths.is_empty());
+        table.grid.window_inserts = false;
         let mut exact = table.clone();
         exact.grid.widths = Box::default();
         for q in &pts {
@@ -372,6 +373,7 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
     fn dense<const D: usize>(cell: f64, cap: f64, seed: u64) {
         let pts = aggregate::<D>(700, seed);
         let mut full = DistanceMap::<D>::new(cell, cap).unwrap();
+        full.grid.window_inserts = false;
         let mut beside = full.clone();
         for (q, p) in &pts {
             full.insert(q).unwrap();
@@ -388,6 +390,8 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
         let pts = aggregate::<D>(700, seed);
         let mut full = SparseDistanceMap::<D>::new(cell, cap, 8).unwrap();
         let mut beside = SparseDistanceMap::<D>::new(cell, cap, 8).unwrap();
+        full.grid_mut().window_inserts = false;
+        beside.grid_mut().window_inserts = false;
         for (q, p) in &pts {
             full.insert(q).unwrap();
             match p {
@@ -451,7 +455,7 @@ fn window_inserts_give_the_row_inserts_bytes() {
         pts
     }
     /// Inserts `pts` into `window` (exclusively) and into `rows` (shared, reserved to the
-    /// first one's reach).
+    /// first one's reach: shared inserts go by rows).
     fn fill<M: PointMap<D>, const D: usize>(
         window: &mut M,
         rows: &mut M,
@@ -474,7 +478,7 @@ fn window_inserts_give_the_row_inserts_bytes() {
     }
     fn dense<const D: usize>(cell: f64, cap: f64, seed: u64) {
         let mut window = DistanceMap::<D>::new(cell, cap).unwrap();
-        let mut rows = DistanceMap::<D>::new(cell, cap).unwrap();
+        let mut rows = window.clone();
         fill(&mut window, &mut rows, &points::<D>(cell, cap, seed));
         assert_eq!(window.side, rows.side);
         let lowered = bytes(&window).iter().filter(|&&v| v < CAPPED).count();
@@ -482,8 +486,8 @@ fn window_inserts_give_the_row_inserts_bytes() {
         assert!(bytes(&window) == bytes(&rows), "cell {cell}, cap {cap}");
     }
     fn sparse<const D: usize>(cell: f64, cap: f64, block: usize, seed: u64) {
-        let mut window = SparseDistanceMap::<D>::new(cell, cap, block).unwrap();
-        let mut rows = SparseDistanceMap::<D>::new(cell, cap, block).unwrap();
+        let new = || SparseDistanceMap::<D>::new(cell, cap, block).unwrap();
+        let (mut window, mut rows) = (new(), new());
         fill(&mut window, &mut rows, &points::<D>(cell, cap, seed));
         assert_eq!(window.blocks(), rows.blocks());
         let reach = window.reach();
