@@ -1,7 +1,7 @@
 //! The dense distance map: one byte per cell over the whole covered cube (see the parent
 //! module for what a cell stores and the bound it gives), and its inserts of boxes.
 
-use super::grid::{Grid, merge_row, window_rows};
+use super::grid::{Grid, merge_row};
 use super::{CAPPED, Cells, DistanceMapError, PointMap, finite_max_norm, next_row};
 use crate::round::{ceil, floor, whole_to_usize};
 use std::fmt;
@@ -448,36 +448,28 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
         }
     }
 
-    /// Row by row of the ball's box (in 2D and 3D, [`window_rows`]), 16 bytes of `values`
+    /// Row by row of the ball's box (in 2D and 3D, [`Grid::window_box`]), 16 bytes of `values`
     /// from its first column merged with [`Grid::window_row`] by a byte minimum (plain bytes:
     /// the access is exclusive), or its cells one by one where 16 bytes would run past the
     /// end of the row.
     fn lower_window(&mut self, q: &[f64; D]) -> bool {
-        let g = &self.grid;
-        if !g.window_inserts {
+        let Some(b) = self.grid.window_box(q) else {
             return false;
-        }
-        let Some((lo, hi)) = g.cells_near(q, q) else {
+        };
+        let Some(b) = b else {
             return true;
         };
-        let x2 = g.window_offsets(lo[0] as f64 + 0.5, q[0], hi[0] - lo[0] + 1);
-        let start = (lo[0] + g.half) as usize;
-        let len = if start + 16 <= self.side {
+        let len = if b.start + 16 <= self.side {
             16
         } else {
-            (hi[0] - lo[0]) as usize + 1
+            b.cells
         };
-        let (cell, skip) = (g.cell, g.window_skip);
-        window_rows(
+        b.rows(
             self,
-            q,
-            (&lo, &hi),
-            cell,
-            skip,
             |m, i, k| m.row_key(i, k),
             |m, s, key| {
-                let w = m.grid.window_row(&x2, s);
-                let base = key as usize + start;
+                let w = m.grid.window_row(&b.x2, s);
+                let base = key as usize + b.start;
                 let row = &mut m.values[base..base + len];
                 if let Ok(row) = <&mut [AtomicU8; 16]>::try_from(&mut *row) {
                     merge_row(row, w, u8::min);
@@ -488,7 +480,8 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
                     }
                 }
             },
-        )
+        );
+        true
     }
 
     type RowCache<'a> = ();

@@ -284,56 +284,96 @@ impl Grid {
     }
 }
 
-/// Calls `f(map, s, key)` for the rows of an exclusive window insert of `q` into `map` in 2D
-/// or 3D ([`Grid::window_row`]): the rows of the box `lo..=hi` of cells of side `cell` with a
-/// cell within the cap, each given by its squared offset `s` from `q` along axes 1 and 2
-/// (below `skip`, the map's [`Grid::window_skip`]) and its key, the sum of `key(map, i, k_i)`
-/// over those axes; axis 1 fastest. In 3D both are sums of per-axis terms tabulated once.
-/// `false` (and no call) in 4D and more, or if the box is wider than [`WINDOW`] cells along
-/// some axis.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(super) fn window_rows<M, const D: usize>(
-    map: &mut M,
-    q: &[f64; D],
-    (lo, hi): (&[i64; D], &[i64; D]),
+/// The box of cells an exclusive window insert of a point visits ([`Grid::window_box`]).
+pub(super) struct WindowBox<const D: usize> {
+    /// The point.
+    q: [f64; D],
+    /// Per axis, the cells `lo..=hi` whose centres lie within the cap of the point.
+    lo: [i64; D],
+    hi: [i64; D],
+    /// The squared offsets of the box's columns ([`Grid::window_offsets`]).
+    pub(super) x2: [f64; WINDOW],
+    /// The box's first column in the map's rows, `lo_0 + half`.
+    pub(super) start: usize,
+    /// Cells in a row of the box.
+    pub(super) cells: usize,
     cell: f64,
+    /// [`Grid::window_skip`].
     skip: f64,
-    key: impl Fn(&M, usize, i64) -> u64,
-    mut f: impl FnMut(&mut M, f64, u64),
-) -> bool {
-    if !(D == 2 || D == 3) || (0..D).any(|i| hi[i] - lo[i] >= WINDOW as i64) {
-        return false;
-    }
-    // As `RowTables` and `Grid::row_offset`: a row's squared offset is then the same sum, to
-    // the bits.
-    let e2 = |i: usize, k: i64| {
-        let e = q[i] - (k as f64 + 0.5) * cell;
-        e * e
-    };
-    if D == 2 {
-        // A 2D box's rows all come within about a cell of the cap: none is worth a test.
-        for k in lo[1]..=hi[1] {
-            let key = key(map, 1, k);
-            f(map, e2(1, k), key);
+}
+
+impl Grid {
+    /// The box of an exclusive window insert of `q` (`Some(None)` when no cell of the map lies
+    /// within the cap of it), or `None` when the map goes by rows instead: window inserts off,
+    /// 4D and more, or a box wider than [`WINDOW`] cells along some axis.
+    #[inline(always)]
+    pub(super) fn window_box<const D: usize>(&self, q: &[f64; D]) -> Option<Option<WindowBox<D>>> {
+        if !self.window_inserts || !(D == 2 || D == 3) {
+            return None;
         }
-        return true;
+        let Some((lo, hi)) = self.cells_near(q, q) else {
+            return Some(None);
+        };
+        if (0..D).any(|i| hi[i] - lo[i] >= WINDOW as i64) {
+            return None;
+        }
+        let cells = hi[0] - lo[0] + 1;
+        Some(Some(WindowBox {
+            q: *q,
+            lo,
+            hi,
+            x2: self.window_offsets(lo[0] as f64 + 0.5, q[0], cells),
+            start: (lo[0] + self.half) as usize,
+            cells: cells as usize,
+            cell: self.cell,
+            skip: self.window_skip,
+        }))
     }
-    let mut t1 = [(0.0, 0); WINDOW];
-    for (t, k) in t1.iter_mut().zip(lo[1]..=hi[1]) {
-        *t = (e2(1, k), key(map, 1, k));
-    }
-    let n1 = (hi[1] - lo[1]) as usize + 1;
-    for k2 in lo[2]..=hi[2] {
-        let (s2, key2) = (e2(2, k2), key(map, 2, k2));
-        for &(s1, key1) in &t1[..n1] {
-            let s = s1 + s2;
-            if s < skip {
-                f(map, s, key1 + key2);
+}
+
+impl<const D: usize> WindowBox<D> {
+    /// Calls `f(map, s, key)` for the rows of the box with a cell within the cap, each given
+    /// by its squared offset `s` from the point along axes 1 and 2 (below
+    /// [`Grid::window_skip`]) and its key, the sum of `key(map, i, k_i)` over those axes; axis
+    /// 1 fastest ([`Grid::window_row`] gives a row's values). In 3D both are sums of per-axis
+    /// terms tabulated once.
+    #[inline(always)]
+    pub(super) fn rows<M>(
+        &self,
+        map: &mut M,
+        key: impl Fn(&M, usize, i64) -> u64,
+        mut f: impl FnMut(&mut M, f64, u64),
+    ) {
+        let (q, lo, hi, cell, skip) = (&self.q, &self.lo, &self.hi, self.cell, self.skip);
+        // As `RowTables` and `Grid::row_offset`: a row's squared offset is then the same sum, to
+        // the bits.
+        let e2 = |i: usize, k: i64| {
+            let e = q[i] - (k as f64 + 0.5) * cell;
+            e * e
+        };
+        if D == 2 {
+            // A 2D box's rows all come within about a cell of the cap: none is worth a test.
+            for k in lo[1]..=hi[1] {
+                let key = key(map, 1, k);
+                f(map, e2(1, k), key);
+            }
+            return;
+        }
+        let mut t1 = [(0.0, 0); WINDOW];
+        for (t, k) in t1.iter_mut().zip(lo[1]..=hi[1]) {
+            *t = (e2(1, k), key(map, 1, k));
+        }
+        let n1 = (hi[1] - lo[1]) as usize + 1;
+        for k2 in lo[2]..=hi[2] {
+            let (s2, key2) = (e2(2, k2), key(map, 2, k2));
+            for &(s1, key1) in &t1[..n1] {
+                let s = s1 + s2;
+                if s < skip {
+                    f(map, s, key1 + key2);
+                }
             }
         }
     }
-    true
 }
 
 /// What the rows of one insert need from each axis `1..D`, tabulated once per cell index along

@@ -295,7 +295,7 @@ mod sealed {
 
         /// An exclusive insert of `q` in 2D or 3D by whole rows of
         /// [`WINDOW`](super::grid::WINDOW) cells ([`Grid::window_row`]) from the first column
-        /// of the ball's box ([`window_rows`](super::grid::window_rows)): every cell of the
+        /// of the ball's box ([`Grid::window_box`]): every cell of the
         /// box gets the value [`lower_row`](Self::lower_row) would store, branch-free and a
         /// row at a time, where the rows of [`lower_rows`](Self::lower_rows) spend most of
         /// their work on finding the few cells of the ball's half beside the touched point.

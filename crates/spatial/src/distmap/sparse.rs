@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::grid::{Grid, merge_row, window_rows};
+use super::grid::{Grid, merge_row};
 use super::{CAPPED, Cells, DistanceMapError, PointMap};
 use crate::round::{floor, whole_to_usize};
 use std::fmt;
@@ -246,40 +246,33 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// [`Cells::lower_window`] with blocks of `B` cells a side (`B = mask + 1`).
     #[inline(always)]
     fn lower_window_in<const B: usize>(&mut self, q: &[f64; D]) -> bool {
-        let g = &self.grid;
-        if !g.window_inserts {
+        let Some(b) = self.grid.window_box(q) else {
             return false;
-        }
-        let Some((lo, hi)) = g.cells_near(q, q) else {
+        };
+        let Some(b) = b else {
             return true;
         };
-        let x2 = g.window_offsets(lo[0] as f64 + 0.5, q[0], hi[0] - lo[0] + 1);
-        let start = (lo[0] + g.half) as usize;
-        let off = start % B;
+        let off = b.start % B;
         // Block rows spanned by the box's rows: at most 2 of 16 cells, 3 of 8.
-        let blocks = (off + (hi[0] - lo[0]) as usize) / B + 1;
-        let (cell, skip) = (g.cell, g.window_skip);
+        let blocks = (off + b.cells - 1) / B + 1;
         let mut near = [0u8; 32];
-        window_rows(
+        b.rows(
             self,
-            q,
-            (&lo, &hi),
-            cell,
-            skip,
             |m, i, k| m.row_key(i, k),
             |m, s, key| {
-                let w = m.grid.window_row(&x2, s);
+                let w = m.grid.window_row(&b.x2, s);
                 for (n, w) in near[off..off + 16].iter_mut().zip(w) {
                     *n = CAPPED - w;
                 }
-                let at = ((key >> CELL_BITS) as usize) + start / B;
+                let at = ((key >> CELL_BITS) as usize) + b.start / B;
                 let crow = (key & ((1 << CELL_BITS) - 1)) as usize;
                 for j in 0..blocks {
                     let near: [u8; B] = near[j * B..(j + 1) * B].try_into().expect("B bytes");
                     m.raise_row(at + j, crow, near);
                 }
             },
-        )
+        );
+        true
     }
 
     /// Raises the `B` cells of the block row at in-block offset `crow` of the block at table

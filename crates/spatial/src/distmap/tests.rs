@@ -366,6 +366,22 @@ fn aggregate<const D: usize>(n: usize, seed: u64) -> Vec<([f64; D], Option<[f64;
     pts
 }
 
+/// The centres of the `per_axis^D` cells of side `cell` from `-reach` on along every axis.
+fn centres<const D: usize>(
+    reach: f64,
+    cell: f64,
+    per_axis: usize,
+) -> impl Iterator<Item = [f64; D]> {
+    (0..per_axis.pow(D as u32)).map(move |idx| {
+        let mut rem = idx;
+        std::array::from_fn(|_| {
+            let k = rem % per_axis;
+            rem /= per_axis;
+            -reach + (k as f64 + 0.5) * cell
+        })
+    })
+}
+
 /// A point inserted beside the point it touches (visiting only the cells nearer it) leaves the
 /// dense and the sparse maps exactly as a full insert does: every byte and every block.
 #[test]
@@ -407,15 +423,8 @@ fn inserts_beside_the_touched_point_give_the_full_inserts_bytes() {
             .fold(0.0, f64::max)
             + cap
             + cell;
-        let per_axis = (2.0 * reach / cell).ceil() as usize;
         let (mut cells, mut lowered) = (0, 0);
-        for idx in 0..per_axis.pow(D as u32) {
-            let mut rem = idx;
-            let c: [f64; D] = std::array::from_fn(|_| {
-                let k = rem % per_axis;
-                rem /= per_axis;
-                -reach + (k as f64 + 0.5) * cell
-            });
+        for c in centres::<D>(reach, cell, (2.0 * reach / cell).ceil() as usize) {
             let v = full.value(&c);
             assert_eq!(v, beside.value(&c), "at {c:?}");
             cells += 1;
@@ -491,15 +500,8 @@ fn window_inserts_give_the_row_inserts_bytes() {
         fill(&mut window, &mut rows, &points::<D>(cell, cap, seed));
         assert_eq!(window.blocks(), rows.blocks());
         let reach = window.reach();
-        let per_axis = (2.0 * reach / cell).round() as usize;
         let mut lowered = 0;
-        for idx in 0..per_axis.pow(D as u32) {
-            let mut rem = idx;
-            let c: [f64; D] = std::array::from_fn(|_| {
-                let k = rem % per_axis;
-                rem /= per_axis;
-                -reach + (k as f64 + 0.5) * cell
-            });
+        for c in centres::<D>(reach, cell, (2.0 * reach / cell).round() as usize) {
             let v = window.value(&c);
             assert_eq!(v, rows.value(&c), "at {c:?}");
             lowered += usize::from(v.is_some_and(|v| v < CAPPED));
