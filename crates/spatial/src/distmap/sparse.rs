@@ -463,9 +463,10 @@ impl<const D: usize> Cells<D> for SparseDistanceMap<D> {
     /// blocks a block row at a time by a byte maximum ([`raise_row`](Self::raise_row)). Needs
     /// blocks of 8 or 16 cells a side (a row of the box then spans at most three or two).
     fn lower_window(&mut self, q: &[f64; D]) -> bool {
-        match (D, self.mask + 1) {
-            (2 | 3, 8) => self.lower_window_in::<8>(q),
-            (2 | 3, 16) => self.lower_window_in::<16>(q),
+        // `Grid::window_box` turns down the other dimensions.
+        match self.mask + 1 {
+            8 => self.lower_window_in::<8>(q),
+            16 => self.lower_window_in::<16>(q),
             _ => false,
         }
     }
