@@ -18,6 +18,20 @@ const POLL: Duration = Duration::from_millis(50);
 /// How often progress is reported (and once at the end).
 const REPORT_EVERY: Duration = Duration::from_millis(500);
 
+/// Environment variable that sets the time between progress reports for tests, in seconds:
+/// `0` reports at every poll, so that a test can stop a run at its first report however fast
+/// the machine runs it.
+pub const REPORT_EVERY_ENV: &str = "AGGSIM_TEST_REPORT_EVERY";
+
+/// [`REPORT_EVERY`], or the test hook's [`REPORT_EVERY_ENV`] if it is set to seconds >= 0.
+fn report_every() -> Duration {
+    std::env::var(REPORT_EVERY_ENV)
+        .ok()
+        .and_then(|s| s.trim().parse::<f64>().ok())
+        .and_then(|s| Duration::try_from_secs_f64(s).ok())
+        .unwrap_or(REPORT_EVERY)
+}
+
 /// How often progress goes to `sys.stderr` when it is neither a terminal nor Jupyter.
 const LOG_EVERY: Duration = Duration::from_secs(10);
 
@@ -169,6 +183,7 @@ pub fn interruptible_guarded<T: Send>(
     };
     let finished = (Mutex::new(false), Condvar::new());
     let started = Instant::now();
+    let report_every = report_every();
     std::thread::scope(|s| {
         let worker = std::thread::Builder::new()
             .name("aggsim".into())
@@ -197,7 +212,7 @@ pub fn interruptible_guarded<T: Send>(
             }
             if failure.is_none() {
                 let mut check = py.check_signals();
-                if check.is_ok() && reported.elapsed() >= REPORT_EVERY {
+                if check.is_ok() && reported.elapsed() >= report_every {
                     reported = Instant::now();
                     let n = shared.done.load(Ordering::Relaxed);
                     check = progress.report(py, n, total, started, false);

@@ -14,8 +14,8 @@ import pytest
 
 import aggsim
 
-# Runs of 1.2 to 1.8 s from a release build on a 2-core machine: the progress callback is
-# first called after half a second, while they are still running.
+# Runs of a few tenths of a second from a release build: with progress reported at every poll
+# (50 ms, the library's test hook below), the callback is first called while they run.
 LONG = {
     "dla": dict(particles=200_000, seed=3),
     "dlca": dict(size=1024, fill=0.03, target_clusters=30, seed=2),
@@ -42,6 +42,13 @@ def run(model, **kwargs):
 
 def files(d):
     return {p.name for p in d.iterdir()}
+
+
+@pytest.fixture(autouse=True)
+def report_at_every_poll(monkeypatch):
+    """Progress reports at every poll rather than every half second, so that a run stops at its
+    first report however fast the machine runs it."""
+    monkeypatch.setenv("AGGSIM_TEST_REPORT_EVERY", "0")
 
 
 def interrupt_at_first_report(done, total):
@@ -94,8 +101,9 @@ def test_rerunning_the_same_call_after_each_interrupt_finishes_the_run(tmp_path)
 
 
 def test_sigterm_checkpoints_and_stops_like_ctrl_c(tmp_path):
-    # Long enough (0.6 s from a release build) that the signal comes well before its end.
-    kwargs = dict(particles=100_000, seed=3)
+    # Long enough (0.7-1.5 s from a release build) that the signal, which comes after the first
+    # timed checkpoint, comes well before its end.
+    kwargs = dict(particles=400_000, seed=3)
     whole = aggsim.dla(**kwargs)
     before = signal.getsignal(signal.SIGTERM)
     ck = tmp_path / "checkpoint.bin"
