@@ -1,11 +1,15 @@
 //! The dense distance map: one byte per cell over the whole covered cube (see the parent
 //! module for what a cell stores and the bound it gives), and its inserts of boxes.
 
-use super::grid::{Grid, merge_row};
+use super::grid::{Grid, WINDOW, WindowBox, merge_row};
 use super::{CAPPED, Cells, DistanceMapError, PointMap, finite_max_norm, next_row};
 use crate::round::{ceil, floor, whole_to_usize};
 use std::fmt;
 use std::sync::atomic::{AtomicU8, AtomicU64, Ordering};
+
+/// Capped bytes after the last cell of `values`: a window insert merges 16 bytes from the box's
+/// first column ([`Cells::lower_window`]), which may run past the last row's end.
+const PAD: usize = 15;
 
 /// The coarse distance map (see the [module docs](super)).
 pub struct DistanceMap<const D: usize> {
@@ -334,6 +338,27 @@ impl<const D: usize> DistanceMap<D> {
     }
 }
 
+impl<const D: usize> DistanceMap<D> {
+    /// [`Cells::lower_window`]'s rows, `L` lanes of each computed ([`Grid::window_row`]).
+    #[inline(always)]
+    fn window_rows<const L: usize>(&mut self, b: &WindowBox<D>) {
+        b.rows(
+            self,
+            |m, i, k| m.row_key(i, k),
+            |m, s, key| {
+                let w = m.grid.window_row::<L>(&b.x2, s);
+                let base = key as usize + b.start;
+                // Past the box the lanes are capped, which the minimum leaves as they are: 16
+                // bytes may run into the next row, or into the [`PAD`] after the last one.
+                let row: &mut [AtomicU8; 16] = (&mut m.values[base..base + 16])
+                    .try_into()
+                    .expect("16 bytes");
+                merge_row(row, w, u8::min);
+            },
+        );
+    }
+}
+
 impl<const D: usize> PointMap<D> for DistanceMap<D> {
     /// Heap bytes held (one byte per cell, counting the vector's capacity).
     fn memory_bytes(&self) -> usize {
@@ -400,11 +425,11 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
         // Fallible, so a map that does not fit is an error rather than an abort.
         let mut values: Vec<AtomicU8> = Vec::new();
         values
-            .try_reserve_exact(total as usize)
+            .try_reserve_exact(total as usize + PAD)
             .map_err(|_| DistanceMapError::Alloc {
-                bytes: total as u64,
+                bytes: total as u64 + PAD as u64,
             })?;
-        values.extend((0..total as usize).map(|_| AtomicU8::new(CAPPED)));
+        values.extend((0..total as usize + PAD).map(|_| AtomicU8::new(CAPPED)));
         if self.side > 0 {
             self.copy_rows(side, half, |new, old| {
                 *values[new].get_mut() = self.values[old].load(Ordering::Relaxed);
@@ -450,8 +475,7 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
 
     /// Row by row of the ball's box (in 2D and 3D, [`Grid::window_box`]), 16 bytes of `values`
     /// from its first column merged with [`Grid::window_row`] by a byte minimum (plain bytes:
-    /// the access is exclusive), or its cells one by one where 16 bytes would run past the
-    /// end of the row.
+    /// the access is exclusive).
     fn lower_window(&mut self, q: &[f64; D]) -> bool {
         let Some(b) = self.grid.window_box(q) else {
             return false;
@@ -459,28 +483,11 @@ impl<const D: usize> Cells<D> for DistanceMap<D> {
         let Some(b) = b else {
             return true;
         };
-        let len = if b.start + 16 <= self.side {
-            16
+        if b.cells <= 8 {
+            self.window_rows::<8>(&b);
         } else {
-            b.cells
-        };
-        b.rows(
-            self,
-            |m, i, k| m.row_key(i, k),
-            |m, s, key| {
-                let w = m.grid.window_row(&b.x2, s);
-                let base = key as usize + b.start;
-                let row = &mut m.values[base..base + len];
-                if let Ok(row) = <&mut [AtomicU8; 16]>::try_from(&mut *row) {
-                    merge_row(row, w, u8::min);
-                } else {
-                    for (v, w) in row.iter_mut().zip(w) {
-                        let v = v.get_mut();
-                        *v = (*v).min(w);
-                    }
-                }
-            },
-        );
+            self.window_rows::<WINDOW>(&b);
+        }
         true
     }
 

@@ -155,10 +155,15 @@ impl Grid {
     ///
     /// [`Cells::lower_window`]: super::sealed::Cells::lower_window
     /// [`Cells::lower_row`]: super::sealed::Cells::lower_row
+    ///
+    /// Only the first `L` lanes are computed (the rest are capped): a box of at most `L`
+    /// cells a row needs no more. A cap of 4 cells, `dla`'s, makes boxes of 8 cells a row for
+    /// all but the points at exact cell boundaries, and 8 lanes are two 4-lane vectors of
+    /// square roots where 12 are three.
     #[inline(always)]
-    pub(super) fn window_row(&self, x2: &[f64; WINDOW], s: f64) -> [u8; 16] {
+    pub(super) fn window_row<const L: usize>(&self, x2: &[f64; WINDOW], s: f64) -> [u8; 16] {
         let mut w = [CAPPED; 16];
-        for (w, x2) in w.iter_mut().zip(x2) {
+        for (w, x2) in w[..L].iter_mut().zip(&x2[..L]) {
             let d = ((x2 + s).sqrt() * self.inv_quantum).min(f64::from(CAPPED));
             // `floor(d)` (a whole number in [0, 255]) plus 2^52 is exact and holds it in the
             // mantissa's low byte: a conversion without the saturating cast's tests, which

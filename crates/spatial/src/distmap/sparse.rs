@@ -49,7 +49,7 @@
 //! the exact distance, at most a cell diagonal plus one quantum below it in a cell that is not
 //! capped.
 
-use super::grid::{Grid, merge_row};
+use super::grid::{Grid, WINDOW, WindowBox, merge_row};
 use super::{CAPPED, Cells, DistanceMapError, PointMap};
 use crate::round::{floor, whole_to_usize};
 use std::fmt;
@@ -252,6 +252,18 @@ impl<const D: usize> SparseDistanceMap<D> {
         let Some(b) = b else {
             return true;
         };
+        if b.cells <= 8 {
+            self.window_rows::<B, 8>(&b);
+        } else {
+            self.window_rows::<B, WINDOW>(&b);
+        }
+        true
+    }
+
+    /// [`lower_window_in`](Self::lower_window_in)'s rows, `L` lanes of each computed
+    /// ([`Grid::window_row`]).
+    #[inline(always)]
+    fn window_rows<const B: usize, const L: usize>(&mut self, b: &WindowBox<D>) {
         let off = b.start % B;
         // Block rows spanned by the box's rows: at most 2 of 16 cells, 3 of 8.
         let blocks = (off + b.cells - 1) / B + 1;
@@ -260,10 +272,9 @@ impl<const D: usize> SparseDistanceMap<D> {
             self,
             |m, i, k| m.row_key(i, k),
             |m, s, key| {
-                let w = m.grid.window_row(&b.x2, s);
-                for (n, w) in near[off..off + 16].iter_mut().zip(w) {
-                    *n = CAPPED - w;
-                }
+                // As nearness, then placed at the box's first column by one 16-byte copy.
+                let w = m.grid.window_row::<L>(&b.x2, s).map(|w| CAPPED - w);
+                near[off..off + 16].copy_from_slice(&w);
                 let at = ((key >> CELL_BITS) as usize) + b.start / B;
                 let crow = (key & ((1 << CELL_BITS) - 1)) as usize;
                 for j in 0..blocks {
@@ -272,7 +283,6 @@ impl<const D: usize> SparseDistanceMap<D> {
                 }
             },
         );
-        true
     }
 
     /// Raises the `B` cells of the block row at in-block offset `crow` of the block at table
