@@ -337,6 +337,12 @@ impl Grid {
 }
 
 impl<const D: usize> WindowBox<D> {
+    /// The box's first cell index along axis `i`.
+    #[inline(always)]
+    pub(super) fn lo(&self, i: usize) -> i64 {
+        self.lo[i]
+    }
+
     /// Calls `f(map, s, key)` for the rows of the box with a cell within the cap, each given
     /// by its squared offset `s` from the point along axes 1 and 2 (below
     /// [`Grid::window_skip`]) and its key, the sum of `key(map, i, k_i)` over those axes; axis
