@@ -153,13 +153,13 @@ impl Grid {
     /// run in vector registers: a cell beyond the cap comes out capped, and a cell already
     /// nearer another point keeps its value when merged.
     ///
-    /// [`Cells::lower_window`]: super::sealed::Cells::lower_window
-    /// [`Cells::lower_row`]: super::sealed::Cells::lower_row
-    ///
     /// Only the first `L` lanes are computed (the rest are capped): a box of at most `L`
     /// cells a row needs no more. A cap of 4 cells, `dla`'s, makes boxes of 8 cells a row for
     /// all but the points at exact cell boundaries, and 8 lanes are two 4-lane vectors of
     /// square roots where 12 are three.
+    ///
+    /// [`Cells::lower_window`]: super::sealed::Cells::lower_window
+    /// [`Cells::lower_row`]: super::sealed::Cells::lower_row
     #[inline(always)]
     pub(super) fn window_row<const L: usize>(&self, x2: &[f64; WINDOW], s: f64) -> [u8; 16] {
         let mut w = [CAPPED; 16];
