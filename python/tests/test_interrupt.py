@@ -19,6 +19,17 @@ PROMPT = 3.0
 AFTER = 0.3
 
 
+@pytest.fixture(autouse=True)
+def python_handles_sigint():
+    """Python's own SIGINT handler (which raises KeyboardInterrupt) for each test: a Python
+    started with SIGINT ignored, as a background job of a non-interactive shell is, keeps it
+    ignored, and then neither signal below would reach the run."""
+    before = signal.getsignal(signal.SIGINT)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, before)
+
+
 def interrupted(call, send):
     """Runs ``call`` with ``send()`` from another thread after AFTER seconds; returns the seconds
     from the signal to KeyboardInterrupt."""
