@@ -125,6 +125,16 @@ struct Staged {
 /// Where a row's key carries its group in a 3D window insert (above the table index).
 const GROUP_SHIFT: u32 = 56;
 
+/// Raises the `B` cells of `block` from offset `crow` on to the nearness `near` where it is
+/// higher (plain bytes: the access is exclusive).
+#[inline(always)]
+fn raise<const B: usize>(block: &mut [AtomicU8], crow: usize, near: [u8; B]) {
+    let row: &mut [AtomicU8; B] = (&mut block[crow..crow + B])
+        .try_into()
+        .expect("a block row holds B cells");
+    merge_row(row, near, u8::max);
+}
+
 impl<const D: usize> fmt::Debug for SparseDistanceMap<D> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("SparseDistanceMap")
@@ -337,29 +347,12 @@ impl<const D: usize> SparseDistanceMap<D> {
                         .try_into()
                         .expect("B bytes")
                 };
-                let slot = &self.table[brow[g] + j];
-                let entry = match slot.load(Ordering::Relaxed) {
-                    ABSENT if rows.iter().all(|r| segment(r).iter().all(|&n| n == 0)) => {
-                        continue;
-                    }
-                    ABSENT => self.allocate(slot),
-                    entry => entry,
-                };
-                if entry == UNKNOWN {
+                let wanted = || rows.iter().any(|r| segment(r).iter().any(|&n| n > 0));
+                let Some(block) = self.block_mut(brow[g] + j, wanted) else {
                     continue;
-                }
-                let n = entry as usize - 1;
-                let first = (n & ((1 << self.chunk_shift) - 1)) * self.block_cells;
-                let chunk = self.chunks[n >> self.chunk_shift]
-                    .get_mut()
-                    .expect("a block is published after its chunk is created");
-                let block = &mut chunk[first..first + self.block_cells];
+                };
                 for r in rows {
-                    let crow = staged[usize::from(*r)].crow as usize;
-                    let row: &mut [AtomicU8; B] = (&mut block[crow..crow + B])
-                        .try_into()
-                        .expect("a block row holds B cells");
-                    merge_row(row, segment(r), u8::max);
+                    raise(block, staged[usize::from(*r)].crow as usize, segment(r));
                 }
             }
         }
@@ -396,24 +389,30 @@ impl<const D: usize> SparseDistanceMap<D> {
     /// allocating the block if it is absent and some nearness is above zero.
     #[inline(always)]
     fn raise_row<const B: usize>(&mut self, at: usize, crow: usize, near: [u8; B]) {
+        if let Some(block) = self.block_mut(at, || near.iter().any(|&n| n > 0)) {
+            raise(block, crow, near);
+        }
+    }
+
+    /// The cells of the block at table index `at` (exclusive access), allocated if absent and
+    /// `wanted()`; `None` if it stays absent or is unknown.
+    #[inline(always)]
+    fn block_mut(&mut self, at: usize, wanted: impl FnOnce() -> bool) -> Option<&mut [AtomicU8]> {
         let slot = &self.table[at];
         let entry = match slot.load(Ordering::Relaxed) {
-            ABSENT if near.iter().all(|&n| n == 0) => return,
+            ABSENT if !wanted() => return None,
             ABSENT => self.allocate(slot),
             entry => entry,
         };
         if entry == UNKNOWN {
-            return;
+            return None;
         }
         let n = entry as usize - 1;
-        let first = (n & ((1 << self.chunk_shift) - 1)) * self.block_cells + crow;
+        let first = (n & ((1 << self.chunk_shift) - 1)) * self.block_cells;
         let chunk = self.chunks[n >> self.chunk_shift]
             .get_mut()
             .expect("a block is published after its chunk is created");
-        let row: &mut [AtomicU8; B] = (&mut chunk[first..first + B])
-            .try_into()
-            .expect("a block row holds B cells");
-        merge_row(row, near, u8::max);
+        Some(&mut chunk[first..first + self.block_cells])
     }
 
     /// The block at table index `at` for a segment of `len + 1` cells starting `x0` from `q`
